@@ -1,0 +1,1 @@
+"""The paper's analytical virtual-work model (numpy/scipy only; no FEM imports)."""

@@ -1,0 +1,1 @@
+"""What connects the layers: FEM studies, comparisons, the batch runner and the CLI."""

@@ -1,0 +1,98 @@
+"""The ``softhand`` command line.
+
+Each verb lives in ``studies/commands/<verb>.py`` and defines
+
+* ``HELP``: one line for ``softhand --help``;
+* ``configure(parser)``: adds its arguments to an :class:`argparse.ArgumentParser`;
+* ``run(args) -> int``: does the work, prints, returns the exit code.
+
+Verb modules are imported only when their verb is called, so ``softhand curve``
+never pays for importing the FEM stack. Bad input anywhere (an
+:class:`reduced.errors.InputError`, or an argparse error) becomes one line on
+stderr and exit code 2.
+"""
+from __future__ import annotations
+
+import argparse
+import importlib
+import sys
+
+from reduced.errors import InputError
+
+#: verb -> module under studies.commands; the order is the order of ``--help``.
+VERBS = (
+    "curve", "grasp", "control", "fit",
+    "verify", "reservoir", "bend", "weights",
+    "study", "inspect", "reproduce",
+)
+
+
+class ArgumentParser(argparse.ArgumentParser):
+    """argparse, but a usage error is one line and exit code 2."""
+
+    def error(self, message):
+        self.exit(2, f"{self.prog}: error: {message}\n")
+
+
+def _version() -> str:
+    from importlib.metadata import PackageNotFoundError, version
+
+    try:
+        return version("softhand")
+    except PackageNotFoundError:
+        return "unknown"
+
+
+def _verb_module(verb: str):
+    return importlib.import_module(f"studies.commands.{verb}")
+
+
+def _available_verbs() -> list[tuple[str, str]]:
+    verbs = []
+    for verb in VERBS:
+        try:
+            verbs.append((verb, _verb_module(verb).HELP))
+        except ModuleNotFoundError:
+            continue  # a verb not built yet is simply not listed
+    return verbs
+
+
+def _top_parser() -> ArgumentParser:
+    lines = "\n".join(f"  {verb:<10} {help_}" for verb, help_ in _available_verbs())
+    parser = ArgumentParser(
+        prog="softhand",
+        description="Model fluid-driven soft robot hands: reduced model and FEM.",
+        epilog=f"verbs:\n{lines}\n\n'softhand VERB --help' shows a verb's options.",
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    parser.add_argument("--version", action="version", version=f"softhand {_version()}")
+    parser.add_argument("verb", help="what to do (see below)")
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    argv = list(sys.argv[1:] if argv is None else argv)
+    if not argv or argv[0].startswith("-"):
+        _top_parser().parse_args(argv or ["--help"])
+        return 0
+    verb, rest = argv[0], argv[1:]
+    if verb not in VERBS:
+        print(f"softhand: error: unknown verb {verb!r}; allowed: {', '.join(VERBS)}",
+              file=sys.stderr)
+        return 2
+    module = _verb_module(verb)
+    parser = ArgumentParser(prog=f"softhand {verb}", description=module.HELP)
+    module.configure(parser)
+    args = parser.parse_args(rest)
+    try:
+        return int(module.run(args) or 0)
+    except InputError as exc:
+        print(f"softhand {verb}: error: {exc}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print(f"softhand {verb}: interrupted; finished results are kept", file=sys.stderr)
+        return 130
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())

@@ -1,0 +1,23 @@
+"""The CLI front door: help, version, unknown verbs."""
+import subprocess
+import sys
+
+from studies.cli import main
+
+
+def run(*argv):
+    return subprocess.run([sys.executable, "-m", "studies.cli", *argv],
+                          capture_output=True, text=True)
+
+
+def test_version_and_help():
+    out = run("--version")
+    assert out.returncode == 0 and out.stdout.startswith("softhand ")
+    out = run("--help")
+    assert out.returncode == 0 and "verbs:" in out.stdout
+
+
+def test_unknown_verb_is_one_line_exit_2(capsys):
+    assert main(["frobnicate"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "frobnicate" in err

@@ -1,0 +1,56 @@
+"""HandDesign: the paper's file equals Table I; bad input names the field."""
+import math
+
+import pytest
+
+from reduced.design import PUBLIC_KEYS, HandDesign, design_from_dict, load_design
+from reduced.errors import InputError
+
+
+def test_paper_file_is_table_one():
+    d = load_design()
+    assert d == HandDesign()
+    assert (d.l0, d.a, d.b, d.d, d.R, d.t, d.V0, d.n, d.n_s) == (180, 4, 5, 15, 24, 1, 17800, 4, 5)
+    assert math.isclose(math.degrees(d.theta0), 20.0)
+    assert d.mu_sf == d.mu_sr == 1.15
+    assert sum(d.link_lengths) == pytest.approx(d.l0)
+
+
+def test_toml_round_trip(tmp_path):
+    d = HandDesign(V0=15000.0, hinge_s=(20, 50, 90, 130, 160))
+    path = tmp_path / "d.toml"
+    path.write_text(d.to_toml())
+    assert load_design(path) == d
+    assert set(d.to_dict()) == set(PUBLIC_KEYS)
+
+
+@pytest.mark.parametrize("values, field", [
+    ({"a_mm": -4.0}, "a_mm"),
+    ({"b_mm": 0}, "b_mm"),
+    ({"bogus": 1}, "bogus"),
+    ({"n": 2.5}, "n"),
+    ({"l0_mm": "long"}, "l0_mm"),
+    ({"n_s": 4}, "hinge_s_mm"),
+    ({"hinge_s_mm": [30, 20, 90, 120, 150]}, "hinge_s_mm"),
+    ({"theta0_deg": 95}, "theta0_deg"),
+    ({"reservoir_model": "balloon"}, "reservoir_model"),
+])
+def test_bad_input_names_the_field(values, field):
+    with pytest.raises(InputError, match=field):
+        design_from_dict(values)
+
+
+def test_volume_check():
+    d = HandDesign(V0=1000.0)
+    d.check_volume(math.radians(10))  # 4*pi*16*15*0.17 = 526 mm^3 < 1000
+    with pytest.raises(InputError, match="V0_mm3"):
+        d.check_volume(math.radians(90))
+
+
+def test_bad_files(tmp_path):
+    with pytest.raises(InputError, match="no such file"):
+        load_design(tmp_path / "missing.toml")
+    bad = tmp_path / "bad.toml"
+    bad.write_text("a_mm = = 3")
+    with pytest.raises(InputError, match="not valid TOML"):
+        load_design(bad)
