@@ -1,0 +1,206 @@
+r"""Rigid planar serial chains as nonlinear multi-point constraints (the finger's shell).
+
+The shell of a finger is a chain of ``n_s + 1`` rigid links joined by ``n_s`` revolute
+hinges whose axes are normal to the bending plane (x-y). Link 0 (the base) is fixed.
+The chain's configuration is its vector of hinge angles :math:`q` (the paper's
+:math:`\hat\theta_1 \dots \hat\theta_{n_s}`); link :math:`k` is rotated by
+
+.. math:: \varphi_k = \sum_{i \le k} q_i ,\qquad \theta = \sum_i q_i = \varphi_{n_s}.
+
+With :math:`H_i` the reference position of hinge :math:`i` and :math:`p_i(q)` its current
+one (:math:`p_1 = H_1`, :math:`p_{i+1} = p_i + R(\varphi_i)(H_{i+1} - H_i)`), a material
+point :math:`X` of link :math:`k` is at
+
+.. math:: x = p_k + R(\varphi_k)(X - H_k) = c_k + R(\varphi_k) X .
+
+Hinge :math:`j` turns every link :math:`k \ge j` about :math:`p_j`, so with
+:math:`\Omega` the in-plane rotation by +90 degrees
+
+.. math::
+    \frac{\partial x}{\partial q_j} = \Omega (x - p_j) \quad (j \le k), \qquad
+    \frac{\partial^2 x}{\partial q_j \partial q_l} = -(x - p_{\max(j, l)})
+    \quad (\max(j, l) \le k),
+
+and zero otherwise. Out of plane (z) a link does not move.
+
+A finite-element vector :math:`u` is tied to the chain by :class:`ChainConstraint`: the
+displacement DOFs of the tied nodes follow the links, :math:`u = T(y)` with
+:math:`y = (u_\mathrm{free}, q)`. Stationarity of the potential gives the reduced residual
+:math:`r = T'^T R` and tangent :math:`K_r = T'^T K T' + \sum_n R_n \cdot T''_n`, the last
+term from the rotation (the constraint's geometric stiffness).
+
+Loads on the links (contact, a grasped object's weight) enter as generalised forces on
+:math:`q`: :meth:`PlanarChain.point_load` turns point forces on link points into
+:math:`Q = J^T f` and its derivative.
+
+Angles are positive counter-clockwise about +z (radians).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+import scipy.sparse as sp
+
+#: rotation of an in-plane vector by +90 degrees
+OMEGA = np.array([[0.0, -1.0], [1.0, 0.0]])
+
+
+def rotation(phi) -> np.ndarray:
+    """In-plane rotation matrices R(phi), shape (2, 2, *phi.shape)."""
+    c, s = np.cos(phi), np.sin(phi)
+    return np.array([[c, -s], [s, c]])
+
+
+@dataclass(frozen=True)
+class PlanarChain:
+    """A planar serial chain of rigid links; link 0 fixed, hinge i between links i-1 and i."""
+
+    hinges: np.ndarray  #: (n_s, 2) reference hinge positions in the x-y plane [mm]
+
+    def __post_init__(self):
+        object.__setattr__(self, "hinges", np.asarray(self.hinges, dtype=float).reshape(-1, 2))
+
+    @property
+    def n_s(self) -> int:
+        return len(self.hinges)
+
+    def link_angles(self, q) -> np.ndarray:
+        """Rotation of each link, phi_k = sum_{i<=k} q_i, shape (n_s + 1,) [rad]."""
+        return np.concatenate(([0.0], np.cumsum(q)))
+
+    def hinge_positions(self, q) -> np.ndarray:
+        """Current hinge positions p_i, shape (n_s, 2) [mm]."""
+        q = np.asarray(q, dtype=float)
+        R = rotation(self.link_angles(q)[1:-1])            # links 1..n_s-1 span the hinges
+        steps = np.einsum("ijk,kj->ki", R, np.diff(self.hinges, axis=0))
+        return self.hinges[0] + np.concatenate((np.zeros((1, 2)), np.cumsum(steps, axis=0)))
+
+    def link_poses(self, q) -> tuple[np.ndarray, np.ndarray]:
+        """Poses (c_k, phi_k) of all links: a point X of link k is at c_k + R(phi_k) X.
+
+        Returns ``origins`` (n_s + 1, 2) [mm] and ``angles`` (n_s + 1,) [rad].
+        """
+        phi = self.link_angles(q)
+        p = self.hinge_positions(q)
+        H = np.concatenate((np.zeros((1, 2)), self.hinges))
+        P = np.concatenate((np.zeros((1, 2)), p))
+        return P - np.einsum("ijk,kj->ki", rotation(phi), H), phi
+
+    def point_map(self, q, links, X):
+        """Current position of points X (m, 2) on links (m,), with derivatives in q.
+
+        Returns x (m, 2), J = dx/dq (m, 2, n_s) and H = d2x/dq2 (m, 2, n_s, n_s).
+        """
+        links = np.asarray(links, dtype=int)
+        X = np.asarray(X, dtype=float).reshape(-1, 2)
+        c, phi = self.link_poses(q)
+        x = c[links] + np.einsum("ijm,mj->mi", rotation(phi[links]), X)
+        p = self.hinge_positions(q)
+        j = np.arange(self.n_s)
+        moved = j[None, :] < links[:, None]                      # hinge j+1 moves link k
+        arm = x[:, None, :] - p[None, :, :]                      # (m, n_s, 2)
+        J = np.einsum("ab,mjb->maj", OMEGA, arm) * moved[:, None, :]
+        jl = np.maximum(j[:, None], j[None, :])                  # (n_s, n_s)
+        H = -np.moveaxis(arm[:, jl, :], -1, 1) * (jl[None, None] < links[:, None, None, None])
+        return x, J, H
+
+    def point_load(self, q, links, X, f, dfdx=None):
+        """Generalised force Q = sum J^T f of point forces f (m, 2) on link points X.
+
+        ``dfdx`` (m, 2, 2), optional: the forces' derivative with respect to the point's
+        position (a penalty contact). Returns Q (n_s,) [N mm] and dQ/dq (n_s, n_s).
+        """
+        f = np.asarray(f, dtype=float).reshape(-1, 2)
+        _, J, H = self.point_map(q, links, X)
+        Q = np.einsum("maj,ma->j", J, f)
+        dQ = np.einsum("majl,ma->jl", H, f)
+        if dfdx is not None:
+            dQ = dQ + np.einsum("maj,mab,mbl->jl", J, dfdx, J)
+        return Q, dQ
+
+    def moment_load(self, links, M):
+        """Generalised force of moments M (m,) about +z on links (m,): Q_j = sum_{k>j} M_k."""
+        links = np.asarray(links, dtype=int)
+        moved = np.arange(self.n_s)[None, :] < links[:, None]
+        return np.asarray(M, dtype=float) @ moved
+
+
+@dataclass
+class ChainConstraint:
+    """Nodes of a finite-element vector tied to the links of a :class:`PlanarChain`.
+
+    The full vector u (size ``n_dofs``; any layout, e.g. displacements then pressures)
+    is parametrised by y = (u[free], q): tied nodes move with their link, ``fixed``
+    entries are zero, the rest are free.
+    """
+
+    chain: PlanarChain
+    n_dofs: int               #: size of the full vector
+    tied: np.ndarray          #: (m, 3) indices of the tied nodes' x, y, z displacement DOFs
+    links: np.ndarray         #: (m,) the link each tied node belongs to
+    X: np.ndarray             #: (m, 2) reference x-y position of each tied node [mm]
+    fixed: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=int))  #: zero DOFs
+
+    def __post_init__(self):
+        self.tied = np.asarray(self.tied, dtype=int).reshape(-1, 3)
+        self.links = np.asarray(self.links, dtype=int)
+        self.X = np.asarray(self.X, dtype=float).reshape(-1, 2)
+        slaved = np.zeros(self.n_dofs, dtype=bool)
+        slaved[self.tied.ravel()] = True
+        slaved[np.asarray(self.fixed, dtype=int)] = True
+        self.free = np.flatnonzero(~slaved)
+
+    @property
+    def n_reduced(self) -> int:
+        return len(self.free) + self.chain.n_s
+
+    def zero(self) -> np.ndarray:
+        return np.zeros(self.n_reduced)
+
+    def q(self, y) -> np.ndarray:
+        """The hinge angles in y [rad]."""
+        return np.asarray(y)[len(self.free):]
+
+    def expand(self, y) -> np.ndarray:
+        """The full vector u = T(y)."""
+        u = np.zeros(self.n_dofs)
+        u[self.free] = y[:len(self.free)]
+        x, _, _ = self.chain.point_map(self.q(y), self.links, self.X)
+        u[self.tied[:, :2]] = x - self.X
+        return u
+
+    def operator(self, y) -> sp.csr_matrix:
+        """T' = du/dy at y, shape (n_dofs, n_reduced); its pattern does not depend on y."""
+        n_f, n_s = len(self.free), self.chain.n_s
+        _, J, _ = self.chain.point_map(self.q(y), self.links, self.X)
+        rows_t = np.repeat(self.tied[:, :2], n_s, axis=1).ravel()       # (m, 2 n_s)
+        cols_t = np.tile(n_f + np.arange(n_s), 2 * len(self.links))
+        rows = np.concatenate((self.free, rows_t))
+        cols = np.concatenate((np.arange(n_f), cols_t))
+        vals = np.concatenate((np.ones(n_f), J.ravel()))
+        return sp.csr_matrix((vals, (rows, cols)), shape=(self.n_dofs, self.n_reduced))
+
+    def reduce(self, y, R, K=None):
+        """Reduced residual T'^T R and, with K, tangent T'^T K T' + sum_n R_n . T''_n."""
+        B = self.operator(y)
+        r = B.T @ R
+        if K is None:
+            return r
+        _, _, H = self.chain.point_map(self.q(y), self.links, self.X)
+        G = np.einsum("majl,ma->jl", H, R[self.tied[:, :2]])
+        n_f, n_s = len(self.free), self.chain.n_s
+        idx = n_f + np.arange(n_s)
+        geo = sp.csr_matrix((G.ravel(), (np.repeat(idx, n_s), np.tile(idx, n_s))),
+                            shape=(self.n_reduced, self.n_reduced))
+        Kr = (B.T @ (K @ B) + geo).tocsr()
+        Kr.sort_indices()
+        return r, Kr
+
+    def link_forces(self, R) -> np.ndarray:
+        """Net in-plane force the body exerts on each link through its tied nodes [N].
+
+        ``R`` is the full residual (internal minus external force); shape (n_s + 1, 2).
+        """
+        return -np.stack([np.bincount(self.links, R[self.tied[:, c]],
+                                      minlength=self.chain.n_s + 1) for c in (0, 1)], axis=1)
