@@ -1,0 +1,124 @@
+r"""The hand without load: pump pressure P(theta) (27), (28) and its inverse theta(P).
+
+Eq. (25) with F_x = F_y = 0 gives, for n fingers sharing one pump and one reservoir,
+
+.. math:: P(\theta) = \frac{n\mu_{sf}\zeta_f(\theta) + \mu_{sr}\zeta_r(\theta)}{n a^2\pi d}
+                    = \frac{\mu_{sf}\zeta_f(\theta)}{a^2\pi d} - p_r(V(\theta))   \quad (27)
+
+since mu_sr zeta_r / (n a^2 pi d) = -p_r(V(theta)) (dV/dtheta = -n a^2 pi d); the second form
+works for every reservoir model of :mod:`reduced.reservoir`. Without reservoir (28) the last
+term is absent. P is the pump's differential pressure: with the reservoir P(0) < 0, i.e. at
+zero pump pressure the charged sheet already bends the fingers a little (reported, not clipped).
+
+The inverse theta(P) is found on the monotone branch of P(theta) through theta = 0 inside
+:data:`THETA_RANGE`: a table of 1025 angles, cubic Hermite interpolation of the inverse
+function, and one Newton step on the exact P (no per-value root finder).
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from . import finger, reservoir
+from .design import HandDesign
+from .errors import InputError
+
+#: bend angles the reduced model accepts [rad]: a finger bent back by 90 deg up to curled by 180 deg
+THETA_RANGE = (-0.5 * math.pi, math.pi)
+_TABLE_SIZE = 1025
+
+
+def check_theta(theta) -> np.ndarray:
+    """theta [rad] as a float array; InputError (in degrees) unless finite and in THETA_RANGE."""
+    theta = np.asarray(theta, dtype=float)
+    lo, hi = THETA_RANGE
+    bad = ~np.isfinite(theta) | (theta < lo - 1e-12) | (theta > hi + 1e-12)
+    if np.any(bad):
+        raise InputError("theta_deg", float(np.degrees(theta[bad].flat[0])),
+                         f"must be a number in [{math.degrees(lo):.0f}, {math.degrees(hi):.0f}] deg")
+    return theta
+
+
+def finger_pressure(theta, design: HandDesign):
+    """Eq. (28): P = mu_sf zeta_f / (a^2 pi d) [MPa], the hand without reservoir, theta [rad]."""
+    return design.mu_sf * finger.zeta_f(theta, design) / (design.a**2 * math.pi * design.d)
+
+
+def pressure(theta, design: HandDesign, reservoir: bool = True):
+    """Eq. (27) (reservoir=True) or (28): pump pressure [MPa] holding bend theta [rad], free fingers."""
+    theta = check_theta(theta)
+    P = finger_pressure(theta, design)
+    if reservoir:
+        if theta.size:
+            design.check_volume(float(np.max(theta)))
+        P = P - _reservoir_pressure(theta, design)
+    return P
+
+
+def _reservoir_pressure(theta, design: HandDesign):
+    return reservoir.pressure(reservoir.oil_volume(theta, design), design)
+
+
+def bend_angle(P, design: HandDesign, reservoir: bool = True):
+    """Inverse of :func:`pressure`: free bend theta [rad] at pump pressure P [MPa], vectorised."""
+    lo, hi = THETA_RANGE
+    if reservoir:  # the fingers cannot take more oil than the reservoir holds
+        hi = min(hi, 0.999 * design.V0 / (design.n * design.a**2 * math.pi * design.d))
+    return invert_monotone(lambda th: pressure(th, design, reservoir), P, (lo, hi),
+                           field="pressure_MPa", unit="MPa")
+
+
+def invert_monotone(fn, y, bracket: tuple[float, float], *, field: str, unit: str = "",
+                    anchor: float = 0.0, size: int = _TABLE_SIZE):
+    """x with fn(x) = y on the increasing branch of the vectorised fn through ``anchor``.
+
+    Tabulates fn on ``size`` points of ``bracket``, keeps the increasing run that holds
+    ``anchor``, interpolates the inverse with cubic Hermite polynomials (slopes 1/fn' by
+    central differences) and takes one Newton step on fn. InputError for y off the branch.
+    """
+    y = np.asarray(y, dtype=float)
+    x, fx, slope = _table(fn, bracket, size)
+    x, fx, slope = _increasing_run(x, fx, slope, anchor)
+    bad = ~np.isfinite(y) | (y < fx[0]) | (y > fx[-1])
+    if np.any(bad):
+        raise InputError(field, float(y[bad].flat[0]),
+                         f"must be in [{fx[0]:.4g}, {fx[-1]:.4g}] {unit} "
+                         f"(reached at {math.degrees(x[0]):.0f}..{math.degrees(x[-1]):.0f} deg)")
+    guess, dxdy = _hermite_inverse(x, fx, slope, y)
+    return np.clip(guess - (fn(guess) - y) * dxdy, x[0], x[-1])
+
+
+def _table(fn, bracket, size):
+    x = np.linspace(bracket[0], bracket[1], size)
+    step = 1e-6 * (bracket[1] - bracket[0])
+    inner = np.clip(x, bracket[0] + step, bracket[1] - step)  # keep the stencil inside
+    slope = (fn(inner + step) - fn(inner - step)) / (2.0 * step)
+    return x, fn(x), slope
+
+
+def _increasing_run(x, fx, slope, anchor):
+    """The longest stretch of the table around ``anchor`` where fx increases strictly."""
+    rising = (np.diff(fx) > 0) & (slope[:-1] > 0) & (slope[1:] > 0)
+    k = int(np.clip(np.searchsorted(x, anchor) - 1, 0, rising.size - 1))
+    if not rising[k]:
+        raise InputError("design", "P(theta)", f"is not increasing at {math.degrees(anchor):.0f} deg; "
+                         "the bend angle is not unique")
+    falls = np.flatnonzero(~rising)
+    first = falls[falls < k].max() + 1 if np.any(falls < k) else 0
+    last = falls[falls > k].min() if np.any(falls > k) else rising.size
+    keep = slice(first, last + 1)
+    return x[keep], fx[keep], slope[keep]
+
+
+def _hermite_inverse(x, fx, slope, y):
+    """Cubic Hermite interpolant of x(y) through (fx, x) with dx/dy = 1/slope, and its dx/dy."""
+    k = np.clip(np.searchsorted(fx, y) - 1, 0, fx.size - 2)
+    dy = fx[k + 1] - fx[k]
+    s = (y - fx[k]) / dy
+    m0, m1 = dy / slope[k], dy / slope[k + 1]
+    s2, s3 = s * s, s * s * s
+    x_y = ((2 * s3 - 3 * s2 + 1) * x[k] + (s3 - 2 * s2 + s) * m0
+           + (-2 * s3 + 3 * s2) * x[k + 1] + (s3 - s2) * m1)
+    dxds = ((6 * s2 - 6 * s) * (x[k] - x[k + 1]) + (3 * s2 - 4 * s + 1) * m0 + (3 * s2 - 2 * s) * m1)
+    return x_y, dxds / dy

@@ -1,0 +1,121 @@
+r"""The rubber-sheet reservoir: oil volume (15), height (14), Ramanujan arc (13), stretch (16),
+strain energy (11), zeta_r (18) and the reservoir pressure p_r(V) = dW_r/dV.
+
+The sheet (radius R, thickness t) is clamped at its rim and bulges into half an ellipsoid of
+revolution with height h holding the oil volume V = (2/3) pi R^2 h (14). The fingers take oil
+from it, V(theta) = V0 - n a^2 pi d theta (15). Its meridian, half an ellipse with semi-axes
+R and h, has the length L(h) (13), 2L being Ramanujan's full perimeter; the sheet is taken as
+equi-biaxially stretched by lambda_r = L / (2R) (12), (16). Neo-Hookean (11):
+
+.. math:: W_r = \frac{\mu_{sr}}{2}\,(2\lambda_r^2 + \lambda_r^{-4} - 3)\,\pi R^2 t, \qquad
+          \zeta_r = 2(\lambda_r - \lambda_r^{-5})\frac{d\lambda_r}{d\theta}\pi R^2 t  \quad (18)
+
+with the analytic chain rule d lambda_r / d theta = L'(h) / (2R) * 3 / (2 pi R^2) * (-n a^2 pi d).
+The reservoir's gauge pressure is p_r(V) = dW_r/dV, hence
+mu_sr zeta_r(theta) / (n a^2 pi d) = -p_r(V(theta)).
+
+Reservoir models. :func:`pressure` dispatches on ``design.reservoir_model`` through a small
+registry: ``"ellipse"`` (this module) is built in; another model registers a function
+``pressure_fn(V, design) -> p_r [MPa]`` with :func:`register_model`. A model name that is
+not registered yet is looked up in the module ``reduced.reservoir_<name>``, which must call
+:func:`register_model` when imported.
+
+Units: mm, mm^3, MPa, N*mm, rad.
+"""
+from __future__ import annotations
+
+import importlib
+from typing import Callable
+
+import numpy as np
+
+from .design import HandDesign
+from .errors import InputError
+
+PressureFn = Callable[[np.ndarray, HandDesign], np.ndarray]
+_MODELS: dict[str, PressureFn] = {}
+
+
+def oil_volume(theta, design: HandDesign):
+    """Eq. (15): oil left in the reservoir at finger bend theta [rad] -> V [mm^3]."""
+    g = design
+    return g.V0 - g.a**2 * np.pi * g.d * g.n * np.asarray(theta, float)
+
+
+def height(V, design: HandDesign):
+    """Eq. (14): height h [mm] of the half-ellipsoid holding the volume V [mm^3]."""
+    return 3.0 * np.asarray(V, float) / (2.0 * np.pi * design.R**2)
+
+
+def half_perimeter(h, design: HandDesign):
+    """Eq. (13): L(h) [mm], half of Ramanujan's perimeter of the ellipse with semi-axes R, h."""
+    R, h = design.R, np.asarray(h, float)
+    return 0.5 * np.pi * (3.0 * (R + h) - np.sqrt((R + 3.0 * h) * (h + 3.0 * R)))
+
+
+def dhalf_perimeter_dh(h, design: HandDesign):
+    """dL/dh of eq. (13) [-], analytic."""
+    R, h = design.R, np.asarray(h, float)
+    return 0.5 * np.pi * (3.0 - (3.0 * h + 5.0 * R) / np.sqrt((R + 3.0 * h) * (h + 3.0 * R)))
+
+
+def stretch(V, design: HandDesign):
+    """Eq. (16): equi-biaxial sheet stretch lambda_r = L(h(V)) / (2R) [-]."""
+    return half_perimeter(height(V, design), design) / (2.0 * design.R)
+
+
+def dstretch_dV(V, design: HandDesign):
+    """d lambda_r / dV [1/mm^3] from (13), (14), (16), analytic."""
+    return dhalf_perimeter_dh(height(V, design), design) * 3.0 / (4.0 * np.pi * design.R**3)
+
+
+def dstretch_dtheta(theta, design: HandDesign):
+    """d lambda_r / d theta [1/rad], analytic: (d lambda_r/dV) (dV/dtheta), dV/dtheta = -n a^2 pi d."""
+    g = design
+    return dstretch_dV(oil_volume(theta, g), g) * (-g.n * g.a**2 * np.pi * g.d)
+
+
+def zeta_r(theta, design: HandDesign):
+    """Eq. (18): zeta_r(theta) [mm^3] with dW_r/dtheta = mu_sr * zeta_r; the ellipse model."""
+    lam = stretch(oil_volume(theta, design), design)
+    return 2.0 * (lam - lam**-5) * dstretch_dtheta(theta, design) * np.pi * design.R**2 * design.t
+
+
+def strain_energy(V, design: HandDesign):
+    """Eq. (11) with (12): strain energy W_r [N*mm] of the sheet holding V [mm^3] (ellipse model)."""
+    lam = stretch(V, design)
+    return 0.5 * design.mu_sr * (2.0 * lam**2 + lam**-4 - 3.0) * np.pi * design.R**2 * design.t
+
+
+def ellipse_pressure(V, design: HandDesign):
+    """p_r(V) = dW_r/dV [MPa] of the ellipse model: mu_sr 2 (lam - lam^-5) (dlam/dV) pi R^2 t."""
+    V = np.asarray(V, float)
+    if np.any(V <= 0.0):
+        raise InputError("V_mm3", float(np.min(V)), "reservoir volume must be positive")
+    lam = stretch(V, design)
+    return design.mu_sr * 2.0 * (lam - lam**-5) * dstretch_dV(V, design) * np.pi * design.R**2 * design.t
+
+
+def register_model(name: str, pressure_fn: PressureFn) -> None:
+    """Make ``pressure_fn(V [mm^3], design) -> p_r [MPa]`` the reservoir model called ``name``."""
+    _MODELS[name] = pressure_fn
+
+
+def model(name: str) -> PressureFn:
+    """The registered pressure function of reservoir model ``name`` (imports reduced.reservoir_<name>)."""
+    if name not in _MODELS:
+        try:
+            importlib.import_module(f"{__package__}.reservoir_{name}")
+        except ModuleNotFoundError:
+            pass
+    if name not in _MODELS:
+        raise InputError("reservoir_model", name, f"no such model; available: {', '.join(_MODELS)}")
+    return _MODELS[name]
+
+
+def pressure(V, design: HandDesign):
+    """Reservoir gauge pressure p_r(V) = dW_r/dV [MPa] of the model ``design.reservoir_model``."""
+    return model(design.reservoir_model)(np.asarray(V, float), design)
+
+
+register_model("ellipse", ellipse_pressure)
