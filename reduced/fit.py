@@ -1,0 +1,362 @@
+r"""Calibrate design parameters to measurements: bounded nonlinear least squares.
+
+Given measured points (:class:`~reduced.csvdata.Measurements`) and a model that predicts
+the measured quantity from a :class:`~reduced.design.HandDesign`, find the named public
+design parameters :math:`p` (e.g. ``V0_mm3``, ``mu_sf_MPa``) that minimise
+
+.. math:: S(p) = \sum_i r_i(p)^2, \qquad r_i = y_i^{model}(p) - y_i^{measured}
+
+in the data's own units (degrees for free bending, newtons for grasp forces), as the
+paper does for V0 (section III-B). Parameters are scaled by their starting values,
+:math:`x = p / p_0`, so the optimiser sees numbers of order one.
+
+Uncertainty, with :math:`J = \partial r / \partial p` at the optimum (central
+differences), :math:`N` points and :math:`k` parameters:
+
+.. math:: \hat\sigma^2 = S / (N - k), \qquad \mathrm{Cov}(p) = \hat\sigma^2 (J^T J)^{-1},
+
+standard errors are the square roots of its diagonal and the correlation matrix is the
+covariance normalised by them. This linearised estimate assumes independent errors of
+equal variance in the measured quantity.
+
+Identifiability: the columns of J are normalised to unit length and decomposed by SVD.
+A singular value below ``FitOptions.singular_tol`` (relative to the largest) is a
+direction in parameter space that leaves every prediction unchanged, to the accuracy
+of the Jacobian; the parameters taking part in it are reported as not identifiable
+(standard error infinite) with the combination the data cannot see. A condition number
+above ``FitOptions.cond_warn`` is reported as poorly determined. Nothing is returned
+silently.
+"""
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy.optimize import least_squares
+
+from .csvdata import Measurements
+from .design import PUBLIC_KEYS, HandDesign, design_from_dict
+from .errors import InputError
+
+#: public design keys a fit may vary (numbers; not counts, lists or names)
+FITTABLE = ("theta0_deg", "l0_mm", "a_mm", "b_mm", "d_mm", "R_mm", "t_mm", "V0_mm3",
+            "mu_sf_MPa", "mu_sr_MPa", "base_offset_mm", "g_N_per_kg")
+
+#: a predictor maps a design to the model's value of each measured point (data units)
+Predictor = Callable[[HandDesign], np.ndarray]
+#: models a fit can use (``--model``)
+MODELS = ("reduced",)
+
+
+@dataclass(frozen=True)
+class FitOptions:
+    """Tolerances of the fit and of its identifiability diagnosis."""
+
+    rel_step: float = 1e-6  #: central-difference step for J, relative to each parameter
+    singular_tol: float = 1e-6  #: s_min / s_max of the column-normalised J: below, singular
+    cond_warn: float = 1e3  #: condition number above which parameters are poorly determined
+    bound_factor: float = 100.0  #: default bounds p0 / factor .. p0 * factor (positive keys)
+    tol: float = 1e-12  #: ftol, xtol and gtol of scipy.optimize.least_squares
+
+
+@dataclass(frozen=True)
+class FitResult:
+    """Fitted parameters with their uncertainty, and how well the model matches the data."""
+
+    params: tuple[str, ...]  #: public design keys fitted
+    initial: np.ndarray  #: starting values (units in the keys)
+    values: np.ndarray  #: fitted values (units in the keys)
+    stderr: np.ndarray  #: standard errors (inf where not identifiable)
+    correlation: np.ndarray  #: k x k correlation matrix (nan where not identifiable)
+    observed: np.ndarray  #: measured values (data units)
+    predicted: np.ndarray  #: model values at the fitted parameters (data units)
+    initial_predicted: np.ndarray  #: model values at the starting parameters
+    design: HandDesign  #: the calibrated design
+    quantity: str  #: what was fitted, with its unit: theta_deg or F_v_N
+    condition: float  #: condition number of the column-normalised Jacobian
+    singular_values: np.ndarray  #: of the column-normalised Jacobian, largest first
+    unidentifiable: tuple[str, ...] = ()  #: parameters the data cannot determine
+    at_bound: tuple[str, ...] = ()  #: parameters that ended on a bound
+    warnings: tuple[str, ...] = ()  #: one sentence each
+    nfev: int = 0  #: model evaluations of the optimiser
+    finger: np.ndarray | None = field(default=None, repr=False)  #: finger label per point
+
+    @property
+    def residuals(self) -> np.ndarray:
+        """Model minus measurement, data units."""
+        return self.predicted - self.observed
+
+    @property
+    def rmse(self) -> float:
+        return float(np.sqrt(np.mean(self.residuals**2)))
+
+    @property
+    def max_error(self) -> float:
+        return float(np.max(np.abs(self.residuals)))
+
+    @property
+    def initial_rmse(self) -> float:
+        return float(np.sqrt(np.mean((self.initial_predicted - self.observed) ** 2)))
+
+    @property
+    def dof(self) -> int:
+        return self.observed.size - len(self.params)
+
+    @property
+    def sigma(self) -> float:
+        """Estimated measurement scatter sqrt(S / (N - k)), data units."""
+        return float(np.sqrt(np.sum(self.residuals**2) / self.dof))
+
+    def rmse_by_finger(self) -> dict[int, float]:
+        if self.finger is None:
+            return {}
+        return {int(f): float(np.sqrt(np.mean(self.residuals[self.finger == f] ** 2)))
+                for f in np.unique(self.finger)}
+
+    def to_dict(self) -> dict:
+        """Plain numbers for JSON (inf/nan as None)."""
+        unit = self.quantity.rsplit("_", 1)[1]
+        return {
+            "params": {k: {"initial": _num(p0), "value": _num(v), "stderr": _num(se)}
+                       for k, p0, v, se in zip(self.params, self.initial, self.values, self.stderr)},
+            "correlation": [[_num(c) for c in row] for row in self.correlation],
+            "quantity": self.quantity, f"rmse_{unit}": self.rmse,
+            f"max_error_{unit}": self.max_error, f"initial_rmse_{unit}": self.initial_rmse,
+            f"sigma_{unit}": self.sigma, "n_points": int(self.observed.size), "dof": self.dof,
+            "condition": _num(self.condition),
+            "singular_values": [_num(s) for s in self.singular_values],
+            "unidentifiable": list(self.unidentifiable), "at_bound": list(self.at_bound),
+            "warnings": list(self.warnings), "nfev": self.nfev,
+            "rmse_by_finger": {str(k): v for k, v in self.rmse_by_finger().items()},
+            "design": self.design.to_dict(),
+        }
+
+
+def fit(data: Measurements, params, predictor: Callable[[HandDesign], np.ndarray],
+        design: HandDesign | None = None, *, bounds: dict | None = None,
+        options: FitOptions = FitOptions()) -> FitResult:
+    """Fit the public design keys ``params`` so that ``predictor(design)`` matches ``data.observed``.
+
+    ``bounds`` maps a key to ``(low, high)`` in the key's units (default: see
+    :func:`default_bounds`). Raises InputError for unknown keys or too few points.
+    """
+    design = design if design is not None else HandDesign()
+    keys = check_params(params, len(data))
+    p0 = np.array([design.to_dict()[k] for k in keys], dtype=float)
+    lo, hi = _bounds(keys, p0, design, data, bounds, options)
+    scale = np.where(p0 != 0.0, np.abs(p0), 1.0)
+    observed = np.asarray(data.observed, dtype=float)
+
+    failed = 1e3 * (1.0 + float(np.max(np.abs(observed))))
+
+    def residual(x):  # a trial point where the model has no answer: a large residual, step rejected
+        try:
+            return _predict(predictor, keys, x * scale, design) - observed
+        except InputError:
+            return np.full(observed.shape, failed)
+
+    x0 = np.clip(p0 / scale, lo / scale, hi / scale)
+    sol = least_squares(residual, x0, bounds=(lo / scale, hi / scale), method="trf",
+                        ftol=options.tol, xtol=options.tol, gtol=options.tol,
+                        diff_step=1e-7)
+    values = sol.x * scale
+    J = jacobian(residual, sol.x, lo / scale, hi / scale, options.rel_step) / scale
+    fitted = _with(keys, values, design)
+    diag = diagnose(keys, J, sol.fun, values, options)
+    at_bound = tuple(k for k, a in zip(keys, sol.active_mask) if a != 0)
+    warnings = diag.warnings + tuple(
+        f"{k} ended on its bound {v:.6g}: widen the bound or fix it; its standard error "
+        "is not meaningful" for k, v in zip(keys, values) if k in at_bound)
+    return FitResult(
+        params=keys, initial=p0, values=values, stderr=diag.stderr,
+        correlation=diag.correlation, observed=observed,
+        predicted=_predict(predictor, keys, values, design),
+        initial_predicted=_predict(predictor, keys, p0, design), design=fitted,
+        quantity=data.quantity, condition=diag.condition,
+        singular_values=diag.singular_values, unidentifiable=diag.unidentifiable,
+        at_bound=at_bound, warnings=warnings, nfev=int(sol.nfev), finger=data.finger,
+    )
+
+
+def make_predictor(data: Measurements, model: str = "reduced", *, reservoir: bool = True,
+                   weights=None) -> Predictor:
+    """The model's prediction of ``data.observed``: theta [deg] from the free-bending inverse
+    of eq. (27) (or (28) without reservoir), or F_v [N] from eqs. (24), (25), (29).
+
+    Free bending: theta is what was measured at set pump pressures (the paper raises P in
+    0.1 MPa steps and reads the angles), so the residual is in theta. Grasp data: w comes from
+    the ``diameter_mm`` column (the paper's presets) or else from ``weights`` (n_s numbers).
+    """
+    from . import grasp, hand
+
+    if model not in MODELS:
+        raise InputError("--model", model, f"allowed: {', '.join(MODELS)}")
+    if data.kind == "bending":
+        return lambda design: np.degrees(hand.bend_angle(data.P, design, reservoir))
+    groups = _weight_groups(data, weights)
+
+    def predict(design):
+        F_v = np.empty(len(data))
+        for w, rows in groups:
+            F_v[rows] = grasp.grasp_forces(data.P[rows], data.theta[rows], data.mass[rows], w,
+                                           design, reservoir=reservoir).F_v
+        return F_v
+    return predict
+
+
+def _weight_groups(data: Measurements, weights):
+    """[(w, row mask)]: one weight vector per object diameter, or ``weights`` for all rows."""
+    from .grasp import PAPER_WEIGHTS
+
+    if data.diameter is None:
+        if weights is None:
+            raise InputError("--weights", None, "grasp data need the weight vector w: a "
+                             "diameter_mm column or --diameter-mm / --weights")
+        return [(np.asarray(weights, dtype=float), np.ones(len(data), dtype=bool))]
+    groups = []
+    for D in np.unique(data.diameter):
+        if float(D) not in PAPER_WEIGHTS:
+            raise InputError(f"{data.source}: diameter_mm", float(D), "no weight vector for "
+                             f"it; available: {', '.join(f'{k:g}' for k in PAPER_WEIGHTS)}")
+        groups.append((np.asarray(PAPER_WEIGHTS[float(D)]), data.diameter == D))
+    return groups
+
+
+def check_params(params, n_points: int) -> tuple[str, ...]:
+    """Validate the names of the parameters to fit; a comma list or a sequence."""
+    keys = tuple(k.strip() for k in (params.split(",") if isinstance(params, str) else params)
+                 if k.strip())
+    if not keys:
+        raise InputError("--params", params, f"name at least one of {', '.join(FITTABLE)}")
+    for k in keys:
+        if k not in FITTABLE:
+            why = "is not a number that can be fitted" if k in PUBLIC_KEYS else "unknown key"
+            raise InputError("--params", k, f"{why}; allowed: {', '.join(FITTABLE)}")
+    if len(set(keys)) != len(keys):
+        raise InputError("--params", ",".join(keys), "a parameter appears twice")
+    if n_points <= len(keys):
+        raise InputError("--data", f"{n_points} points",
+                         f"need more points than the {len(keys)} parameters fitted")
+    return keys
+
+
+def default_bounds(key: str, p0: float, design: HandDesign, data: Measurements,
+                   factor: float = 100.0) -> tuple[float, float]:
+    """Bounds of one key: p0/factor .. p0*factor for positive quantities.
+
+    ``theta0_deg`` stays in [0, 89.9]; ``base_offset_mm`` is free; ``V0_mm3`` stays above
+    the oil the fingers take at 1.05 times the largest measured angle (eq. (15)).
+    """
+    if key == "theta0_deg":
+        return 0.0, 89.9
+    if key == "base_offset_mm":
+        return -math.inf, math.inf
+    lo, hi = p0 / factor, p0 * factor
+    if key == "V0_mm3":
+        theta_max = 1.05 * float(np.max(data.theta, initial=0.0))
+        lo = max(lo, design.n * math.pi * design.a**2 * design.d * theta_max * 1.001)
+    return lo, hi
+
+
+def jacobian(residual, x, lo, hi, rel_step: float) -> np.ndarray:
+    """d residual / d x by central differences (one-sided next to a bound), (N, k)."""
+    columns = []
+    for j in range(x.size):
+        h = rel_step * max(abs(x[j]), 1.0)
+        up, down = x.copy(), x.copy()
+        up[j] = min(x[j] + h, hi[j])
+        down[j] = max(x[j] - h, lo[j])
+        columns.append((residual(up) - residual(down)) / (up[j] - down[j]))
+    return np.column_stack(columns)
+
+
+@dataclass(frozen=True)
+class Diagnosis:
+    stderr: np.ndarray
+    correlation: np.ndarray
+    condition: float
+    singular_values: np.ndarray
+    unidentifiable: tuple[str, ...]
+    warnings: tuple[str, ...]
+
+
+def diagnose(keys, J: np.ndarray, residuals: np.ndarray, values=None,
+             options: FitOptions = FitOptions()) -> Diagnosis:
+    """Standard errors, correlation and identifiability from J = d residual / d p [data unit / key unit].
+
+    ``values`` (the parameters, default 1) only express a singular direction in per cent.
+    """
+    n, k = J.shape
+    norms = np.linalg.norm(J, axis=0)
+    dead = norms <= 1e-12 * max(norms.max(initial=0.0), 1e-300)
+    Jn = J / np.where(dead, 1.0, norms)
+    Jn[:, dead] = 0.0
+    _, s, Vt = np.linalg.svd(Jn, full_matrices=False)
+    rel = s / s[0] if s[0] > 0 else np.zeros_like(s)
+    null = Vt[rel < options.singular_tol]
+    involved = dead | np.any(np.abs(null) > 0.1, axis=0)
+    sigma2 = float(residuals @ residuals) / max(n - k, 1)
+    cov_n = np.linalg.pinv(Jn.T @ Jn, rcond=options.singular_tol**2, hermitian=True)
+    cov = sigma2 * cov_n / np.outer(np.where(dead, 1.0, norms), np.where(dead, 1.0, norms))
+    stderr = np.sqrt(np.clip(np.diag(cov), 0.0, None))
+    stderr[involved] = np.inf
+    se = np.where(involved, np.nan, stderr)
+    corr = cov / np.outer(se, se)
+    np.fill_diagonal(corr, np.where(involved, np.nan, 1.0))
+    condition = float(s[0] / s[-1]) if s[-1] > 0 else math.inf
+    # a null direction of Jn is the change dp_j = v_j / |J_j| of the parameters; in per cent:
+    values = np.ones(k) if values is None else np.asarray(values, dtype=float)
+    rel_null = null / np.where(dead, 1.0, norms) / np.where(values != 0, np.abs(values), 1.0)
+    warnings = _identifiability_warnings(keys, dead, rel_null, condition, corr, options)
+    return Diagnosis(stderr, corr, condition, s, tuple(k_ for k_, i in zip(keys, involved) if i),
+                     warnings)
+
+
+def _identifiability_warnings(keys, dead, rel_null, condition, corr, options) -> tuple[str, ...]:
+    out = [f"{k} does not change any prediction for these data: it cannot be fitted from them"
+           for k, d in zip(keys, dead) if d]
+    for v in rel_null:
+        v = np.where(dead, 0.0, v)
+        if not np.any(v):
+            continue  # the direction of a parameter with no effect, reported above
+        v = v / v[np.argmax(np.abs(v))]
+        if np.count_nonzero(np.abs(v) > 1e-3) < 2:
+            continue
+        parts = " and ".join(f"{k} by {c:+.3g} %" for k, c in zip(keys, v) if abs(c) > 1e-3)
+        out.append(f"not identifiable: changing {parts} leaves every prediction unchanged "
+                   "(singular Jacobian); the data determine only that combination: "
+                   "fit one of these and fix the others")
+    if not out and condition > options.cond_warn:
+        i, j = np.unravel_index(np.nanargmax(np.abs(corr - np.eye(len(keys)))), corr.shape)
+        out.append(f"poorly determined: condition number {condition:.3g} of the scaled "
+                   f"Jacobian; {keys[i]} and {keys[j]} are correlated {corr[i, j]:+.5f}")
+    return tuple(out)
+
+
+def _bounds(keys, p0, design, data, bounds, options):
+    bounds = dict(bounds or {})
+    unknown = set(bounds) - set(keys)
+    if unknown:
+        raise InputError("--bounds", ",".join(sorted(unknown)), "bounds only for fitted parameters")
+    pairs = [bounds.get(k) or default_bounds(k, p, design, data, options.bound_factor)
+             for k, p in zip(keys, p0)]
+    lo, hi = (np.array(v, dtype=float) for v in zip(*pairs))
+    for k, a, b in zip(keys, lo, hi):
+        if not a < b:
+            raise InputError(f"--bounds {k}", f"{a:g}:{b:g}", "need low < high")
+    return lo, hi
+
+
+def _with(keys, values, design: HandDesign) -> HandDesign:
+    return design_from_dict({k: float(v) for k, v in zip(keys, values)}, design)
+
+
+def _predict(predictor, keys, values, design) -> np.ndarray:
+    return np.asarray(predictor(_with(keys, values, design)), dtype=float)
+
+
+def _num(x):
+    x = float(x)
+    return x if math.isfinite(x) else None

@@ -1,0 +1,134 @@
+"""Calibration (reduced.fit, reduced.csvdata, reduced.materials_data, softhand fit).
+
+Independent checks: a model linear in its parameters, where ordinary least squares gives
+the exact estimate and covariance; synthetic data from known parameters plus noise, where
+the truth is known; degenerate parameter pairs that follow from the model's equations.
+"""
+import math
+
+import numpy as np
+import pytest
+
+from reduced.csvdata import Measurements, read_measurements
+from reduced.design import HandDesign
+from reduced.errors import InputError
+from reduced.fit import FitOptions, check_params, diagnose, fit
+from reduced.materials_data import shear_modulus_from_shore_a, young_modulus_gent
+
+
+# ---------------------------------------------------------------- a model linear in p
+def _linear_data(seed=0, n=30, sigma=0.5):
+    """theta_deg = 40 mu_sf P + 1e-3 V0 P^2 : linear in (mu_sf, V0), an OLS problem."""
+    rng = np.random.default_rng(seed)
+    P = np.linspace(0.05, 0.8, n)
+    X = np.column_stack([40 * P, 1e-3 * P**2])
+    theta_deg = X @ np.array([1.3, 16000.0]) + sigma * rng.standard_normal(n)
+    data = Measurements(kind="bending", P=P, theta=np.radians(theta_deg))
+
+    def predictor(design):
+        return X @ np.array([design.mu_sf, design.V0])
+    return data, X, predictor
+
+
+def test_linear_model_matches_ordinary_least_squares():
+    data, X, predictor = _linear_data()
+    result = fit(data, "mu_sf_MPa,V0_mm3", predictor)
+    y = data.observed
+    beta, *_ = np.linalg.lstsq(X, y, rcond=None)
+    s2 = np.sum((y - X @ beta) ** 2) / (y.size - 2)
+    cov = s2 * np.linalg.inv(X.T @ X)
+    # rtol 1e-6: optimiser tolerance 1e-12 on a well-conditioned problem, FD Jacobian 1e-6
+    np.testing.assert_allclose(result.values, beta, rtol=1e-6)
+    np.testing.assert_allclose(result.stderr, np.sqrt(np.diag(cov)), rtol=1e-5)
+    r = cov[0, 1] / math.sqrt(cov[0, 0] * cov[1, 1])
+    assert result.correlation[0, 1] == pytest.approx(r, rel=1e-5)
+    assert result.rmse == pytest.approx(np.sqrt(np.mean((X @ beta - y) ** 2)), rel=1e-6)
+    assert not result.warnings and result.unidentifiable == ()
+
+
+def test_a_parameter_the_model_ignores_is_flagged():
+    data, _, predictor = _linear_data()
+    result = fit(data, "mu_sf_MPa,t_mm", predictor)       # t_mm is not in the stand-in model
+    assert result.unidentifiable == ("t_mm",)
+    assert math.isinf(result.stderr[1]) and math.isfinite(result.stderr[0])
+    assert any("t_mm does not change any prediction" in w for w in result.warnings)
+
+
+def test_diagnose_finds_a_product_and_a_near_collinear_pair():
+    keys = ("mu_sr_MPa", "t_mm", "V0_mm3")
+    rng = np.random.default_rng(1)
+    g = rng.standard_normal((20, 2))
+    J = np.column_stack([g[:, 0], 2.0 * g[:, 0], g[:, 1]])   # columns 1, 2 proportional
+    d = diagnose(keys, J, rng.standard_normal(20))
+    assert d.unidentifiable == ("mu_sr_MPa", "t_mm")
+    assert math.isfinite(d.stderr[2])
+    J2 = np.column_stack([g[:, 0], g[:, 0] + 1e-5 * g[:, 1]])  # correlation 1 - O(1e-10)
+    d2 = diagnose(keys[:2], J2, rng.standard_normal(20), options=FitOptions())
+    assert d2.unidentifiable == () and d2.condition > 1e3
+    assert any("poorly determined" in w for w in d2.warnings)
+
+
+@pytest.mark.parametrize("params, match", [
+    ("", "at least one"), ("n_s", "not a number that can be fitted"),
+    ("bogus_mm", "unknown key"), ("V0_mm3,V0_mm3", "twice"),
+])
+def test_bad_params(params, match):
+    with pytest.raises(InputError, match=match):
+        check_params(params, 10)
+
+
+def test_too_few_points():
+    with pytest.raises(InputError, match="more points"):
+        check_params("V0_mm3,mu_sf_MPa", 2)
+
+
+# ---------------------------------------------------------------- CSV
+def test_csv_round_trip(tmp_path):
+    f = tmp_path / "d.csv"
+    f.write_text("# synthetic\nP_MPa,theta_deg,finger\n0.1,10.5,1\n0.2, 20,2\n\n")
+    m = read_measurements(f)
+    assert m.kind == "bending" and len(m) == 2
+    np.testing.assert_allclose(m.observed, [10.5, 20.0])
+    np.testing.assert_array_equal(m.finger, [1, 2])
+    g = tmp_path / "g.csv"
+    g.write_text("P_MPa,theta_deg,mass_kg,F_v_N,diameter_mm\n0.8,50,2,6.0,180\n")
+    m = read_measurements(g)
+    assert m.kind == "grasp" and m.quantity == "F_v_N" and m.diameter[0] == 180
+
+
+@pytest.mark.parametrize("text, match", [
+    ("", "is empty"),
+    ("# only a comment\n", "is empty"),
+    ("P_MPa,theta_deg\n", "no data rows"),
+    ("P_MPa\n0.1\n", "missing column theta_deg"),
+    ("P_MPa,theta_deg\n0.1,ten\n", "line 2, column theta_deg"),
+    ("P_MPa,theta_deg\n0.1,nan\n", "finite number"),
+    ("P_MPa,theta_deg,colour\n0.1,10,red\n", "unknown column"),
+    ("P_MPa,theta_deg\n0.1,10,3\n", "has 3 cells"),
+    ("P_MPa,theta_deg,mass_kg\n0.1,10,2\n", "missing column F_v_N"),
+    ("P_MPa,theta_deg,theta_deg\n0.1,10,2\n", "twice"),
+])
+def test_bad_csv_is_one_input_error(tmp_path, text, match):
+    f = tmp_path / "bad.csv"
+    f.write_text(text)
+    with pytest.raises(InputError, match=match) as info:
+        read_measurements(f)
+    assert "\n" not in str(info.value)
+
+
+def test_missing_file():
+    with pytest.raises(InputError, match="no such file"):
+        read_measurements("/nonexistent/x.csv")
+
+
+# ---------------------------------------------------------------- Shore A
+def test_gent_relation_limits_and_paper_value():
+    # Gent's formula at its end points: S = 0 -> 0.0981*56/(0.137505*254)
+    assert young_modulus_gent(1e-9) == pytest.approx(0.0981 * 56 / (0.137505 * 254))
+    assert young_modulus_gent(99.9) > 1e3                    # singular at S = 100
+    mu70 = shear_modulus_from_shore_a(70)
+    assert mu70 == pytest.approx(1.84, abs=0.005)            # E = 5.52 MPa, mu = E / 3
+    assert mu70 / 1.15 == pytest.approx(1.6, abs=0.01)       # the paper's 1.15 MPa is lower
+    for bad in (0, 100, -5, float("nan"), "70"):
+        with pytest.raises(InputError, match="shore_a"):
+            shear_modulus_from_shore_a(bad)
