@@ -1,0 +1,116 @@
+"""The batch runner: Dask == process pool, kill and resume, failures recorded, case keys."""
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+from reduced.design import HandDesign
+from studies.cli import main
+from studies.runner import RESULT, case_key, plan, run_study, status, study_dir
+from studies.studyfile import load_study
+
+ROOT = Path(__file__).resolve().parent.parent
+
+SLOW_KIND = '''
+import time
+def case(params, design, outdir):
+    time.sleep(params["sleep_s"])
+    (outdir / "field.txt").write_text("x" * 100000)   # a file the kind writes, like a VTK
+    return {"y": params["x"] ** 2 * design.mu_sf}
+'''
+
+
+def write_study(tmp_path, text, name="s.toml") -> Path:
+    path = tmp_path / name
+    path.write_text(text)
+    return path
+
+
+def results_by_key(root: Path, study) -> dict:
+    sdir = study_dir(study, root)
+    return {c.key: json.loads((sdir / c.key / RESULT).read_text())["numbers"] for c in plan(study)}
+
+
+def test_dask_local_cluster_gives_the_same_results_as_the_process_pool(tmp_path):
+    pytest.importorskip("dask.distributed")
+    study = load_study(write_study(tmp_path, 'kind = "curve"\n[sweep]\n'
+                                   'theta_deg = "0:90:15"\nmu_sf_MPa = [1.0, 1.3]\n'))
+    pool = run_study(study, results_root=tmp_path / "pool", workers=2, progress=False)
+    dask = run_study(study, results_root=tmp_path / "dask", workers=2, scheduler="local",
+                     progress=False)
+    assert pool.ok and dask.ok and pool.computed == dask.computed == 14
+    a, b = results_by_key(tmp_path / "pool", study), results_by_key(tmp_path / "dask", study)
+    assert a == b  # bit-identical: the same function on the same inputs
+    # and the curve is the curve: without reservoir P(0) = 0 (eq. (28)), P rises with theta
+    rows = sorted((c.point["mu_sf_MPa"], c.point["theta_deg"], a[c.key]) for c in plan(study))
+    assert all(r[2]["P_no_reservoir_MPa"] == 0.0 for r in rows if r[1] == 0.0)
+
+
+@pytest.mark.parametrize("sig", [signal.SIGKILL, signal.SIGINT])
+def test_killed_run_resumes_with_only_the_missing_cases(tmp_path, monkeypatch, sig):
+    (tmp_path / "slowkind.py").write_text(SLOW_KIND)
+    path = write_study(tmp_path, 'kind = "slowkind:case"\n[params]\nsleep_s = 0.25\n'
+                       '[sweep]\nx = "1:12:1"\n')
+    study, root = load_study(path), tmp_path / "res"
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(tmp_path), str(ROOT)])}
+    proc = subprocess.Popen([sys.executable, "-m", "studies.cli", "study", "run", str(path),
+                             "--workers", "2", "--results", str(root), "--no-progress"],
+                            env=env, start_new_session=True, stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE)
+    sdir = study_dir(study, root)
+    deadline = time.monotonic() + 60
+    while len(list(sdir.glob(f"*/{RESULT}"))) < 3 and time.monotonic() < deadline:
+        time.sleep(0.05)
+    os.killpg(proc.pid, sig)
+    proc.communicate(timeout=60)
+    assert proc.returncode == (-signal.SIGKILL if sig == signal.SIGKILL else 130)
+
+    # every case folder that exists is complete and readable
+    before = {p.parent.name: p.read_bytes() for p in sdir.glob(f"*/{RESULT}")}
+    folders = [p for p in sdir.iterdir() if p.is_dir() and p.name != ".tmp"]
+    assert {p.name for p in folders} == set(before)
+    assert all(json.loads(b)["status"] == "done" for b in before.values())
+    assert all((sdir / k / "field.txt").stat().st_size == 100000 for k in before)
+    assert 3 <= len(before) < 12
+
+    monkeypatch.syspath_prepend(str(tmp_path))
+    summary = run_study(study, results_root=root, workers=1, progress=False)
+    assert summary.ok and summary.reused == len(before) and summary.computed == 12 - len(before)
+    assert all((sdir / k / RESULT).read_bytes() == b for k, b in before.items())
+    assert not (sdir / ".tmp").exists()
+    assert len(status(study, root)["done"]) == 12
+
+
+def test_a_failing_case_is_recorded_and_the_others_finish(tmp_path, capsys):
+    # 400 deg is outside the reduced model's range: that case raises an InputError
+    path = write_study(tmp_path, 'kind = "curve"\n[sweep]\ntheta_deg = [10, 400, 20]\n')
+    root = tmp_path / "res"
+    args = ["study", "run", str(path), "--workers", "1", "--results", str(root), "--no-progress"]
+    assert main(args) == 1
+    assert "1 failed" in capsys.readouterr().out
+    study = load_study(path)
+    groups = status(study, root)
+    assert [c.point["theta_deg"] for c in groups["failed"]] == [400]
+    assert sorted(c.point["theta_deg"] for c in groups["done"]) == [10, 20]
+    failed = json.loads((study_dir(study, root) / groups["failed"][0].key / "failed.json")
+                        .read_text())
+    assert "theta_deg" in failed["error"] and "Traceback" in failed["traceback"]
+    index = (study_dir(study, root) / "index.csv").read_text().splitlines()
+    assert len(index) == 4 and sum(",failed," in line for line in index) == 1
+    assert main(["study", "status", str(path), "--results", str(root)]) == 0
+    assert "2 done, 0 pending, 1 failed" in capsys.readouterr().out
+    assert main(["study", "report", str(path), "--results", str(root)]) == 0
+    assert (study_dir(study, root) / "report" / "P_MPa.png").stat().st_size > 0
+
+
+def test_case_key_follows_the_inputs_not_their_spelling():
+    paper = HandDesign()
+    assert case_key("curve", {"theta_deg": 10}, paper) == case_key("curve", {"theta_deg": 10.0}, paper)
+    assert case_key("curve", {"theta_deg": 10.0}, paper) != case_key("curve", {"theta_deg": 11.0}, paper)
+    assert case_key("curve", {"theta_deg": 10.0}, paper) != \
+        case_key("curve", {"theta_deg": 10.0}, paper.replace(mu_sf=1.2))
