@@ -1,0 +1,56 @@
+"""A cache of generated meshes, so the same mesh is never generated twice.
+
+The key is a hash of (the geometry function's module and name, its parameters, the
+element size, the element order, the gmsh version, :data:`FORMAT`). Files live in
+``$SOFTHAND_CACHE/meshes`` (default ``~/.cache/softhand/meshes``) and are written
+atomically, so concurrent workers asking for the same mesh at worst both generate it.
+"""
+from __future__ import annotations
+
+import dataclasses
+import hashlib
+import json
+import os
+from pathlib import Path
+
+import skfem
+
+from meshes.convert import read_mesh
+from meshes.gmsh_io import GMSH_VERSION, Geometry, generate_msh
+
+#: bump when the way meshes are generated changes, to invalidate old cache entries
+FORMAT = 1
+
+
+def cache_dir() -> Path:
+    """The mesh cache folder: ``$SOFTHAND_CACHE/meshes`` or ``~/.cache/softhand/meshes``."""
+    root = os.environ.get("SOFTHAND_CACHE") or Path.home() / ".cache" / "softhand"
+    return Path(root) / "meshes"
+
+
+def mesh_key(geometry: Geometry, params, *, size: float, order: int) -> str:
+    """A stable hex digest naming this mesh."""
+    fields = dataclasses.asdict(params) if dataclasses.is_dataclass(params) else dict(params)
+    blob = json.dumps({
+        "geometry": f"{geometry.__module__}.{geometry.__qualname__}",
+        "params": fields, "size": float(size), "order": int(order),
+        "gmsh": GMSH_VERSION, "format": FORMAT,
+    }, sort_keys=True, default=repr)
+    return hashlib.sha256(blob.encode()).hexdigest()[:20]
+
+
+def cached_msh(geometry: Geometry, params, *, size: float, order: int = 2,
+               folder: str | Path | None = None) -> Path:
+    """The ``.msh`` file of this geometry; generated with gmsh only if not cached yet."""
+    name = f"{geometry.__name__}-{mesh_key(geometry, params, size=size, order=order)}.msh"
+    path = Path(folder) if folder is not None else cache_dir()
+    path = path / name
+    if not path.is_file():
+        generate_msh(geometry, params, path, size=size, order=order)
+    return path
+
+
+def load_mesh(geometry: Geometry, params, *, size: float, order: int = 2,
+              folder: str | Path | None = None) -> skfem.Mesh:
+    """A scikit-fem mesh (named boundaries/subdomains) of this geometry, through the cache."""
+    return read_mesh(cached_msh(geometry, params, size=size, order=order, folder=folder))

@@ -1,0 +1,72 @@
+"""Run gmsh on a geometry given as a Python function and write a ``.msh`` file.
+
+A *geometry function* has the signature ``geometry(model, params, size) -> None``: it
+builds the CAD with ``model.occ`` (``model`` is ``gmsh.model``), synchronises, and names
+its parts with ``model.addPhysicalGroup(dim, tags, name=...)``; ``params`` is a frozen
+dataclass (or a mapping) of its dimensions in mm, ``size`` the target element size in mm
+(it may set finer local sizes itself). Only elements in physical groups are saved, so a
+geometry without a group of its top dimension gets one named ``"domain"``.
+
+gmsh is imported only inside ``meshes/``; callers use :mod:`meshes.cache`.
+"""
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any, Callable
+
+import gmsh
+
+from meshes.atomic import atomic_path
+
+Geometry = Callable[[Any, Any, float], None]
+
+GMSH_VERSION = gmsh.__version__
+
+
+def generate_msh(geometry: Geometry, params, path: str | Path, *, size: float,
+                 order: int = 2) -> Path:
+    """Mesh ``geometry(model, params, size)`` with elements of ``order`` (1 or 2); write ``path``."""
+    if not size > 0 or order not in (1, 2):
+        raise ValueError(f"size must be > 0 and order 1 or 2, got size={size}, order={order}")
+    started_here = not gmsh.isInitialized()
+    if started_here:
+        gmsh.initialize(readConfigFiles=False, interruptible=False)
+    try:
+        gmsh.model.add(getattr(geometry, "__name__", "geometry"))
+        _set_options(size)
+        geometry(gmsh.model, params, size)
+        gmsh.model.occ.synchronize()
+        dim = gmsh.model.getDimension()
+        _ensure_domain_group(dim)
+        gmsh.model.mesh.generate(dim)
+        if order == 2:
+            gmsh.model.mesh.setOrder(2)
+        with atomic_path(path) as tmp:
+            gmsh.write(str(tmp))
+        return Path(path)
+    finally:
+        gmsh.model.remove()
+        if started_here:
+            gmsh.finalize()
+
+
+def _set_options(size: float) -> None:
+    gmsh.option.setNumber("General.Terminal", 0)
+    gmsh.option.setNumber("General.NumThreads", 1)
+    gmsh.option.setNumber("Mesh.MeshSizeMax", size)
+    gmsh.option.setNumber("Mesh.MshFileVersion", 4.1)
+    gmsh.option.setNumber("Mesh.Binary", 1)
+    gmsh.option.setNumber("Mesh.SaveAll", 0)
+
+
+def _ensure_domain_group(dim: int) -> None:
+    if not gmsh.model.getPhysicalGroups(dim):
+        tags = [tag for _, tag in gmsh.model.getEntities(dim)]
+        gmsh.model.addPhysicalGroup(dim, tags, name="domain")
+
+
+def name_groups(model, dim: int, groups: dict[str, list[int]]) -> None:
+    """Add a physical group per non-empty entry of ``groups`` (name -> entity tags of ``dim``)."""
+    for name, tags in groups.items():
+        if tags:
+            model.addPhysicalGroup(dim, list(tags), name=name)

@@ -1,0 +1,112 @@
+"""Meshes: gmsh geometry -> .msh -> scikit-fem with named groups; the cache; bad files."""
+import numpy as np
+import pytest
+import skfem
+
+from meshes import cache, gmsh_io
+from meshes.convert import read_mesh
+from meshes.tube import Tube, tube_mesh
+from reduced.errors import InputError
+
+
+@pytest.fixture(autouse=True)
+def private_cache(tmp_path, monkeypatch):
+    monkeypatch.setenv("SOFTHAND_CACHE", str(tmp_path / "cache"))
+
+
+def measure(mesh, facets=None):
+    """Volume of the mesh, or area of the given boundary facets (isoparametric geometry)."""
+    elem = type(mesh).elem()
+    basis = (skfem.CellBasis(mesh, elem) if facets is None
+             else skfem.FacetBasis(mesh, elem, facets=facets))
+    return skfem.Functional(lambda w: 1.0 + 0.0 * w.x[0]).assemble(basis)
+
+
+@pytest.mark.parametrize("sector, fraction", [("full", 1.0), ("half", 0.5), ("quarter", 0.25)])
+def test_tube_groups_measure_the_closed_form(sector, fraction):
+    ri, ro, length, cap = 4.0, 9.0, 6.0, 1.5
+    mesh = tube_mesh(Tube(ri, ro, length, cap=cap, sector=sector), size=2.0)
+    assert isinstance(mesh, skfem.MeshTet2)
+    expected_groups = {"full": 4, "half": 5, "quarter": 6}[sector]
+    assert len(mesh.boundaries) == expected_groups and set(mesh.subdomains) == {"wall"}
+    # quadratic (curved) facets: a circle of radius r with chords h is matched to O((h/r)^4)
+    rtol = 2e-3
+    inner = fraction * (2 * np.pi * ri * length + np.pi * ri ** 2)
+    outer = fraction * 2 * np.pi * ro * (length + cap)
+    annulus = fraction * np.pi * (ro ** 2 - ri ** 2)
+    volume = annulus * length + fraction * np.pi * ro ** 2 * cap
+    assert measure(mesh, mesh.boundaries["inner"]) == pytest.approx(inner, rel=rtol)
+    assert measure(mesh, mesh.boundaries["outer"]) == pytest.approx(outer, rel=rtol)
+    assert measure(mesh, mesh.boundaries["base"]) == pytest.approx(annulus, rel=rtol)
+    assert measure(mesh, mesh.boundaries["tip"]) == pytest.approx(fraction * np.pi * ro ** 2, rel=rtol)
+    assert measure(mesh) == pytest.approx(volume, rel=rtol)
+    if sector != "full":
+        assert np.allclose(mesh.p[1, mesh.facets[:, mesh.boundaries["symmetry"]]], 0.0)
+
+
+def test_linear_order_gives_straight_tetrahedra():
+    mesh = tube_mesh(Tube(4.0, 9.0, 3.0, sector="quarter"), size=2.0, order=1)
+    assert type(mesh) is skfem.MeshTet1 and "inner" in mesh.boundaries
+
+
+def rectangle(model, params, size):
+    """A 2D r-z strip with named edges, as the axisymmetric models use."""
+    occ = model.occ
+    occ.addRectangle(0, 0, 0, params["width"], params["height"])
+    occ.synchronize()
+    for _, tag in model.getEntities(1):
+        x0, y0, _, x1, y1, _ = model.getBoundingBox(1, tag)
+        name = "axis" if x1 < 1e-6 else "bottom" if y1 < 1e-6 else "other"  # OCC boxes pad 1e-7
+        model.addPhysicalGroup(1, [tag], name=f"{name}{tag}" if name == "other" else name)
+
+
+@pytest.mark.parametrize("order, kind", [(1, skfem.MeshTri1), (2, skfem.MeshTri2)])
+def test_2d_geometry_gives_triangles_with_named_edges(order, kind):
+    mesh = cache.load_mesh(rectangle, {"width": 3.0, "height": 1.0}, size=0.5, order=order)
+    assert type(mesh) is kind and set(mesh.subdomains) == {"domain"}
+    assert measure(mesh) == pytest.approx(3.0, rel=1e-12)  # straight edges: exact
+    assert measure(mesh, mesh.boundaries["bottom"]) == pytest.approx(3.0, rel=1e-12)
+    assert np.allclose(mesh.p[0, mesh.facets[:, mesh.boundaries["axis"]]], 0.0)
+
+
+def test_cache_generates_each_mesh_once(monkeypatch):
+    tube = Tube(4.0, 9.0, 2.0, sector="quarter")
+    first = cache.cached_msh(tube_geometry_fn(), tube, size=3.0)
+
+    def forbidden(*args, **kwargs):
+        raise AssertionError("gmsh called for a cached mesh")
+
+    monkeypatch.setattr(cache, "generate_msh", forbidden)
+    assert cache.cached_msh(tube_geometry_fn(), tube, size=3.0) == first
+    with pytest.raises(AssertionError):  # another size is another mesh
+        cache.cached_msh(tube_geometry_fn(), tube, size=2.5)
+    key = cache.mesh_key(tube_geometry_fn(), tube, size=3.0, order=2)
+    assert key != cache.mesh_key(tube_geometry_fn(), Tube(4.0, 9.0, 2.5, sector="quarter"),
+                                 size=3.0, order=2)
+    assert first.parent == cache.cache_dir()
+
+
+def tube_geometry_fn():
+    from meshes.tube import tube_geometry
+    return tube_geometry
+
+
+def test_failed_generation_leaves_nothing(tmp_path):
+    def broken(model, params, size):
+        model.occ.addBox(0, 0, 0, 1, 1, 1)
+        raise RuntimeError("geometry bug")
+
+    with pytest.raises(RuntimeError):
+        gmsh_io.generate_msh(broken, {}, tmp_path / "m.msh", size=1.0)
+    assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize("content", ["hello\n", "$MeshFormat\n4.1 0 8\n$EndMeshFormat\n"])
+def test_a_file_that_is_not_a_mesh_is_one_line_input_error(tmp_path, content):
+    path = tmp_path / "bad.msh"
+    path.write_text(content)
+    with pytest.raises(InputError) as err:
+        read_mesh(path)
+    assert "\n" not in str(err.value) and "bad.msh" in str(err.value)
+    with pytest.raises(InputError):
+        read_mesh(tmp_path / "missing.msh")
