@@ -1,0 +1,131 @@
+"""Sparse assembly for vector fields: a CSR pattern built once, element matrices scattered into it.
+
+Vector dofs are interleaved as scikit-fem's ``ElementVector`` numbers them:
+dof ``3 * s + a`` is component ``a`` of scalar dof ``s``. The pattern is built at
+the scalar level (100 node pairs per P2 tetrahedron instead of 900) and expanded
+to 3x3 blocks by index arithmetic, so building it is cheap and the per-element
+positions are stored as one small int32 array. Assembling a matrix is then one
+``np.bincount`` per chunk of elements into the CSR data array: no Python loop
+over elements, no COO-to-CSR conversion per Newton iterate.
+"""
+from __future__ import annotations
+
+import numpy as np
+import scipy.sparse as sp
+
+
+class ElementScatter:
+    """Scatter element vectors/matrices of a 3-component field into a fixed CSR pattern.
+
+    ``scalar_dofs``: (nloc, nel) scalar dofs of each element (``basis.element_dofs``),
+    ``n_scalar``: number of scalar dofs. The vector system has ``3 * n_scalar`` dofs.
+    """
+
+    def __init__(self, scalar_dofs: np.ndarray, n_scalar: int):
+        dofs = np.ascontiguousarray(scalar_dofs.T)  # (nel, nloc)
+        nel, nloc = dofs.shape
+        rows = np.repeat(dofs, nloc, axis=1)
+        cols = np.tile(dofs, (1, nloc))
+        keys, inverse = np.unique(rows.astype(np.int64) * n_scalar + cols, return_inverse=True)
+        s_rows, s_cols = np.divmod(keys, n_scalar)
+        ip = np.zeros(n_scalar + 1, dtype=np.int64)
+        np.cumsum(np.bincount(s_rows, minlength=n_scalar), out=ip[1:])
+        deg = np.diff(ip)
+        self.n = 3 * n_scalar
+        self.nnz = 9 * len(keys)
+        self.dofs = dofs
+        self._spos = inverse.reshape(nel, nloc, nloc).astype(np.int64)
+        self._ip, self._deg = ip, deg
+        self.indptr, self.indices = self._vector_pattern(ip, deg, s_cols)
+        itype = np.int32 if self.nnz < 2 ** 31 else np.int64
+        self._itype = itype
+
+    @staticmethod
+    def _vector_pattern(ip, deg, s_cols):
+        n_scalar = len(deg)
+        # vector row 3i+a holds 3*deg_i entries, starting at 9 ip_i + 3 a deg_i
+        starts = 9 * ip[:-1, None] + 3 * np.arange(3)[None, :] * deg[:, None]
+        indptr = np.append(starts.ravel(), 9 * ip[-1])
+        row_cols = (3 * s_cols[:, None] + np.arange(3)).ravel()  # per scalar row: 3*deg columns
+        indices = np.empty(9 * len(s_cols), dtype=np.int32 if 9 * len(s_cols) < 2 ** 31 else np.int64)
+        for a in range(3):  # three interleaved copies of each scalar row's column list
+            seg = np.repeat(np.arange(n_scalar), 3 * deg)
+            offs = np.arange(3 * ip[-1]) - 3 * ip[:-1][seg]
+            indices[starts[seg, a] + offs] = row_cols
+        return indptr.astype(indices.dtype), indices
+
+    def positions(self, elements) -> np.ndarray:
+        """CSR data positions of the (3 nloc)^2 entries of the given elements, (len, 3nloc, 3nloc)."""
+        s = self._spos[elements]  # (ne, nloc, nloc)
+        rows = self.dofs[elements]  # (ne, nloc)
+        ip, deg = self._ip[rows], self._deg[rows]
+        base = 6 * ip[:, :, None] + 3 * s  # = 9 ip + 3 (s - ip)
+        a = np.arange(3)
+        pos = (base[:, :, None, :, None] + 3 * a[None, None, :, None, None] * deg[:, :, None, None, None]
+               + a[None, None, None, None, :])
+        ne, nloc = rows.shape
+        return pos.reshape(ne, 3 * nloc, 3 * nloc)
+
+    def vector_dofs(self, elements=slice(None)) -> np.ndarray:
+        """Vector dofs (ne, 3 nloc) of the elements, ordered (node, component)."""
+        return (3 * self.dofs[elements][:, :, None] + np.arange(3)).reshape(
+            self.dofs[elements].shape[0], -1)
+
+    def add_matrix(self, data: np.ndarray, Ke: np.ndarray, elements) -> None:
+        """data += scatter of element matrices Ke (ne, 3nloc, 3nloc) of the given elements."""
+        data += np.bincount(self.positions(elements).ravel(), weights=Ke.ravel(), minlength=self.nnz)
+
+    def add_vector(self, out: np.ndarray, re: np.ndarray, elements) -> None:
+        """out += scatter of element vectors re (ne, 3nloc)."""
+        out += np.bincount(self.vector_dofs(elements).ravel(), weights=re.ravel(), minlength=self.n)
+
+    def csr(self, data: np.ndarray) -> sp.csr_matrix:
+        """The CSR matrix with this pattern and the given data (index arrays shared, not copied)."""
+        K = sp.csr_matrix((data, self.indices, self.indptr), shape=(self.n, self.n), copy=False)
+        K.has_sorted_indices = True
+        return K
+
+
+class Restriction:
+    """Rows and columns ``keep`` (sorted, unique) of square CSR matrices; index map built once per pattern.
+
+    ``restrict(K)`` is a gather of K.data (no sparse slicing per Newton iterate);
+    ``expand(x, fill)`` puts a reduced vector back into a full one.
+    """
+
+    def __init__(self, n: int, keep: np.ndarray):
+        self.n = n
+        self.keep = np.unique(np.asarray(keep, dtype=np.int64))
+        self._new = np.full(n, -1, dtype=np.int64)
+        self._new[self.keep] = np.arange(len(self.keep))
+        self._pattern = None
+
+    def _build(self, K):
+        rows = np.repeat(np.arange(self.n), np.diff(K.indptr))
+        sel = np.flatnonzero((self._new[rows] >= 0) & (self._new[K.indices] >= 0))
+        new_rows = self._new[rows[sel]]  # nondecreasing, and columns stay sorted: keep is sorted
+        indptr = np.zeros(len(self.keep) + 1, dtype=np.int64)
+        np.cumsum(np.bincount(new_rows, minlength=len(self.keep)), out=indptr[1:])
+        indices = self._new[K.indices[sel]]
+        self._pattern = (K.indptr.copy(), K.indices.copy(), sel, indptr, indices)
+
+    def restrict(self, K: sp.spmatrix) -> sp.csr_matrix:
+        """K[keep][:, keep] as CSR."""
+        K = K.tocsr()
+        p = self._pattern
+        if p is None or not (np.array_equal(p[0], K.indptr) and np.array_equal(p[1], K.indices)):
+            self._build(K)
+            p = self._pattern
+        Kr = sp.csr_matrix((K.data[p[2]], p[4], p[3]), shape=(len(self.keep),) * 2, copy=False)
+        Kr.has_sorted_indices = True
+        return Kr
+
+    def vector(self, R: np.ndarray) -> np.ndarray:
+        """R[keep]."""
+        return R[self.keep]
+
+    def expand(self, x: np.ndarray, fill: np.ndarray | float = 0.0) -> np.ndarray:
+        """Full vector equal to ``fill`` outside ``keep`` and to ``x`` on it."""
+        out = np.array(np.broadcast_to(fill, (self.n,)), dtype=float)
+        out[self.keep] = x
+        return out
