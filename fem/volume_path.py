@@ -1,0 +1,173 @@
+r"""Volume-controlled path following for an axisymmetric cavity (pressure = Lagrange multiplier).
+
+Oil is incompressible, so the reservoir and the balloon are driven by their enclosed
+volume V*, not by pressure: a rubber membrane's p(V) has a maximum past which pressure
+control has no solution. The equilibrium states are the stationary points of
+
+.. math:: L(u, p) = Π(u) - p\,(V(u) - V^*),
+
+solved by Newton on the bordered (symmetric, indefinite) system
+
+.. math:: \begin{pmatrix} K - p\,H_V & -g_V \\ -g_V^T & 0 \end{pmatrix}
+          \begin{pmatrix} Δu \\ Δp \end{pmatrix}
+          = -\begin{pmatrix} Π'(u) - p\,g_V \\ V^* - V(u) \end{pmatrix},
+
+with :math:`g_V = V'(u)` and :math:`H_V = V''(u)` (the load stiffness of the follower
+pressure). The bordered matrix stays regular at and past the pressure maximum, where
+:math:`K - pH_V` itself is singular. Along the path :math:`dΠ/dV^* = p`, so
+:math:`\int p\,dV = Π` is an independent check of the residual, the tangent-free parts
+and the volume functional (``tests/test_reservoir.py``).
+
+Steps: a secant predictor from the last two converged states, Newton with a backtracking
+line search on the residual norm, and load-step cut-back (halve ΔV*) when Newton fails;
+the step grows again after easy steps. Raises :class:`NotConverged` with the residual
+history and the last converged state.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+
+__all__ = ["PathOptions", "PathState", "NotConverged", "follow_volume"]
+
+
+@dataclass(frozen=True)
+class PathOptions:
+    """Step control and tolerances of :func:`follow_volume`."""
+
+    first_step: float = 1.0  #: first volume increment [mm^3]
+    max_step: float = 200.0  #: largest volume increment [mm^3]
+    rtol: float = 1e-9  #: force residual, relative to the pressure load |p g_V| (or |Π'|)
+    atol: float = 0.0  #: force residual floor [N]: round-off of the stiff volumetric terms
+    vtol: float = 1e-10  #: volume residual, relative to max(V*, volume_scale)
+    max_iter: int = 12  #: Newton iterations per step before cut-back
+    min_step: float = 1e-6  #: smallest volume increment before giving up [mm^3]
+    grow: float = 1.5  #: step growth after a step that took <= 5 iterations
+
+
+@dataclass(frozen=True)
+class PathState:
+    """One converged equilibrium state."""
+
+    volume: float  #: enclosed volume V [mm^3]
+    pressure: float  #: Lagrange multiplier p [MPa]
+    energy: float  #: stored strain energy Π [N mm]
+    u: np.ndarray = field(repr=False)  #: displacement vector [mm]
+    iterations: int = 0  #: Newton iterations of this step
+
+
+class NotConverged(RuntimeError):
+    """Newton failed at the smallest step; carries the history and the last converged state."""
+
+    def __init__(self, message, history, last: PathState):
+        super().__init__(f"{message}; residual history {['%.2e' % r for r in history]}")
+        self.history = history
+        self.last = last
+
+
+def _solve_bordered(K, g, rhs_u, rhs_v):
+    """Solve [[K, -g], [-g^T, 0]] [du, dp] = [rhs_u, rhs_v]."""
+    n = g.size
+    A = sp.bmat([[K, sp.csr_matrix(-g[:, None])], [sp.csr_matrix(-g[None, :]), None]], format="csc")
+    x = spla.spsolve(A, np.concatenate([rhs_u, [rhs_v]]))
+    return x[:n], x[n]
+
+
+class _Problem:
+    """Residual and tangent of L(u, p) on the free DOFs."""
+
+    def __init__(self, solid, volume, free, volume_scale):
+        self.solid, self.volume, self.free = solid, volume, free
+        self.volume_scale = volume_scale
+
+    def full(self, uf):
+        u = np.zeros(self.solid.ndofs)
+        u[self.free] = uf
+        return u
+
+    def residual(self, uf, p, target):
+        u = self.full(uf)
+        f, g = self.solid.residual(u)[self.free], self.volume.gradient(u)[self.free]
+        return f - p * g, target - self.volume.value(u), max(np.linalg.norm(p * g), np.linalg.norm(f))
+
+    def newton_step(self, uf, p, ru, rv):
+        u = self.full(uf)
+        K = self.solid.tangent(u) - p * self.volume.hessian(u)
+        K = K[self.free][:, self.free]
+        return _solve_bordered(K, self.volume.gradient(u)[self.free], -ru, -rv)
+
+
+def _newton(prob, uf, p, target, opt: PathOptions):
+    """Newton with backtracking line search; returns ((uf, p, iterations) or None, history).
+
+    The first step (from the predictor) is taken whole; later steps backtrack on the merit
+    |R_u| / f + |R_V| / v, f the largest force scale (|p g_V|, |Π'|, atol) met in this
+    solve, v the volume scale.
+    """
+    history = []
+    vscale = max(abs(target), prob.volume_scale)
+    ru, rv, fscale = prob.residual(uf, p, target)
+    fnorm = max(fscale, opt.atol, 1e-300)
+    for it in range(opt.max_iter + 1):
+        merit = np.linalg.norm(ru) / fnorm + abs(rv) / vscale
+        history.append(merit)
+        if np.linalg.norm(ru) <= opt.rtol * fscale + opt.atol and abs(rv) <= opt.vtol * vscale:
+            return (uf, p, it), history
+        if it == opt.max_iter or not np.isfinite(merit):
+            break
+        du, dp = prob.newton_step(uf, p, ru, rv)
+        for alpha in (1.0, 0.5, 0.25, 0.125, 0.0625):
+            trial = prob.residual(uf + alpha * du, p + alpha * dp, target)
+            new = np.linalg.norm(trial[0]) / max(fnorm, trial[2]) + abs(trial[1]) / vscale
+            if it == 0 or (np.isfinite(new) and new < merit):
+                break
+        uf, p = uf + alpha * du, p + alpha * dp
+        ru, rv, fscale = trial
+        fnorm = max(fnorm, fscale)
+    return None, history
+
+
+def follow_volume(solid, volume, fixed_dofs, targets, *, options=PathOptions(),
+                  volume_scale=1.0, progress=None) -> tuple[list[PathState], list[PathState]]:
+    """Follow the equilibrium path from u = 0 (V = 0) through the volumes ``targets`` [mm^3].
+
+    ``targets`` must be increasing and positive (a reversible elastic path: decreasing
+    volumes are the same states). Returns (states at the targets, every converged state).
+    """
+    targets = np.asarray(targets, dtype=float)
+    if np.any(np.diff(targets) <= 0) or targets[0] <= 0:
+        raise ValueError("volume targets must be positive and strictly increasing")
+    free = np.setdiff1d(np.arange(solid.ndofs), fixed_dofs)
+    prob = _Problem(solid, volume, free, volume_scale)
+    path = [PathState(0.0, 0.0, 0.0, np.zeros(solid.ndofs))]
+    prev = None  # (uf, p, V) of the state before the last one, for the secant predictor
+    uf, p, v, step = np.zeros(free.size), 0.0, 0.0, options.first_step
+    hits = []
+    for target in targets:
+        while v < target:
+            nxt = min(v + step, target)
+            if prev is not None:
+                s = (nxt - v) / (v - prev[2])
+                guess = (uf + s * (uf - prev[0]), p + s * (p - prev[1]))
+            else:
+                guess = (uf, p)
+            result, history = _newton(prob, *guess, nxt, options)
+            if result is None:
+                step /= 2
+                if step < options.min_step:
+                    raise NotConverged(f"no equilibrium at V = {nxt:.6g} mm^3", history, path[-1])
+                continue
+            prev = (uf, p, v)
+            uf, p, its = result
+            v = nxt
+            u = prob.full(uf)
+            path.append(PathState(v, p, solid.energy(u), u, its))
+            if progress is not None:
+                progress(v)
+            if its <= 5:
+                step = min(step * options.grow, options.max_step)
+        hits.append(path[-1])
+    return hits, path
