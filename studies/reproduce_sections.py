@@ -1,0 +1,198 @@
+"""The sections of ``softhand reproduce``: one function per result of the paper.
+
+Each builder ``build(ctx, outdir) -> (markdown, numbers)`` calls the owning library
+function, writes its CSV/PNG/VTK files into ``outdir`` and returns the Markdown body
+(links relative to ``outdir``) and its headline numbers. No printing; no CLI calls.
+The FEM sections live in :mod:`studies.reproduce_fem`.
+"""
+from __future__ import annotations
+
+import math
+import warnings
+from pathlib import Path
+
+import numpy as np
+
+from studies.output import save_figure, write_csv
+from studies.reproduce import Context, Section
+
+#: the paper's statements that the sections compare with
+PAPER_RESERVOIR_OFFSET_MPA = 0.1  #: "bent at 0.1 MPa lower pressure" (Fig. 7)
+PAPER_FIG8_ERROR_KGF = {180.0: 0.22, 240.0: 0.39}  #: F_v estimation errors vs measurement
+FIG8_CASES = ((2.0, 180.0, (0.6, 0.7, 0.8, 0.9)), (6.0, 240.0, (1.1, 1.2, 1.3, 1.4)))
+
+
+def figure(ncols: int = 1, *, width: float = 5.5):
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, axes = plt.subplots(1, ncols, figsize=(width * ncols, 4.0), squeeze=False)
+    return fig, axes[0]
+
+
+def md_table(rows: list[dict], columns: list[str] | None = None, *, digits: int = 4) -> str:
+    """A Markdown table of ``rows`` (dicts); floats to ``digits`` significant digits."""
+    columns = columns or list(rows[0])
+
+    def cell(v):
+        if isinstance(v, (float, np.floating)):
+            return f"{v:.{digits}g}"
+        if isinstance(v, (list, tuple, np.ndarray)):
+            return "(" + ", ".join(cell(x) for x in v) + ")"
+        return str(v)
+
+    lines = ["| " + " | ".join(columns) + " |", "|" + "---|" * len(columns)]
+    lines += ["| " + " | ".join(cell(r.get(c, "")) for c in columns) + " |" for r in rows]
+    return "\n".join(lines)
+
+
+# ---------------------------------------------------------------------- Fig. 7, reduced
+def fig7_reduced(ctx: Context, outdir: Path):
+    """Eq. (27) with and (28) without reservoir over 0-90 deg; the reservoir's offset."""
+    from reduced import hand
+
+    d = ctx.design
+    theta_deg = np.arange(0.0, 90.0 + 1e-9, 1.0)
+    theta = np.radians(theta_deg)
+    P, P0 = hand.pressure(theta, d, reservoir=True), hand.pressure(theta, d, reservoir=False)
+    offset = P0 - P
+    write_csv(outdir / "fig7_reduced.csv", [
+        {"theta_deg": t, "P_MPa": p, "P_no_reservoir_MPa": q} for t, p, q in zip(theta_deg, P, P0)])
+    pressures = np.round(np.arange(0.0, 0.8 + 1e-9, 0.1), 10)
+    by_p = _angles_at(pressures, d)
+    write_csv(outdir / "fig7_reduced_by_pressure.csv", by_p)
+    fig, (ax,) = figure()
+    ax.plot(P, theta_deg, "-", label="eq. (27), with reservoir")
+    ax.plot(P0, theta_deg, ":", label="eq. (28), without reservoir")
+    ax.set(xlabel="pump pressure P [MPa]", ylabel="bend angle θ [deg]", xlim=(-0.15, None),
+           title="Fig. 7 analogue: reduced model")
+    ax.grid(alpha=0.3)
+    ax.legend()
+    save_figure(fig, outdir / "fig7_reduced.png")
+    numbers = {"offset_mean_MPa": float(offset.mean()), "offset_min_MPa": float(offset.min()),
+               "offset_max_MPa": float(offset.max()), "P_at_0deg_MPa": float(P[0]),
+               "P_at_90deg_MPa": float(P[-1])}
+    text = f"""Free fingers, the paper's design; θ = 0–90° in 1° steps
+([fig7_reduced.csv](fig7_reduced.csv)), and θ at the paper's pressures 0–0.8 MPa
+([fig7_reduced_by_pressure.csv](fig7_reduced_by_pressure.csv)).
+
+![Fig. 7 analogue](fig7_reduced.png)
+
+The reservoir lowers the pressure needed for a bend by {offset.mean():.4f} MPa on average
+over 0–90° (from {offset.min():.4f} to {offset.max():.4f} MPa); the paper says about
+{PAPER_RESERVOIR_OFFSET_MPA} MPa. With the reservoir P(0) = {P[0]:.4f} MPa < 0: at zero pump
+pressure the charged sheet already bends the fingers a little.
+
+{md_table(by_p)}
+"""
+    return text, numbers
+
+
+def _angles_at(pressures, design) -> list[dict]:
+    """θ(P) with and without reservoir; None where P is outside the model's range."""
+    from reduced import hand
+    from reduced.errors import InputError
+
+    rows = []
+    for P in pressures:
+        row = {"P_MPa": float(P)}
+        for key, res in (("theta_deg", True), ("theta_no_reservoir_deg", False)):
+            try:
+                row[key] = float(np.degrees(hand.bend_angle(P, design, reservoir=res)))
+            except InputError:
+                row[key] = float("nan")
+        rows.append(row)
+    return rows
+
+
+# ---------------------------------------------------------------------- Table II, reduced
+def table2_reduced(ctx: Context, outdir: Path):
+    """F_v by eqs. (24), (25), (29) at the three (P, θ) of Table II, m = 2 kg, 180 mm w."""
+    from reduced.control import PAPER_TABLE_II
+    from reduced.grasp import KGF, PAPER_WEIGHTS, WeightSumWarning, check_weights, grasp_forces
+
+    d = ctx.design
+    w_paper = np.asarray(PAPER_WEIGHTS[180.0])
+    w_unit = check_weights(w_paper, d, normalise=True)
+    rows = []
+    for state, (P, theta_deg, F_paper) in PAPER_TABLE_II.items():
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", WeightSumWarning)  # stated in the text below
+            F = grasp_forces(P, math.radians(theta_deg), 2.0, w_paper, d).F_v / KGF
+        F_unit = grasp_forces(P, math.radians(theta_deg), 2.0, w_unit, d).F_v / KGF
+        rows.append({"state": state, "P_MPa": P, "theta_deg": theta_deg, "F_v_paper_kgf": F_paper,
+                     "F_v_kgf": float(F), "F_v_w_normalised_kgf": float(F_unit)})
+    write_csv(outdir / "table2_reduced.csv", rows)
+    numbers = {f"F_v_{r['state']}_kgf": r["F_v_kgf"] for r in rows}
+    numbers |= {f"F_v_{r['state']}_w_normalised_kgf": r["F_v_w_normalised_kgf"] for r in rows}
+    text = f"""The grasping force the reduced model gives for the three (P, θ) states of
+Table II, m = 2 kg, with the paper's 180 mm weight vector w = {tuple(w_paper.tolist())} exactly as
+printed (Σw = {w_paper.sum():.2f}, violating eq. (23)) and normalised to Σw = 1
+([table2_reduced.csv](table2_reduced.csv)).
+
+{md_table(rows)}
+
+The paper's flexibility claim is that the push under angle control (c) leaves a lower
+force than the push under pressure control (b). With these (P, θ) the model gives
+F_v(c) = {rows[2]['F_v_kgf']:.3f} and F_v(b) = {rows[1]['F_v_kgf']:.3f} kgf (w as printed):
+the ordering {"holds" if rows[2]['F_v_kgf'] < rows[1]['F_v_kgf'] else "does not hold"}.
+A negative F_v means eq. (25) finds the finger pulled toward the object rather than
+pressing on it at that (P, θ).
+"""
+    return text, numbers
+
+
+# ---------------------------------------------------------------------- Fig. 8, reduced
+def fig8_reduced(ctx: Context, outdir: Path):
+    """F_v(θ) by eq. (25), (29) at the paper's pressures for 2 kg/180 mm and 6 kg/240 mm."""
+    from reduced.grasp import KGF, PAPER_WEIGHTS, WeightSumWarning, angle_at, grasp_forces
+
+    d = ctx.design
+    theta_deg = np.arange(0.0, 90.0 + 1e-9, 1.0)
+    fig, axes = figure(2)
+    rows, numbers = [], {}
+    for ax, (mass, D, pressures) in zip(axes, FIG8_CASES):
+        w = np.asarray(PAPER_WEIGHTS[D])
+        for P in pressures:
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore", WeightSumWarning)
+                F_v = grasp_forces(P, np.radians(theta_deg), mass, w, d).F_v / KGF
+                theta_free = float(np.degrees(angle_at(P, mass, w, d)))
+            ax.plot(theta_deg, F_v, label=f"{P} MPa")
+            rows += [{"diameter_mm": D, "mass_kg": mass, "P_MPa": P, "theta_deg": t, "F_v_kgf": f}
+                     for t, f in zip(theta_deg, F_v)]
+            numbers[f"theta_F0_{D:.0f}mm_{P}MPa_deg"] = theta_free
+        ax.axhline(0.0, color="k", lw=0.6)
+        ax.set(xlabel="bend angle θ [deg]", ylabel="F_v [kgf]",
+               title=f"{mass:g} kg, {D:g} mm, paper's w")
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=8)
+    save_figure(fig, outdir / "fig8_reduced.png")
+    write_csv(outdir / "fig8_reduced.csv", rows)
+    free = [{"diameter_mm": D, "mass_kg": m, "P_MPa": P,
+             "theta_at_F_v_0_deg": numbers[f"theta_F0_{D:.0f}mm_{P}MPa_deg"]}
+            for m, D, ps in FIG8_CASES for P in ps]
+    text = f"""Eq. (25) solved for F_x, with F_y = mg/n (24) and F_v by (29), against θ at the
+paper's grasp pressures, with the paper's w vectors as printed
+([fig8_reduced.csv](fig8_reduced.csv)). The paper compares such lines with measured
+points (errors {PAPER_FIG8_ERROR_KGF[180.0]} and {PAPER_FIG8_ERROR_KGF[240.0]} kgf); the
+measurements are not public, so only the model side is reproduced here. The angle at
+which F_v falls to 0 (the finger just stops pressing) at each pressure:
+
+![Fig. 8 analogue](fig8_reduced.png)
+
+{md_table(free)}
+"""
+    return text, numbers
+
+
+SECTIONS: list[Section] = [
+    Section("fig7_reduced", "Fig. 7: pressure and bend angle, reduced model",
+            ("reduced.hand:pressure",), fig7_reduced),
+    Section("table2_reduced", "Table II: grasping force, reduced model",
+            ("reduced.grasp:grasp_forces", "reduced.control:PAPER_TABLE_II"), table2_reduced),
+    Section("fig8_reduced", "Fig. 8 analogue: grasping force against bend angle",
+            ("reduced.grasp:angle_at",), fig8_reduced),
+]

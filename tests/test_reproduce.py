@@ -1,0 +1,70 @@
+"""``softhand reproduce``: every section present, guarded, resumable; the report is complete."""
+import csv
+import json
+import re
+
+import numpy as np
+
+from studies.cli import main
+from studies.reproduce import Section, exit_code, reproduce, sections
+
+#: the cheap sections (reduced model only): the "tiny" run of the tests
+REDUCED = ("fig7_reduced", "table2_reduced", "fig8_reduced")
+
+
+def test_tiny_run_writes_a_report_with_every_section(tmp_path):
+    out = tmp_path / "rep"
+    outcomes = reproduce(out, quick=True, only=REDUCED, progress=False)
+    status = {o.section.key: o.status for o in outcomes}
+    assert [o.section.key for o in outcomes] == [s.key for s in sections()]
+    assert all(status[k] == "done" for k in REDUCED), status
+    assert set(status.values()) <= {"done", "not available", "not selected"}
+    report = (out / "report.md").read_text()
+    for s in sections():  # every section has its heading and its status in the report
+        assert f"## {s.title}" in report
+    for key in REDUCED:
+        assert (out / key / "result.json").is_file() and f"]({key}/" in report
+    assert exit_code(outcomes) == 0
+
+    # the headline number is the one in the section's own data, computed in this run
+    rows = list(csv.DictReader(open(out / "fig7_reduced" / "fig7_reduced.csv")))
+    offset = [float(r["P_no_reservoir_MPa"]) - float(r["P_MPa"]) for r in rows]
+    summary = {r["name"]: r["value"] for r in csv.DictReader(open(out / "summary.csv"))}
+    assert np.isclose(float(summary["offset_max_MPa"]), max(offset), rtol=1e-12)  # CSV rounding
+
+    # a second run reuses what is finished, with the same numbers
+    again = reproduce(out, quick=True, only=REDUCED, progress=False)
+    assert all(o.status == "reused" for o in again if o.section.key in REDUCED)
+    assert [o.numbers for o in again] == [o.numbers for o in outcomes]
+
+
+def _ok(ctx, outdir):
+    (outdir / "data.csv").write_text("x\n1\n")
+    return "see [data](data.csv)", {"x": 1.0}
+
+
+def _boom(ctx, outdir):
+    raise RuntimeError("solver exploded")
+
+
+def test_missing_and_failing_sections_are_reported_and_the_others_go_on(tmp_path):
+    fake = [Section("missing", "Missing", ("no_such_module_softhand",), _ok),
+            Section("attr", "Missing attribute", ("reduced.hand:no_such_function",), _ok),
+            Section("boom", "Boom", (), _boom),
+            Section("fine", "Fine", ("reduced.hand",), _ok)]
+    outcomes = reproduce(tmp_path, section_list=fake, progress=False)
+    assert [o.status for o in outcomes] == ["not available", "not available", "failed", "done"]
+    assert exit_code(outcomes) == 1
+    failed = json.loads((tmp_path / "boom" / "failed.json").read_text())
+    assert "solver exploded" in failed["error"]
+    report = (tmp_path / "report.md").read_text()
+    assert "no_such_module_softhand" in report and "solver exploded" in report
+    assert "see [data](fine/data.csv)" in report and (tmp_path / "fine" / "data.csv").is_file()
+
+
+def test_cli(tmp_path, capsys):
+    out = str(tmp_path / "r")
+    assert main(["reproduce", "--out", out, "--only", "table2_reduced", "--no-progress"]) == 0
+    assert re.search(r"table2_reduced +done", capsys.readouterr().out)
+    assert main(["reproduce", "--out", out, "--only", "fig99"]) == 2
+    assert capsys.readouterr().err.count("\n") == 1
