@@ -188,6 +188,86 @@ which F_v falls to 0 (the finger just stops pressing) at each pressure:
     return text, numbers
 
 
+# ---------------------------------------------------------------------- Table II and Fig. 10, controller
+PUSH_N, PUSH_AT_S, T_END_S = 10.0, 5.0, 10.0  #: the simulated push (the paper gives no magnitude)
+
+
+def _flexibility(ctx: Context):
+    """Angle control to 50 deg holding 2 kg, a push at 5 s; then pressure control (Table II)."""
+    from reduced.control import flexibility
+    from reduced.grasp import PAPER_WEIGHTS
+
+    push = lambda t: np.where(t >= PUSH_AT_S, PUSH_N, 0.0)  # noqa: E731
+    return flexibility(ctx.design, math.radians(50.0), 2.0, PAPER_WEIGHTS[180.0], push,
+                       t_end=T_END_S)
+
+
+def table2_control(ctx: Context, outdir: Path):
+    """Table II by simulation: the three states of the flexibility experiment."""
+    result = _flexibility(ctx)
+    columns = ["state", "P_MPa", "theta_deg", "F_v_estimated_kgf", "F_v_actual_mean_N",
+               "paper_P_MPa", "paper_theta_deg", "paper_F_v_kgf"]
+    write_csv(outdir / "table2_control.csv", result.rows)
+    F = {r["state"]: r["F_v_estimated_kgf"] for r in result.rows}
+    numbers = {f"F_v_{k}_kgf": v for k, v in F.items()}
+    numbers["P_a_MPa"] = result.rows[0]["P_MPa"]
+    verdict = "holds" if F["c_push_angle_control"] < F["b_push_pressure_control"] else "does not hold"
+    text = f"""The simulated hand (reduced-model statics, pump and finger lags; the paper's
+design and 180 mm w) holds a 2 kg object under angle control at θ_ref = 50° (eqs. (30),
+(31)); a {PUSH_N:g} N horizontal push starts at {PUSH_AT_S:g} s. Pressure control then holds
+the pressure angle control had before the push. Each state's F_v is estimated as the
+paper does, by eq. (25) from the window-mean P and θ; the plant's actual mean pad force is
+next to it ([table2_control.csv](table2_control.csv)).
+
+{md_table(result.rows, columns)}
+
+The paper's flexibility result — the push under angle control (c) leaves a lower force
+than under pressure control (b) — {verdict} in this simulation:
+F_v(c) = {F['c_push_angle_control']:.3f} kgf, F_v(b) = {F['b_push_pressure_control']:.3f} kgf
+(paper: 0.53 and 0.82 kgf).
+"""
+    return text, numbers
+
+
+def fig10_control(ctx: Context, outdir: Path):
+    """Fig. 10 analogue: finger angles and pressure against time, angle vs pressure control."""
+    result = _flexibility(ctx)
+    sim, sp = result.angle, result.pressure
+    fig, (ax1, ax2) = figure(2)
+    ax1.plot(sim.t, np.degrees(sim.theta), lw=0.8)
+    ax1.plot(sim.t, np.degrees(sim.theta_mean), "k", lw=1.5, label="mean, angle control")
+    ax1.plot(sp.t, np.degrees(sp.theta_mean), "k:", lw=1.5, label="mean, pressure control")
+    ax1.set(xlabel="t [s]", ylabel="bend angle θ [deg]", title="Fig. 10 (c) analogue")
+    ax2.plot(sim.t, sim.P, label="angle control")
+    ax2.plot(sp.t, sp.P, ":", label="pressure control")
+    ax2.set(xlabel="t [s]", ylabel="pump pressure P [MPa]", title="Fig. 10 (d) analogue")
+    for ax in (ax1, ax2):
+        ax.axvline(PUSH_AT_S, color="grey", lw=0.6)
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=8)
+    save_figure(fig, outdir / "fig10_control.png")
+    every = max(1, int(round(0.01 / (sim.t[1] - sim.t[0]))))  # the CSV at 100 Hz
+    write_csv(outdir / "fig10_control.csv", [
+        {"t_s": t, "P_MPa": P, "theta_mean_deg": m, **{f"theta_{j + 1}_deg": a for j, a in enumerate(th)}}
+        for t, P, m, th in zip(sim.t[::every], sim.P[::every], np.degrees(sim.theta_mean[::every]),
+                               np.degrees(sim.theta[::every]))])
+    s = result.angle_summary
+    numbers = {"settling_time_s": s.settling_time, "theta_error_deg": math.degrees(s.theta_error),
+               "P_before_MPa": s.P_before, "P_during_MPa": s.P_during,
+               "theta_before_deg": math.degrees(s.theta_before),
+               "theta_during_deg": math.degrees(s.theta_during)}
+    text = f"""Angle control to θ_ref = 50° with a 2 kg object; a {PUSH_N:g} N push from
+{PUSH_AT_S:g} s ([fig10_control.csv](fig10_control.csv), angle control, 100 Hz).
+Settling time {s.settling_time:.2f} s (±1°), steady error {math.degrees(s.theta_error):.3f}°;
+pressure {s.P_before:.3f} MPa before and {s.P_during:.3f} MPa during the push; mean angle
+{math.degrees(s.theta_before):.2f}° before and {math.degrees(s.theta_during):.2f}° during it.
+In the paper the pressure drops under the push (0.89 → 0.79 MPa).
+
+![Fig. 10 analogue](fig10_control.png)
+"""
+    return text, numbers
+
+
 SECTIONS: list[Section] = [
     Section("fig7_reduced", "Fig. 7: pressure and bend angle, reduced model",
             ("reduced.hand:pressure",), fig7_reduced),
@@ -195,4 +275,8 @@ SECTIONS: list[Section] = [
             ("reduced.grasp:grasp_forces", "reduced.control:PAPER_TABLE_II"), table2_reduced),
     Section("fig8_reduced", "Fig. 8 analogue: grasping force against bend angle",
             ("reduced.grasp:angle_at",), fig8_reduced),
+    Section("table2_control", "Table II: angle control vs pressure control, simulated",
+            ("reduced.control:flexibility",), table2_control),
+    Section("fig10_control", "Fig. 10 analogue: angle control under a push",
+            ("reduced.control:flexibility",), fig10_control),
 ]

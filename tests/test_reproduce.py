@@ -9,7 +9,7 @@ from studies.cli import main
 from studies.reproduce import Section, exit_code, reproduce, sections
 
 #: the cheap sections (reduced model only): the "tiny" run of the tests
-REDUCED = ("fig7_reduced", "table2_reduced", "fig8_reduced")
+REDUCED = ("fig7_reduced", "table2_reduced", "fig8_reduced", "table2_control", "fig10_control")
 
 
 def test_tiny_run_writes_a_report_with_every_section(tmp_path):
