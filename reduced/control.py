@@ -161,8 +161,11 @@ def _integrate(controller, tables: HandTables, plant: PlantParams, theta, F_x, F
     V = float(tables.volume(theta.sum()))
     Pm, P_cmd, limit = 0.0, 0.0, 0
     rec_theta, rec = np.empty((N, d.n)), np.empty((N, 4))
+    lo, hi = tables.theta[0], tables.theta[-1]
     for k in range(N):
         if k % every == 0:
+            if theta.min() < lo or theta.max() > hi:
+                tables.check(theta)
             noise_t = rng.normal(0.0, plant.noise_theta, d.n) if plant.noise_theta else 0.0
             noise_P = rng.normal(0.0, plant.noise_P) if plant.noise_P else 0.0
             P_cmd = controller(theta + noise_t, Pm + noise_P, limit)
@@ -198,6 +201,16 @@ class Summary:
     fingers_during: tuple  #: each finger's angle at the end of the push [rad]
     push_start: float  #: first time the push is non-zero [s]; nan without a push
     push_end: float  #: last time it is non-zero [s]
+
+
+def ramp(F: float, at: float, rise: float = 0.5, until: float = math.inf):
+    """A push profile [N] of t [s]: 0 before ``at``, rising linearly to F over ``rise`` s, held
+    until ``until``; rise = 0 is a step."""
+    def profile(t):
+        t = np.asarray(t, float)
+        up = np.clip((t - at) / rise, 0.0, 1.0) if rise > 0 else (t >= at).astype(float)
+        return np.where(t < until, F * up, 0.0)
+    return profile
 
 
 def push_interval(sim: Simulation) -> tuple[float, float]:

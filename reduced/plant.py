@@ -70,8 +70,8 @@ from .errors import InputError
 from .grasp import PAPER_WEIGHTS, projected_jacobian
 
 #: angles the tables cover [rad]; a loaded finger may open past 0
-TABLE_RANGE = (math.radians(-60.0), math.radians(150.0))
-TABLE_SIZE = 4201  #: 0.05 deg spacing: linear interpolation error ~ h^2/8 p'' < 1e-6 MPa
+TABLE_RANGE = (math.radians(-45.0), math.radians(150.0))
+TABLE_SIZE = 3901  #: 0.05 deg spacing: linear interpolation error ~ h^2/8 p'' < 1e-6 MPa
 
 
 @dataclass(frozen=True)
