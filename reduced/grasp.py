@@ -57,12 +57,15 @@ class GraspForces(NamedTuple):
 
 
 def weights_for_diameter(diameter_mm: float, design: HandDesign) -> np.ndarray:
-    """The weight vector w for an object of the given diameter [mm]: the paper's presets."""
+    """The weight vector w (n_s,) for an object of the given diameter [mm], as stored (unchecked).
+
+    For now the paper's presets (:data:`PAPER_WEIGHTS`); the one place to extend (FEM-derived w).
+    """
     w = PAPER_WEIGHTS.get(float(diameter_mm))
     if w is None:
         raise InputError("diameter_mm", diameter_mm, "no weight vector for this diameter; "
                          f"available: {', '.join(f'{D:g}' for D in PAPER_WEIGHTS)}")
-    return check_weights(w, design)
+    return np.array(w, dtype=float)
 
 
 def check_weights(w, design: HandDesign, normalise: bool = False) -> np.ndarray:

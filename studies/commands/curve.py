@@ -1,0 +1,98 @@
+"""``softhand curve``: pump pressure <-> bend angle of the free hand, eqs. (27) and (28).
+
+``--theta-deg RANGE`` gives, per angle, the pressure with and without the reservoir and the
+reservoir's state (V (15), h (14), lambda_r (16)); ``--pressure-mpa RANGE`` gives, per
+pressure, the bend angle with and without the reservoir. ``--plot FILE.png`` draws the
+analogue of the paper's Fig. 7. Only numpy and the reduced model are imported unless a plot
+is asked for.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from reduced import hand, reservoir
+from reduced.design import HandDesign
+from studies.args import add_design_option, add_json_option, design_from_args, parse_values, \
+    print_json, print_table
+
+HELP = "pressure <-> bend angle of the free hand, with and without reservoir (eqs. 27, 28)"
+
+
+def configure(parser) -> None:
+    what = parser.add_mutually_exclusive_group(required=True)
+    what.add_argument("--theta-deg", metavar="RANGE",
+                      help="bend angles [deg]: start:stop:step (stop included) or a,b,c")
+    what.add_argument("--pressure-mpa", metavar="RANGE",
+                      help="pump pressures [MPa]: start:stop:step (stop included) or a,b,c")
+    parser.add_argument("--plot", metavar="FILE.png", help="draw P vs bend angle (the paper's Fig. 7)")
+    add_design_option(parser)
+    add_json_option(parser)
+
+
+def rows_at_angles(theta_deg: np.ndarray, design: HandDesign) -> list[dict]:
+    """Per bend angle [deg]: P with / without reservoir [MPa], reservoir V [mm^3], h [mm], lambda_r."""
+    theta = hand.check_theta(np.radians(theta_deg))
+    P = hand.pressure(theta, design)
+    P_free = hand.pressure(theta, design, reservoir=False)
+    V = reservoir.oil_volume(theta, design)
+    h, lam = reservoir.height(V, design), reservoir.stretch(V, design)
+    return [{"theta_deg": float(t), "P_MPa": float(p), "P_no_reservoir_MPa": float(q),
+             "h_mm": float(hh), "V_mm3": float(v), "lambda_r": float(lr)}
+            for t, p, q, hh, v, lr in zip(theta_deg, P, P_free, h, V, lam)]
+
+
+def rows_at_pressures(P: np.ndarray, design: HandDesign) -> list[dict]:
+    """Per pump pressure [MPa]: the free bend angle with / without reservoir [deg]."""
+    theta = np.degrees(hand.bend_angle(P, design))
+    theta_free = np.degrees(hand.bend_angle(P, design, reservoir=False))
+    return [{"P_MPa": float(p), "theta_deg": float(t), "theta_no_reservoir_deg": float(u)}
+            for p, t, u in zip(P, theta, theta_free)]
+
+
+def run(args) -> int:
+    design = design_from_args(args)
+    if args.theta_deg is not None:
+        theta_deg = parse_values(args.theta_deg, "--theta-deg")
+        rows = rows_at_angles(theta_deg, design)
+    else:
+        rows = rows_at_pressures(parse_values(args.pressure_mpa, "--pressure-mpa"), design)
+    if args.plot:
+        plot_curve(args.plot, design, rows, by_pressure=args.theta_deg is None)
+    if args.json:
+        print_json({"rows": rows, "design": design.to_dict()})
+    else:
+        print_table(rows)
+    return 0
+
+
+def plot_curve(path, design: HandDesign, rows: list[dict], *, by_pressure: bool = False):
+    """Bend angle vs pump pressure with and without the reservoir (Fig. 7) over the span of
+    ``rows`` (their pressures if ``by_pressure``, else their angles) -> PNG at ``path``."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from studies.output import save_figure
+
+    key = "P_MPa" if by_pressure else "theta_deg"
+    lo, hi = min(r[key] for r in rows), max(r[key] for r in rows)
+    span = np.linspace(lo, hi, 200) if hi > lo else np.array([lo])
+    if by_pressure:
+        P = P_free = span
+        theta, theta_free = (np.degrees(hand.bend_angle(span, design, reservoir=res))
+                             for res in (True, False))
+    else:
+        theta = theta_free = span
+        P, P_free = (hand.pressure(np.radians(span), design, reservoir=res) for res in (True, False))
+    fig, ax = plt.subplots(figsize=(5.5, 4.0))
+    ax.plot(P, theta, "-", label="with reservoir (27)")
+    ax.plot(P_free, theta_free, ":", label="without reservoir (28)")
+    ax.plot([r["P_MPa"] for r in rows], [r["theta_deg"] for r in rows], "o", ms=4,
+            label="rows printed (with reservoir)")
+    ax.set_xlabel("pump pressure P [MPa]")
+    ax.set_ylabel("bend angle theta [deg]")
+    ax.axvline(0.0, color="0.7", lw=0.8)
+    ax.grid(alpha=0.3)
+    ax.legend()
+    ax.set_title("Free bending, reduced model (paper Fig. 7)")
+    save_figure(fig, path)

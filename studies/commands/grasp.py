@@ -1,0 +1,85 @@
+"""``softhand grasp``: tip forces of a finger holding an object, eqs. (24), (25), (29).
+
+Given the pump pressure, the bend angle, the object's mass and a weight vector w (given, or
+the paper's preset for an object diameter), prints F_x (25), F_y (24) and the normal force
+F_v (29) in N and kgf. Axes and signs: docs/conventions.md (F_v > 0: the finger squeezes).
+"""
+from __future__ import annotations
+
+import math
+import sys
+import warnings
+
+import numpy as np
+
+from reduced import grasp, hand
+from reduced.errors import InputError
+from studies.args import add_design_option, add_json_option, design_from_args, parse_values, \
+    print_json
+
+HELP = "grasping forces F_x, F_y, F_v at a pressure, bend angle and mass (eqs. 24, 25, 29)"
+
+
+def configure(parser) -> None:
+    parser.add_argument("--pressure-mpa", required=True, metavar="P", help="pump pressure [MPa]")
+    parser.add_argument("--theta-deg", required=True, metavar="T", help="bend angle [deg]")
+    parser.add_argument("--mass-kg", required=True, metavar="M", help="mass of the object [kg]")
+    which = parser.add_mutually_exclusive_group(required=True)
+    which.add_argument("--weights", metavar="W1,..",
+                       help="weight vector w, n_s comma-separated numbers "
+                            "(write --weights=-0.13,0,... when the first is negative)")
+    which.add_argument("--diameter-mm", metavar="D",
+                       help=f"object diameter [mm]; presets: {', '.join(f'{D:g}' for D in grasp.PAPER_WEIGHTS)}")
+    parser.add_argument("--normalise", action="store_true", help="scale w to sum to 1 (eq. (23))")
+    add_design_option(parser)
+    add_json_option(parser)
+
+
+def _scalar(text: str, field: str) -> float:
+    values = parse_values(text, field)
+    if values.size != 1:
+        raise InputError(field, text, "must be one number")
+    return float(values[0])
+
+
+def _weights(args, design) -> tuple[np.ndarray, list[str]]:
+    """The w asked for (checked, maybe normalised) and the warnings about it."""
+    if args.weights is not None:
+        w = parse_values(args.weights, "--weights")
+    else:
+        w = grasp.weights_for_diameter(_scalar(args.diameter_mm, "--diameter-mm"), design)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", grasp.WeightSumWarning)
+        w = grasp.check_weights(w, design, normalise=args.normalise)
+    return w, [str(warning.message) for warning in caught]
+
+
+def evaluate(P: float, theta_deg: float, mass: float, w, design) -> dict:
+    """One grasp state -> the flat result (forces in N and kgf, the w used, the free pressure)."""
+    theta = math.radians(theta_deg)
+    F = grasp.grasp_forces(P, theta, mass, w, design)
+    return {"P_MPa": P, "theta_deg": theta_deg, "mass_kg": mass,
+            "F_x_N": float(F.F_x), "F_y_N": float(F.F_y), "F_v_N": float(F.F_v),
+            "F_v_kgf": float(F.F_v) / grasp.KGF,
+            "w": [float(x) for x in w], "w_sum": float(np.sum(w)),
+            "P_free_MPa": float(hand.pressure(theta, design))}
+
+
+def run(args) -> int:
+    design = design_from_args(args)
+    P = _scalar(args.pressure_mpa, "--pressure-mpa")
+    theta_deg = _scalar(args.theta_deg, "--theta-deg")
+    mass = _scalar(args.mass_kg, "--mass-kg")
+    w, notes = _weights(args, design)
+    result = evaluate(P, theta_deg, mass, w, design)
+    for note in notes:  # only once the inputs are known to be good
+        print(f"softhand grasp: warning: {note}", file=sys.stderr)
+    if args.json:
+        print_json(result)
+    else:
+        width = max(map(len, result))
+        for key, value in result.items():
+            text = "[" + ", ".join(f"{v:g}" for v in value) + "]" if isinstance(value, list) \
+                else f"{value:.4g}"
+            print(f"{key:<{width}}  {text}")
+    return 0

@@ -1,0 +1,99 @@
+"""softhand curve / grasp: columns, JSON shapes, the plot, bad input -> one line, exit 2."""
+import json
+import math
+
+import numpy as np
+import pytest
+
+from reduced import grasp, hand
+from reduced.design import HandDesign
+from studies.cli import main
+
+D = HandDesign()
+
+
+def run_json(capsys, *argv):
+    assert main([*argv, "--json"]) == 0
+    return json.loads(capsys.readouterr().out)
+
+
+def test_curve_by_angle(capsys):
+    out = run_json(capsys, "curve", "--theta-deg", "0:90:10")
+    rows = out["rows"]
+    assert [r["theta_deg"] for r in rows] == pytest.approx(np.arange(0, 91, 10))  # stop included
+    assert set(rows[0]) == {"theta_deg", "P_MPa", "P_no_reservoir_MPa", "h_mm", "V_mm3", "lambda_r"}
+    assert rows[0]["P_no_reservoir_MPa"] == 0.0 and rows[0]["P_MPa"] < 0
+    assert rows[0]["V_mm3"] == D.V0
+    assert rows[5]["P_MPa"] == pytest.approx(float(hand.pressure(math.radians(50), D)), rel=1e-12)
+    assert out["design"]["V0_mm3"] == D.V0
+
+
+def test_curve_by_pressure_and_table(capsys):
+    rows = run_json(capsys, "curve", "--pressure-mpa", "0,0.4,0.8")["rows"]
+    assert set(rows[0]) == {"P_MPa", "theta_deg", "theta_no_reservoir_deg"}
+    for r in rows:  # the angles reproduce the pressures
+        assert hand.pressure(math.radians(r["theta_deg"]), D) == pytest.approx(r["P_MPa"], abs=1e-12)
+        assert r["theta_deg"] > r["theta_no_reservoir_deg"]  # the reservoir helps
+    assert main(["curve", "--theta-deg", "0:90:15"]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    assert lines[0].split()[:3] == ["theta_deg", "P_MPa", "P_no_reservoir_MPa"] and len(lines) == 8
+
+
+def test_curve_plot(tmp_path, capsys):
+    path = tmp_path / "fig7.png"
+    assert main(["curve", "--pressure-mpa", "0:0.8:0.1", "--plot", str(path)]) == 0
+    assert path.read_bytes()[:4] == b"\x89PNG"
+
+
+def test_grasp_json(capsys):
+    out = run_json(capsys, "grasp", "--pressure-mpa", "0.89", "--theta-deg", "50", "--mass-kg", "2",
+                   "--diameter-mm", "180", "--normalise")
+    w = np.array(grasp.PAPER_WEIGHTS[180.0]) / 1.4
+    F = grasp.grasp_forces(0.89, math.radians(50), 2.0, w, D)
+    assert out["F_v_N"] == pytest.approx(float(F.F_v), rel=1e-12)
+    assert out["F_v_kgf"] == pytest.approx(out["F_v_N"] / 9.80665)
+    assert out["F_y_N"] == pytest.approx(2 * D.g / 4)
+    assert out["w"] == pytest.approx(w) and out["w_sum"] == pytest.approx(1.0)
+
+
+def test_grasp_warns_on_weight_sum(capsys):
+    assert main(["grasp", "--pressure-mpa", "1", "--theta-deg", "40", "--mass-kg", "1",
+                 "--weights=-0.13,0,0.67,0.33,0.53"]) == 0
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "sum to 1.4" in err
+
+
+@pytest.mark.parametrize("argv, field", [
+    (["curve", "--theta-deg", "0:-10:5"], "--theta-deg"),
+    (["curve", "--theta-deg", "0:400:100"], "theta_deg"),
+    (["curve", "--pressure-mpa", "0,9"], "pressure_MPa"),
+    (["curve", "--theta-deg", "a,b"], "--theta-deg"),
+    (["grasp", "--pressure-mpa", "0.9", "--theta-deg", "50", "--mass-kg", "-2",
+      "--diameter-mm", "180"], "mass_kg"),
+    (["grasp", "--pressure-mpa", "0.9", "--theta-deg", "50", "--mass-kg", "2",
+      "--diameter-mm", "200"], "diameter_mm"),
+    (["grasp", "--pressure-mpa", "0.9", "--theta-deg", "50", "--mass-kg", "2",
+      "--weights", "0.5,0.5"], "weights"),
+    (["grasp", "--pressure-mpa", "0.9,1", "--theta-deg", "50", "--mass-kg", "2",
+      "--diameter-mm", "180"], "--pressure-mpa"),
+])
+def test_bad_input_is_one_line_exit_2(argv, field, capsys):
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and field in err
+
+
+def test_small_reservoir_design_is_bad_input(tmp_path, capsys):
+    design = tmp_path / "small.toml"
+    design.write_text("V0_mm3 = 3000.0\n")
+    assert main(["curve", "--theta-deg", "0:90:10", "--design", str(design)]) == 2
+    assert "V0_mm3" in capsys.readouterr().err
+
+
+def test_usage_errors_exit_2(capsys):
+    with pytest.raises(SystemExit) as exc:
+        main(["curve", "--theta-deg", "0:90:10", "--pressure-mpa", "0.1"])
+    assert exc.value.code == 2
+    with pytest.raises(SystemExit) as exc:
+        main(["grasp", "--pressure-mpa", "0.9", "--theta-deg", "50", "--mass-kg", "2"])
+    assert exc.value.code == 2
