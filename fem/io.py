@@ -1,0 +1,189 @@
+r"""VTK output of a solid's state: ``.vtu`` per state, ``.pvd`` over load steps.
+
+Fields written (3D displacement bases ``ElementVector`` of P1/P2 tetrahedra):
+
+* point data: ``displacement`` [mm], ``principal_stretches`` (λ1 ≥ λ2 ≥ λ3, the square
+  roots of the eigenvalues of :math:`C = F^T F`), ``cauchy_stress`` [MPa] (the 9 components,
+  row-major), ``von_mises`` [MPa] (:math:`\sqrt{3/2\, s:s}`, s = dev σ), ``J`` and, when the
+  law has a fiber family, ``fiber_stretch`` :math:`|F a_0|`;
+* cell data: the same stress-like quantities averaged over each element's quadrature points.
+
+Quadratic meshes are written as **quadratic cells** (``tetra10``), so ParaView and pyvista
+draw the curved P2 geometry; the points are the P2 nodes (vertices and edge midpoints).
+Gradients are discontinuous between elements: a point value is the average over the
+elements sharing the node of the element's value at that node. Cauchy stress is
+:math:`σ = P F^T / J`; with ``J_bar`` (per element, the mean dilatation of a
+mean-dilatation solid) its volumetric part is :math:`U'(\bar J)\,I`, as in that formulation.
+
+All files are written atomically (temporary name + rename).
+"""
+from __future__ import annotations
+
+from pathlib import Path
+from xml.sax.saxutils import quoteattr
+
+import numpy as np
+from skfem import Basis
+
+from fem import kinematics as kin
+from meshes.atomic import atomic_path
+from meshes.convert import write_vtu
+
+#: scikit-fem scalar element -> VTK cell type (scikit-fem's local node order is VTK's)
+CELL_TYPES = {
+    "ElementTetP2": "tetra10", "ElementTetP1": "tetra",
+    "ElementTriP2": "triangle6", "ElementTriP1": "triangle",
+    "ElementQuad2": "quad9", "ElementQuad1": "quad",
+}
+
+
+def state_fields(basis: Basis, u: np.ndarray, law=None, *, J_bar=None) -> tuple[dict, dict]:
+    """(point_data, cell_data) of displacement ``u`` on the vector ``basis`` (see module doc)."""
+    scalar = basis.split(u)[0][1]
+    point_data = {"displacement": _nodal_vector(basis, u)}
+    if law is None:
+        return point_data, {}
+    at_nodes = Basis(basis.mesh, basis.elem,
+                     quadrature=(scalar.elem.doflocs.T, np.ones(scalar.elem.doflocs.shape[0])))
+    node_values = _measures(at_nodes, u, _per_element(law, basis.mesh.nelements), J_bar)
+    qp_values = _measures(basis, u, _per_element(law, basis.mesh.nelements), J_bar)
+    dofs = scalar.element_dofs
+    for name, value in node_values.items():
+        point_data[name] = _average_to_nodes(value, dofs, scalar.N)
+    cell_data = {name: _average_cells(value, basis.dx) for name, value in qp_values.items()}
+    return point_data, cell_data
+
+
+def write_state(path: str | Path, basis: Basis, u: np.ndarray, law=None, *, J_bar=None,
+                point_data: dict | None = None, cell_data: dict | None = None) -> Path:
+    """Write one ``.vtu``: the state's fields plus any extra point data (per P2 node or per
+    vertex; vertex data are extended to edge midpoints by averaging) and cell data."""
+    scalar = basis.split(u)[0][1]
+    points, cells = _geometry(scalar)
+    fields_p, fields_c = state_fields(basis, u, law, J_bar=J_bar)
+    for name, value in (point_data or {}).items():
+        fields_p[name] = _extend_to_nodes(np.asarray(value), scalar)
+    fields_c.update({k: np.asarray(v) for k, v in (cell_data or {}).items()})
+    return write_vtu(path, points, cells, point_data=fields_p, cell_data=fields_c)
+
+
+class VtkSeries:
+    """A ``.pvd`` collection over load steps; each :meth:`write` adds a ``.vtu`` and rewrites
+    the ``.pvd`` (atomically), so after an interruption every listed state is complete."""
+
+    def __init__(self, pvd_path: str | Path):
+        self.path = Path(pvd_path)
+        self.entries: list[tuple[float, str]] = []
+
+    def write(self, time: float, basis: Basis, u: np.ndarray, law=None, **extra) -> Path:
+        """Write the state at load parameter ``time`` (e.g. pressure in MPa); see :func:`write_state`."""
+        vtu = self.path.with_name(f"{self.path.stem}_{len(self.entries):04d}.vtu")
+        write_state(vtu, basis, u, law, **extra)
+        self.entries.append((float(time), vtu.name))
+        write_pvd(self.path, self.entries)
+        return vtu
+
+
+def write_pvd(path: str | Path, entries: list[tuple[float, str]]) -> Path:
+    """A ParaView collection file listing (time, file name relative to the .pvd)."""
+    rows = "".join(f'    <DataSet timestep="{t!r}" part="0" file={quoteattr(name)}/>\n'
+                   for t, name in entries)
+    text = ('<?xml version="1.0"?>\n<VTKFile type="Collection" version="0.1">\n'
+            f"  <Collection>\n{rows}  </Collection>\n</VTKFile>\n")
+    with atomic_path(path) as tmp:
+        tmp.write_text(text)
+    return Path(path)
+
+
+def _measures(basis: Basis, u, law, J_bar) -> dict:
+    """Stretch and stress measures at the basis' points, each shape (nel, npts[, ncomp])."""
+    F = kin.deformation_gradient(basis.interpolate(u).grad)
+    J = kin.det(F)
+    sigma = _cauchy(F, J, law, J_bar)
+    s = sigma - np.trace(sigma) / 3.0 * kin.identity(J.shape)
+    C = kin.right_cauchy_green(F)
+    eig = np.linalg.eigvalsh(np.moveaxis(C, (0, 1), (-2, -1)))
+    out = {
+        "principal_stretches": np.sqrt(np.clip(eig, 0.0, None))[..., ::-1],
+        "cauchy_stress": np.moveaxis(sigma, (0, 1), (-2, -1)).reshape(J.shape + (9,)),
+        "von_mises": np.sqrt(1.5 * np.einsum("ab...,ab...->...", s, s)),
+        "J": J,
+    }
+    fibers = [p for p in getattr(law, "parts", (law,)) if hasattr(p, "stretch")]
+    if fibers:
+        out["fiber_stretch"] = fibers[0].stretch(F)
+    return out
+
+
+def _cauchy(F, J, law, J_bar):
+    if J_bar is None:
+        return np.einsum("aK...,bK...->ab...", law.stress(F), F) / J
+    dev, vol = law.split()
+    sigma = np.einsum("aK...,bK...->ab...", dev.stress(F), F) / J
+    p = vol.dU(np.asarray(J_bar, dtype=float))[:, None] * np.ones_like(J)
+    return sigma + p * kin.identity(J.shape)
+
+
+def _per_element(law, nel: int):
+    """The law with per-quadrature-point fiber directions averaged per element (3, nel),
+    so it can be evaluated at any points of the elements (nodes for the point data)."""
+    parts = getattr(law, "parts", None)
+    if parts is not None:
+        return type(law)(tuple(_per_element(p, nel) for p in parts))
+    a0 = getattr(law, "a0", None)
+    if a0 is not None and a0.ndim == 3:
+        return type(law)(law.k, a0.mean(axis=2))
+    return law
+
+
+def _average_to_nodes(value: np.ndarray, dofs: np.ndarray, n: int) -> np.ndarray:
+    """Average element-node values (nel, nloc[, ncomp]) over the elements sharing a node."""
+    count = np.bincount(dofs.T.ravel(), minlength=n)
+    flat = value.reshape(dofs.T.size, -1)
+    summed = np.stack([np.bincount(dofs.T.ravel(), weights=flat[:, c], minlength=n)
+                       for c in range(flat.shape[1])], axis=1)
+    out = summed / np.maximum(count, 1)[:, None]
+    return out[:, 0] if value.ndim == 2 else out
+
+
+def _average_cells(value: np.ndarray, dx: np.ndarray) -> np.ndarray:
+    """Volume-weighted mean over each element's quadrature points."""
+    weights = dx / dx.sum(axis=1, keepdims=True)
+    return np.einsum("eq,eq...->e...", weights, value)
+
+
+def _nodal_vector(basis: Basis, u: np.ndarray) -> np.ndarray:
+    """A vector field's nodal values as (n_nodes, dim)."""
+    return np.stack([part for part, _ in basis.split(u)], axis=1)
+
+
+def _geometry(scalar: Basis) -> tuple[np.ndarray, dict]:
+    points = scalar.doflocs.T
+    if points.shape[1] == 2:
+        points = np.hstack([points, np.zeros((points.shape[0], 1))])
+    cell_type = CELL_TYPES[type(scalar.elem).__name__]
+    return points, {cell_type: scalar.element_dofs.T}
+
+
+def _extend_to_nodes(value: np.ndarray, scalar: Basis) -> np.ndarray:
+    """Point data given per vertex -> per node (edge midpoints get their end points' mean)."""
+    if value.shape[0] == scalar.N:
+        return value
+    mesh = scalar.mesh
+    if value.shape[0] != mesh.nvertices or scalar.N != mesh.nvertices + mesh.nedges:
+        raise ValueError(f"point data of length {value.shape[0]}: need {scalar.N} nodes "
+                         f"or {mesh.nvertices} vertices")
+    return np.concatenate([value, 0.5 * (value[mesh.edges[0]] + value[mesh.edges[1]])])
+
+
+def solid_output(solid, u: np.ndarray) -> dict:
+    """Keyword arguments of :func:`write_state` / :meth:`VtkSeries.write` for a
+    :class:`fem.solid.Solid` (its vector basis, law and, if mean-dilatation, J_bar)."""
+    from skfem import ElementVector
+
+    basis = Basis(solid.mesh, ElementVector(solid.element), intorder=2)
+    J_bar = None
+    if getattr(solid, "formulation", None) == "mean_dilatation":
+        J = kin.det(solid.F(u))
+        J_bar = (solid.W * J).sum(axis=1) / solid.W.sum(axis=1)
+    return {"basis": basis, "u": u, "law": solid.law, "J_bar": J_bar}

@@ -1,0 +1,65 @@
+"""softhand inspect: a picture that is not blank, the field's range and peak, bad input."""
+import numpy as np
+import pytest
+import skfem
+from matplotlib.image import imread
+
+from fem.io import VtkSeries
+from fem.materials import NeoHookean
+from studies.cli import main
+from studies.inspect import inspect
+
+
+@pytest.fixture(scope="module")
+def series(tmp_path_factory):
+    """A bar twisted by an increasing angle: von Mises grows away from the axis."""
+    mesh = skfem.MeshTet2.from_mesh(skfem.MeshTet.init_tensor(
+        np.linspace(-1, 1, 4), np.linspace(-1, 1, 4), np.linspace(0, 6, 7)))
+    basis = skfem.Basis(mesh, skfem.ElementVector(skfem.ElementTetP2()))
+    path = tmp_path_factory.mktemp("vtk") / "twist.pvd"
+    out = VtkSeries(path)
+    for k, angle in enumerate((0.0, 0.05, 0.1)):
+        def twist(x, a=angle):
+            c, s = np.cos(a * x[2]), np.sin(a * x[2])
+            return np.array([c * x[0] - s * x[1] - x[0], s * x[0] + c * x[1] - x[1], 0 * x[2]])
+        out.write(k, basis, basis.project(twist), NeoHookean(1.0, kappa=100.0))
+    return path
+
+
+def test_png_is_not_blank_and_range_is_reported(series, tmp_path):
+    png = tmp_path / "pic.png"
+    summary = inspect(series, field="von_mises", out=png)
+    image = imread(png)[..., :3]
+    assert image.shape[0] > 100 and image.std() > 0.05  # a blank picture has std 0
+    assert summary.step == 2 and summary.n_steps == 3
+    # the twist's shear grows with the distance from the axis: peak on a corner edge
+    assert np.hypot(*summary.peak_at[:2]) == pytest.approx(np.sqrt(2), rel=1e-6)
+    assert summary.maximum > summary.minimum >= 0
+
+
+def test_cli_prints_range_and_writes_default_png(series, capsys):
+    assert main(["inspect", str(series), "--step", "1", "--field", "principal_stretches[0]"]) == 0
+    out = capsys.readouterr().out
+    assert "principal_stretches[0]" in out and "max" in out
+    assert (series.parent / "twist_step1_principal_stretches_0.png").is_file()
+
+
+@pytest.mark.parametrize("argv, word", [
+    (["--field", "nope"], "nope"),
+    (["--step", "3"], "--step"),
+    (["--field", "J[2]"], "J"),
+])
+def test_bad_field_or_step_is_one_line_exit_2(series, capsys, argv, word):
+    assert main(["inspect", str(series), *argv]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and word in err
+
+
+@pytest.mark.parametrize("content", ["not a mesh\n", '<?xml version="1.0"?>\n<VTKFile type="U'])
+def test_bad_file_is_one_line_exit_2(tmp_path, capsys, content):
+    bad = tmp_path / "bad.vtu"
+    bad.write_text(content)
+    for path in (bad, tmp_path / "missing.vtu", tmp_path / "x.txt"):
+        assert main(["inspect", str(path)]) == 2
+        err = capsys.readouterr().err
+        assert err.count("\n") == 1 and str(path.name) in err
