@@ -33,3 +33,39 @@ def curve(params: dict, design: HandDesign, outdir: Path) -> dict:
     P = params["pressure_mpa"]
     return {"theta_deg": math.degrees(hand.bend_angle(P, design, reservoir=True)),
             "theta_no_reservoir_deg": math.degrees(hand.bend_angle(P, design, reservoir=False))}
+
+
+def grasp(params: dict, design: HandDesign, outdir: Path) -> dict:
+    """Eqs. (24), (25), (29) at one state: F_x, F_y, F_v for (P, theta, m) and w.
+
+    ``weights`` (n_s numbers) or ``diameter_mm`` (the paper's presets, 180 or 240).
+    """
+    from reduced.grasp import KGF, check_weights, grasp_forces, weights_for_diameter
+
+    if "weights" in params:
+        w = check_weights(params["weights"], design)
+    else:
+        w = weights_for_diameter(params.get("diameter_mm", 180.0), design)
+    F = grasp_forces(params["pressure_mpa"], math.radians(params["theta_deg"]),
+                     params.get("mass_kg", 0.0), w, design)
+    return {"F_x_N": F.F_x, "F_y_N": F.F_y, "F_v_N": F.F_v, "F_v_kgf": F.F_v / KGF, "w": w}
+
+
+def control(params: dict, design: HandDesign, outdir: Path) -> dict:
+    """The flexibility experiment (Table II) at one setting: angle control, push, pressure control."""
+    import numpy as np
+
+    from reduced.control import flexibility
+    from reduced.grasp import PAPER_WEIGHTS
+
+    push_n, push_at = params.get("push_n", 10.0), params.get("push_at_s", 5.0)
+    result = flexibility(design, math.radians(params.get("theta_ref_deg", 50.0)),
+                         params.get("mass_kg", 2.0),
+                         PAPER_WEIGHTS[params.get("diameter_mm", 180.0)],
+                         lambda t: np.where(t >= push_at, push_n, 0.0),
+                         t_end=params.get("t_end_s", 10.0))
+    s = result.angle_summary
+    out = {"settling_time_s": s.settling_time, "P_before_MPa": s.P_before,
+           "P_during_MPa": s.P_during, "theta_during_deg": math.degrees(s.theta_during)}
+    out |= {f"F_v_{r['state']}_kgf": r["F_v_estimated_kgf"] for r in result.rows}
+    return out

@@ -3,8 +3,10 @@
 Resumable and safe by construction:
 
 * a case is keyed by a hash of its inputs (kind, case parameters, design hash) and the
-  code version (package version + a hash of the package sources), so a rerun finds
-  what is already done and a code change recomputes;
+  package version, so a rerun finds what is already done and a new release recomputes.
+  The hash of the package's sources is recorded in each result's provenance;
+  ``status`` counts the results that other sources computed, and ``run(fresh=True)``
+  recomputes everything (a working tree under development changes its sources often);
 * a worker computes a case in its own temporary folder and returns the numbers and the
   files; this process writes them into ``results/<study>/.tmp/<key>.*`` and renames
   that folder to ``results/<study>/<key>/`` in one step. A killed run leaves finished
@@ -100,11 +102,11 @@ def _version(name: str) -> str:
 
 
 def case_key(kind: str, params: dict, design: HandDesign) -> str:
-    """16 hex digits of the hash of (kind, params, design hash, code version)."""
+    """16 hex digits of the hash of (kind, params, design hash, package version)."""
     canon = {k: float(v) if isinstance(v, int) and not isinstance(v, bool) else v
              for k, v in params.items()}
     text = json.dumps({"kind": kind, "params": canon, "design": design.hash(),
-                       "code": code_version()}, sort_keys=True)
+                       "softhand": code_version()["softhand"]}, sort_keys=True)
     return hashlib.sha256(text.encode()).hexdigest()[:16]
 
 
@@ -225,8 +227,9 @@ def _provenance(params: dict, design: HandDesign, output: dict) -> dict:
 
 # ---------------------------------------------------------------------- the run
 def run_study(study: Study, *, results_root: str | Path = "results", workers: int | None = None,
-              scheduler: str | None = None, progress: bool = True) -> RunSummary:
-    """Run every case of ``study`` not yet done; write results and index.csv.
+              scheduler: str | None = None, progress: bool = True,
+              fresh: bool = False) -> RunSummary:
+    """Run every case of ``study`` not yet done (``fresh``: every case); write results and index.csv.
 
     ``workers``: processes (default: the CPU count); 1 runs in this process.
     ``scheduler``: a Dask scheduler address, or 'local' for a LocalCluster.
@@ -234,7 +237,7 @@ def run_study(study: Study, *, results_root: str | Path = "results", workers: in
     sdir = study_dir(study, results_root)
     shutil.rmtree(sdir / ".tmp", ignore_errors=True)  # leftovers of a killed run
     cases = plan(study)
-    todo = [c for c in cases if case_state(sdir, c) != "done"]
+    todo = [c for c in cases if fresh or case_state(sdir, c) != "done"]
     summary = RunSummary(total=len(cases), reused=len(cases) - len(todo), not_run=len(todo))
     workers = max(1, workers or os.cpu_count() or 1)
     bar = _progress_bar(study, summary, progress)
@@ -335,6 +338,13 @@ def status(study: Study, results_root: str | Path = "results") -> dict[str, list
     for case in plan(study):
         groups[case_state(sdir, case)].append(case)
     return groups
+
+
+def other_sources(study: Study, done: list[Case], results_root: str | Path = "results") -> list[Case]:
+    """The done cases whose result was computed by other package sources than these."""
+    sdir, mine = study_dir(study, results_root), code_version()["source_sha256"]
+    return [c for c in done
+            if read_case(sdir, c)["provenance"]["code"]["source_sha256"] != mine]
 
 
 def index_rows(study: Study, results_root: str | Path = "results") -> list[dict]:

@@ -55,6 +55,10 @@ class Kind:
 #: kind name -> Kind. Add a kind with one line here.
 KINDS: dict[str, Kind] = {
     "curve": Kind("studies.kinds:curve", ("theta_deg", "pressure_mpa")),
+    "grasp": Kind("studies.kinds:grasp",
+                  ("pressure_mpa", "theta_deg", "mass_kg", "diameter_mm", "weights")),
+    "control": Kind("studies.kinds:control", ("theta_ref_deg", "mass_kg", "diameter_mm",
+                                              "push_n", "push_at_s", "t_end_s")),
 }
 
 _TOP_KEYS = ("kind", "name", "description", "design", "mesh_size_mm", "sweep", "params")

@@ -17,6 +17,8 @@ def configure(parser) -> None:
                      help="worker processes (default: the CPU count; 1 runs in this process)")
     run.add_argument("--scheduler", default=None, metavar="ADDRESS|local",
                      help="run on a Dask cluster at ADDRESS ('local' starts a LocalCluster)")
+    run.add_argument("--fresh", action="store_true",
+                     help="recompute every case, also those already done")
     run.add_argument("--no-progress", action="store_true", help="no progress bar")
     status = actions.add_parser("status", help="print done / pending / failed cases")
     status.add_argument("--json", action="store_true", help="print one JSON object on stdout")
@@ -42,7 +44,7 @@ def _run(study, args) -> int:
 
         raise InputError("--workers", args.workers, "must be a whole number >= 1")
     s = run_study(study, results_root=args.results, workers=args.workers,
-                  scheduler=args.scheduler, progress=not args.no_progress)
+                  scheduler=args.scheduler, progress=not args.no_progress, fresh=args.fresh)
     print(f"study {study.name} ({study.kind}): {s.total} cases: "
           f"{s.total - len(s.failed) - s.not_run} done ({s.computed} computed, {s.reused} reused), "
           f"{len(s.failed)} failed, {s.not_run} not run")
@@ -53,7 +55,7 @@ def _run(study, args) -> int:
 
 
 def _status(study, args) -> int:
-    from studies.runner import read_case, status, study_dir
+    from studies.runner import other_sources, read_case, status, study_dir
 
     groups = status(study, args.results)
     sdir = study_dir(study, args.results)
@@ -66,6 +68,10 @@ def _status(study, args) -> int:
     total = sum(map(len, groups.values()))
     print(f"study {study.name} ({study.kind}): {total} cases: "
           + ", ".join(f"{len(groups[s])} {s}" for s in ("done", "pending", "failed")))
+    stale = other_sources(study, groups["done"], args.results)
+    if stale:
+        print(f"  note: {len(stale)} done cases were computed by other package sources "
+              f"(an edited working tree); 'study run --fresh' recomputes them all")
     for state in ("failed", "pending"):
         for case in groups[state][:_SHOWN]:
             point = " ".join(f"{k}={v}" for k, v in case.point.items())
