@@ -99,7 +99,7 @@ class AxisymSolid:
         for a in range(nb):  # 18 local basis functions, not elements
             phi = self.basis.basis[a][0]
             G[a, :2, :2] = phi.grad
-            G[a, 2, 2] = phi.value[0] / self.r0
+            G[a, 2, 2] = np.asarray(phi)[0] / self.r0
         return G
 
     def deformation_gradient(self, u):
@@ -181,7 +181,8 @@ class RevolvedVolume:
     .. math:: V = -π \int r^2\,dz
 
     along the curve traversed with the solid on its left (for a sheet's underside: from the
-    axis outwards). Exact for the Q2 geometry (4-point Gauss on a degree-5 integrand).
+    axis outwards). Exact for Q2 displacements on straight or quadratic (``MeshQuad2``)
+    facets: 4-point Gauss on a degree-5 integrand.
     ``value``, ``gradient`` and ``hessian`` are those of V(u) [mm³, mm², mm].
     """
 
@@ -189,7 +190,7 @@ class RevolvedVolume:
         basis, mesh = solid.basis, solid.mesh
         facets = np.asarray(facets)
         v0, v1 = mesh.facets[:, facets]
-        mid = mesh.p[:, mesh.t[:, mesh.f2t[0, facets]]].mean(axis=1)
+        mid = mesh.p[:, mesh.t[:4, mesh.f2t[0, facets]]].mean(axis=1)
         tang = mesh.p[:, v1] - mesh.p[:, v0]
         into_solid = mid - (mesh.p[:, v0] + mesh.p[:, v1]) / 2
         flip = (-tang[1] * into_solid[0] + tang[0] * into_solid[1]) < 0  # solid on the right
@@ -197,8 +198,7 @@ class RevolvedVolume:
         nd, fd = basis.nodal_dofs, basis.facet_dofs
         self.r_dofs = np.array([nd[0, v0], fd[0, facets], nd[0, v1]])  # (3, nf)
         self.z_dofs = np.array([nd[1, v0], fd[1, facets], nd[1, v1]])
-        X = mesh.p[:, [v0, v1]]  # (2, 2, nf): straight reference facets
-        self.X = np.stack([X[:, 0], X.mean(axis=1), X[:, 1]], axis=1)  # (2, 3, nf)
+        self.X = np.array([basis.doflocs[0, self.r_dofs], basis.doflocs[1, self.z_dofs]])  # (2, 3, nf)
         self.ndofs = basis.N
         rows = np.concatenate([self.r_dofs, self.z_dofs])  # (6, nf)
         n, nf = rows.shape

@@ -132,19 +132,21 @@ def _newton(prob, uf, p, target, opt: PathOptions):
 
 def follow_volume(solid, volume, fixed_dofs, targets, *, options=PathOptions(),
                   volume_scale=1.0, progress=None) -> tuple[list[PathState], list[PathState]]:
-    """Follow the equilibrium path from u = 0 (V = 0) through the volumes ``targets`` [mm^3].
+    """Follow the equilibrium path from u = 0 through the volumes ``targets`` [mm^3].
 
-    ``targets`` must be increasing and positive (a reversible elastic path: decreasing
-    volumes are the same states). Returns (states at the targets, every converged state).
+    ``targets`` must increase strictly from the reference volume V(u = 0) (a reversible
+    elastic path: decreasing volumes are the same states). Returns (states at the targets,
+    every converged state from the reference on).
     """
     targets = np.asarray(targets, dtype=float)
-    if np.any(np.diff(targets) <= 0) or targets[0] <= 0:
-        raise ValueError("volume targets must be positive and strictly increasing")
     free = np.setdiff1d(np.arange(solid.ndofs), fixed_dofs)
     prob = _Problem(solid, volume, free, volume_scale)
-    path = [PathState(0.0, 0.0, 0.0, np.zeros(solid.ndofs))]
+    uf, p, step = np.zeros(free.size), 0.0, options.first_step
+    v = volume.value(prob.full(uf))
+    if np.any(np.diff(targets) <= 0) or targets[0] <= v:
+        raise ValueError(f"volume targets must increase strictly from the reference {v:.6g} mm^3")
+    path = [PathState(v, 0.0, 0.0, prob.full(uf))]
     prev = None  # (uf, p, V) of the state before the last one, for the secant predictor
-    uf, p, v, step = np.zeros(free.size), 0.0, 0.0, options.first_step
     hits = []
     for target in targets:
         while v < target:
