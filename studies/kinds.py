@@ -53,16 +53,14 @@ def grasp(params: dict, design: HandDesign, outdir: Path) -> dict:
 
 def control(params: dict, design: HandDesign, outdir: Path) -> dict:
     """The flexibility experiment (Table II) at one setting: angle control, push, pressure control."""
-    import numpy as np
-
-    from reduced.control import flexibility
+    from reduced.control import flexibility, ramp
     from reduced.grasp import PAPER_WEIGHTS
 
     push_n, push_at = params.get("push_n", 10.0), params.get("push_at_s", 5.0)
     result = flexibility(design, math.radians(params.get("theta_ref_deg", 50.0)),
                          params.get("mass_kg", 2.0),
                          PAPER_WEIGHTS[params.get("diameter_mm", 180.0)],
-                         lambda t: np.where(t >= push_at, push_n, 0.0),
+                         ramp(push_n, push_at),
                          t_end=params.get("t_end_s", 10.0))
     s = result.angle_summary
     out = {"settling_time_s": s.settling_time, "P_before_MPa": s.P_before,
