@@ -181,13 +181,16 @@ def fit(data: Measurements, params, predictor: Callable[[HandDesign], np.ndarray
 
 
 def make_predictor(data: Measurements, model: str = "reduced", *, reservoir: bool = True,
-                   weights=None) -> Predictor:
+                   weights=None, normalise: bool = False,
+                   design: HandDesign | None = None) -> Predictor:
     """The model's prediction of ``data.observed``: theta [deg] from the free-bending inverse
     of eq. (27) (or (28) without reservoir), or F_v [N] from eqs. (24), (25), (29).
 
     Free bending: theta is what was measured at set pump pressures (the paper raises P in
     0.1 MPa steps and reads the angles), so the residual is in theta. Grasp data: w comes from
-    the ``diameter_mm`` column (the paper's presets) or else from ``weights`` (n_s numbers).
+    the ``diameter_mm`` column (the paper's presets, checked against ``design.n_s``) or else
+    from ``weights`` (n_s numbers); a w whose sum is not 1 warns (eq. (23)), or is scaled to
+    sum 1 with ``normalise``.
     """
     from . import grasp, hand
 
@@ -195,7 +198,8 @@ def make_predictor(data: Measurements, model: str = "reduced", *, reservoir: boo
         raise InputError("--model", model, f"allowed: {', '.join(MODELS)}")
     if data.kind == "bending":
         return lambda design: np.degrees(hand.bend_angle(data.P, design, reservoir))
-    groups = _weight_groups(data, weights)
+    groups = _weight_groups(data, weights, design if design is not None else HandDesign(),
+                            normalise)
 
     def predict(design):
         F_v = np.empty(len(data))
@@ -206,22 +210,18 @@ def make_predictor(data: Measurements, model: str = "reduced", *, reservoir: boo
     return predict
 
 
-def _weight_groups(data: Measurements, weights):
+def _weight_groups(data: Measurements, weights, design: HandDesign, normalise: bool):
     """[(w, row mask)]: one weight vector per object diameter, or ``weights`` for all rows."""
-    from .grasp import PAPER_WEIGHTS
+    from .grasp import check_weights, weights_for_diameter
 
     if data.diameter is None:
         if weights is None:
             raise InputError("--weights", None, "grasp data need the weight vector w: a "
                              "diameter_mm column or --diameter-mm / --weights")
-        return [(np.asarray(weights, dtype=float), np.ones(len(data), dtype=bool))]
-    groups = []
-    for D in np.unique(data.diameter):
-        if float(D) not in PAPER_WEIGHTS:
-            raise InputError(f"{data.source}: diameter_mm", float(D), "no weight vector for "
-                             f"it; available: {', '.join(f'{k:g}' for k in PAPER_WEIGHTS)}")
-        groups.append((np.asarray(PAPER_WEIGHTS[float(D)]), data.diameter == D))
-    return groups
+        return [(check_weights(weights, design, normalise), np.ones(len(data), dtype=bool))]
+    # w does not depend on the fitted parameters (n_s is not fittable): looked up once here
+    return [(check_weights(weights_for_diameter(D, design), design, normalise), data.diameter == D)
+            for D in np.unique(data.diameter)]
 
 
 def check_params(params, n_points: int) -> tuple[str, ...]:
