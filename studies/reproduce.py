@@ -51,12 +51,13 @@ class Section:
     title: str
     needs: tuple[str, ...]  #: "module" or "module:attribute" that must exist
     build: Callable  #: writes files into outdir; returns (markdown body, {name: number})
+    in_quick: bool = True  #: False: skipped by --quick (reported as such)
 
 
 @dataclass
 class Outcome:
     section: Section
-    status: str  #: 'done', 'reused', 'failed', 'not available', 'not selected'
+    status: str  #: 'done', 'reused', 'failed', 'not available', 'not selected', 'skipped'
     detail: str = ""  #: error or missing module
     wall_time_s: float = 0.0
     numbers: dict | None = None
@@ -64,9 +65,9 @@ class Outcome:
 
 def sections() -> list[Section]:
     """Every section of the report, in order (imported here to keep start-up light)."""
-    from studies import reproduce_sections
+    from studies import reproduce_fem, reproduce_sections
 
-    return reproduce_sections.SECTIONS
+    return reproduce_sections.REDUCED_SECTIONS + reproduce_fem.SECTIONS
 
 
 def missing(section: Section) -> str:
@@ -125,6 +126,8 @@ def reproduce(out: str | Path = "results/reproduce", *, quick: bool = False,
 def _one(section: Section, ctx: Context, out: Path, only, fresh: bool) -> Outcome:
     if only is not None and section.key not in only:
         return Outcome(section, "not selected")
+    if ctx.quick and not section.in_quick:
+        return Outcome(section, "skipped", "not part of --quick")
     lack = missing(section)
     if lack:
         return Outcome(section, "not available", lack)

@@ -267,7 +267,7 @@ In the paper the pressure drops under the push (0.89 → 0.79 MPa).
     return text, numbers
 
 
-SECTIONS: list[Section] = [
+REDUCED_SECTIONS: list[Section] = [
     Section("fig7_reduced", "Fig. 7: pressure and bend angle, reduced model",
             ("reduced.hand:pressure",), fig7_reduced),
     Section("table2_reduced", "Table II: grasping force, reduced model",
