@@ -4,6 +4,7 @@ References that are not the simulation itself: the reduced model's own statics
 (eq. (27) via reduced.hand, eq. (25) via reduced.grasp, eq. (2) via reduced.finger),
 vector identities of the push split, and the same run with a feature switched off.
 """
+import json
 import math
 import warnings
 
@@ -187,3 +188,61 @@ def test_bad_inputs(tables):
         PlantParams(P_min=1.0, P_max=0.5)
     with pytest.raises(InputError, match="theta_deg"):  # a push no finger can hold
         simulate(ctrl, tables, plant, mass=2.0, force=step_push(200.0, at=1.0), t_end=3.0)
+
+
+# ---------------------------------------------------------------------------- the CLI
+from studies.cli import main  # noqa: E402
+
+CLI = ["control", "--theta-ref-deg", "50", "--mass-kg", "2", "--t-end-s", "6", "--push-at-s", "3"]
+
+
+def test_cli_json_reports_table_ii(capsys, tmp_path):
+    assert main([*CLI, "--json", "--out", str(tmp_path / "run"), "--plot", str(tmp_path / "f.png")]) == 0
+    assert (tmp_path / "f.png").read_bytes()[:4] == b"\x89PNG"
+    report = json.loads(capsys.readouterr().out)
+    states = [row["state"] for row in report["table2"]]
+    assert states == ["a_no_push", "b_push_pressure_control", "c_push_angle_control"]
+    assert [row["paper_F_v_kgf"] for row in report["table2"]] == [0.61, 0.82, 0.53]
+    s = report["summary"]
+    assert s["mode"] == "angle" and abs(s["theta_during_deg"] - 50.0) < 0.5
+    assert report["other_mode"]["P_during_MPa"] == pytest.approx(s["P_before_MPa"], abs=0.01)
+    rows = (tmp_path / "run" / "control_angle.csv").read_text().splitlines()
+    assert rows[0].startswith("t_s,P_MPa,P_ref_MPa,theta_mean_deg,theta_1_deg")
+    assert len(rows) == 1 + 600  # 6 s at the 100 Hz sensor rate
+    assert (tmp_path / "run" / "summary.json").exists()
+
+
+def test_cli_disturbance_file_equals_push_options(capsys, tmp_path):
+    """A file holding the same ramp as --push-N 5 --push-at-s 3 gives the same numbers."""
+    path = tmp_path / "push.csv"
+    path.write_text("# a 5 N push from 3 s, 0.5 s rise\nt_s,force_N\n0,0\n3,0\n3.5,5\n")
+    assert main([*CLI, "--json", "--disturbance", str(path)]) == 0
+    from_file = json.loads(capsys.readouterr().out)["table2"]
+    assert main([*CLI, "--json"]) == 0
+    from_options = json.loads(capsys.readouterr().out)["table2"]
+    for a, b in zip(from_file, from_options):
+        assert a["F_v_estimated_N"] == pytest.approx(b["F_v_estimated_N"], rel=1e-9)
+
+
+@pytest.mark.parametrize("text, message", [
+    ("time,force\n0,1\n", "header"),
+    ("t_s,force_N\n", "no data rows"),
+    ("t_s,force_N\n0,1\n1,abc\n", "line 3"),
+    ("t_s,force_N\n0,1\n2,1\n1,1\n", "strictly increasing"),
+    ("t_s,force_N\n0,1,2\n", "two numbers"),
+    ("t_s,force_N\n0,inf\n", "finite"),
+])
+def test_cli_bad_disturbance_file_is_one_line(capsys, tmp_path, text, message):
+    path = tmp_path / "bad.csv"
+    path.write_text(text)
+    assert main([*CLI, "--disturbance", str(path)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and message in err
+
+
+def test_cli_bad_values_are_one_line(capsys, tmp_path):
+    for extra in (["--disturbance", str(tmp_path / "missing.csv")], ["--push-at-s", "9"],
+                  ["--mass-kg", "-1"], ["--diameter-mm", "100"]):
+        assert main([*CLI, *extra]) == 2
+        err = capsys.readouterr().err
+        assert err.count("\n") == 1 and err.startswith("softhand control: error:")
