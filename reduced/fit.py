@@ -168,7 +168,10 @@ def fit(data: Measurements, params, predictor: Callable[[HandDesign], np.ndarray
     at_bound = tuple(k for k, a in zip(keys, sol.active_mask) if a != 0)
     warnings = diag.warnings + tuple(
         f"{k} ended on its bound {v:.6g}: widen the bound or fix it; its standard error "
-        "is not meaningful" for k, v in zip(keys, values) if k in at_bound)
+        "is not meaningful" for k, v in zip(keys, values) if k in at_bound) + tuple(
+        f"{k} is poorly determined: its standard error {se:.3g} exceeds its value {v:.6g}"
+        for k, v, se in zip(keys, values, diag.stderr)
+        if math.isfinite(se) and se > abs(v) and k not in at_bound)
     return FitResult(
         params=keys, initial=p0, values=values, stderr=diag.stderr,
         correlation=diag.correlation, observed=observed,
@@ -321,9 +324,11 @@ def _identifiability_warnings(keys, dead, rel_null, condition, corr, options) ->
         v = np.where(dead, 0.0, v)
         if not np.any(v):
             continue  # the direction of a parameter with no effect, reported above
-        v = v / v[np.argmax(np.abs(v))]
-        if np.count_nonzero(np.abs(v) > 1e-3) < 2:
+        v = v / np.max(np.abs(v))
+        shown = np.flatnonzero(np.abs(v) > 1e-3)
+        if shown.size < 2:
             continue
+        v = v * np.sign(v[shown[0]])  # the first parameter named goes up
         parts = " and ".join(f"{k} by {c:+.3g} %" for k, c in zip(keys, v) if abs(c) > 1e-3)
         out.append(f"not identifiable: changing {parts} leaves every prediction unchanged "
                    "(singular Jacobian); the data determine only that combination: "

@@ -20,7 +20,7 @@ For a nearly incompressible rubber (Poisson ratio 1/2) the initial shear modulus
 Neo-Hookean law (5), (11) is mu = E / 3.
 
 The paper's NBR is Shore A 70 and uses mu = 1.15 MPa; Gent gives mu = 1.84 MPa for
-Shore A 70, 1.6 times more; 1.15 MPa is Gent's value for about Shore A 59.5. Fit mu to
+Shore A 70, 1.6 times more; 1.15 MPa is Gent's value for Shore A 58.9. Fit mu to
 bending data (``softhand fit``) rather than trusting either number.
 """
 from __future__ import annotations
