@@ -33,7 +33,6 @@ import numpy as np
 from . import hand
 from .design import HandDesign
 from .errors import InputError
-from .kinematics import hinge_angles, jacobian
 
 #: newtons per kilogram-force (standard gravity, by definition of the kgf)
 KGF = 9.80665
@@ -89,9 +88,17 @@ def check_weights(w, design: HandDesign, normalise: bool = False) -> np.ndarray:
 
 
 def projected_jacobian(theta, w, design: HandDesign):
-    """(J_x w, J_y w) [mm/rad] at theta_hat = w theta, vectorised over theta [rad]."""
-    J_x, J_y = jacobian(hinge_angles(theta, w), design)
-    return J_x @ w, J_y @ w
+    """(J_x w, J_y w) [mm/rad] at theta_hat = w theta, vectorised over theta [rad].
+
+    Summed link by link (hinge i moves links k >= i):
+    J_x w = -sum_k L_k W_k cos(alpha_k), J_y w = -sum_k L_k W_k sin(alpha_k), where
+    W_k = w_1 + .. + w_k and alpha_k = W_k theta - theta0 (links k = 1..n_s; the base link
+    does not move). Equal to ``jacobian(hinge_angles(theta, w)) @ w`` (tested).
+    """
+    W = np.cumsum(np.asarray(w, dtype=float))
+    arm = np.asarray(design.link_lengths[1:]) * W                 # L_k W_k, k = 1..n_s
+    alpha = np.multiply.outer(np.asarray(theta, float), W) - design.theta0
+    return -np.einsum("...k,k", np.cos(alpha), arm), -np.einsum("...k,k", np.sin(alpha), arm)
 
 
 def _check_mass(mass) -> np.ndarray:

@@ -90,11 +90,16 @@ def invert_monotone(fn, y, bracket: tuple[float, float], *, field: str, unit: st
 
 
 def _table(fn, bracket, size):
+    """x, fn(x), fn'(x) on ``size`` points; slopes by central differences (one-sided at the ends)."""
     x = np.linspace(bracket[0], bracket[1], size)
     step = 1e-6 * (bracket[1] - bracket[0])
-    inner = np.clip(x, bracket[0] + step, bracket[1] - step)  # keep the stencil inside
-    slope = (fn(inner + step) - fn(inner - step)) / (2.0 * step)
-    return x, fn(x), slope
+    points = x[:, None] + step * np.array([-1.0, 1.0])
+    points[0], points[-1] = x[0] + step * np.array([1.0, 2.0]), x[-1] - step * np.array([1.0, 2.0])
+    fx, near = fn(x), fn(points)
+    slope = (near[:, 1] - near[:, 0]) / (2.0 * step)
+    slope[0] = (4.0 * near[0, 0] - near[0, 1] - 3.0 * fx[0]) / (2.0 * step)
+    slope[-1] = (3.0 * fx[-1] - 4.0 * near[-1, 0] + near[-1, 1]) / (2.0 * step)
+    return x, fx, slope
 
 
 def _increasing_run(x, fx, slope, anchor):

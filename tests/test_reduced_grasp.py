@@ -31,6 +31,14 @@ def test_forces_satisfy_the_virtual_work_balance_eq_1():
     assert F.F_y == pytest.approx(m * D.g / D.n)
 
 
+def test_projected_jacobian_equals_the_full_jacobian_times_w():
+    theta = np.radians([-20.0, 0.0, 35.0, 80.0])
+    for w in (W180, W, np.array(grasp.PAPER_WEIGHTS[240.0])):
+        J_x, J_y = kin.jacobian(kin.hinge_angles(theta, w), D)
+        J_xw, J_yw = grasp.projected_jacobian(theta, w, D)
+        assert J_xw == pytest.approx(J_x @ w, rel=1e-12) and J_yw == pytest.approx(J_y @ w, rel=1e-12)
+
+
 def test_no_load_at_the_free_pressure():
     theta = np.radians([10.0, 45.0, 80.0])
     F = grasp.grasp_forces(hand.pressure(theta, D), theta, 0.0, W, D)

@@ -1,0 +1,60 @@
+"""Speed of the reduced model: P(theta), theta(P), F_v for 1e5 values; `softhand curve` wall time.
+
+Run: python benchmarks/bench_reduced.py   (prints the best of a few repeats, in seconds)
+"""
+from __future__ import annotations
+
+import math
+import os
+import subprocess
+import sys
+import time
+
+import numpy as np
+
+from reduced import grasp, hand
+from reduced.design import HandDesign
+
+N = 100_000
+
+
+def best_of(fn, repeats: int = 5) -> tuple[float, float]:
+    """Best wall and CPU time of ``repeats`` calls [s] (after one warm-up call).
+
+    The CPU time of this process says what the code costs when other jobs share the cores.
+    """
+    fn()
+    walls, cpus = [], []
+    for _ in range(repeats):
+        wall, cpu = time.perf_counter(), time.process_time()
+        fn()
+        walls.append(time.perf_counter() - wall)
+        cpus.append(time.process_time() - cpu)
+    return min(walls), min(cpus)
+
+
+def main() -> None:
+    design = HandDesign()
+    rng = np.random.default_rng(0)
+    theta = rng.uniform(0.0, math.pi / 2, N)
+    P = hand.pressure(theta, design)
+    w = np.array(grasp.PAPER_WEIGHTS[240.0])
+    mass = rng.uniform(0.0, 6.0, N)
+    P_grasp = P + rng.uniform(0.0, 0.5, N)
+    rows = [
+        ("P(theta), eq. (27), 1e5 angles", lambda: hand.pressure(theta, design)),
+        ("P(theta), eq. (28), 1e5 angles", lambda: hand.pressure(theta, design, reservoir=False)),
+        ("theta(P), eq. (27) inverted, 1e5 pressures", lambda: hand.bend_angle(P, design)),
+        ("F_v, eqs. (25), (29), 1e5 states",
+         lambda: grasp.grasp_forces(P_grasp, theta, mass, w, design).F_v),
+    ]
+    print(f"{'':<45} {'wall [s]':>9} {'cpu [s]':>9}   (load average {os.getloadavg()[0]:.1f})")
+    for label, fn in rows:
+        print(f"{label:<45} {'%9.4f %9.4f' % best_of(fn)}")
+    command = [sys.executable, "-m", "studies.cli", "curve", "--theta-deg", "0:90:10"]
+    wall, _ = best_of(lambda: subprocess.run(command, check=True, capture_output=True), repeats=3)
+    print(f"{'softhand curve --theta-deg 0:90:10, start-up incl.':<45} {wall:9.4f}")
+
+
+if __name__ == "__main__":
+    main()
