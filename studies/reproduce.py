@@ -128,7 +128,10 @@ def _one(section: Section, ctx: Context, out: Path, only, fresh: bool) -> Outcom
         return Outcome(section, "not selected")
     if ctx.quick and not section.in_quick:
         return Outcome(section, "skipped", "not part of --quick")
-    lack = missing(section)
+    try:
+        lack = missing(section)
+    except Exception as exc:  # the module exists but does not import: a failure, not absence
+        return Outcome(section, "failed", f"{type(exc).__name__}: {exc}")
     if lack:
         return Outcome(section, "not available", lack)
     folder, key = out / section.key, section_key(section, ctx)

@@ -278,7 +278,21 @@ def _outcomes(study: Study, todo: list[Case], workers: int, scheduler: str | Non
         yield from _pool_outcomes(study, todo, workers)
 
 
-def _pool_outcomes(study: Study, todo: list[Case], workers: int):
+def _pool_outcomes(study: Study, todo: list[Case], workers: int, restarts: int = 2):
+    """A process pool; if a worker dies, a new pool takes the cases not finished (twice at most)."""
+    remaining = todo
+    for attempt in range(restarts + 1):
+        lost: list[Case] = []
+        yield from _one_pool(study, remaining, workers, lost)
+        if not lost:
+            return
+        remaining = lost
+        again = "; a new pool takes them" if attempt < restarts else "; rerun to finish them"
+        print(f"softhand study: a worker died; {len(lost)} cases not finished{again}",
+              file=sys.stderr)
+
+
+def _one_pool(study: Study, todo: list[Case], workers: int, lost: list[Case]):
     pool = ProcessPoolExecutor(max_workers=min(workers, len(todo)))
     try:
         futures = {pool.submit(execute_case, study.kind, c.params, c.design): c for c in todo}
@@ -287,10 +301,11 @@ def _pool_outcomes(study: Study, todo: list[Case], workers: int):
             finished, pending = wait(pending, return_when=FIRST_COMPLETED)
             for future in finished:
                 try:
-                    yield futures[future], future.result()
+                    output = future.result()
                 except BrokenProcessPool:
-                    print(f"softhand study: a worker died; case {futures[future].key} not run",
-                          file=sys.stderr)
+                    lost.append(futures[future])
+                    continue
+                yield futures[future], output
     finally:
         pool.shutdown(wait=True, cancel_futures=True)
 

@@ -114,3 +114,26 @@ def test_case_key_follows_the_inputs_not_their_spelling():
     assert case_key("curve", {"theta_deg": 10.0}, paper) != case_key("curve", {"theta_deg": 11.0}, paper)
     assert case_key("curve", {"theta_deg": 10.0}, paper) != \
         case_key("curve", {"theta_deg": 10.0}, paper.replace(mu_sf=1.2))
+
+
+DYING_KIND = '''
+import os, pathlib, time
+def case(params, design, outdir):
+    marker = pathlib.Path(params["marker"])
+    if params["x"] == 3 and not marker.exists():   # the worker dies once, mid-study
+        marker.touch()
+        os._exit(1)
+    time.sleep(0.05)
+    return {"y": params["x"]}
+'''
+
+
+def test_a_killed_worker_loses_nothing_and_its_cases_are_rerun(tmp_path, monkeypatch):
+    (tmp_path / "dyingkind.py").write_text(DYING_KIND)
+    monkeypatch.syspath_prepend(str(tmp_path))
+    study = load_study(write_study(tmp_path, f'kind = "dyingkind:case"\n[params]\n'
+                                   f'marker = "{tmp_path / "died"}"\n[sweep]\nx = "1:8:1"\n'))
+    summary = run_study(study, results_root=tmp_path / "res", workers=2, progress=False)
+    assert (tmp_path / "died").exists()  # a worker did die
+    assert summary.ok and summary.computed == 8
+    assert sorted(v["y"] for v in results_by_key(tmp_path / "res", study).values()) == list(range(1, 9))
