@@ -152,10 +152,8 @@ def fit(data: Measurements, params, predictor: Callable[[HandDesign], np.ndarray
     failed = 1e3 * (1.0 + float(np.max(np.abs(observed))))
 
     def residual(x):  # a trial point where the model has no answer: a large residual, step rejected
-        try:
-            return _predict(predictor, keys, x * scale, design) - observed
-        except InputError:
-            return np.full(observed.shape, failed)
+        r = _try_predict(predictor, keys, x * scale, design, observed.shape) - observed
+        return np.where(np.isnan(r), failed, r)
 
     x0 = np.clip(p0 / scale, lo / scale, hi / scale)
     sol = least_squares(residual, x0, bounds=(lo / scale, hi / scale), method="trf",
@@ -166,21 +164,28 @@ def fit(data: Measurements, params, predictor: Callable[[HandDesign], np.ndarray
     fitted = _with(keys, values, design)
     diag = diagnose(keys, J, sol.fun, values, options)
     at_bound = tuple(k for k, a in zip(keys, sol.active_mask) if a != 0)
-    warnings = diag.warnings + tuple(
-        f"{k} ended on its bound {v:.6g}: widen the bound or fix it; its standard error "
-        "is not meaningful" for k, v in zip(keys, values) if k in at_bound) + tuple(
-        f"{k} is poorly determined: its standard error {se:.3g} exceeds its value {v:.6g}"
-        for k, v, se in zip(keys, values, diag.stderr)
-        if math.isfinite(se) and se > abs(v) and k not in at_bound)
     return FitResult(
         params=keys, initial=p0, values=values, stderr=diag.stderr,
         correlation=diag.correlation, observed=observed,
         predicted=_predict(predictor, keys, values, design),
-        initial_predicted=_predict(predictor, keys, p0, design), design=fitted,
+        initial_predicted=_try_predict(predictor, keys, p0, design, observed.shape), design=fitted,
         quantity=data.quantity, condition=diag.condition,
         singular_values=diag.singular_values, unidentifiable=diag.unidentifiable,
-        at_bound=at_bound, warnings=warnings, nfev=int(sol.nfev), finger=data.finger,
+        at_bound=at_bound, warnings=diag.warnings + _fit_warnings(sol, keys, values, diag, at_bound),
+        nfev=int(sol.nfev), finger=data.finger,
     )
+
+
+def _fit_warnings(sol, keys, values, diag, at_bound) -> tuple[str, ...]:
+    """Non-convergence, parameters on a bound, errors larger than the value."""
+    out = [] if sol.status > 0 else [f"the optimiser stopped without converging after "
+                                     f"{sol.nfev} evaluations: {sol.message}"]
+    out += [f"{k} ended on its bound {v:.6g}: widen the bound or fix it; its standard error "
+            "is not meaningful" for k, v in zip(keys, values) if k in at_bound]
+    out += [f"{k} is poorly determined: its standard error {se:.3g} exceeds its value {v:.6g}"
+            for k, v, se in zip(keys, values, diag.stderr)
+            if math.isfinite(se) and se > abs(v) and k not in at_bound]
+    return tuple(out)
 
 
 def make_predictor(data: Measurements, model: str = "reduced", *, reservoir: bool = True,
@@ -200,6 +205,8 @@ def make_predictor(data: Measurements, model: str = "reduced", *, reservoir: boo
     if model not in MODELS:
         raise InputError("--model", model, f"allowed: {', '.join(MODELS)}")
     if data.kind == "bending":
+        if weights is not None:
+            raise InputError("--weights", "given", "a weight vector is only for grasp data")
         return lambda design: np.degrees(hand.bend_angle(data.P, design, reservoir))
     groups = _weight_groups(data, weights, design if design is not None else HandDesign(),
                             normalise)
@@ -222,6 +229,9 @@ def _weight_groups(data: Measurements, weights, design: HandDesign, normalise: b
             raise InputError("--weights", None, "grasp data need the weight vector w: a "
                              "diameter_mm column or --diameter-mm / --weights")
         return [(check_weights(weights, design, normalise), np.ones(len(data), dtype=bool))]
+    if weights is not None:
+        raise InputError("--weights", "given", f"{data.source} has a diameter_mm column, "
+                         "which picks w; drop --weights / --diameter-mm")
     # w does not depend on the fitted parameters (n_s is not fittable): looked up once here
     return [(check_weights(weights_for_diameter(D, design), design, normalise), data.diameter == D)
             for D in np.unique(data.diameter)]
@@ -360,6 +370,14 @@ def _with(keys, values, design: HandDesign) -> HandDesign:
 
 def _predict(predictor, keys, values, design) -> np.ndarray:
     return np.asarray(predictor(_with(keys, values, design)), dtype=float)
+
+
+def _try_predict(predictor, keys, values, design, shape) -> np.ndarray:
+    """The prediction, or nan where the model has no answer (e.g. the starting design)."""
+    try:
+        return _predict(predictor, keys, values, design)
+    except InputError:
+        return np.full(shape, np.nan)
 
 
 def _num(x):

@@ -266,3 +266,17 @@ def test_cli_reports_an_unidentifiable_pair(capsys):
     captured = capsys.readouterr()
     assert "WARNING: not identifiable" in captured.out
     assert "softhand fit: warning: not identifiable" in captured.err
+
+
+def test_cli_grasp_file_without_diameter_takes_the_option(tmp_path, capsys):
+    lines = (EXAMPLES / "example_grasp.csv").read_text().splitlines()
+    rows = [",".join(line.split(",")[:4]) for line in lines if not line.startswith("#")]
+    f = tmp_path / "grasp.csv"
+    f.write_text("\n".join(rows) + "\n")
+    args = ["fit", "--data", str(f), "--params", "mu_sf_MPa", "--json"]
+    assert main(args) == 2                                    # which w? one-line error
+    assert main(args + ["--diameter-mm", "180"]) == 0
+    err = capsys.readouterr().err
+    assert "--weights" in err and "weights sum to 1.4" in err  # the paper's 180 mm w, as printed
+    assert main(["fit", "--data", str(EXAMPLES / "example_grasp.csv"), "--params",
+                 "mu_sf_MPa", "--diameter-mm", "180"]) == 2    # the column already picks w
