@@ -154,12 +154,13 @@ def _setup(args):
 
 
 def _summary_dict(s) -> dict:
+    """The summary in edge units; nan (not applicable, e.g. no push) becomes None (JSON null)."""
     deg = math.degrees
-    return {"mode": s.mode, "settling_time_s": s.settling_time, "theta_error_deg": deg(s.theta_error),
+    return {key: None if isinstance(value, float) and math.isnan(value) else value for key, value in {"mode": s.mode, "settling_time_s": s.settling_time, "theta_error_deg": deg(s.theta_error),
             "P_error_MPa": s.P_error, "P_before_MPa": s.P_before, "theta_before_deg": deg(s.theta_before),
             "P_during_MPa": s.P_during, "theta_during_deg": deg(s.theta_during),
             "fingers_during_deg": [deg(x) for x in s.fingers_during],
-            "push_start_s": s.push_start, "push_end_s": s.push_end}
+            "push_start_s": s.push_start, "push_end_s": s.push_end}.items()}
 
 
 def _series_rows(sim, every: int) -> list[dict]:
@@ -230,6 +231,7 @@ def run(args) -> int:
 
 
 def _print_text(report: dict) -> None:
+    """The summary of both runs side by side, then Table II."""
     s = report["summary"]
     print(f"{s['mode']} control; push: {report['push']['source']} "
           f"(azimuth {report['push']['azimuth_deg']:g} deg, elevation {report['push']['elevation_deg']:g} deg)")
