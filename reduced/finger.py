@@ -30,6 +30,7 @@ from functools import lru_cache
 import numpy as np
 
 from .design import HandDesign
+from .errors import InputError
 
 #: Gauss-Legendre orders across the wall (r) and around the tube (phi, half turn); the
 #: relative quadrature error is below 1e-11 for -pi/2 <= theta <= pi (tests/test_reduced_finger.py).
@@ -101,7 +102,6 @@ def _energy_kernel(x):
 def _check_stretch(theta, design: HandDesign) -> None:
     c_max = (design.d + design.a + design.b) / design.l0
     if np.any(np.asarray(theta) * c_max <= -1.0):
-        from .errors import InputError
         raise InputError("theta_deg", float(np.degrees(np.min(theta))),
                          f"must exceed {-np.degrees(1 / c_max):.0f} deg (tube stretch > 0)")
 

@@ -31,8 +31,8 @@ def test_curve_by_angle(capsys):
 def test_curve_by_pressure_and_table(capsys):
     rows = run_json(capsys, "curve", "--pressure-mpa", "0,0.4,0.8")["rows"]
     assert set(rows[0]) == {"P_MPa", "theta_deg", "theta_no_reservoir_deg"}
-    for r in rows:  # the angles reproduce the pressures
-        assert hand.pressure(math.radians(r["theta_deg"]), D) == pytest.approx(r["P_MPa"], abs=1e-12)
+    for r in rows:  # the angles (rounded to 1e-10 deg, dP/dtheta < 3 MPa/rad) reproduce the pressures
+        assert hand.pressure(math.radians(r["theta_deg"]), D) == pytest.approx(r["P_MPa"], abs=1e-10)
         assert r["theta_deg"] > r["theta_no_reservoir_deg"]  # the reservoir helps
     assert main(["curve", "--theta-deg", "0:90:15"]) == 0
     lines = capsys.readouterr().out.splitlines()

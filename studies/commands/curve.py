@@ -43,8 +43,10 @@ def rows_at_angles(theta_deg: np.ndarray, design: HandDesign) -> list[dict]:
 
 def rows_at_pressures(P: np.ndarray, design: HandDesign) -> list[dict]:
     """Per pump pressure [MPa]: the free bend angle with / without reservoir [deg]."""
-    theta = np.degrees(hand.bend_angle(P, design))
-    theta_free = np.degrees(hand.bend_angle(P, design, reservoir=False))
+    # rounded to 1e-10 deg, far below the inverse's error (~1e-11 rad), so that an exact
+    # zero prints as 0 (+ 0.0 turns -0.0 into 0.0)
+    theta, theta_free = (np.round(np.degrees(hand.bend_angle(P, design, reservoir=res)), 10) + 0.0
+                         for res in (True, False))
     return [{"P_MPa": float(p), "theta_deg": float(t), "theta_no_reservoir_deg": float(u)}
             for p, t, u in zip(P, theta, theta_free)]
 
