@@ -131,7 +131,9 @@ def simulate(controller, tables: HandTables, plant: PlantParams, *, mass: float,
              force: np.ndarray, push: Push = Push(), t_end: float = 10.0) -> Simulation:
     """Run ``controller`` on the plant for ``t_end`` s; ``force`` [N] per step, (N,) or callable of t.
 
-    Explicit Euler at plant.dt; sensors and controller every plant.steps_per_sample steps.
+    The push magnitude is shared among the fingers by ``push.shares(n) -> (sx, sy)``; any
+    object with that method gives other per-finger loads. Explicit Euler at plant.dt; sensors
+    and controller every plant.steps_per_sample steps.
     """
     d, dt = tables.design, plant.dt
     N = int(round(t_end / dt))
@@ -239,7 +241,7 @@ def summarize(sim: Simulation, controller, *, window: float = 1.0,
     start, end = push_interval(sim)
     quiet_end = start if math.isfinite(start) else float(sim.t[-1] + sim.t[1] - sim.t[0])
     if quiet_end - window < sim.t[0] - 1e-12:
-        raise InputError("push_at_s", start, f"must leave at least {window} s before the push")
+        raise InputError("push_start_s", start, f"must leave at least {window} s before the push")
     before, quiet = _window(sim, quiet_end, window), sim.t < quiet_end
     angle = isinstance(controller, AngleController)
     target = controller.theta_ref if angle else controller.P_ref

@@ -22,8 +22,7 @@ from pathlib import Path
 import numpy as np
 
 from reduced import grasp
-from reduced.control import (AngleController, Gains, PressureController, default_gains, flexibility,
-                             ramp)
+from reduced.control import Gains, default_gains, flexibility, ramp
 from reduced.errors import InputError
 from reduced.plant import HandTables, PlantParams, Push
 from studies.args import add_design_option, add_json_option, design_from_args, print_json, \
