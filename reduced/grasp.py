@@ -130,7 +130,7 @@ def grasp_forces(P, theta, mass, w, design: HandDesign, *, reservoir: bool = Tru
     J_xw, J_yw = projected_jacobian(theta, w, design)
     if np.any(np.abs(J_xw) < 1e-9):
         raise InputError("weights", np.asarray(w).tolist(),
-                         "give J_x w = 0: the tip does not move sideways, F_x is undetermined")
+                         "make J_x w = 0: the tip does not move sideways, F_x is undetermined")
     mg = mass * design.g
     F_x = (_pump_area(design) * (hand.pressure(theta, design, reservoir) - np.asarray(P, float))
            - mg * J_yw) / (design.n * J_xw)
@@ -155,8 +155,11 @@ def angle_at(P, mass: float, w, design: HandDesign, *, F_v: float = 0.0, reservo
     """Bend angle [rad] reached at pump pressure P [MPa] (vectorised) carrying mass [kg] (scalar)
     with normal force F_v [N]: the inverse of :func:`pressure_to_hold` on its rising branch.
     """
+    if np.ndim(mass) or np.ndim(F_v):
+        raise InputError("mass_kg", np.asarray(mass).tolist(), "angle_at takes one mass and one F_v")
     lo, hi = hand.THETA_RANGE
-    hi = min(hi, design.theta0 + 0.45 * math.pi)  # cos(theta - theta0) > 0 in (29)
+    lo = max(lo, design.theta0 - 0.45 * math.pi)  # cos(theta - theta0) > 0 in (29)
+    hi = min(hi, design.theta0 + 0.45 * math.pi)
     return hand.invert_monotone(
         lambda th: pressure_to_hold(mass, th, w, design, F_v=F_v, reservoir=reservoir),
         P, (lo, hi), field="pressure_MPa", unit="MPa")
