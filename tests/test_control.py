@@ -11,9 +11,10 @@ import warnings
 import numpy as np
 import pytest
 
-from reduced import finger, grasp
+from reduced import finger, grasp, hand
 from reduced.control import (AngleController, Gains, PressureController, default_gains,
-                             flexibility, push_interval, ramp, simulate, summarize)
+                             flexibility, initial_state, push_interval, ramp, simulate,
+                             summarize)
 from reduced.design import HandDesign
 from reduced.errors import InputError
 from reduced.plant import HandTables, PlantParams, Push, equilibrium
@@ -65,6 +66,23 @@ def test_equilibrium_is_the_grasp_relation(tables):
         F_v = F_y * math.sin(theta[0] - DESIGN.theta0)  # no squeeze: F_x = 0
         P_25 = grasp.pressure_to_hold(F_y * DESIGN.n / DESIGN.g, theta[0], W180, DESIGN, F_v=F_v)
         assert P_25 == pytest.approx(P, abs=1e-5)
+
+
+def test_small_pressure_step_is_a_first_order_lag(tables):
+    """Free hand, a 0.02 MPa step with an instant pump: theta follows 1 - exp(-t/tau) with
+    tau = k_bar tau_f / f'(theta0), f'(theta0) the slope of eq. (27) (reduced.hand, central
+    differences). 1 % bounds the Euler error (dt/tau ~ 0.3 %) and the step's curvature."""
+    plant = PlantParams(tau_m=1e-6)
+    theta0 = float(initial_state(tables, 0.0)[0])
+    h = 1e-5
+    slope = float(hand.pressure(theta0 + h, DESIGN) - hand.pressure(theta0 - h, DESIGN)) / (2 * h)
+    tau = tables.k_bar * plant.tau_f / slope
+    sim = simulate(PressureController(float(hand.pressure(theta0, DESIGN)) + 0.02, plant), tables,
+                   plant, mass=0.0, force=np.zeros(3000), t_end=3.0)
+    rise = (sim.theta_mean - theta0) / (sim.theta_mean[-1] - theta0)
+    for t in (0.5 * tau, tau, 2 * tau):
+        k = int(round(t / plant.dt))
+        assert -sim.t[k] / np.log(1.0 - rise[k]) == pytest.approx(tau, rel=0.01)
 
 
 def test_feedforward_alone_reaches_reference_on_nominal_plant(tables):
