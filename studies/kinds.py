@@ -56,7 +56,7 @@ def control(params: dict, design: HandDesign, outdir: Path) -> dict:
     from reduced.control import flexibility, ramp
     from reduced.grasp import PAPER_WEIGHTS
 
-    push_n, push_at = params.get("push_n", 10.0), params.get("push_at_s", 5.0)
+    push_n, push_at = params.get("push_n", 5.0), params.get("push_at_s", 5.0)
     result = flexibility(design, math.radians(params.get("theta_ref_deg", 50.0)),
                          params.get("mass_kg", 2.0),
                          PAPER_WEIGHTS[params.get("diameter_mm", 180.0)],
@@ -67,3 +67,29 @@ def control(params: dict, design: HandDesign, outdir: Path) -> dict:
            "P_during_MPa": s.P_during, "theta_during_deg": math.degrees(s.theta_during)}
     out |= {f"F_v_{r['state']}_kgf": r["F_v_estimated_kgf"] for r in result.rows}
     return out
+
+
+def reservoir(params: dict, design: HandDesign, outdir: Path) -> dict:
+    """The reservoir sheet by FEM against the ellipse model over the fingers' stroke.
+
+    ``mesh_size_mm`` sets the elements along the radius and through the thickness;
+    ``theta_max_deg`` the largest finger bend of the operating range (default 90).
+    """
+    from studies.reservoir import ReservoirStudy, run
+
+    mesh = {}
+    if "mesh_size_mm" in params:
+        h = params["mesh_size_mm"]
+        mesh = {"n_radial": max(4, math.ceil(design.R / h)), "n_thick": max(1, math.ceil(design.t / h))}
+    result = run(ReservoirStudy(design=design, theta_max=math.radians(params.get("theta_max_deg", 90.0)),
+                                **mesh))
+    v, at_v0 = result.verdict, result.rows[1]
+    out = {f"{key}_rel_error_max": max(abs(v[key]["min"]), abs(v[key]["max"]))
+           for key in ("apex_height", "mean_stretch", "strain_energy", "pressure")}
+    out |= {"p_V0_MPa": at_v0["p_MPa"], "p_ellipse_V0_MPa": at_v0["p_ellipse_MPa"],
+            "stroke_dp_fem_MPa": v["stroke_dp_fem_MPa"],
+            "stroke_dp_ellipse_MPa": v["stroke_dp_ellipse_MPa"], "max_gap_mm": v["max_gap_mm"]}
+    fem = result.fem
+    return {**out, "mesh": {**(mesh or {"n_radial": result.study.n_radial,
+                                        "n_thick": result.study.n_thick}), "dofs": fem.ndofs},
+            "solver": {"newton_iterations": fem.newton_iterations, "wall_time_s": fem.wall_time}}

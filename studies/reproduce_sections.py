@@ -189,7 +189,7 @@ which F_v falls to 0 (the finger just stops pressing) at each pressure:
 
 
 # ---------------------------------------------------------------------- Table II and Fig. 10, controller
-PUSH_N, PUSH_AT_S, T_END_S = 10.0, 5.0, 10.0  #: the simulated push (the paper gives no magnitude)
+PUSH_N, PUSH_AT_S, T_END_S = 5.0, 5.0, 10.0  #: the push of `softhand control` (the paper gives no magnitude)
 
 
 def _flexibility(ctx: Context):

@@ -59,6 +59,7 @@ KINDS: dict[str, Kind] = {
                   ("pressure_mpa", "theta_deg", "mass_kg", "diameter_mm", "weights")),
     "control": Kind("studies.kinds:control", ("theta_ref_deg", "mass_kg", "diameter_mm",
                                               "push_n", "push_at_s", "t_end_s")),
+    "reservoir": Kind("studies.kinds:reservoir", ("theta_max_deg",), fem=True),
 }
 
 _TOP_KEYS = ("kind", "name", "description", "design", "mesh_size_mm", "sweep", "params")
