@@ -12,7 +12,9 @@ zero pump pressure the charged sheet already bends the fingers a little (reporte
 
 The inverse theta(P) is found on the monotone branch of P(theta) through theta = 0 inside
 :data:`THETA_RANGE`: a table of 1025 angles, cubic Hermite interpolation of the inverse
-function, and one Newton step on the exact P (no per-value root finder).
+function (error ~1e-13 rad for the ellipse model), and vectorised chord-Newton steps on the
+exact P until converged -- one step for a smooth P; a kinked reservoir model p_r(V) takes a
+few more for the values near its kinks (no per-value root finder).
 """
 from __future__ import annotations
 
@@ -75,9 +77,11 @@ def invert_monotone(fn, y, bracket: tuple[float, float], *, field: str, unit: st
 
     Tabulates fn on ``size`` points of ``bracket``, keeps the increasing run that holds
     ``anchor``, interpolates the inverse with cubic Hermite polynomials (slopes 1/fn' by
-    central differences) and takes one Newton step on fn. InputError for y off the branch.
+    central differences), then takes chord-Newton steps on fn until each step is below
+    1e-12 of the bracket (one step for a smooth fn). InputError for y off the branch.
     """
     y = np.asarray(y, dtype=float)
+    shape = y.shape
     x, fx, slope = _table(fn, bracket, size)
     x, fx, slope = _increasing_run(x, fx, slope, anchor)
     bad = ~np.isfinite(y) | (y < fx[0]) | (y > fx[-1])
@@ -85,8 +89,30 @@ def invert_monotone(fn, y, bracket: tuple[float, float], *, field: str, unit: st
         raise InputError(field, float(y[bad].flat[0]),
                          f"must be in [{fx[0]:.4g}, {fx[-1]:.4g}] {unit} "
                          f"(reached at {math.degrees(x[0]):.0f}..{math.degrees(x[-1]):.0f} deg)")
-    guess, dxdy = _hermite_inverse(x, fx, slope, y)
-    return np.clip(guess - (fn(guess) - y) * dxdy, x[0], x[-1])
+    y = y.ravel()
+    guess, dxdy_at_y = _hermite_inverse(x, fx, slope, y)
+    step = (fn(guess) - y) * dxdy_at_y                 # first step: every value at once
+    root = np.clip(guess - step, x[0], x[-1])
+    xtol = 1e-12 * (bracket[1] - bracket[0])
+    todo = np.abs(step) > xtol
+    if todo.any():                                      # kinked fn: iterate the few left
+        dxdy = lambda value: _hermite_inverse(x, fx, slope, value)[1]  # noqa: E731
+        root[todo] = _chord_newton(fn, y[todo], root[todo], dxdy, (x[0], x[-1]), xtol)
+    return root.reshape(shape)
+
+
+def _chord_newton(fn, y, x, dxdy, bounds, xtol, max_iter: int = 30):
+    """Solve fn(x) = y (1-d) from x with the table's dx/dy; only unconverged values iterate."""
+    todo = np.ones(y.shape, dtype=bool)
+    for _ in range(max_iter):
+        value = fn(x[todo])
+        step = (value - y[todo]) * dxdy(value)
+        x[todo] = np.clip(x[todo] - step, *bounds)
+        todo[todo] = np.abs(step) > xtol
+        if not todo.any():
+            return x
+    raise RuntimeError(f"inverse not converged for {todo.sum()} values after {max_iter} steps "
+                       f"(first: {y[todo][0]!r})")
 
 
 def _table(fn, bracket, size):

@@ -68,3 +68,14 @@ def test_reservoir_lowers_the_pressure_by_about_0p1_MPa():
 def test_bad_input_names_the_field(call, field):
     with pytest.raises(InputError, match=field):
         call()
+
+
+def test_inverse_converges_for_a_kinked_reservoir_model(monkeypatch):
+    # a piecewise-linear p_r(V), as a tabulated calibration could be: P(theta) has slope jumps
+    kinked = lambda V, design: np.interp(V, [0.0, 1.2e4, 1.6e4, 2e4, 4e4], [0.0, 0.05, 0.12, 0.1, 0.2])
+    monkeypatch.setitem(reservoir._MODELS, "fem", kinked)
+    design = D.replace(reservoir_model="fem")
+    theta = np.random.default_rng(3).uniform(-math.pi / 2, math.pi, 3000)
+    theta[:3] = [0.0, (D.V0 - 1.6e4) / (D.n * D.a**2 * math.pi * D.d), -0.5]  # one on a kink
+    back = hand.bend_angle(hand.pressure(theta, design), design)
+    assert np.max(np.abs(back - theta)) < 1e-10  # converged to the 5e-12 rad step tolerance
