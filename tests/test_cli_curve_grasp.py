@@ -83,11 +83,20 @@ def test_bad_input_is_one_line_exit_2(argv, field, capsys):
     assert err.count("\n") == 1 and field in err
 
 
-def test_small_reservoir_design_is_bad_input(tmp_path, capsys):
-    design = tmp_path / "small.toml"
-    design.write_text("V0_mm3 = 3000.0\n")
-    assert main(["curve", "--theta-deg", "0:90:10", "--design", str(design)]) == 2
-    assert "V0_mm3" in capsys.readouterr().err
+@pytest.mark.parametrize("text, argv, field", [
+    ("V0_mm3 = 3000.0\n", ["curve", "--theta-deg", "0:90:10"], "V0_mm3"),  # 4737 mm^3 needed at 90 deg
+    ("bogus = 1\n", ["curve", "--theta-deg", "0:90:10"], "bogus"),
+    ("b_mm = -5.0\n", ["curve", "--pressure-mpa", "0.5"], "b_mm"),
+    ("n_s = 4\nhinge_s_mm = [40.0, 80.0, 120.0, 160.0]\n",
+     ["grasp", "--pressure-mpa", "1", "--theta-deg", "40", "--mass-kg", "2", "--diameter-mm", "180"],
+     "n_s = 4"),
+])
+def test_bad_design_is_one_line_exit_2(tmp_path, capsys, text, argv, field):
+    design = tmp_path / "design.toml"
+    design.write_text(text)
+    assert main([*argv, "--design", str(design)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and field in err
 
 
 def test_usage_errors_exit_2(capsys):

@@ -59,6 +59,8 @@ def test_pressure_to_hold_and_angle_at_are_inverses():
     P = grasp.pressure_to_hold(2.0, theta, W, D, F_v=3.0)
     assert grasp.grasp_forces(P, theta, 2.0, W, D).F_v == pytest.approx(3.0, rel=1e-10)
     assert grasp.angle_at(P, 2.0, W, D, F_v=3.0) == pytest.approx(theta, abs=1e-10)
+    with pytest.raises(InputError, match="one mass"):
+        grasp.angle_at(P, [1.0, 2.0], W, D)
 
 
 def test_weights_checks():
