@@ -63,9 +63,12 @@ def fig7_reduced(ctx: Context, outdir: Path):
     pressures = np.round(np.arange(0.0, 0.8 + 1e-9, 0.1), 10)
     by_p = _angles_at(pressures, d)
     write_csv(outdir / "fig7_reduced_by_pressure.csv", by_p)
+    P_fem, why = _pressure_fem_reservoir(theta, d)
     fig, (ax,) = figure()
     ax.plot(P, theta_deg, "-", label="eq. (27), with reservoir")
     ax.plot(P0, theta_deg, ":", label="eq. (28), without reservoir")
+    if P_fem is not None:
+        ax.plot(P_fem, theta_deg, "--", label="eq. (27), FEM-calibrated reservoir")
     ax.set(xlabel="pump pressure P [MPa]", ylabel="bend angle θ [deg]", xlim=(-0.15, None),
            title="Fig. 7 analogue: reduced model")
     ax.grid(alpha=0.3)
@@ -74,6 +77,8 @@ def fig7_reduced(ctx: Context, outdir: Path):
     numbers = {"offset_mean_MPa": float(offset.mean()), "offset_min_MPa": float(offset.min()),
                "offset_max_MPa": float(offset.max()), "P_at_0deg_MPa": float(P[0]),
                "P_at_90deg_MPa": float(P[-1])}
+    if P_fem is not None:
+        numbers["offset_mean_fem_reservoir_MPa"] = float(np.mean(P0 - P_fem))
     text = f"""Free fingers, the paper's design; θ = 0–90° in 1° steps
 ([fig7_reduced.csv](fig7_reduced.csv)), and θ at the paper's pressures 0–0.8 MPa
 ([fig7_reduced_by_pressure.csv](fig7_reduced_by_pressure.csv)).
@@ -84,10 +89,30 @@ The reservoir lowers the pressure needed for a bend by {offset.mean():.4f} MPa o
 over 0–90° (from {offset.min():.4f} to {offset.max():.4f} MPa); the paper says about
 {PAPER_RESERVOIR_OFFSET_MPA} MPa. With the reservoir P(0) = {P[0]:.4f} MPa < 0: at zero pump
 pressure the charged sheet already bends the fingers a little.
+{_fem_reservoir_note(P0, P_fem, why)}
 
 {md_table(by_p)}
 """
     return text, numbers
+
+
+def _pressure_fem_reservoir(theta, design):
+    """(eq. (27) with the FEM-calibrated reservoir model, None) or (None, why not)."""
+    from reduced import hand
+
+    try:
+        return hand.pressure(theta, design.replace(reservoir_model="fem"), reservoir=True), None
+    except Exception as exc:  # an optional line of the figure: say why it is missing
+        return None, f"{type(exc).__name__}: {exc}"
+
+
+def _fem_reservoir_note(P0, P_fem, why) -> str:
+    if P_fem is None:
+        return f"(No FEM-calibrated reservoir line: {why}.)"
+    offset = P0 - P_fem
+    return (f"With the FEM-calibrated reservoir model (`reservoir_model = \"fem\"`) the "
+            f"offset is {offset.mean():.4f} MPa on average ({offset.min():.4f} to "
+            f"{offset.max():.4f} MPa).")
 
 
 def _angles_at(pressures, design) -> list[dict]:
