@@ -198,11 +198,11 @@ class Summary:
     P_error: float  #: P_ref - P before the push [MPa] (pressure control; nan for angle control)
     P_before: float  #: mean pressure before the push [MPa]
     theta_before: float  #: mean finger angle before the push [rad]
-    P_during: float  #: mean pressure at the end of the push [MPa]; nan without a push
-    theta_during: float  #: mean finger angle at the end of the push [rad]; nan without a push
-    fingers_during: tuple  #: each finger's angle at the end of the push [rad]
+    P_during: float  #: mean pressure at the end of the full push [MPa]; nan without a push
+    theta_during: float  #: mean finger angle at the end of the full push [rad]; nan without a push
+    fingers_during: tuple  #: each finger's angle at the end of the full push [rad]
     push_start: float  #: first time the push is non-zero [s]; nan without a push
-    push_end: float  #: last time it is non-zero [s]
+    push_end: float  #: end of the last stretch at the push's full magnitude [s]
 
 
 def ramp(F: float, at: float, rise: float = 0.5, until: float = math.inf):
@@ -216,11 +216,14 @@ def ramp(F: float, at: float, rise: float = 0.5, until: float = math.inf):
 
 
 def push_interval(sim: Simulation) -> tuple[float, float]:
-    """(start, end) [s] of the non-zero push; (nan, nan) without one."""
-    on = np.flatnonzero(sim.force != 0.0)
+    """(start, end) [s]: the first non-zero push, and the end of the last stretch at its full
+    magnitude (within 1 %), where "during the push" windows end; (nan, nan) without a push."""
+    size = np.abs(sim.force)
+    on = np.flatnonzero(size > 0.0)
     if on.size == 0:
         return math.nan, math.nan
-    return float(sim.t[on[0]]), float(sim.t[on[-1]] + (sim.t[1] - sim.t[0]))
+    full = np.flatnonzero(size >= 0.99 * size.max())
+    return float(sim.t[on[0]]), float(sim.t[full[-1]] + (sim.t[1] - sim.t[0]))
 
 
 def _window(sim: Simulation, end: float, window: float) -> np.ndarray:

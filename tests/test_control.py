@@ -55,6 +55,16 @@ def test_push_split_carries_the_force():
         Push(0.1, 0.0).shares(2)
 
 
+def test_push_interval_ends_with_the_full_push(tables):
+    """A push rising 1-1.5 s, full until 2.5 s, released by 3 s: 'during' ends at 2.5 s
+    (+ 0.006 s: the 1 % band of 'full' on the 0.5 s release ramp, plus one step)."""
+    plant = PlantParams()
+    force = lambda t: np.interp(t, [1.0, 1.5, 2.5, 3.0], [0.0, 4.0, 4.0, 0.0])  # noqa: E731
+    sim = simulate(PressureController(1.0, plant), tables, plant, mass=1.0, force=force, t_end=4.0)
+    start, end = push_interval(sim)
+    assert start == pytest.approx(1.0 + plant.dt) and end == pytest.approx(2.506, abs=1e-9)
+
+
 def test_equilibrium_is_the_grasp_relation(tables):
     """Per-finger statics summed = eq. (25): with equal loads the static angle needs exactly
     reduced.grasp.pressure_to_hold's P. Tolerance 1e-5 MPa: linear tables at 0.05 deg."""
