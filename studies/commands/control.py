@@ -222,6 +222,9 @@ def run(args) -> int:
         write_json(out / "summary.json", report)
     if args.plot:
         _plot(result, args.mode, args.theta_ref_deg, args.plot)
+    if result.angle_summary.P_before >= plant.P_max - 1e-3:
+        print(f"softhand control: warning: angle control saturates the pump at P_max = {plant.P_max:g} MPa "
+              f"before the push; theta_ref is not reached", file=sys.stderr)
     if args.json:
         print_json(report)
     else:
