@@ -89,6 +89,9 @@ def reservoir(params: dict, design: HandDesign, outdir: Path) -> dict:
     out |= {"p_V0_MPa": at_v0["p_MPa"], "p_ellipse_V0_MPa": at_v0["p_ellipse_MPa"],
             "stroke_dp_fem_MPa": v["stroke_dp_fem_MPa"],
             "stroke_dp_ellipse_MPa": v["stroke_dp_ellipse_MPa"], "max_gap_mm": v["max_gap_mm"]}
+    from studies.reproduce_fem import write_sheet_vtk
+
+    write_sheet_vtk(result, outdir)
     fem = result.fem
     return {**out, "mesh": {**(mesh or {"n_radial": result.study.n_radial,
                                         "n_thick": result.study.n_thick}), "dofs": fem.ndofs},

@@ -6,6 +6,7 @@ CI-sized with ``--quick``, the module's default otherwise.
 from __future__ import annotations
 
 import math
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -51,7 +52,9 @@ def reservoir_fem(ctx: Context, outdir: Path):
     from studies.reservoir import COLUMNS, ReservoirStudy, run
 
     mesh = {"n_radial": 16, "n_thick": 1} if ctx.quick else {}
-    result = run(ReservoirStudy(design=ctx.design, **mesh))
+    with progress_bar("  inflating the sheet", "mm³") as bar:
+        result = run(ReservoirStudy(design=ctx.design, **mesh),
+                     progress=lambda v: bar.update(v - bar.n))
     write_csv(outdir / "reservoir.csv", result.rows, COLUMNS)
     v = result.verdict
     verdict = [{"quantity": name, "min": v[key]["min"], "max": v[key]["max"], "at_V0": v[key]["at_V0"]}
@@ -61,7 +64,7 @@ def reservoir_fem(ctx: Context, outdir: Path):
                     "max": v["stroke_dp"], "at_V0": v["stroke_dp"]})
     write_csv(outdir / "reservoir_verdict.csv", verdict)
     _reservoir_plot(result, ctx.design, outdir / "reservoir.png")
-    _write_vtk(result, outdir)
+    vtk = write_sheet_vtk(result, outdir)
     fem = result.fem
     numbers = {f"{row['quantity'].replace(' ', '_').replace('/', '_')}_max_rel_error":
                max(abs(row["min"]), abs(row["max"])) for row in verdict}
@@ -86,6 +89,8 @@ is {v['stroke_dp_fem_MPa']:.4f} MPa by FEM and {v['stroke_dp_ellipse_MPa']:.4f} 
 ellipse model; the largest gap between the profiles is {v['max_gap_mm']:.2f} mm.
 
 ![reservoir](reservoir.png)
+
+VTK of the deformed sheet (ParaView, `softhand inspect`): {", ".join(f"[{n}]({n})" for n in vtk)}.
 """
     return text, numbers
 
@@ -111,18 +116,31 @@ def _reservoir_plot(result, design, path: Path) -> None:
     save_figure(fig, path)
 
 
-def _write_vtk(result, outdir: Path) -> None:
-    """The deformed sheet per volume, if the reservoir module offers a VTK writer."""
-    import studies.reservoir as module
+def write_sheet_vtk(result, outdir: Path) -> list[str]:
+    """The deformed sheet per volume (r-z section and revolved to 3D) as .vtu files."""
+    from fem.reservoir import sheet_vtk
+    from meshes.convert import write_vtu
 
-    writer = getattr(module, "write_vtk", None)
-    if writer is not None:
-        writer(result, outdir)
+    solid, names = result.fem.model.build()[0], []
+    for state in result.states:
+        for suffix, (points, cells, data) in zip(("", "_3d"), sheet_vtk(solid, state)):
+            name = f"sheet_V{state.volume:.0f}{suffix}.vtu"
+            write_vtu(outdir / name, points, cells, point_data=data)
+            names.append(name)
+    return names
+
+
+def progress_bar(desc: str, unit: str):
+    """A nested tqdm bar (stderr, removed when done) for a long FEM path."""
+    from tqdm import tqdm
+
+    return tqdm(desc=desc, unit=unit, leave=False, position=1, file=sys.stderr)
 
 
 SECTIONS: list[Section] = [
     Section("reservoir_fem", "Reservoir: FEM against the ellipse model",
-            ("studies.reservoir:run", "studies.reservoir:ReservoirStudy"), reservoir_fem),
+            ("studies.reservoir:run", "fem.reservoir:sheet_vtk", "meshes.convert:write_vtu"),
+            reservoir_fem),
     Section("verify", "FEM verification against closed forms",
             ("studies.verify:run_case", "studies.verify:REGISTRY"), verify, in_quick=False),
 ]
