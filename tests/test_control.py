@@ -18,6 +18,7 @@ from reduced.control import (AngleController, Gains, PressureController, default
 from reduced.design import HandDesign
 from reduced.errors import InputError
 from reduced.plant import HandTables, PlantParams, Push, equilibrium
+from studies.cli import main
 
 W180 = grasp.PAPER_WEIGHTS[180.0]
 THETA_REF = math.radians(50.0)
@@ -233,8 +234,6 @@ def test_bad_inputs(tables):
 
 
 # ---------------------------------------------------------------------------- the CLI
-from studies.cli import main  # noqa: E402
-
 CLI = ["control", "--theta-ref-deg", "50", "--mass-kg", "2", "--t-end-s", "6", "--push-at-s", "3"]
 
 
