@@ -93,6 +93,8 @@ class PlantParams:
         for name in ("tau_f", "tau_m", "q_max", "dt", "sample_hz"):
             if not getattr(self, name) > 0:
                 raise InputError(name, getattr(self, name), "must be positive")
+        if self.dt > 0.1 * self.tau_f:  # explicit Euler on the finger lag: keep dt/tau small
+            raise InputError("tau_f", self.tau_f, f"must be at least 10 dt = {10 * self.dt:g} s")
         if not self.P_min < self.P_max:
             raise InputError("P_max", self.P_max, f"must exceed P_min = {self.P_min}")
         if self.noise_theta < 0 or self.noise_P < 0:

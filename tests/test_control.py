@@ -227,6 +227,8 @@ def test_bad_inputs(tables):
         simulate(ctrl, tables, plant, mass=2.0, force=np.zeros(5), t_end=1.0)
     with pytest.raises(InputError, match="tau_f"):
         PlantParams(tau_f=0.0)
+    with pytest.raises(InputError, match="tau_f"):  # too fast a lag for explicit Euler at dt
+        PlantParams(tau_f=0.005)
     with pytest.raises(InputError, match="P_max"):
         PlantParams(P_min=1.0, P_max=0.5)
     with pytest.raises(InputError, match="theta_deg"):  # a push no finger can hold
