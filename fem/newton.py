@@ -4,19 +4,23 @@ Generic: ``fun(x) -> (R, K)`` with R the residual (n,) and K its Jacobian (spars
 n x n), for any extended system (Dirichlet-reduced displacements, bordered volume
 control, rigid-body reduced coordinates, ...).
 
-Line search: the merit is :math:`\phi(s) = \|R(x + s\,\Delta x)\|`. A trial step
-is accepted when :math:`\phi(s) \le (1 - c\,s)\,\phi(0)` (Armijo, c = 1e-4);
-otherwise s shrinks to the minimiser of the quadratic through
-:math:`\phi^2(0), \tfrac{d}{ds}\phi^2(0) = -2\phi^2(0), \phi^2(s)`, clipped to
-[0.1 s, 0.5 s]. The Jacobian evaluated at an accepted trial point is reused for
+Line search (default ``merit="slope"``): the slope
+:math:`g(s) = R(x + s\,\Delta x)\cdot\Delta x` is the derivative of the energy along
+the Newton direction for a potential problem (hyperelasticity with dead loads or
+volume control), and a good indicator otherwise. The full step is taken when the
+energy still decreases there (g(1) < 0) or :math:`|g(s)| \le \eta |g(0)|`; when it
+overshoots (g(1) > 0) the zero of g is bracketed and found by regula falsi. The
+residual norm is a poor merit for slender bodies (a good step can raise
+:math:`\|R\|` a lot); ``merit="residual"`` keeps Armijo backtracking on it.
+A non-finite residual (inverted element) halves the step. The Jacobian evaluated at an accepted trial point is reused for
 the next iteration, so a full step costs one assembly.
 
 Load stepping (:func:`solve_path`): t runs from 0 to 1; each step starts from a
-predictor: the secant extrapolation of the last two converged states, or, when
-only one is known, the tangent (Euler) predictor
-:math:`x - K^{-1}(R + \partial_t R\,\Delta t)` with :math:`\partial_t R` by a
-forward difference in t (this keeps a prescribed boundary displacement from
-distorting the boundary elements alone in the first step); a step that fails is
+predictor direction, line-searched like a Newton step from the last converged
+state: the secant of the last two converged states, or, when only one is known,
+the tangent (Euler) direction :math:`-K^{-1}(R + \partial_t R\,\Delta t)` with
+:math:`\partial_t R` by a forward difference in t (this keeps a prescribed boundary
+displacement from distorting the boundary elements alone); a step that fails is
 halved (cut-back) down to ``min_dt``; easy steps let the increment grow again.
 On final failure :class:`NotConverged` carries the last converged (t, x).
 """
@@ -35,9 +39,11 @@ class NewtonOptions:
     rtol: float = 1e-8  #: on ||R||, relative to ``scale`` (default: ||R(x0)||)
     atol: float = 1e-10  #: absolute floor on ||R|| [units of R]
     max_iter: int = 25  #: Newton iterations per solve
-    line_search: bool = True  #: backtracking on ||R||
-    max_backtracks: int = 8  #: trial step halvings before giving up the iteration
-    armijo: float = 1e-4  #: sufficient-decrease constant c
+    line_search: bool = True  #: adjust the step length (see ``merit``)
+    merit: str = "slope"  #: "slope": R(x + s dx).dx -> 0 (energy); "residual": Armijo on ||R||
+    eta: float = 0.5  #: "slope": accept when |R(x + s dx).dx| <= eta |R(x).dx|
+    max_backtracks: int = 6  #: trial steps before taking the last one
+    armijo: float = 1e-4  #: "residual": sufficient-decrease constant c
 
 
 class NotConverged(RuntimeError):
@@ -64,11 +70,14 @@ class NewtonResult:
     solve_seconds: float = 0.0  #: time spent in the linear solver
 
 
-def newton(fun, x0, options: NewtonOptions = NewtonOptions(), *, solver=None, scale=None) -> NewtonResult:
+def newton(fun, x0, options: NewtonOptions = NewtonOptions(), *, solver=None, scale=None,
+           direction=None) -> NewtonResult:
     """Solve R(x) = 0 from x0; raises NotConverged with the residual history.
 
     fun(x) -> (R, K); solver: a :mod:`fem.linsolve` solver (default auto, unsymmetric);
-    scale: reference for the relative tolerance (default ||R(x0)||).
+    scale: reference for the relative tolerance (default ||R(x0)||);
+    direction: search direction of the first iteration instead of -K^{-1} R (a load-step
+    predictor, line-searched like a Newton step).
     """
     solver = solver or make_solver()
     t0 = time.perf_counter()
@@ -87,31 +96,48 @@ def newton(fun, x0, options: NewtonOptions = NewtonOptions(), *, solver=None, sc
             break
         t1 = time.perf_counter()
         try:
-            dx = solver.solve(K, -R)
+            dx = solver.solve(K, -R) if (it > 0 or direction is None) else np.asarray(direction)
         except (RuntimeError, np.linalg.LinAlgError, ValueError) as err:
             raise NotConverged(f"linear solve failed ({err})", history, x) from err
         t_solve += time.perf_counter() - t1
         t1 = time.perf_counter()
-        x, R, K, norm, s = _line_search(fun, x, dx, norm, options)
+        x, R, K, norm, s = _line_search(fun, x, dx, R, norm, options)
         t_asm += time.perf_counter() - t1
         history.append(norm)
         steps.append(s)
     raise NotConverged(f"no convergence in {options.max_iter} iterations (tol {tol:.2e})", history, x)
 
 
-def _line_search(fun, x, dx, norm0, options):
-    """Backtracking on ||R||; returns the accepted (x, R, K, ||R||, s)."""
-    s = 1.0
+def _line_search(fun, x, dx, R0, norm0, options):
+    """Step length on x + s dx; returns the accepted (x, R, K, ||R||, s). See the module docstring."""
+    g0 = float(R0 @ dx)  # slope of the energy along dx at s = 0 (< 0 for a descent direction)
+    s, lo, glo, hi, ghi = 1.0, 0.0, g0, None, None
     for _ in range(options.max_backtracks + 1):
         xt = x + s * dx
         with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
             R, K = fun(xt)
         norm = float(np.linalg.norm(R))
-        if not options.line_search or (np.isfinite(norm) and norm <= (1 - options.armijo * s) * norm0):
+        if not options.line_search:
             return xt, R, K, norm, s
-        phi0, phis = norm0 ** 2, norm ** 2 if np.isfinite(norm) else np.inf
-        s_quad = s * s * phi0 / (phis - phi0 + 2 * s * phi0) if np.isfinite(phis) else 0.1 * s
-        s = float(np.clip(s_quad, 0.1 * s, 0.5 * s))
+        if not np.isfinite(norm):  # e.g. an inverted element: shorten
+            hi, ghi, s = s, None, 0.5 * (lo + s)
+            continue
+        if options.merit == "residual":
+            if norm <= (1 - options.armijo * s) * norm0:
+                return xt, R, K, norm, s
+            phi0, phis = norm0 ** 2, norm ** 2
+            s = float(np.clip(s * s * phi0 / (phis - phi0 + 2 * s * phi0), 0.1 * s, 0.5 * s))
+            continue
+        g = float(R @ dx)
+        if g0 >= 0 or abs(g) <= options.eta * abs(g0) or (g < 0 and hi is None):
+            return xt, R, K, norm, s  # slope small enough, or still descending at the full step
+        if g < 0:
+            lo, glo = s, g
+        else:
+            hi, ghi = s, g
+        # regula falsi for the zero of the slope in [lo, hi], kept off the ends
+        s_new = lo + (hi - lo) * glo / (glo - ghi) if ghi is not None else 0.5 * (lo + hi)
+        s = float(np.clip(s_new, lo + 0.1 * (hi - lo), hi - 0.1 * (hi - lo)))
     return xt, R, K, norm, s  # not sufficient: take the last trial, Newton may still recover
 
 
@@ -152,10 +178,10 @@ def solve_path(fun_t, x0, options: PathOptions = PathOptions(), *, solver=None, 
     dt = 1.0 / options.steps
     while res.t[-1] < 1.0 - 1e-12:
         t = min(1.0, res.t[-1] + dt)
-        guess = _predict(res, t, fun_t, solver) if options.predictor else res.x[-1]
+        step = _predict(res, t, fun_t, solver) if options.predictor else None
         try:
-            r = newton(lambda x: fun_t(x, t), guess, options.newton, solver=solver,
-                       scale=None if scale_t is None else scale_t(t))
+            r = newton(lambda x: fun_t(x, t), res.x[-1], options.newton, solver=solver,
+                       scale=None if scale_t is None else scale_t(t), direction=step)
         except NotConverged as err:
             res.cutbacks += 1
             dt *= 0.5
@@ -176,16 +202,16 @@ def solve_path(fun_t, x0, options: PathOptions = PathOptions(), *, solver=None, 
     return res
 
 
-def _predict(res: PathResult, t: float, fun_t, solver) -> np.ndarray:
-    """Secant extrapolation from the last two converged states to t, else the tangent predictor."""
+def _predict(res: PathResult, t: float, fun_t, solver):
+    """Predictor step from the last converged state to t: secant, else tangent (None if singular)."""
     if len(res.t) < 2:
         t0, x0 = res.t[-1], res.x[-1]
         eps = 1e-7 * max(t - t0, 1e-3)
         R0, K0 = fun_t(x0, t0)
         R1 = fun_t(x0, t0 + eps)[0]
         try:
-            return x0 - solver.solve(K0, R0 + (R1 - R0) * ((t - t0) / eps))
+            return -solver.solve(K0, R0 + (R1 - R0) * ((t - t0) / eps))
         except (RuntimeError, np.linalg.LinAlgError, ValueError):
-            return x0
+            return None
     t1, t2 = res.t[-2], res.t[-1]
-    return res.x[-1] + (t - t2) / (t2 - t1) * (res.x[-1] - res.x[-2])
+    return (t - t2) / (t2 - t1) * (res.x[-1] - res.x[-2])

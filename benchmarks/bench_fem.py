@@ -1,0 +1,123 @@
+"""FEM speed benchmark (issue 3): a compressible Neo-Hookean tube under dead loads.
+
+Tube inner radius 4 mm, outer 9 mm, length 60 mm, clamped at z = 0; dead internal
+pressure 0.3 MPa on the inner surface, dead traction (0.05, 0, 0) MPa on the end face;
+W = mu/2 (I1 - 3) - mu ln J + lam/2 (ln J)^2, mu = 1.15 MPa, lam = 50 MPa; P2
+displacements on straight-sided tetrahedra (gmsh), 5 equal load steps.
+
+Prints DOFs, load steps, Newton iterations, assembly and solve seconds per iteration,
+total, peak memory, and the tip displacement (mean over the end face). With
+``ngsolve`` importable (the ``bench`` extra) it solves the same problem on the same
+mesh with NGSolve (same quadrature, sparse Cholesky, plain Newton) and prints ratios.
+
+    python benchmarks/bench_fem.py                 # ~20k DOFs
+    python benchmarks/bench_fem.py --size medium   # ~80k DOFs
+    python benchmarks/bench_fem.py --size large    # ~200k DOFs (heavy: run once)
+"""
+from __future__ import annotations
+
+import argparse
+import resource
+import time
+
+import numpy as np
+
+from fem.assembly import Restriction
+from fem.linsolve import make_solver
+from fem.loads import dead_load
+from fem.materials import CompressibleNeoHookean
+from fem.newton import NewtonOptions, PathOptions, solve_path
+from fem.solid import Solid
+from meshes.tube import Tube, tube_mesh
+
+#: gmsh element size [mm] giving about 20k / 80k / 200k P2 DOFs on this tube
+SIZES = {"small": 2.6, "medium": 1.6, "large": 1.15}
+MU, LAM, P_IN, T_END = 1.15, 50.0, 0.3, (0.05, 0.0, 0.0)
+
+
+def peak_mb() -> float:
+    """Peak resident memory of this process so far [MB] (Linux ru_maxrss is in kB)."""
+    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
+
+
+def tip_mean(solid, u) -> np.ndarray:
+    """Mean displacement over the end face (area-weighted) [mm]."""
+    from skfem import FacetBasis
+    fb = FacetBasis(solid.mesh, solid.element, facets="tip", intorder=4)
+    uu = solid.nodal(u)
+    vals = [fb.interpolate(uu[a]).value for a in range(3)]
+    area = fb.dx.sum()
+    return np.array([(v * fb.dx).sum() / area for v in vals])
+
+
+def run_ours(mesh, steps: int, solver_name: str, intorder: int):
+    t0 = time.perf_counter()
+    solid = Solid(mesh, CompressibleNeoHookean(MU, LAM), intorder=intorder)
+    fixed = solid.dofs("base")
+    red = Restriction(solid.ndofs, solid.free_dofs(fixed))
+    f_ext = dead_load(solid, "inner", pressure=P_IN) + dead_load(solid, "tip", traction=T_END)
+    setup = time.perf_counter() - t0
+    solver = make_solver(solver_name, symmetric=True)
+
+    def fun_t(x, t):
+        R, K = solid.residual_tangent(red.expand(x))
+        return red.vector(R - t * f_ext), red.restrict(K)
+
+    scale = np.linalg.norm(red.vector(f_ext))
+    opts = PathOptions(steps=steps, grow=1.0, newton=NewtonOptions(rtol=1e-10, atol=0.0))
+    res = solve_path(fun_t, np.zeros(len(red.keep)), opts, solver=solver, scale_t=lambda t: t * scale)
+    total = time.perf_counter() - t0
+    u = red.expand(res.x[-1])
+    return dict(dofs=solid.ndofs, steps=len(res.t) - 1, iterations=res.total_iterations,
+                cutbacks=res.cutbacks, setup=setup, total=total,
+                assembly=res.assembly_seconds, solve=res.solve_seconds,
+                tip=tip_mean(solid, u), solver=solver.describe(), per_step=res.iterations)
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--size", choices=list(SIZES), default="small")
+    ap.add_argument("--h", type=float, help="gmsh element size [mm] (overrides --size)")
+    ap.add_argument("--steps", type=int, default=5)
+    ap.add_argument("--solver", default="auto")
+    ap.add_argument("--intorder", type=int, default=2, help="quadrature degree (both codes)")
+    ap.add_argument("--no-ngsolve", action="store_true")
+    args = ap.parse_args(argv)
+    h = args.h or SIZES[args.size]
+    mesh = tube_mesh(Tube(4.0, 9.0, 60.0), size=h, order=1)
+    base_mb = peak_mb()
+    ours = run_ours(mesh, args.steps, args.solver, args.intorder)
+    ours["peak_mb"] = peak_mb()
+    it = max(ours["iterations"], 1)
+    print(f"mesh h = {h} mm: {mesh.t.shape[1]} tets, {ours['dofs']} DOFs (P2); "
+          f"peak RSS before solving {base_mb:.0f} MB")
+    print(f"solver: {ours['solver']}")
+    print(f"ours   : {ours['steps']} load steps, {ours['iterations']} Newton iterations "
+          f"{ours['per_step']}, {ours['cutbacks']} cut-backs")
+    print(f"ours   : assembly {ours['assembly'] / it:.3f} s/it, solve {ours['solve'] / it:.3f} s/it, "
+          f"setup {ours['setup']:.2f} s, total {ours['total']:.2f} s, peak RSS {ours['peak_mb']:.0f} MB")
+    print(f"ours   : tip displacement (mean over end face) {np.array2string(ours['tip'], precision=10)} mm")
+    if args.no_ngsolve:
+        return
+    try:
+        import ngsolve  # noqa: F401
+    except ImportError:
+        print("ngsolve not importable: no comparison (pip install softhand[bench])")
+        return
+    from bench_ngsolve import run_ngsolve
+    ng = run_ngsolve(mesh, args.steps, args.intorder)
+    ng["peak_mb"] = peak_mb()
+    nit = max(ng["iterations"], 1)
+    print(f"ngsolve: {ng['steps']} load steps, {ng['iterations']} Newton iterations {ng['per_step']}")
+    print(f"ngsolve: assembly {ng['assembly'] / nit:.3f} s/it, solve {ng['solve'] / nit:.3f} s/it, "
+          f"total {ng['total']:.2f} s (peak RSS of the process after both: {ng['peak_mb']:.0f} MB)")
+    print(f"ngsolve: tip displacement {np.array2string(ng['tip'], precision=10)} mm; "
+          f"max |difference| {np.abs(ng['tip'] - ours['tip']).max():.2e} mm")
+    per_it = (ours["assembly"] + ours["solve"]) / it / ((ng["assembly"] + ng["solve"]) / nit)
+    print(f"ratio ours/ngsolve: time per iteration {per_it:.2f}, "
+          f"assembly {ours['assembly'] / it / (ng['assembly'] / nit):.2f}, "
+          f"solve {ours['solve'] / it / (ng['solve'] / nit):.2f}, total {ours['total'] / ng['total']:.2f}")
+
+
+if __name__ == "__main__":
+    main()
