@@ -32,7 +32,7 @@ from fem.materials import NeoHookean
 from fem.volume_path import PathOptions, follow_volume
 from meshes.reservoir import sheet_mesh
 
-__all__ = ["SheetModel", "SheetState", "ReservoirResult", "inflate", "pressure_maximum"]
+__all__ = ["SheetModel", "SheetState", "ReservoirResult", "inflate", "pressure_maximum", "sheet_vtk"]
 
 
 @dataclass(frozen=True)
@@ -163,3 +163,37 @@ def inflate(model: SheetModel, volumes, *, options: PathOptions | None = None,
         path_energy=np.array([s.energy for s in path]), pressure_max=pressure_maximum(V, p),
         ndofs=solid.ndofs, newton_iterations=sum(s.iterations for s in path),
         wall_time=time.perf_counter() - start)
+
+
+def sheet_vtk(solid, state: SheetState, *, n_phi: int = 48):
+    """Two VTK datasets (points, cells, point_data) of a deformed sheet.
+
+    1. the r–z section on its Q2 mesh (``quad9``): reference points (r, z, 0) with the
+       ``displacement`` (u_r, u_z, 0) and the ``hoop_stretch`` (Warp By Vector shows it);
+    2. the wet and dry surfaces revolved about the axis into ``quad`` cells, in deformed
+       position, with the ``height`` z, for viewing the 3D dome.
+    """
+    from skfem import Basis, ElementQuad2
+
+    scalar = Basis(solid.mesh, ElementQuad2())
+    X = scalar.doflocs
+    u = state.u.reshape(-1, 2).T  # interleaved (u_r, u_z) per scalar DOF
+    hoop = np.where(X[0] > 0, (X[0] + u[0]) / np.where(X[0] > 0, X[0], 1.0), np.nan)
+    hoop[np.isnan(hoop)] = state.lambda_hoop[0]
+    section = (np.c_[X.T, np.zeros(X.shape[1])], {"quad9": scalar.element_dofs.T},
+               {"displacement": np.c_[u.T, np.zeros(X.shape[1])], "hoop_stretch": hoop})
+    points, quads, height = [], [], []
+    phi = np.linspace(0.0, 2 * np.pi, n_phi, endpoint=False)
+    for z0 in (0.0, float(solid.mesh.p[1].max())):  # wet and dry surfaces
+        _, r, z = _surface(solid, state.u, z0)
+        base = sum(len(p) for p in points)
+        points.append(np.stack([np.outer(r, np.cos(phi)).ravel(), np.outer(r, np.sin(phi)).ravel(),
+                                np.repeat(z, n_phi)], axis=1))
+        height.append(np.repeat(z, n_phi))
+        i, j = np.meshgrid(np.arange(len(r) - 1), np.arange(n_phi), indexing="ij")
+        jn = (j + 1) % n_phi
+        quads.append(base + np.stack([i * n_phi + j, (i + 1) * n_phi + j, (i + 1) * n_phi + jn,
+                                      i * n_phi + jn], axis=-1).reshape(-1, 4))
+    revolved = (np.concatenate(points), {"quad": np.concatenate(quads)},
+                {"height": np.concatenate(height)})
+    return section, revolved

@@ -42,6 +42,9 @@ class PathOptions:
     max_step: float = 200.0  #: largest volume increment [mm^3]
     rtol: float = 1e-9  #: force residual, relative to the pressure load |p g_V| (or |Π'|)
     atol: float = 0.0  #: force residual floor [N]: round-off of the stiff volumetric terms
+    #: merit below which Newton that stops converging quadratically has reached round-off
+    #: (the bordered matrix's condition grows with κ/μ and the mesh)
+    floor: float = 1e-5
     vtol: float = 1e-10  #: volume residual, relative to max(V*, volume_scale)
     max_iter: int = 12  #: Newton iterations per step before cut-back
     min_step: float = 1e-6  #: smallest volume increment before giving up [mm^3]
@@ -105,7 +108,8 @@ def _newton(prob, uf, p, target, opt: PathOptions):
 
     The first step (from the predictor) is taken whole; later steps backtrack on the merit
     |R_u| / f + |R_V| / v, f the largest force scale (|p g_V|, |Π'|, atol) met in this
-    solve, v the volume scale.
+    solve, v the volume scale. Converged: both residuals within tolerance, or the merit
+    below ``floor`` and no longer halving (round-off).
     """
     history = []
     vscale = max(abs(target), prob.volume_scale)
@@ -116,6 +120,8 @@ def _newton(prob, uf, p, target, opt: PathOptions):
         history.append(merit)
         if np.linalg.norm(ru) <= opt.rtol * fscale + opt.atol and abs(rv) <= opt.vtol * vscale:
             return (uf, p, it), history
+        if it >= 2 and merit < opt.floor and merit > 0.5 * history[-2]:
+            return (uf, p, it), history  # stagnating at the round-off floor of the solve
         if it == opt.max_iter or not np.isfinite(merit):
             break
         du, dp = prob.newton_step(uf, p, ru, rv)

@@ -1,0 +1,170 @@
+"""``softhand reservoir``: FEM inflation of the reservoir sheet vs the paper's ellipse model.
+
+Per volume: FEM pressure, apex height, strain energy; the ellipse model's (13)–(18) at the
+same volume; the mean stretches and the largest gap between the profiles. Then the pressure
+maximum (if the path passes one) and the verdict over the operating range (V0 - stroke .. V0).
+``--plot``: profiles, p(V) of both models, and the hand's P(theta) with both reservoir
+models. ``--out DIR``: result.json, rows.csv, VTK of the deformed sheet per volume (r–z and
+revolved to 3D). ``--write-calibration FILE.csv``: the table of ``reduced/reservoir_fem.py``.
+"""
+from __future__ import annotations
+
+import math
+import subprocess
+from pathlib import Path
+
+import numpy as np
+
+from reduced.errors import InputError
+from studies.args import add_design_option, add_json_option, design_from_args, parse_values, \
+    print_json, print_table
+
+HELP = "inflate the reservoir sheet (FEM) and measure the ellipse assumption (eqs. 11-18)"
+
+
+def configure(parser) -> None:
+    parser.add_argument("--volume-mm3", metavar="LIST",
+                        help="oil volumes [mm^3]: start:stop:step or a,b,c "
+                             "(default: V0 - stroke at 90 deg, V0, V0 + 2000)")
+    parser.add_argument("--plot", metavar="FILE.png", help="profiles, p(V) and P(theta), both models")
+    parser.add_argument("--out", metavar="DIR", help="write result.json, rows.csv and VTK here")
+    parser.add_argument("--n-radial", type=int, default=40, help="Q2 elements along the radius")
+    parser.add_argument("--n-thick", type=int, default=2, help="Q2 elements through the thickness")
+    parser.add_argument("--write-calibration", metavar="FILE.csv",
+                        help="write the FEM calibration table of the 'fem' reservoir model")
+    add_design_option(parser)
+    add_json_option(parser)
+
+
+def _study(args):
+    from studies.reservoir import ReservoirStudy
+
+    design = design_from_args(args)
+    for name in ("n_radial", "n_thick"):
+        if getattr(args, name) < 1:
+            raise InputError(f"--{name.replace('_', '-')}", getattr(args, name), "must be >= 1")
+    volumes = ()
+    if args.volume_mm3 is not None:
+        volumes = tuple(parse_values(args.volume_mm3, "--volume-mm3"))
+        if min(volumes) <= 0:
+            raise InputError("--volume-mm3", args.volume_mm3, "volumes must be positive")
+    return ReservoirStudy(design=design, volumes_mm3=volumes, n_radial=args.n_radial,
+                          n_thick=args.n_thick)
+
+
+def run(args) -> int:
+    study = _study(args)
+    if args.write_calibration:
+        return _write_calibration(study, args.write_calibration)
+    from tqdm import tqdm
+
+    from studies.reservoir import COLUMNS, run as run_study
+
+    with tqdm(desc="inflating", unit="mm^3", leave=False) as bar:
+        result = run_study(study, progress=lambda v: bar.update(v - bar.n))
+    summary = _summary(result)
+    if args.out:
+        _write_outputs(Path(args.out), result, summary)
+    if args.plot:
+        plot_reservoir(args.plot, result)
+    if args.json:
+        print_json({"rows": result.rows, **summary})
+    else:
+        print_table(result.rows, COLUMNS)
+        pm = summary["pressure_max"]
+        print("pressure maximum: " + ("none in 0..%.0f mm^3" % summary["path_max_volume_mm3"] if pm is None
+                                      else f"p = {pm['p_MPa']:.4g} MPa at V = {pm['V_mm3']:.0f} mm^3"))
+        v = result.verdict
+        print(f"stroke {v['stroke_mm3']:.0f} mm^3: dp FEM {v['stroke_dp_fem_MPa']:.4g} MPa, "
+              f"ellipse {v['stroke_dp_ellipse_MPa']:.4g} MPa ({100 * v['stroke_dp']:+.1f} %)")
+    return 0
+
+
+def _summary(result) -> dict:
+    fem = result.fem
+    pm = fem.pressure_max
+    return {
+        "pressure_max": None if pm is None else {"V_mm3": pm[0], "p_MPa": pm[1]},
+        "path_max_volume_mm3": float(fem.path_volume[-1]),
+        "verdict": result.verdict, "design": result.study.design.to_dict(),
+        "design_hash": result.study.design.hash(),
+        "mesh": {"n_radial": fem.model.n_radial, "n_thick": fem.model.n_thick, "ndofs": fem.ndofs,
+                 "element": "Q2/P1disc axisymmetric", "kappa_over_mu": fem.model.kappa_ratio},
+        "newton_iterations": fem.newton_iterations, "load_steps": len(fem.path_volume) - 1,
+        "wall_time_s": fem.wall_time,
+    }
+
+
+def _write_outputs(out: Path, result, summary) -> None:
+    from fem.reservoir import sheet_vtk
+    from meshes.convert import write_vtu
+    from studies.output import write_csv, write_json
+
+    write_json(out / "result.json", {"rows": result.rows, **summary})
+    write_csv(out / "rows.csv", result.rows)
+    solid = result.fem.model.build()[0]
+    for state in result.states:
+        for suffix, (points, cells, data) in zip(("", "_3d"), sheet_vtk(solid, state)):
+            write_vtu(out / f"sheet_V{state.volume:.0f}{suffix}.vtu", points, cells, point_data=data)
+
+
+def _git_commit() -> str:
+    try:
+        return subprocess.run(["git", "rev-parse", "--short", "HEAD"], capture_output=True,
+                              text=True, cwd=Path(__file__).parent, check=True).stdout.strip()
+    except (OSError, subprocess.CalledProcessError):
+        return "unknown"
+
+
+def _write_calibration(study, path) -> int:
+    from datetime import datetime, timezone
+
+    from studies.output import write_atomic
+    from studies.reservoir import calibration_csv, calibration_rows
+
+    model = study.model()
+    rows = calibration_rows(model)
+    provenance = (f"FEM calibration of reduced/reservoir_fem.py, written "
+                  f"{datetime.now(timezone.utc):%Y-%m-%d %H:%M} UTC at commit {_git_commit()} by\n"
+                  f"softhand reservoir --write-calibration {Path(path).name} "
+                  f"--n-radial {model.n_radial} --n-thick {model.n_thick}")
+    write_atomic(path, calibration_csv(model, rows, provenance))
+    print(f"wrote {len(rows)} rows to {path}")
+    return 0
+
+
+def plot_reservoir(path, result) -> None:
+    """Profiles (FEM vs ellipse), p(V) of both models, P(theta) with both reservoir models."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from reduced import hand, reservoir
+    from studies.output import save_figure
+
+    d = result.study.design
+    fig, ax = plt.subplots(1, 3, figsize=(15, 4.2))
+    r = np.linspace(0, d.R, 200)
+    for k, s in enumerate(result.states):
+        c = f"C{k}"
+        ax[0].plot(s.r, s.z, "-", color=c, label=f"FEM V={s.volume:.0f}")
+        h = float(reservoir.height(s.volume, d))
+        ax[0].plot(r, h * np.sqrt(1 - (r / d.R) ** 2), "--", color=c)
+    ax[0].set(xlabel="r [mm]", ylabel="z [mm] (wet surface)", title="profiles: FEM (-), ellipse (--)",
+              aspect="equal")
+    fem = result.fem
+    V = fem.path_volume[1:]
+    ax[1].plot(V, fem.path_pressure[1:], "-", label="FEM")
+    ax[1].plot(V, reservoir.ellipse_pressure(V, d), "--", label="ellipse (11)-(18)")
+    ax[1].axvspan(*result.verdict["V_range_mm3"], color="0.9", label="operating range")
+    ax[1].set(xlabel="V [mm^3]", ylabel="p_r [MPa]", title="reservoir pressure p(V)")
+    theta = np.linspace(0, math.pi / 2, 91)
+    for name, style in (("ellipse", "--"), ("fem", "-")):
+        P = hand.pressure(theta, d.replace(reservoir_model=name))
+        ax[2].plot(np.degrees(theta), P, style, label=f"reservoir model '{name}'")
+    ax[2].plot(np.degrees(theta), hand.pressure(theta, d, reservoir=False), ":", label="no reservoir")
+    ax[2].set(xlabel="theta [deg]", ylabel="P [MPa]", title="pump pressure P(theta), eq. (27)")
+    for a in ax:
+        a.grid(alpha=0.3)
+        a.legend(fontsize=8)
+    save_figure(fig, path)

@@ -1,0 +1,134 @@
+"""The reservoir study: FEM inflation of the sheet against the paper's ellipse model (11)–(18).
+
+``run(study)`` inflates the clamped sheet (:mod:`fem.reservoir`) through the requested oil
+volumes and through the operating range, and returns per volume the FEM pressure, apex
+height, strain energy, the ellipse model's values at the same volume, the largest vertical
+gap between the FEM wet-surface profile and the half-ellipse, and the verdict: the ellipse
+model's errors over the operating range (fingers from 0 to ``theta_max``). No printing,
+no files: the CLI (``softhand reservoir``) writes those.
+
+The operating range is V0 - n a² π d θ_max <= V <= V0 (eq. (15)); the stroke pressure change
+Δp = p(V0) - p(V0 - ΔV) is what the reservoir takes off the pump pressure between a straight
+and a fully bent finger.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from fem.reservoir import ReservoirResult, SheetModel, inflate
+from reduced import reservoir as ellipse
+from reduced.design import HandDesign
+
+__all__ = ["ReservoirStudy", "ReservoirStudyResult", "run", "stroke_volume", "COLUMNS"]
+
+#: table columns of the CLI, in order
+COLUMNS = ["V_mm3", "p_MPa", "h_mm", "W_Nmm", "p_ellipse_MPa", "h_ellipse_mm", "W_ellipse_Nmm",
+           "lambda_r", "lambda_fem", "max_gap_mm"]
+
+
+@dataclass(frozen=True)
+class ReservoirStudy:
+    """Which volumes, which design, how fine a mesh."""
+
+    design: HandDesign = field(default_factory=HandDesign)
+    volumes_mm3: tuple = ()  #: requested oil volumes [mm^3]; empty: stroke ends, V0, V0 + 2000
+    theta_max: float = math.pi / 2  #: largest finger bend of the operating range [rad]
+    n_range: int = 9  #: FEM volumes sampled over the operating range for the verdict
+    n_radial: int = 40  #: Q2 elements along the radius
+    n_thick: int = 2  #: Q2 elements through the thickness
+
+    def model(self) -> SheetModel:
+        return SheetModel.from_design(self.design, n_radial=self.n_radial, n_thick=self.n_thick)
+
+
+@dataclass(frozen=True)
+class ReservoirStudyResult:
+    study: ReservoirStudy
+    rows: list  #: one dict per requested volume, keys COLUMNS
+    states: tuple = field(repr=False)  #: fem.reservoir.SheetState per requested volume
+    fem: ReservoirResult = field(repr=False)  #: the whole FEM path
+    verdict: dict = field(default_factory=dict)  #: ellipse-model errors over the operating range
+
+
+def stroke_volume(design: HandDesign, theta_max: float) -> float:
+    """Oil the n fingers take from the reservoir at bend theta_max [rad], eq. (15) [mm^3]."""
+    return design.n * design.a**2 * math.pi * design.d * theta_max
+
+
+def _ellipse_gap(state, design: HandDesign) -> float:
+    """Largest vertical gap [mm] between the FEM wet surface and the half-ellipse of the same V."""
+    r = np.linspace(0.0, design.R, 201)
+    h = float(ellipse.height(state.volume, design))
+    return float(np.max(np.abs(state.profile_at(r) - h * np.sqrt(1.0 - (r / design.R) ** 2))))
+
+
+def _row(state, design: HandDesign) -> dict:
+    V = state.volume
+    return {
+        "V_mm3": V, "p_MPa": state.pressure, "h_mm": state.apex, "W_Nmm": state.energy,
+        "p_ellipse_MPa": float(ellipse.ellipse_pressure(V, design)),
+        "h_ellipse_mm": float(ellipse.height(V, design)),
+        "W_ellipse_Nmm": float(ellipse.strain_energy(V, design)),
+        "lambda_r": float(ellipse.stretch(V, design)), "lambda_fem": state.mean_stretch,
+        "max_gap_mm": _ellipse_gap(state, design),
+    }
+
+
+def _verdict(rows: list, design: HandDesign, dV: float) -> dict:
+    """Relative errors of the ellipse model, (ellipse - FEM) / FEM, over the operating range."""
+    def err(ell, fem):
+        e = np.array([(r[ell] - r[fem]) / r[fem] for r in rows])
+        return {"min": float(e.min()), "max": float(e.max()), "at_V0": float(e[-1])}
+
+    dp_fem = rows[-1]["p_MPa"] - rows[0]["p_MPa"]
+    dp_ell = rows[-1]["p_ellipse_MPa"] - rows[0]["p_ellipse_MPa"]
+    return {
+        "V_range_mm3": [rows[0]["V_mm3"], rows[-1]["V_mm3"]], "stroke_mm3": dV,
+        "apex_height": err("h_ellipse_mm", "h_mm"), "mean_stretch": err("lambda_r", "lambda_fem"),
+        "strain_energy": err("W_ellipse_Nmm", "W_Nmm"), "pressure": err("p_ellipse_MPa", "p_MPa"),
+        "stroke_dp_fem_MPa": dp_fem, "stroke_dp_ellipse_MPa": dp_ell,
+        "stroke_dp": (dp_ell - dp_fem) / dp_fem,
+        "max_gap_mm": max(r["max_gap_mm"] for r in rows),
+    }
+
+
+def run(study: ReservoirStudy, *, progress=None) -> ReservoirStudyResult:
+    """Inflate the sheet through the requested volumes and the operating range; compare."""
+    d = study.design
+    dV = stroke_volume(d, study.theta_max)
+    d.check_volume(study.theta_max)
+    requested = np.asarray(study.volumes_mm3 or (d.V0 - dV, d.V0, d.V0 + 2000.0), dtype=float)
+    grid = np.linspace(d.V0 - dV, d.V0, study.n_range)
+    volumes = np.concatenate([requested, grid])
+    fem = inflate(study.model(), volumes, progress=progress)
+    states = fem.states[:requested.size]
+    rows = [_row(s, d) for s in states]
+    verdict = _verdict([_row(s, d) for s in fem.states[requested.size:]], d, dV)
+    return ReservoirStudyResult(study, rows, states, fem, verdict)
+
+
+def calibration_rows(model: SheetModel, *, v_max: float = 1.75, n: int = 71, progress=None) -> list:
+    """FEM table for :mod:`reduced.reservoir_fem`: v = V/R³ in (0, v_max] on n points, with
+    p̃ = pR/(μt), W̃ = W/(μtR²), h̃ = h/R."""
+    R, t, mu = model.R, model.t, model.mu
+    v = np.linspace(0.0, v_max, n)[1:]
+    fem = inflate(model, v * R**3, progress=progress)
+    rows = [{"v": 0.0, "p_tilde": 0.0, "W_tilde": 0.0, "h_tilde": 0.0}]
+    rows += [{"v": s.volume / R**3, "p_tilde": s.pressure * R / (mu * t),
+              "W_tilde": s.energy / (mu * t * R**2), "h_tilde": s.apex / R} for s in fem.states]
+    return rows
+
+
+def calibration_csv(model: SheetModel, rows: list, provenance: str) -> str:
+    """The calibration table as CSV text with a provenance header (``#`` lines)."""
+    head = [f"# {line}" for line in provenance.splitlines()]
+    head.append(f"# model: R={model.R} mm, t={model.t} mm (t/R={model.t / model.R:.5g}), "
+                f"mu={model.mu} MPa, kappa/mu={model.kappa_ratio}, Q2/P1disc, "
+                f"{model.n_radial} x {model.n_thick} elements (clamp ratio {model.clamp_ratio})")
+    head.append("# v = V/R^3, p_tilde = p R/(mu t), W_tilde = W/(mu t R^2), h_tilde = h/R")
+    lines = ["v,p_tilde,W_tilde,h_tilde"]
+    lines += [f"{r['v']:.6g},{r['p_tilde']:.10g},{r['W_tilde']:.10g},{r['h_tilde']:.10g}" for r in rows]
+    return "\n".join(head + lines) + "\n"
