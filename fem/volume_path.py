@@ -29,7 +29,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 import scipy.sparse as sp
-import scipy.sparse.linalg as spla
+
+from fem.linsolve import make_solver
 
 __all__ = ["PathOptions", "PathState", "NotConverged", "follow_volume"]
 
@@ -49,6 +50,7 @@ class PathOptions:
     max_iter: int = 12  #: Newton iterations per step before cut-back
     min_step: float = 1e-6  #: smallest volume increment before giving up [mm^3]
     grow: float = 1.5  #: step growth after a step that took <= 5 iterations
+    solver: str = "auto"  #: :func:`fem.linsolve.make_solver` method for the bordered system
 
 
 @dataclass(frozen=True)
@@ -71,20 +73,13 @@ class NotConverged(RuntimeError):
         self.last = last
 
 
-def _solve_bordered(K, g, rhs_u, rhs_v):
-    """Solve [[K, -g], [-g^T, 0]] [du, dp] = [rhs_u, rhs_v]."""
-    n = g.size
-    A = sp.bmat([[K, sp.csr_matrix(-g[:, None])], [sp.csr_matrix(-g[None, :]), None]], format="csc")
-    x = spla.spsolve(A, np.concatenate([rhs_u, [rhs_v]]))
-    return x[:n], x[n]
-
-
 class _Problem:
     """Residual and tangent of L(u, p) on the free DOFs."""
 
-    def __init__(self, solid, volume, free, volume_scale):
+    def __init__(self, solid, volume, free, volume_scale, solver):
         self.solid, self.volume, self.free = solid, volume, free
         self.volume_scale = volume_scale
+        self.solver = solver
 
     def full(self, uf):
         u = np.zeros(self.solid.ndofs)
@@ -99,8 +94,11 @@ class _Problem:
     def newton_step(self, uf, p, ru, rv):
         u = self.full(uf)
         K = self.solid.tangent(u) - p * self.volume.hessian(u)
-        K = K[self.free][:, self.free]
-        return _solve_bordered(K, self.volume.gradient(u)[self.free], -ru, -rv)
+        g = self.volume.gradient(u)[self.free][:, None]
+        A = sp.bmat([[K[self.free][:, self.free], sp.csr_matrix(-g)], [sp.csr_matrix(-g.T), None]],
+                    format="csr")
+        x = self.solver.solve(A, -np.append(ru, rv))
+        return x[:-1], x[-1]
 
 
 def _newton(prob, uf, p, target, opt: PathOptions):
@@ -146,7 +144,7 @@ def follow_volume(solid, volume, fixed_dofs, targets, *, options=PathOptions(),
     """
     targets = np.asarray(targets, dtype=float)
     free = np.setdiff1d(np.arange(solid.ndofs), fixed_dofs)
-    prob = _Problem(solid, volume, free, volume_scale)
+    prob = _Problem(solid, volume, free, volume_scale, make_solver(options.solver, symmetric=True))
     uf, p, step = np.zeros(free.size), 0.0, options.first_step
     v = volume.value(prob.full(uf))
     if np.any(np.diff(targets) <= 0) or targets[0] <= v:

@@ -96,16 +96,12 @@ def _summary(result) -> dict:
 
 
 def _write_outputs(out: Path, result, summary) -> None:
-    from fem.reservoir import sheet_vtk
-    from meshes.convert import write_vtu
     from studies.output import write_csv, write_json
+    from studies.reproduce_fem import write_sheet_vtk
 
     write_json(out / "result.json", {"rows": result.rows, **summary})
     write_csv(out / "rows.csv", result.rows)
-    solid = result.fem.model.build()[0]
-    for state in result.states:
-        for suffix, (points, cells, data) in zip(("", "_3d"), sheet_vtk(solid, state)):
-            write_vtu(out / f"sheet_V{state.volume:.0f}{suffix}.vtu", points, cells, point_data=data)
+    write_sheet_vtk(result, out)  # sheet_V<volume>.vtu (r–z) and sheet_V<volume>_3d.vtu
 
 
 def _git_commit() -> str:
