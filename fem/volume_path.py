@@ -124,7 +124,8 @@ def _newton(prob, uf, p, target, opt: PathOptions):
             break
         du, dp = prob.newton_step(uf, p, ru, rv)
         for alpha in (1.0, 0.5, 0.25, 0.125, 0.0625):
-            trial = prob.residual(uf + alpha * du, p + alpha * dp, target)
+            with np.errstate(invalid="ignore", divide="ignore", over="ignore"):  # J < 0 trials
+                trial = prob.residual(uf + alpha * du, p + alpha * dp, target)
             new = np.linalg.norm(trial[0]) / max(fnorm, trial[2]) + abs(trial[1]) / vscale
             if it == 0 or (np.isfinite(new) and new < merit):
                 break
