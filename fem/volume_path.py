@@ -136,26 +136,29 @@ def _newton(prob, uf, p, target, opt: PathOptions):
 
 
 def follow_volume(solid, volume, fixed_dofs, targets, *, options=PathOptions(),
-                  volume_scale=1.0, progress=None) -> tuple[list[PathState], list[PathState]]:
-    """Follow the equilibrium path from u = 0 through the volumes ``targets`` [mm^3].
+                  volume_scale=1.0, progress=None,
+                  start: PathState | None = None) -> tuple[list[PathState], list[PathState]]:
+    """Follow the equilibrium path from ``start`` (default u = 0) through the volumes ``targets``.
 
-    ``targets`` must increase strictly from the reference volume V(u = 0) (a reversible
-    elastic path: decreasing volumes are the same states). Returns (states at the targets,
-    every converged state from the reference on).
+    ``targets`` [mm^3] must run strictly monotonically away from the start volume, up
+    (inflating) or down (oil leaving). Returns (states at the targets, every converged state
+    from the start on).
     """
     targets = np.asarray(targets, dtype=float)
     free = np.setdiff1d(np.arange(solid.ndofs), fixed_dofs)
     prob = _Problem(solid, volume, free, volume_scale, make_solver(options.solver, symmetric=True))
-    uf, p, step = np.zeros(free.size), 0.0, options.first_step
-    v = volume.value(prob.full(uf))
-    if np.any(np.diff(targets) <= 0) or targets[0] <= v:
-        raise ValueError(f"volume targets must increase strictly from the reference {v:.6g} mm^3")
-    path = [PathState(v, 0.0, 0.0, prob.full(uf))]
+    if start is None:
+        start = PathState(volume.value(np.zeros(solid.ndofs)), 0.0, 0.0, np.zeros(solid.ndofs))
+    uf, p, v, step = start.u[free], start.pressure, start.volume, options.first_step
+    sign = np.sign(targets[0] - v)
+    if sign == 0 or np.any(sign * np.diff(targets) <= 0):
+        raise ValueError(f"volume targets must run strictly monotonically away from {v:.6g} mm^3")
+    path = [start]
     prev = None  # (uf, p, V) of the state before the last one, for the secant predictor
     hits = []
     for target in targets:
-        while v < target:
-            nxt = min(v + step, target)
+        while sign * (target - v) > 0:
+            nxt = v + sign * min(step, sign * (target - v))
             if prev is not None:
                 s = (nxt - v) / (v - prev[2])
                 guess = (uf + s * (uf - prev[0]), p + s * (p - prev[1]))

@@ -78,11 +78,14 @@ def _row(state, design: HandDesign) -> dict:
 
 
 def _verdict(rows: list, design: HandDesign, dV: float) -> dict:
-    """Relative errors of the ellipse model, (ellipse - FEM) / FEM, over the operating range."""
+    """Relative errors of the ellipse model, (ellipse - FEM) / FEM, over the operating range
+    (``rows`` from V0 - dV to V0), and the pressure offsets p_r(V(theta)) of both models."""
     def err(ell, fem):
         e = np.array([(r[ell] - r[fem]) / r[fem] for r in rows])
         return {"min": float(e.min()), "max": float(e.max()), "at_V0": float(e[-1])}
 
+    theta = (design.V0 - np.array([r["V_mm3"] for r in rows])) / (stroke_volume(design, 1.0))
+    diff = [r["p_ellipse_MPa"] - r["p_MPa"] for r in rows]
     dp_fem = rows[-1]["p_MPa"] - rows[0]["p_MPa"]
     dp_ell = rows[-1]["p_ellipse_MPa"] - rows[0]["p_ellipse_MPa"]
     return {
@@ -92,6 +95,11 @@ def _verdict(rows: list, design: HandDesign, dV: float) -> dict:
         "stroke_dp_fem_MPa": dp_fem, "stroke_dp_ellipse_MPa": dp_ell,
         "stroke_dp": (dp_ell - dp_fem) / dp_fem,
         "max_gap_mm": max(r["max_gap_mm"] for r in rows),
+        # the reservoir's pressure offset in eq. (27), P = p_finger - p_r(V(theta))
+        "offset_theta_deg": np.degrees(theta).tolist(),
+        "offset_fem_MPa": [r["p_MPa"] for r in rows],
+        "offset_ellipse_MPa": [r["p_ellipse_MPa"] for r in rows],
+        "offset_difference_MPa": [min(diff), max(diff)],
     }
 
 

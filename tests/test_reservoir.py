@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 
 from fem.reservoir import SheetModel, inflate
+from fem.volume_path import PathOptions, PathState, follow_volume
 from reduced import hand, reservoir
 from reduced import reservoir_fem
 from reduced.design import HandDesign
@@ -102,3 +103,19 @@ def test_cli_table_json_files_and_bad_input(tmp_path, capsys):
     assert (tmp_path / "r.png").stat().st_size > 0
     assert main(["reservoir", "--volume-mm3", "-5"]) == 2
     assert "--volume-mm3" in capsys.readouterr().err
+
+
+def test_oil_leaving_retraces_the_inflation_path(study):
+    """Decreasing the volume from V0 + 2000 back to V0 - stroke (oil leaving for the fingers)
+    meets the same elastic states: p agrees to 1e-9, the Newton tolerance (measured 1e-14)."""
+    model = study.fem.model
+    solid, volume, fixed = model.build()
+    top = study.states[2]  # V0 + 2000
+    start = PathState(top.volume, top.pressure, top.energy, top.u)
+    options = PathOptions(max_step=0.5 * model.R**2 * model.t,
+                          atol=1e-12 * model.kappa_ratio * model.mu * model.R * model.t)
+    down, _ = follow_volume(solid, volume, fixed, (DESIGN.V0, DESIGN.V0 - STROKE), start=start,
+                            options=options, volume_scale=model.R**2 * model.t)
+    for hit, up in zip(down, study.states[1::-1]):
+        assert hit.volume == pytest.approx(up.volume)
+        assert hit.pressure == pytest.approx(up.pressure, rel=1e-9)

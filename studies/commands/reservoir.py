@@ -77,6 +77,10 @@ def run(args) -> int:
         v = result.verdict
         print(f"stroke {v['stroke_mm3']:.0f} mm^3: dp FEM {v['stroke_dp_fem_MPa']:.4g} MPa, "
               f"ellipse {v['stroke_dp_ellipse_MPa']:.4g} MPa ({100 * v['stroke_dp']:+.1f} %)")
+        th, fem, ell = v["offset_theta_deg"], v["offset_fem_MPa"], v["offset_ellipse_MPa"]
+        print(f"reservoir offset p_r over theta {th[-1]:.0f}..{th[0]:.0f} deg: FEM {fem[-1]:.4g}..{fem[0]:.4g} MPa, "
+              f"ellipse {ell[-1]:.4g}..{ell[0]:.4g} MPa, ellipse - FEM "
+              f"{v['offset_difference_MPa'][0]:.4g}..{v['offset_difference_MPa'][1]:.4g} MPa")
     return 0
 
 
