@@ -45,7 +45,7 @@ def tip_mean(solid, u) -> np.ndarray:
     from skfem import FacetBasis
     fb = FacetBasis(solid.mesh, solid.element, facets="tip", intorder=4)
     uu = solid.nodal(u)
-    vals = [fb.interpolate(uu[a]).value for a in range(3)]
+    vals = [np.asarray(fb.interpolate(uu[a])) for a in range(3)]
     area = fb.dx.sum()
     return np.array([(v * fb.dx).sum() / area for v in vals])
 

@@ -52,9 +52,9 @@ class _Facets:
         self.elements = np.asarray(fb.tind)
         self.N = np.asarray(fb.normals)  # (3, nf, nq), outward of the solid
         self.W = np.asarray(fb.dx)  # (nf, nq)
-        self.phi = np.stack([fb.basis[i][0].value for i in range(nloc)], axis=-1)  # (nf, nq, nloc)
+        self.phi = np.stack([np.asarray(fb.basis[i][0]) for i in range(nloc)], axis=-1)  # (nf, nq, nloc)
         self.G = np.stack([fb.basis[i][0].grad for i in range(nloc)]).transpose(2, 3, 0, 1).copy()
-        self.X = np.asarray(fb.global_coordinates().value)  # (3, nf, nq)
+        self.X = np.asarray(fb.global_coordinates())  # (3, nf, nq)
         self.vdofs = solid.scatter.vector_dofs(self.elements)  # (nf, 3 nloc)
 
     def fields(self, u):

@@ -38,6 +38,7 @@ from fem.linsolve import make_solver
 class NewtonOptions:
     rtol: float = 1e-8  #: on ||R||, relative to ``scale`` (default: ||R(x0)||)
     atol: float = 1e-10  #: absolute floor on ||R|| [units of R]
+    xtol: float = 1e-10  #: also converged when the Newton correction ||dx|| <= xtol (1 + ||x||)
     max_iter: int = 25  #: Newton iterations per solve
     line_search: bool = True  #: adjust the step length (see ``merit``)
     merit: str = "slope"  #: "slope": R(x + s dx).dx -> 0 (energy); "residual": Armijo on ||R||
@@ -101,10 +102,13 @@ def newton(fun, x0, options: NewtonOptions = NewtonOptions(), *, solver=None, sc
             raise NotConverged(f"linear solve failed ({err})", history, x) from err
         t_solve += time.perf_counter() - t1
         t1 = time.perf_counter()
+        small = it > 0 and np.linalg.norm(dx) <= options.xtol * (1.0 + np.linalg.norm(x))
         x, R, K, norm, s = _line_search(fun, x, dx, R, norm, options)
         t_asm += time.perf_counter() - t1
         history.append(norm)
         steps.append(s)
+        if small and s == 1.0 and np.isfinite(norm):  # converged to round-off (ill-conditioned K)
+            return NewtonResult(x, it + 1, history, steps, t_asm, t_solve)
     raise NotConverged(f"no convergence in {options.max_iter} iterations (tol {tol:.2e})", history, x)
 
 

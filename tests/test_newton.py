@@ -1,0 +1,102 @@
+"""Newton: quadratic convergence on a hyperelastic problem, line search where plain Newton
+diverges, cut-back and the last converged state on failure; the linear solvers."""
+import numpy as np
+import pytest
+import scipy.sparse as sp
+import skfem as fe
+
+from fem.assembly import Restriction
+from fem.linsolve import available, make_solver
+from fem.loads import FollowerPressure
+from fem.materials import NeoHookean
+from fem.newton import NewtonOptions, NotConverged, PathOptions, newton, solve_path
+from fem.solid import Solid
+
+
+def scalar_system(f, df):
+    return lambda x: (np.array([f(x[0])]), sp.csr_matrix([[df(x[0])]]))
+
+
+ATAN = scalar_system(np.arctan, lambda x: 1.0 / (1.0 + x * x))
+
+
+def test_line_search_converges_where_plain_newton_diverges():
+    # arctan(x) = 0 from x0 = 2: plain Newton overshoots to ever larger |x|
+    with pytest.raises(NotConverged) as err:
+        newton(ATAN, [2.0], NewtonOptions(line_search=False, max_iter=10))
+    assert len(err.value.history) == 11 and err.value.history[-1] > err.value.history[0]
+    r = newton(ATAN, [2.0])
+    assert abs(r.x[0]) < 2e-8 and min(r.steps) < 1.0  # |x| ~ |R| <= rtol |R0|
+
+
+def test_cut_back_and_last_converged_state():
+    """arctan(x) = 2 t has a solution only for t < pi/4: the path stops just before it."""
+    def fun_t(x, t):
+        R, K = ATAN(x)
+        return R - 2 * t, K
+    opts = PathOptions(steps=2, min_dt=1e-3, newton=NewtonOptions(max_iter=8))
+    with pytest.raises(NotConverged) as err:
+        solve_path(fun_t, [0.0], opts)
+    t_last, x_last = err.value.last_converged
+    assert np.pi / 4 - 0.01 < t_last < np.pi / 4
+    assert np.arctan(x_last[0]) == pytest.approx(2 * t_last, abs=1e-8)
+
+
+def test_cut_back_recovers_a_hard_step():
+    def fun_t(x, t):  # x^3 + x = 30 t: a full step from 0 needs several iterations
+        return np.array([x[0] ** 3 + x[0] - 30 * t]), sp.csr_matrix([[3 * x[0] ** 2 + 1]])
+    # plain Newton (a line search solves this 1D problem exactly along its line)
+    opts = PathOptions(steps=1, newton=NewtonOptions(max_iter=3, line_search=False))
+    res = solve_path(fun_t, [0.0], opts)
+    assert res.cutbacks >= 1 and res.t[-1] == 1.0
+    assert res.x[-1][0] ** 3 + res.x[-1][0] == pytest.approx(30.0, rel=1e-10)
+
+
+def test_quadratic_convergence_on_inflated_block():
+    mesh = fe.MeshTet.init_tensor(*(np.linspace(0, 1, 3),) * 3).with_defaults()
+    solid = Solid(mesh, NeoHookean(1.0, 100.0))
+    red = Restriction(solid.ndofs, solid.free_dofs(solid.dofs("left")))
+    load = FollowerPressure(solid, "right")
+
+    def fun(x):
+        u = red.expand(x)
+        R, data = solid.residual_tangent_data(u)
+        return red.vector(R + load.residual(u, 0.3)), red.restrict(solid.scatter.csr(data + load.tangent_data(u, 0.3)))
+
+    r = newton(fun, np.zeros(len(red.keep)), NewtonOptions(rtol=1e-12, atol=0.0, xtol=0.0))
+    h = np.array(r.history)
+    # the last steps: log r_{k+1} ~ 2 log r_k + c  (order 2, before round-off at ~1e-14 |R0|)
+    tail = h[(h < 1e-1 * h[0]) & (h > 1e-12 * h[0])]
+    assert len(tail) >= 3
+    order = np.polyfit(np.log(tail[:-1]), np.log(tail[1:]), 1)[0]
+    assert order > 1.8, f"observed order {order:.2f}, history {h}"
+
+
+def test_restriction_equals_slicing():
+    rng = np.random.default_rng(4)
+    K = sp.random(50, 50, density=0.2, random_state=3, format="csr")
+    keep = np.sort(rng.choice(50, 30, replace=False))
+    red = Restriction(50, keep)
+    for _ in range(2):  # second call: cached index map
+        assert abs(red.restrict(K) - K[keep][:, keep]).max() == 0.0
+        K.data *= 2.0
+    x = rng.standard_normal(30)
+    assert np.array_equal(red.vector(red.expand(x, 5.0)), x) and red.expand(x, 5.0).sum() == pytest.approx(x.sum() + 100)
+
+
+@pytest.mark.parametrize("method", available())
+@pytest.mark.parametrize("symmetric", [True, False])
+def test_linear_solvers_agree_and_reuse_the_analysis(method, symmetric):
+    rng = np.random.default_rng(1)
+    n = 200
+    A = sp.random(n, n, density=0.03, random_state=2, format="csr")
+    A = A + A.T + sp.diags(np.linspace(-3, 5, n)) if symmetric else A + sp.diags(np.full(n, 4.0))
+    A = A.tocsr()
+    solver = make_solver(method, symmetric=symmetric)
+    for _ in range(2):
+        b = rng.standard_normal(n)
+        x = solver.solve(A, b)
+        assert np.linalg.norm(A @ x - b) < 1e-10 * np.linalg.norm(b)  # backward-stable direct solve
+        A.data *= 1.1  # same pattern, new values
+    assert solver.n_analyses == 1 and solver.n_solves == 2
+    assert solver.name in solver.describe()

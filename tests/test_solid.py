@@ -1,0 +1,150 @@
+"""The hyperelastic solid: derivatives by finite differences, the sparse pattern against
+scikit-fem's own assembly, homogeneous tension against the closed form, and the
+locking-free plane-strain tube against the incompressible closed form."""
+import numpy as np
+import pytest
+import skfem as fe
+from scipy.integrate import quad
+from scipy.optimize import brentq
+from skfem.models.elasticity import linear_elasticity
+
+from fem.assembly import Restriction
+from fem.linsolve import make_solver
+from fem.loads import FollowerPressure
+from fem.materials import CompressibleNeoHookean, Fibers, NeoHookean
+from fem.newton import NewtonOptions, PathOptions, solve_path
+from fem.solid import Solid
+
+RNG = np.random.default_rng(3)
+
+
+def box(n=(2, 2, 3), size=(1.0, 1.0, 2.0)):
+    return fe.MeshTet.init_tensor(*(np.linspace(0, s, k + 1) for k, s in zip(n, size))).with_defaults()
+
+
+@pytest.mark.parametrize("formulation", ["mean_dilatation", "displacement"])
+def test_residual_and_tangent_are_derivatives(formulation):
+    mesh = box()
+    law = NeoHookean(1.0, 40.0) + Fibers(30.0, RNG.standard_normal((3, mesh.t.shape[1])))
+    solid = Solid(mesh, law, formulation=formulation, chunk=17)  # several chunks
+    # 5 % dilation + noise: every fiber stretched (lam ~ 1.05), away from the kink at lam = 1
+    u = 0.05 * solid.dof_locations.T.ravel() + 0.005 * RNG.standard_normal(solid.ndofs)
+    R, K = solid.residual_tangent(u)
+    d, h = RNG.standard_normal(solid.ndofs), 1e-6
+    dE = (solid.energy(u + h * d) - solid.energy(u - h * d)) / (2 * h)
+    dR = (solid.residual(u + h * d) - solid.residual(u - h * d)) / (2 * h)
+    # central differences: O(h^2) truncation, round-off ~1e-16 |E| / h
+    assert dE == pytest.approx(R @ d, rel=1e-7)
+    np.testing.assert_allclose(K @ d, dR, atol=1e-7 * np.abs(K @ d).max())
+    assert abs(K - K.T).max() < 1e-12 * abs(K).max()  # hyperelastic: symmetric
+    np.testing.assert_allclose(solid.residual(u), R)
+
+
+def test_tangent_at_rest_is_scikit_fem_linear_elasticity():
+    """An independent assembly (scikit-fem BilinearForm, COO -> CSR) of the same operator."""
+    mesh = box((2, 3, 2))
+    lam, mu = 3.0, 1.15
+    solid = Solid(mesh, CompressibleNeoHookean(mu, lam))
+    vb = fe.Basis(mesh, fe.ElementVector(fe.ElementTetP2()), intorder=2)
+    K_ref = fe.asm(linear_elasticity(lam, mu), vb)
+    assert abs(solid.tangent(np.zeros(solid.ndofs)) - K_ref).max() < 1e-13 * abs(K_ref).max()
+    assert np.array_equal(solid.dofs("left"), np.sort(vb.get_dofs("left").all()))
+
+
+def uniaxial_closed_form(lam, mu, kappa):
+    """Lateral stretch l2 and nominal stress P11 of NH (isochoric + kappa/2 (J-1)^2) in uniaxial
+    tension, from P22 = 0 written out by hand: mu J^{-2/3} (l2^2 - I1/3) + kappa (J - 1) J = 0."""
+    def p22_times_l2(l2):
+        J, I1 = lam * l2 * l2, lam * lam + 2 * l2 * l2
+        return mu * J ** (-2 / 3) * (l2 * l2 - I1 / 3) + kappa * (J - 1) * J
+    l2 = brentq(p22_times_l2, 0.3, 1.0, xtol=1e-15, rtol=1e-15)
+    J, I1 = lam * l2 * l2, lam * lam + 2 * l2 * l2
+    return l2, (mu * J ** (-2 / 3) * (lam * lam - I1 / 3) + kappa * (J - 1) * J) / lam
+
+
+@pytest.mark.parametrize("formulation, kappa", [("mean_dilatation", 1150.0), ("mean_dilatation", 11.5),
+                                                ("displacement", 11.5)])
+def test_homogeneous_uniaxial_tension_matches_closed_form(formulation, kappa):
+    mesh = box((2, 2, 2), (1.0, 1.0, 1.0))
+    mu, lam = 1.15, 1.5
+    solid = Solid(mesh, NeoHookean(mu, kappa), formulation=formulation)
+    x = solid.dof_locations
+    s = np.arange(x.shape[1])
+    right = 3 * s[np.isclose(x[0], 1.0)]
+    fixed = np.concatenate([3 * s[np.isclose(x[0], 0)], right, 3 * s[np.isclose(x[1], 0)] + 1,
+                            3 * s[np.isclose(x[2], 0)] + 2])
+    red = Restriction(solid.ndofs, solid.free_dofs(fixed))
+    u_d = np.zeros(solid.ndofs)
+
+    def fun_t(xf, t):
+        u_d[right] = t * (lam - 1.0)
+        R, K = solid.residual_tangent(red.expand(xf, u_d))
+        return red.vector(R), red.restrict(K)
+
+    opts = PathOptions(steps=2, newton=NewtonOptions(rtol=1e-12, atol=1e-13))
+    res = solve_path(fun_t, np.zeros(len(red.keep)), opts, solver=make_solver(symmetric=True))
+    u_d[right] = lam - 1.0
+    u = red.expand(res.x[-1], u_d)
+    l2, P11 = uniaxial_closed_form(lam, mu, kappa)
+    corner = np.flatnonzero(np.all(np.isclose(x, 1.0), axis=0))[0]
+    force = solid.residual(u)[right].sum()  # reaction on the face x = 1, reference area 1
+    # homogeneous state: the P2 (and P2-P0) spaces contain it exactly -> solver tolerance
+    assert 1.0 + u[3 * corner + 1] == pytest.approx(l2, rel=1e-10)
+    assert force == pytest.approx(P11, rel=1e-9)
+
+
+# -- plane-strain thick-walled tube: locking-free check ----------------------------------
+A, B, MU, P = 4.0, 9.0, 1.15, 0.6  # inner / outer radius [mm], shear modulus, pressure [MPa]
+
+
+def quarter_tube(nr, nt):
+    """Quarter annulus A < r < B, one element thick in z, quadratic (curved) geometry."""
+    m = fe.MeshTet.init_tensor(np.linspace(A, B, nr + 1), np.linspace(0, np.pi / 2, nt + 1),
+                               np.array([0.0, 1.0]))
+    bnd = {"inner": m.facets_satisfying(lambda x: np.isclose(x[0], A)),
+           "theta0": m.facets_satisfying(lambda x: np.isclose(x[1], 0)),
+           "theta90": m.facets_satisfying(lambda x: np.isclose(x[1], np.pi / 2))}
+    r, th, z = fe.MeshTet2.from_mesh(m).doflocs
+    return fe.MeshTet2(doflocs=np.array([r * np.cos(th), r * np.sin(th), z]), t=m.t, _boundaries=bnd)
+
+
+def pressure_closed_form(a):
+    """Incompressible NH tube in plane strain: p = int_a^b mu (l^2 - l^-2) / r dr, l = r/R,
+    R^2 = r^2 - (a^2 - A^2) (radial equilibrium; Ogden, Non-linear elastic deformations, 5.3)."""
+    c = a * a - A * A
+    b = np.sqrt(B * B + c)
+    return quad(lambda r: MU * (r * r / (r * r - c) - (r * r - c) / (r * r)) / r, a, b,
+                epsabs=1e-14, epsrel=1e-13)[0]
+
+
+def tube_inner_radius(mesh, kappa, formulation=None):
+    solid = Solid(mesh, NeoHookean(MU, kappa), formulation=formulation)
+    fixed = np.concatenate([solid.dofs(None, (2,)), solid.dofs("theta0", (1,)), solid.dofs("theta90", (0,))])
+    red = Restriction(solid.ndofs, solid.free_dofs(fixed))
+    load = FollowerPressure(solid, "inner")
+
+    def fun_t(x, t):
+        u = red.expand(x)
+        R, data = solid.residual_tangent_data(u)
+        K = solid.scatter.csr(data + load.tangent_data(u, t * P))
+        return red.vector(R + load.residual(u, t * P)), red.restrict(K)
+
+    res = solve_path(fun_t, np.zeros(len(red.keep)), PathOptions(steps=4), solver=make_solver())
+    u = red.expand(res.x[-1])
+    x = solid.dof_locations
+    s = np.flatnonzero(np.isclose(x[0], A) & np.isclose(x[1], 0) & np.isclose(x[2], 0))[0]
+    return A + u[3 * s]
+
+
+@pytest.mark.slow
+def test_plane_strain_tube_is_locking_free():
+    a_exact = brentq(lambda a: pressure_closed_form(a) - P, 1.0001 * A, 2 * A, xtol=1e-14)
+    mesh = quarter_tube(2, 4)
+    ratios = [1e2, 1e3, 1e4, 1e5]
+    stretch = np.array([tube_inner_radius(mesh, k * MU) / A for k in ratios])
+    # the issue's criterion: the same answer within 1 % for kappa/mu = 1e2 .. 1e5
+    assert np.ptp(stretch) / stretch.mean() < 0.01
+    # and it converges to the incompressible closed form: O(mu/kappa) + discretisation
+    # (this coarse 2 x 4 mesh: 0.4 % of the radial displacement a - A)
+    assert abs(stretch[-1] * A - a_exact) < 0.006 * (a_exact - A)
+    assert abs(stretch[-1] - stretch[-2]) < 1e-3 * (stretch[-1] - 1.0)  # kappa-independent limit
