@@ -47,7 +47,7 @@ def test_curve_plot(tmp_path, capsys):
 
 def test_grasp_json(capsys):
     out = run_json(capsys, "grasp", "--pressure-mpa", "0.89", "--theta-deg", "50", "--mass-kg", "2",
-                   "--diameter-mm", "180", "--normalise")
+                   "--weights", "paper180", "--normalise")
     w = np.array(grasp.PAPER_WEIGHTS[180.0]) / 1.4
     F = grasp.grasp_forces(0.89, math.radians(50), 2.0, w, D)
     assert out["F_v_N"] == pytest.approx(float(F.F_v), rel=1e-12)
@@ -71,7 +71,7 @@ def test_grasp_warns_on_weight_sum(capsys):
     (["grasp", "--pressure-mpa", "0.9", "--theta-deg", "50", "--mass-kg", "-2",
       "--diameter-mm", "180"], "mass_kg"),
     (["grasp", "--pressure-mpa", "0.9", "--theta-deg", "50", "--mass-kg", "2",
-      "--diameter-mm", "200"], "diameter_mm"),
+      "--diameter-mm", "-5"], "diameter_mm"),
     (["grasp", "--pressure-mpa", "0.9", "--theta-deg", "50", "--mass-kg", "2",
       "--weights", "0.5,0.5"], "weights"),
     (["grasp", "--pressure-mpa", "0.9,1", "--theta-deg", "50", "--mass-kg", "2",
@@ -88,7 +88,7 @@ def test_bad_input_is_one_line_exit_2(argv, field, capsys):
     ("bogus = 1\n", ["curve", "--theta-deg", "0:90:10"], "bogus"),
     ("b_mm = -5.0\n", ["curve", "--pressure-mpa", "0.5"], "b_mm"),
     ("n_s = 4\nhinge_s_mm = [40.0, 80.0, 120.0, 160.0]\n",
-     ["grasp", "--pressure-mpa", "1", "--theta-deg", "40", "--mass-kg", "2", "--diameter-mm", "180"],
+     ["grasp", "--pressure-mpa", "1", "--theta-deg", "40", "--mass-kg", "2", "--weights", "paper180"],
      "n_s = 4"),
 ])
 def test_bad_design_is_one_line_exit_2(tmp_path, capsys, text, argv, field):

@@ -1,0 +1,186 @@
+"""Hinge weight vectors w from the grasp FEM, over object diameters; F_v against eq. (25).
+
+* :func:`weights` -- one grasp case (diameter, mass, cavity pressure, mesh) through the FEM
+  (:mod:`fem.grasp`), cached on disk by its inputs: w, theta, hinge angles, contact forces,
+  F_v from the FEM and from eq. (25) with this w at the same P, theta, m.
+* :func:`run` (:class:`WeightsStudy`) -- w(D) over diameters, and w at an unseen diameter
+  by interpolation checked against the FEM there.
+* :func:`fig8` -- the Fig. 8 analogue: F_v against theta at several pressures (theta varied
+  by the object's depth), FEM points and reduced-model values.
+
+Pressures: P is the finger's cavity pressure. Eq. (25) is evaluated without the reservoir
+term at P, which equals eq. (25) with the reservoir at the pump pressure P - p_r(V(theta))
+(docs/conventions.md), so no reservoir model enters the comparison.
+"""
+from __future__ import annotations
+
+import hashlib
+import json
+import math
+from dataclasses import asdict, dataclass, field, replace
+
+import numpy as np
+
+from reduced import grasp
+from reduced.design import HandDesign
+from reduced.errors import InputError
+from studies.output import jsonable, write_json
+
+#: bump when the FEM or the result's fields change, to invalidate cached results
+CACHE_FORMAT = 1
+#: the default element size of the grasp FEM [mm] (docs/grasp.md: w's mesh sensitivity)
+MESH_SIZE = 6.0
+
+
+@dataclass(frozen=True)
+class WeightsCase:
+    """One grasp: the inputs that determine w (and the cache key)."""
+
+    design: HandDesign = field(default_factory=HandDesign)
+    diameter_mm: float = 180.0
+    mass_kg: float = 0.0
+    pressure_mpa: float = 0.8      #: cavity pressure of the first state
+    dP_mpa: float = 0.05           #: pressure step to the second state
+    mesh_size_mm: float = MESH_SIZE
+    depth_mm: float | None = None  #: object centre below the palm; None: fem.grasp.default_depth
+
+    def key(self) -> str:
+        """Hash of the inputs, the cache format and the package version."""
+        values = {k: v for k, v in asdict(self).items() if k != "design"}
+        blob = json.dumps({"design": self.design.to_dict(), **values, "format": CACHE_FORMAT,
+                           "version": _package_version()}, sort_keys=True, default=jsonable)
+        return hashlib.sha256(blob.encode()).hexdigest()[:20]
+
+
+def _package_version() -> str:
+    from importlib.metadata import PackageNotFoundError, version
+
+    try:
+        return version("softhand")
+    except PackageNotFoundError:
+        return "unknown"
+
+
+def cache_dir():
+    """``$SOFTHAND_CACHE/weights`` (default ``~/.cache/softhand/weights``), next to the meshes."""
+    from meshes.cache import cache_dir as mesh_cache_dir
+
+    return mesh_cache_dir().parent / "weights"
+
+
+def reduced_F_v(P: float, theta: float, mass: float, w, design: HandDesign) -> float | None:
+    """Eq. (25) -> (29) at cavity pressure P [MPa], theta [rad]: F_v [N]; None if J_x w = 0."""
+    try:
+        return float(grasp.grasp_forces(P, theta, mass, w, design, reservoir=False).F_v)
+    except InputError:
+        return None
+
+
+def state_row(state, w, mass: float, design: HandDesign) -> dict:
+    """The reported numbers of one converged contact state (forces physical, hand frame)."""
+    F_v_red = reduced_F_v(state.P, state.theta, mass, w, design)
+    return {"P_MPa": state.P, "theta_deg": math.degrees(state.theta),
+            "hinge_deg": np.degrees(state.q).tolist(), "contact_force_N": state.N.tolist(),
+            "F_x_fem_N": float(state.F[0]), "F_y_fem_N": float(state.F[1]),
+            "F_v_fem_N": state.F_v, "F_v_reduced_N": F_v_red,
+            "F_v_error_kgf": None if F_v_red is None else (F_v_red - state.F_v) / grasp.KGF,
+            "max_penetration_mm": float(np.max(-state.gap[state.N > 0], initial=0.0)),
+            "contact_updates": state.updates, "newton_iterations": state.iterations}
+
+
+def compute(case: WeightsCase) -> dict:
+    """Run the grasp FEM for one case (no cache): the flat result."""
+    from fem.finger import FingerModel, FingerOptions
+    from fem.grasp import GraspModel, grasp_weights
+
+    finger = FingerModel(case.design, FingerOptions(mesh_size=case.mesh_size_mm))
+    model = GraspModel(finger, case.diameter_mm, mass=case.mass_kg, depth=case.depth_mm)
+    r = grasp_weights(model, case.pressure_mpa, case.dP_mpa)
+    return {"diameter_mm": case.diameter_mm, "mass_kg": case.mass_kg, "depth_mm": model.depth,
+            "dP_MPa": case.dP_mpa, "w": r.w.tolist(), "w_sum": float(r.w.sum()),
+            **state_row(r.state, r.w, case.mass_kg, case.design),
+            "mesh_size_mm": case.mesh_size_mm, "ndofs": r.ndofs, "wall_seconds": r.wall_seconds}
+
+
+def weights(case: WeightsCase, *, cache: bool = True) -> dict:
+    """:func:`compute`, through the JSON cache keyed by :meth:`WeightsCase.key` (``cached`` says which)."""
+    path = cache_dir() / f"{case.key()}.json"
+    if cache and path.is_file():
+        try:
+            return {**json.loads(path.read_text()), "cached": True}
+        except (OSError, ValueError):
+            pass  # unreadable entry: recompute and overwrite
+    result = compute(case)
+    if cache:
+        write_json(path, result)
+    return {**result, "cached": False}
+
+
+def interpolate(diameters, ws, diameter: float) -> np.ndarray:
+    """w at ``diameter`` [mm], piecewise linear in D between tabulated (diameters, ws (m, n_s));
+    a convex combination of vectors summing to 1 sums to 1."""
+    D = np.asarray(diameters, dtype=float)
+    if not D.min() <= diameter <= D.max():
+        raise InputError("diameter_mm", diameter, f"must be within the table [{D.min():g}, {D.max():g}]")
+    ws = np.asarray(ws, dtype=float)
+    return np.array([np.interp(diameter, D, ws[:, i]) for i in range(ws.shape[1])])
+
+
+@dataclass(frozen=True)
+class WeightsStudy:
+    """w(D) over diameters at one pressure and mass, and its interpolation check."""
+
+    case: WeightsCase = field(default_factory=WeightsCase)   #: everything but the diameter
+    diameters_mm: tuple[float, ...] = (120.0, 150.0, 180.0, 210.0, 240.0, 270.0, 300.0)
+    check_mm: float | None = 165.0  #: an unseen diameter: interpolated w vs the FEM there
+
+
+@dataclass(frozen=True)
+class WeightsResult:
+    rows: list        #: one :func:`weights` result per diameter
+    check: dict | None  #: diameter, w_interpolated, w_fem, max_abs_difference
+
+
+def run(study: WeightsStudy, *, cache: bool = True, progress=None) -> WeightsResult:
+    """The FEM at every diameter (cached), then the interpolation check."""
+    rows = []
+    for D in study.diameters_mm:
+        rows.append(weights(replace(study.case, diameter_mm=float(D)), cache=cache))
+        if progress is not None:
+            progress(rows[-1])
+    check = None
+    if study.check_mm is not None:
+        fem = weights(replace(study.case, diameter_mm=float(study.check_mm)), cache=cache)
+        w_int = interpolate([r["diameter_mm"] for r in rows], [r["w"] for r in rows], study.check_mm)
+        check = {"diameter_mm": study.check_mm, "w_interpolated": w_int.tolist(), "w_fem": fem["w"],
+                 "max_abs_difference": float(np.max(np.abs(w_int - np.array(fem["w"]))))}
+    return WeightsResult(rows, check)
+
+
+def fig8(case: WeightsCase, pressures_mpa, depth_offsets_mm=(0.0, 10.0, 20.0)) -> list[dict]:
+    """The Fig. 8 analogue for one object: at each depth (default depth + offset) the
+    pressures in turn; each point a FEM contact state with its own w (P, P + dP)."""
+    from fem.finger import FingerModel, FingerOptions
+    from fem.grasp import GraspModel, weight_vector
+
+    finger = FingerModel(case.design, FingerOptions(mesh_size=case.mesh_size_mm))
+    base = GraspModel(finger, case.diameter_mm, mass=case.mass_kg).depth
+    rows = []
+    for offset in depth_offsets_mm:
+        model = GraspModel(finger, case.diameter_mm, mass=case.mass_kg, depth=base + offset)
+        state = None
+        for P in sorted(pressures_mpa):
+            state = model.solve(P, start=state)
+            upper = model.solve(P + case.dP_mpa, start=state)
+            w = weight_vector(state, upper)
+            rows.append({"depth_mm": model.depth, "w": w.tolist(),
+                         **state_row(state, w, case.mass_kg, case.design)})
+    return rows
+
+
+def fig8_errors(rows: list[dict]) -> dict:
+    """RMS and largest |F_v_reduced - F_v_fem| [kgf] over the points of :func:`fig8`."""
+    e = np.array([r["F_v_error_kgf"] for r in rows if r["F_v_error_kgf"] is not None])
+    if e.size == 0:
+        return {"rms_error_kgf": None, "max_abs_error_kgf": None}
+    return {"rms_error_kgf": float(np.sqrt(np.mean(e ** 2))), "max_abs_error_kgf": float(np.abs(e).max())}
