@@ -39,6 +39,7 @@ class ElementScatter:
         self.indptr, self.indices = self._vector_pattern(ip, deg, s_cols)
         itype = np.int32 if self.nnz < 2 ** 31 else np.int64
         self._itype = itype
+        self._cache = {}
 
     @staticmethod
     def _vector_pattern(ip, deg, s_cols):
@@ -71,9 +72,20 @@ class ElementScatter:
         return (3 * self.dofs[elements][:, :, None] + np.arange(3)).reshape(
             self.dofs[elements].shape[0], -1)
 
-    def add_matrix(self, data: np.ndarray, Ke: np.ndarray, elements) -> None:
-        """data += scatter of element matrices Ke (ne, 3nloc, 3nloc) of the given elements."""
-        data += np.bincount(self.positions(elements).ravel(), weights=Ke.ravel(), minlength=self.nnz)
+    def add_matrix(self, data: np.ndarray, Ke: np.ndarray, elements, *, cache: bool = False) -> None:
+        """data += scatter of element matrices Ke (ne, 3nloc, 3nloc) of the given elements.
+
+        cache: keep the positions of this element set (a slice) for later calls (memory:
+        (3 nloc)^2 int32 per element), which saves their recomputation every Newton iterate.
+        """
+        if cache:
+            key = (elements.start, elements.stop)
+            if key not in self._cache:
+                self._cache[key] = self.positions(elements).astype(self._itype)
+            pos = self._cache[key]
+        else:
+            pos = self.positions(elements)
+        data += np.bincount(pos.ravel(), weights=Ke.ravel(), minlength=self.nnz)
 
     def add_vector(self, out: np.ndarray, re: np.ndarray, elements) -> None:
         """out += scatter of element vectors re (ne, 3nloc)."""

@@ -152,7 +152,7 @@ class Solid:
             re, Ke = self._element_kernels(u, c, tangent)
             self.scatter.add_vector(R, re, c)
             if tangent:
-                self.scatter.add_matrix(data, Ke, c)
+                self.scatter.add_matrix(data, Ke, c, cache=True)
         return R, data
 
     def _element_kernels(self, u, c, tangent):
@@ -184,12 +184,12 @@ class Solid:
 def element_matrices(A: np.ndarray, G: np.ndarray, GW: np.ndarray) -> np.ndarray:
     """K[e, (n,a), (m,b)] = sum_q GW[e,q,n,k] A[a,k,b,l,e,q] G[e,q,m,l], shape (ne, 3nloc, 3nloc).
 
-    Two batched matrix products over all basis pairs (no loop over elements or points).
+    Two batched matrix products over all basis pairs (no loop over elements or points):
+    D[eq, (a k b), m] = A[eq, (a k b), l] G[eq, m, l], then K[e, n, (a b m)] = GW[e, n, (q k)] D.
     """
     ne, nq, nloc, _ = G.shape
-    Ab = np.ascontiguousarray(A.transpose(4, 5, 1, 0, 2, 3)).reshape(ne * nq, 3, 27)  # [eq, k, (a b l)]
-    T = np.matmul(GW.reshape(ne * nq, nloc, 3), Ab)  # [eq, n, (a b l)]
-    T = T.reshape(ne, nq, nloc, 3, 3, 3).transpose(0, 2, 3, 4, 1, 5).reshape(ne, nloc * 9, nq * 3)
-    Gm = G.transpose(0, 1, 3, 2).reshape(ne, nq * 3, nloc)  # [e, (q l), m]
-    K = np.matmul(T, Gm).reshape(ne, nloc, 3, 3, nloc)  # [e, n, a, b, m]
-    return K.transpose(0, 1, 2, 4, 3).reshape(ne, 3 * nloc, 3 * nloc)
+    Ab = np.ascontiguousarray(A.transpose(4, 5, 0, 1, 2, 3)).reshape(ne * nq, 27, 3)
+    D = np.matmul(Ab, G.reshape(ne * nq, nloc, 3).transpose(0, 2, 1))  # [eq, (a k b), m]
+    D = D.reshape(ne, nq, 3, 3, 3, nloc).transpose(0, 1, 3, 2, 4, 5).reshape(ne, nq * 3, 9 * nloc)
+    K = np.matmul(GW.transpose(0, 2, 1, 3).reshape(ne, nloc, nq * 3), D)  # [e, n, (a b m)]
+    return K.reshape(ne, nloc, 3, 3, nloc).transpose(0, 1, 2, 4, 3).reshape(ne, 3 * nloc, 3 * nloc)
