@@ -82,6 +82,7 @@ class AxisymSolid:
         self.wdV = 2.0 * np.pi * self.r0 * self.basis.dx  # (nel, nqp) [mm^3]
         self.proj = _projection(x, self.wdV, pressure)  # (nel, nqp, nqp)
         self.G = self._gradient_operators()  # (18, 3, 3, nel, nqp)
+        self.G5 = self.G[:, _I5, _J5]  # (18, 5, nel, nqp): its non-zero components
         self.dofs = self.basis.element_dofs  # (18, nel)
         n, nel = self.dofs.shape
         rows = np.broadcast_to(self.dofs[:, None, :], (n, n, nel)).ravel()
@@ -131,19 +132,24 @@ class AxisymSolid:
         return np.bincount(self.dofs.ravel(), weights=fe.ravel(), minlength=self.ndofs)
 
     def tangent(self, u):
-        """Tangent stiffness d²Π/du² (CSR, pattern reused) [N/mm]."""
+        """Tangent stiffness d²Π/du² (CSR, pattern reused) [N/mm].
+
+        Per quadrature point everything acts on the five non-zero components of dF
+        (rr, rz, zr, zz, θθ): K_ab = ∫ G_a · [A_iso + p J (F^-T ⊗ F^-T - F^-T ⊠ F^-1)] · G_b
+        + ∫ U''(Θ) dΘ_a dΘ_b, with dΘ_a = Π_h(J F^-T : G_a).
+        """
         F = self.deformation_gradient(u)
         theta, p = self._pressure(F)
-        AG = np.einsum("ijkleq,bkleq->ijbeq", self.iso.tangent(F), self.G)
-        Ke = np.einsum("aijeq,ijbeq,eq->abe", self.G, AG, self.wdV)
-        # volumetric part: ∫ p d²J + ∫ U''(Θ) dΘ dΘ with dΘ = Π_h (J F^-T : G)
         J = kin.det(F)
-        M = np.einsum("ijeq,ajkeq->aikeq", np.swapaxes(kin.inv_transpose(F), 0, 1), self.G)
-        tr = np.einsum("aiieq->aeq", M)  # F^-T : G_a
-        wJp = J * p * self.wdV
-        Ke += np.einsum("aeq,beq,eq->abe", tr, tr, wJp) - np.einsum("aijeq,bjieq,eq->abe", M, M, wJp)
-        dtheta = np.einsum("eqk,aek->aeq", self.proj, J * tr)
-        Ke += np.einsum("aeq,beq,eq->abe", dtheta, dtheta, self.vol.ddU(theta) * self.wdV)
+        FiT = kin.inv_transpose(F)[_I5, _J5]  # (5, nel, nqp)
+        Finv = np.swapaxes(kin.inv_transpose(F), 0, 1)
+        D = Finv[_J5[:, None], _I5[None, :]] * Finv[_J5[None, :], _I5[:, None]]  # F^-1_Jk F^-1_Li
+        C = self.iso.tangent(F)[_I5[:, None], _J5[:, None], _I5[None, :], _J5[None, :]]
+        C += (J * p) * (FiT[:, None] * FiT[None, :] - D)
+        Ke = np.einsum("aIeq,IJeq,bJeq,eq->abe", self.G5, C, self.G5, self.wdV, optimize=True)
+        dtheta = np.einsum("eqk,aek->aeq", self.proj, J * np.einsum("Ieq,aIeq->aeq", FiT, self.G5))
+        Ke += np.einsum("aeq,beq,eq->abe", dtheta, dtheta, self.vol.ddU(theta) * self.wdV,
+                        optimize=True)
         return _scatter(self.pattern, self.slots, Ke)
 
     def stretches(self, u):
@@ -152,6 +158,10 @@ class AxisymSolid:
         C = np.einsum("kieq,kjeq->ijeq", F[:2, :2], F[:2, :2])
         mean, diff = (C[0, 0] + C[1, 1]) / 2, np.hypot((C[0, 0] - C[1, 1]) / 2, C[0, 1])
         return np.sqrt(mean + diff), np.sqrt(np.maximum(mean - diff, 0.0)), F[2, 2]
+
+
+#: the components of an axisymmetric dF that can be non-zero: rr, rz, zr, zz, θθ
+_I5, _J5 = np.array([0, 0, 1, 1, 2]), np.array([0, 1, 0, 1, 2])
 
 
 def _projection(x, wdV, space: str):
