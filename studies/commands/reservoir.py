@@ -4,8 +4,9 @@ Per volume: FEM pressure, apex height, strain energy; the ellipse model's (13)�
 same volume; the mean stretches and the largest gap between the profiles. Then the pressure
 maximum (if the path passes one) and the verdict over the operating range (V0 - stroke .. V0).
 ``--plot``: profiles, p(V) of both models, and the hand's P(theta) with both reservoir
-models. ``--out DIR``: result.json, rows.csv, VTK of the deformed sheet per volume (r–z and
-revolved to 3D). ``--write-calibration FILE.csv``: the table of ``reduced/reservoir_fem.py``.
+models. ``--out DIR``: result.json (rows, verdict, wet-surface profiles z(r) and mid-surface
+stretches per volume, the whole p(V), W(V) path), rows.csv, VTK of the deformed sheet per
+volume (r–z and revolved to 3D). ``--write-calibration FILE.csv``: the table of ``reduced/reservoir_fem.py``.
 """
 from __future__ import annotations
 
@@ -103,7 +104,13 @@ def _write_outputs(out: Path, result, summary) -> None:
     from studies.output import write_csv, write_json
     from studies.reproduce_fem import write_sheet_vtk
 
-    write_json(out / "result.json", {"rows": result.rows, **summary})
+    profiles = [{"V_mm3": s.volume, "r_mm": s.r, "z_mm": s.z, "r0_mid_mm": s.r0_mid,
+                 "lambda_meridian": s.lambda_meridian, "lambda_hoop": s.lambda_hoop,
+                 "lambda_thickness": s.lambda_thickness} for s in result.states]
+    path = {"V_mm3": result.fem.path_volume, "p_MPa": result.fem.path_pressure,
+            "W_Nmm": result.fem.path_energy}
+    write_json(out / "result.json", {"rows": result.rows, **summary, "profiles": profiles,
+                                     "path": path})
     write_csv(out / "rows.csv", result.rows)
     write_sheet_vtk(result, out)  # sheet_V<volume>.vtu (r–z) and sheet_V<volume>_3d.vtu
 
