@@ -119,3 +119,15 @@ def test_oil_leaving_retraces_the_inflation_path(study):
     for hit, up in zip(down, study.states[1::-1]):
         assert hit.volume == pytest.approx(up.volume)
         assert hit.pressure == pytest.approx(up.pressure, rel=1e-9)
+
+
+def test_cli_reports_newton_failure_in_one_line(monkeypatch, capsys):
+    from fem.volume_path import NotConverged
+
+    def fail(*args, **kwargs):
+        raise NotConverged("no equilibrium at V = 123 mm^3", [1.0, 0.5], PathState(100.0, 0.01, 1.0, None))
+
+    monkeypatch.setattr("studies.reservoir.inflate", fail)
+    assert main(["reservoir", "--volume-mm3", "17800"]) == 1
+    err = capsys.readouterr().err.strip().splitlines()[-1]
+    assert "V = 123 mm^3" in err and "last converged state V = 100 mm^3" in err

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import math
 import subprocess
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -61,8 +62,17 @@ def run(args) -> int:
 
     from studies.reservoir import COLUMNS, run as run_study
 
-    with tqdm(desc="inflating", unit="mm^3", leave=False) as bar:
-        result = run_study(study, progress=lambda v: bar.update(v - bar.n))
+    from fem.volume_path import NotConverged
+
+    try:
+        with tqdm(desc="inflating", unit="mm^3", leave=False) as bar:
+            result = run_study(study, progress=lambda v: bar.update(v - bar.n))
+    except NotConverged as exc:
+        last = exc.last
+        print(f"softhand reservoir: error: {str(exc).split(';')[0]} (Newton failed at the smallest "
+              f"volume step); last converged state V = {last.volume:.6g} mm^3, "
+              f"p = {last.pressure:.6g} MPa", file=sys.stderr)
+        return 1
     summary = _summary(result)
     if args.out:
         _write_outputs(Path(args.out), result, summary)
