@@ -11,16 +11,19 @@ volume control), and a good indicator otherwise. The full step is taken when the
 energy still decreases there (g(1) < 0) or :math:`|g(s)| \le \eta |g(0)|`; when it
 overshoots (g(1) > 0) the zero of g is bracketed and found by regula falsi. The
 residual norm is a poor merit for slender bodies (a good step can raise
-:math:`\|R\|` a lot); ``merit="residual"`` keeps Armijo backtracking on it.
-A non-finite residual (inverted element) halves the step. The Jacobian evaluated at an accepted trial point is reused for
-the next iteration, so a full step costs one assembly.
+:math:`\|R\|` a lot); ``merit="residual"`` keeps Armijo backtracking on it;
+``merit="finite"`` takes full steps (the mixed (u, p) iteration of a nearly
+incompressible solid converges in ~4 full steps although its displacement residual
+jumps by 1e3 after the first: any merit on it would cut those steps). A non-finite
+residual (inverted element) halves the step. The Jacobian evaluated at an accepted
+trial point is reused for the next iteration, so a full step costs one assembly.
 
-Load stepping (:func:`solve_path`): t runs from 0 to 1; each step starts from a
-predictor direction, line-searched like a Newton step from the last converged
-state: the secant of the last two converged states, or, when only one is known,
-the tangent (Euler) direction :math:`-K^{-1}(R + \partial_t R\,\Delta t)` with
-:math:`\partial_t R` by a forward difference in t (this keeps a prescribed boundary
-displacement from distorting the boundary elements alone); a step that fails is
+Load stepping (:func:`solve_path`): t runs from 0 to 1; each step starts from the
+last converged state along a predictor direction, line-searched like a Newton
+step: the tangent (Euler) direction :math:`-K^{-1}(R + \partial_t R\,\Delta t)`
+with :math:`\partial_t R` by a forward difference in t (default: it keeps a
+prescribed boundary displacement from distorting the boundary elements alone), or
+the secant of the last two converged states, or none; a step that fails is
 halved (cut-back) down to ``min_dt``; easy steps let the increment grow again.
 On final failure :class:`NotConverged` carries the last converged (t, x).
 """
@@ -41,7 +44,9 @@ class NewtonOptions:
     xtol: float = 1e-10  #: also converged when the Newton correction ||dx|| <= xtol (1 + ||x||)
     max_iter: int = 25  #: Newton iterations per solve
     line_search: bool = True  #: adjust the step length (see ``merit``)
-    merit: str = "slope"  #: "slope": R(x + s dx).dx -> 0 (energy); "residual": Armijo on ||R||
+    #: "slope": R(x + s dx).dx -> 0 (energy); "residual": Armijo on ||R||; "finite": full
+    #: steps, halved only where R is not finite (the mixed (u, p) iteration, see fem.solid.MixedNewton)
+    merit: str = "slope"
     eta: float = 0.5  #: "slope": accept when |R(x + s dx).dx| <= eta |R(x).dx|
     max_backtracks: int = 6  #: trial steps before taking the last one
     armijo: float = 1e-4  #: "residual": sufficient-decrease constant c
@@ -72,17 +77,20 @@ class NewtonResult:
 
 
 def newton(fun, x0, options: NewtonOptions = NewtonOptions(), *, solver=None, scale=None,
-           direction=None) -> NewtonResult:
+           direction=None, on_accept=None) -> NewtonResult:
     """Solve R(x) = 0 from x0; raises NotConverged with the residual history.
 
     fun(x) -> (R, K); solver: a :mod:`fem.linsolve` solver (default auto, unsymmetric);
     scale: reference for the relative tolerance (default ||R(x0)||);
     direction: search direction of the first iteration instead of -K^{-1} R (a load-step
-    predictor, line-searched like a Newton step).
+    predictor, line-searched like a Newton step); on_accept(x): called with x0 and every
+    accepted iterate before fun is evaluated around it (e.g. :class:`fem.solid.MixedNewton`).
     """
     solver = solver or make_solver()
     t0 = time.perf_counter()
     x = np.array(x0, dtype=float)
+    if on_accept is not None:
+        on_accept(x)
     R, K = fun(x)
     t_asm = time.perf_counter() - t0
     norm = float(np.linalg.norm(R))
@@ -107,6 +115,8 @@ def newton(fun, x0, options: NewtonOptions = NewtonOptions(), *, solver=None, sc
         t_asm += time.perf_counter() - t1
         history.append(norm)
         steps.append(s)
+        if on_accept is not None:
+            on_accept(x)
         if small and s == 1.0 and np.isfinite(norm):  # converged to round-off (ill-conditioned K)
             return NewtonResult(x, it + 1, history, steps, t_asm, t_solve)
     raise NotConverged(f"no convergence in {options.max_iter} iterations (tol {tol:.2e})", history, x)
@@ -126,6 +136,8 @@ def _line_search(fun, x, dx, R0, norm0, options):
         if not np.isfinite(norm):  # e.g. an inverted element: shorten
             hi, ghi, s = s, None, 0.5 * (lo + s)
             continue
+        if options.merit == "finite":
+            return xt, R, K, norm, s
         if options.merit == "residual":
             if norm <= (1 - options.armijo * s) * norm0:
                 return xt, R, K, norm, s
@@ -151,7 +163,10 @@ class PathOptions:
     min_dt: float = 1e-4  #: smallest load increment before giving up
     grow: float = 1.5  #: increment growth after a step converging in <= easy_iter iterations
     easy_iter: int = 4  #: iterations counted as an easy step
-    predictor: bool = True  #: secant extrapolation of the last two converged states
+    #: "tangent": Euler predictor every step (best with prescribed displacements);
+    #: "secant": extrapolate the last two converged states (tangent for the first step);
+    #: "none": start each step from the last converged state (pure load control needs no more)
+    predictor: str = "tangent"
     newton: NewtonOptions = field(default_factory=NewtonOptions)
 
 
@@ -171,21 +186,24 @@ class PathResult:
 
 
 def solve_path(fun_t, x0, options: PathOptions = PathOptions(), *, solver=None, scale_t=None,
-               callback=None) -> PathResult:
+               callback=None, on_accept=None) -> PathResult:
     """Follow R(x, t) = 0 for t from 0 (state x0) to 1; fun_t(x, t) -> (R, K).
 
     scale_t(t): optional reference residual norm for the relative tolerance at t
-    (e.g. the norm of the external load); callback(t, x) after each converged step.
+    (e.g. the norm of the external load); callback(t, x) after each converged step;
+    on_accept: passed to :func:`newton` (also called before each predictor).
     """
     solver = solver or make_solver()
     res = PathResult([0.0], [np.array(x0, dtype=float)], [], 0, [])
     dt = 1.0 / options.steps
     while res.t[-1] < 1.0 - 1e-12:
         t = min(1.0, res.t[-1] + dt)
-        step = _predict(res, t, fun_t, solver) if options.predictor else None
+        if on_accept is not None:
+            on_accept(res.x[-1])
+        step = _predict(res, t, fun_t, solver, options.predictor)
         try:
             r = newton(lambda x: fun_t(x, t), res.x[-1], options.newton, solver=solver,
-                       scale=None if scale_t is None else scale_t(t), direction=step)
+                       scale=None if scale_t is None else scale_t(t), direction=step, on_accept=on_accept)
         except NotConverged as err:
             res.cutbacks += 1
             dt *= 0.5
@@ -206,9 +224,13 @@ def solve_path(fun_t, x0, options: PathOptions = PathOptions(), *, solver=None, 
     return res
 
 
-def _predict(res: PathResult, t: float, fun_t, solver):
-    """Predictor step from the last converged state to t: secant, else tangent (None if singular)."""
-    if len(res.t) < 2:
+def _predict(res: PathResult, t: float, fun_t, solver, kind: str):
+    """Predictor step from the last converged state to t (None: none, or a singular tangent)."""
+    if kind not in ("tangent", "secant", "none"):
+        raise ValueError(f"predictor {kind!r} not in ('tangent', 'secant', 'none')")
+    if kind == "none":
+        return None
+    if kind == "tangent" or len(res.t) < 2:
         t0, x0 = res.t[-1], res.x[-1]
         eps = 1e-7 * max(t - t0, 1e-3)
         R0, K0 = fun_t(x0, t0)
