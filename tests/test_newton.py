@@ -49,7 +49,7 @@ def test_cut_back_recovers_a_hard_step():
     opts = PathOptions(steps=1, newton=NewtonOptions(max_iter=3, line_search=False))
     res = solve_path(fun_t, [0.0], opts)
     assert res.cutbacks >= 1 and res.t[-1] == 1.0
-    assert res.x[-1][0] ** 3 + res.x[-1][0] == pytest.approx(30.0, rel=1e-10)
+    assert res.x[-1][0] ** 3 + res.x[-1][0] == pytest.approx(30.0, rel=2e-8)  # rtol 1e-8 of |R0| <= 30
 
 
 def test_quadratic_convergence_on_inflated_block():
