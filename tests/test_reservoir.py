@@ -50,6 +50,49 @@ def test_small_deflection_limit_is_the_clamped_kirchhoff_plate():
     assert s.pressure / V == pytest.approx(64 * m.mu * m.t**3 / (math.pi * m.R**6), rel=0.02)
 
 
+def _hencky(nu):
+    """Hencky's clamped membrane (Föppl equations, no bending), dimensionless E t = q = a = 1:
+    (apex w0, volume V) by shooting on S = r N_r: r S'' + S' - S/r = -r^4 / (8 S^2),
+    S ~ N0 r at the axis, u(a) = 0 i.e. S'(1) = nu S(1). An independent method."""
+    from scipy.integrate import solve_ivp
+    from scipy.optimize import brentq
+
+    def shoot(N0, dense=False):
+        r0, c = 1e-6, -1.0 / (64 * N0**2)  # series S = N0 r + c r^3 near the axis
+        rhs = lambda r, y: [y[1], (-r**4 / (8 * y[0] ** 2) - y[1] + y[0] / r) / r]  # noqa: E731
+        sol = solve_ivp(rhs, (r0, 1.0), [N0 * r0 + c * r0**3, N0 + 3 * c * r0**2],
+                        rtol=1e-10, atol=1e-13, dense_output=dense)
+        return sol.y[1, -1] - nu * sol.y[0, -1], sol
+
+    sol = shoot(brentq(lambda N: shoot(N)[0], 0.1, 1.0, xtol=1e-13), dense=True)[1]
+    r = np.linspace(1e-6, 1.0, 4001)
+    slope = r**2 / (2 * sol.sol(r)[0])  # |w'| = q r / (2 N_r)
+    w = np.concatenate([[0.0], np.cumsum(0.5 * (slope[1:] + slope[:-1]) * np.diff(r))])
+    w = w[-1] - w
+    return w[0], np.trapezoid(2 * np.pi * r * w, r)
+
+
+def test_hencky_constant_for_nu_0_3():
+    """The shooting solution reproduces Hencky's coefficient w0 = 0.653 a (qa/Et)^(1/3) (nu = 0.3)."""
+    assert _hencky(0.3)[0] == pytest.approx(0.653, abs=1e-3)
+
+
+def test_thin_sheet_membrane_limit_is_hencky():
+    """The other end of the crossover: t/R = 1/480 at w0 = 0.1 R = 48 t is a membrane.
+    Hencky (incompressible plane stress: E = 3 mu, nu = 1/2): p = (E t / a) (V / (K_V a^3))^3.
+    2 % bounds the bending share O((t/w0)^2) and the Föppl small-slope / linear-material
+    errors O((w0/R)^2) (measured -0.2 %)."""
+    m = SheetModel(t=0.05, n_radial=80, n_thick=1)
+    E, a = 3 * m.mu, m.R
+    w0_hat, V_hat = _hencky(0.5)
+    q = (0.1 / w0_hat) ** 3 * E * m.t / a  # w0 = 0.1 a
+    V = V_hat * a**3 * (q * a / (E * m.t)) ** (1 / 3)
+    opts = PathOptions(first_step=0.05, max_step=2 * a**2 * m.t, atol=1e-12 * 1e3 * m.mu * a * m.t)
+    s = inflate(m, [V], options=opts).states[0]
+    assert s.pressure == pytest.approx(q, rel=0.02)
+    assert s.apex == pytest.approx(0.1 * a, rel=0.02)
+
+
 def test_mesh_convergence_radial_and_through_thickness():
     """p at V = 8000 mm^3 (h = 0.4 R): halving the radial size, and halving the layer
     thickness, each change p less than the previous halving did (and by < 0.5 %)."""
