@@ -149,35 +149,37 @@ def follow_volume(solid, volume, fixed_dofs, targets, *, options=PathOptions(),
     prob = _Problem(solid, volume, free, volume_scale, make_solver(options.solver, symmetric=True))
     if start is None:
         start = PathState(volume.value(np.zeros(solid.ndofs)), 0.0, 0.0, np.zeros(solid.ndofs))
-    uf, p, v, step = start.u[free], start.pressure, start.volume, options.first_step
-    sign = np.sign(targets[0] - v)
+    sign = np.sign(targets[0] - start.volume)
     if sign == 0 or np.any(sign * np.diff(targets) <= 0):
-        raise ValueError(f"volume targets must run strictly monotonically away from {v:.6g} mm^3")
-    path = [start]
-    prev = None  # (uf, p, V) of the state before the last one, for the secant predictor
-    hits = []
+        raise ValueError(f"volume targets must run strictly monotonically away from "
+                         f"{start.volume:.6g} mm^3")
+    path, step, hits = [start], options.first_step, []
     for target in targets:
-        while sign * (target - v) > 0:
-            nxt = v + sign * min(step, sign * (target - v))
-            if prev is not None:
-                s = (nxt - v) / (v - prev[2])
-                guess = (uf + s * (uf - prev[0]), p + s * (p - prev[1]))
-            else:
-                guess = (uf, p)
-            result, history = _newton(prob, *guess, nxt, options)
+        while sign * (target - path[-1].volume) > 0:
+            nxt = path[-1].volume + sign * min(step, sign * (target - path[-1].volume))
+            result, history = _newton(prob, *_predict(path, free, nxt), nxt, options)
             if result is None:
                 step /= 2
                 if step < options.min_step:
                     raise NotConverged(f"no equilibrium at V = {nxt:.6g} mm^3", history, path[-1])
                 continue
-            prev = (uf, p, v)
             uf, p, its = result
-            v = nxt
             u = prob.full(uf)
-            path.append(PathState(v, p, solid.energy(u), u, its))
+            path.append(PathState(nxt, p, solid.energy(u), u, its))
             if progress is not None:
-                progress(v)
+                progress(nxt)
             if its <= 5:
                 step = min(step * options.grow, options.max_step)
         hits.append(path[-1])
     return hits, path
+
+
+def _predict(path, free, volume):
+    """(u_free, p) at ``volume``: secant through the last two converged states, else the last."""
+    last = path[-1]
+    if len(path) < 2:
+        return last.u[free], last.pressure
+    before = path[-2]
+    s = (volume - last.volume) / (last.volume - before.volume)
+    return (last.u[free] + s * (last.u[free] - before.u[free]),
+            last.pressure + s * (last.pressure - before.pressure))
