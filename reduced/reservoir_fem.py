@@ -7,11 +7,14 @@ Neo-Hookean sheet of radius R, thickness t and modulus μ has
 .. math:: p = \frac{μ t}{R}\,\tilde p(v, t/R), \qquad W = μ t R^2\,\tilde W(v, t/R),
           \qquad v = V / R^3,\ \tilde p = d\tilde W/dv,
 
-and the dependence on t/R is only the bending share, O((t/R)²) of the membrane energy.
-The table ``reduced/data/reservoir_fem.csv`` holds :math:`\tilde W, \tilde p, \tilde h = h/R`
-at t/R = 1/24 (Table I) with its provenance in the header; this model rescales it to the
-design's R, t, μ_sr. Between table points W̃ is the cubic Hermite interpolant of the
-values W̃ and slopes p̃, and p̃ its derivative, so p = dW/dV holds exactly within the
+and the dependence on τ = t/R is the bending share (mostly the clamp's boundary layer;
+measured close to linear in τ: p̃ at V0 is 1.435, 1.463, 1.512 for τ = 1/48, 1/24, 1/12).
+The file ``reduced/data/reservoir_fem.csv`` holds :math:`\tilde W, \tilde p, \tilde h = h/R`
+on the same v grid at τ = 1/24 (Table I) and τ = 1/12, with its provenance in the header;
+this model rescales them to the design's R, t, μ_sr and interpolates linearly in τ
+(extrapolates outside [1/24, 1/12]; at τ = 1/48 that is within 0.5 %, see
+``tests/test_reservoir.py``). Between table points W̃ is the cubic Hermite interpolant of
+the values W̃ and slopes p̃, and p̃ its derivative, so p = dW/dV holds exactly within the
 model (energy-consistent, p continuous). Above the table's last volume p̃ continues
 linearly (W̃ quadratically); V <= 0 is an error, as in the ellipse model.
 
@@ -36,55 +39,69 @@ COLUMNS = ("v", "p_tilde", "W_tilde", "h_tilde")
 
 @lru_cache(maxsize=1)
 def table() -> dict:
-    """The calibration table: v = V/R³, p̃ = pR/(μt), W̃ = W/(μtR²), h̃ = h/R (arrays)."""
+    """The calibration tables: τ = t/R -> {v = V/R³, p̃ = pR/(μt), W̃ = W/(μtR²), h̃ = h/R}."""
     lines = [line for line in TABLE_FILE.read_text().splitlines()
              if line.strip() and not line.startswith("#")]
     header = lines[0].split(",")
     values = np.array([[float(x) for x in line.split(",")] for line in lines[1:]])
-    return {name: values[:, header.index(name)] for name in COLUMNS}
+    tau = values[:, header.index("tau")]
+    return {float(t): {name: values[tau == t, header.index(name)] for name in COLUMNS}
+            for t in np.unique(tau)}
 
 
-def _locate(V, design: HandDesign):
+def _weights(design: HandDesign):
+    """((tab_a, 1 - s), (tab_b, s)): linear in τ = t/R between (or beyond) the two tables."""
+    (ta, a), (tb, b) = sorted(table().items())
+    s = (design.t / design.R - ta) / (tb - ta)
+    return (a, 1.0 - s), (b, s)
+
+
+def _locate(V, design: HandDesign, tab: dict):
     v = np.asarray(V, dtype=float) / design.R**3
     if np.any(v <= 0.0):
         raise InputError("V_mm3", float(np.min(V)), "reservoir volume must be positive")
-    tab = table()
     x = tab["v"]
     i = np.clip(np.searchsorted(x, v) - 1, 0, x.size - 2)
     dx = x[i + 1] - x[i]
-    return v, np.minimum((v - x[i]) / dx, 1.0), i, dx, tab
+    return v, np.minimum((v - x[i]) / dx, 1.0), i, dx
 
 
-def _dimensionless_pressure(V, design):
-    """p̃(v): derivative of the Hermite W̃; linear beyond the last table point."""
-    v, s, i, dx, tab = _locate(V, design)
-    W, p = tab["W_tilde"], tab["p_tilde"]
+def _p_tilde(V, design, tab):
+    """p̃(v) of one table: derivative of the Hermite W̃; linear beyond the last point."""
+    v, s, i, dx = _locate(V, design, tab)
+    W, p, x = tab["W_tilde"], tab["p_tilde"], tab["v"]
     dh00, dh10, dh11 = 6 * s**2 - 6 * s, 3 * s**2 - 4 * s + 1, 3 * s**2 - 2 * s
     inside = (W[i] - W[i + 1]) * dh00 / dx + p[i] * dh10 + p[i + 1] * dh11
-    end_slope = (p[-1] - p[-2]) / (tab["v"][-1] - tab["v"][-2])
-    return np.where(v > tab["v"][-1], p[-1] + end_slope * (v - tab["v"][-1]), inside)
+    return np.where(v > x[-1], p[-1] + (p[-1] - p[-2]) / (x[-1] - x[-2]) * (v - x[-1]), inside)
 
 
-def pressure(V, design: HandDesign):
-    """Reservoir gauge pressure p_r(V) = dW/dV [MPa] of the FEM-calibrated sheet, V [mm^3]."""
-    return design.mu_sr * design.t / design.R * _dimensionless_pressure(V, design)
-
-
-def strain_energy(V, design: HandDesign):
-    """Strain energy W(V) [N mm] of the FEM-calibrated sheet (Hermite W̃; quadratic beyond)."""
-    v, s, i, dx, tab = _locate(V, design)
+def _W_tilde(V, design, tab):
+    """W̃(v) of one table: cubic Hermite of (W̃, p̃); quadratic beyond the last point."""
+    v, s, i, dx = _locate(V, design, tab)
     W, p, x = tab["W_tilde"], tab["p_tilde"], tab["v"]
     h00, h10, h01, h11 = 2 * s**3 - 3 * s**2 + 1, s**3 - 2 * s**2 + s, -2 * s**3 + 3 * s**2, s**3 - s**2
     inside = W[i] * h00 + dx * p[i] * h10 + W[i + 1] * h01 + dx * p[i + 1] * h11
     e = v - x[-1]
     beyond = W[-1] + p[-1] * e + 0.5 * (p[-1] - p[-2]) / (x[-1] - x[-2]) * e**2
-    return design.mu_sr * design.t * design.R**2 * np.where(v > x[-1], beyond, inside)
+    return np.where(v > x[-1], beyond, inside)
+
+
+def pressure(V, design: HandDesign):
+    """Reservoir gauge pressure p_r(V) = dW/dV [MPa] of the FEM-calibrated sheet, V [mm^3]."""
+    p = sum(w * _p_tilde(V, design, tab) for tab, w in _weights(design))
+    return design.mu_sr * design.t / design.R * p
+
+
+def strain_energy(V, design: HandDesign):
+    """Strain energy W(V) [N mm] of the FEM-calibrated sheet."""
+    W = sum(w * _W_tilde(V, design, tab) for tab, w in _weights(design))
+    return design.mu_sr * design.t * design.R**2 * W
 
 
 def height(V, design: HandDesign):
-    """FEM apex height h(V) [mm] of the wet surface (linear interpolation of h̃)."""
-    tab = table()
-    return design.R * np.interp(np.asarray(V, float) / design.R**3, tab["v"], tab["h_tilde"])
+    """FEM apex height h(V) [mm] of the wet surface (h̃ linear in v and in τ)."""
+    v = np.asarray(V, float) / design.R**3
+    return design.R * sum(w * np.interp(v, tab["v"], tab["h_tilde"]) for tab, w in _weights(design))
 
 
 register_model("fem", pressure)

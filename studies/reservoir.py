@@ -119,24 +119,27 @@ def run(study: ReservoirStudy, *, progress=None) -> ReservoirStudyResult:
 
 
 def calibration_rows(model: SheetModel, *, v_max: float = 1.75, n: int = 71, progress=None) -> list:
-    """FEM table for :mod:`reduced.reservoir_fem`: v = V/R³ in (0, v_max] on n points, with
-    p̃ = pR/(μt), W̃ = W/(μtR²), h̃ = h/R."""
+    """FEM table for :mod:`reduced.reservoir_fem`: v = V/R³ in [0, v_max] on n points, with
+    τ = t/R, p̃ = pR/(μt), W̃ = W/(μtR²), h̃ = h/R."""
     R, t, mu = model.R, model.t, model.mu
     v = np.linspace(0.0, v_max, n)[1:]
     fem = inflate(model, v * R**3, progress=progress)
-    rows = [{"v": 0.0, "p_tilde": 0.0, "W_tilde": 0.0, "h_tilde": 0.0}]
-    rows += [{"v": s.volume / R**3, "p_tilde": s.pressure * R / (mu * t),
+    rows = [{"tau": t / R, "v": 0.0, "p_tilde": 0.0, "W_tilde": 0.0, "h_tilde": 0.0}]
+    rows += [{"tau": t / R, "v": s.volume / R**3, "p_tilde": s.pressure * R / (mu * t),
               "W_tilde": s.energy / (mu * t * R**2), "h_tilde": s.apex / R} for s in fem.states]
     return rows
 
 
-def calibration_csv(model: SheetModel, rows: list, provenance: str) -> str:
-    """The calibration table as CSV text with a provenance header (``#`` lines)."""
+def calibration_csv(models: list, rows: list, provenance: str) -> str:
+    """The calibration table (one block of rows per sheet model) as CSV text with a
+    provenance header (``#`` lines)."""
     head = [f"# {line}" for line in provenance.splitlines()]
-    head.append(f"# model: R={model.R} mm, t={model.t} mm (t/R={model.t / model.R:.5g}), "
-                f"mu={model.mu} MPa, kappa/mu={model.kappa_ratio}, Q2/P1disc, "
-                f"{model.n_radial} x {model.n_thick} elements (clamp ratio {model.clamp_ratio})")
-    head.append("# v = V/R^3, p_tilde = p R/(mu t), W_tilde = W/(mu t R^2), h_tilde = h/R")
-    lines = ["v,p_tilde,W_tilde,h_tilde"]
-    lines += [f"{r['v']:.6g},{r['p_tilde']:.10g},{r['W_tilde']:.10g},{r['h_tilde']:.10g}" for r in rows]
+    for m in models:
+        head.append(f"# model: R={m.R} mm, t={m.t} mm (tau=t/R={m.t / m.R:.6g}), mu={m.mu} MPa, "
+                    f"kappa/mu={m.kappa_ratio}, Q2/P1disc, {m.n_radial} x {m.n_thick} elements "
+                    f"(clamp ratio {m.clamp_ratio})")
+    head.append("# tau = t/R, v = V/R^3, p_tilde = p R/(mu t), W_tilde = W/(mu t R^2), h_tilde = h/R")
+    lines = ["tau,v,p_tilde,W_tilde,h_tilde"]
+    lines += [f"{r['tau']:.10g},{r['v']:.6g},{r['p_tilde']:.10g},{r['W_tilde']:.10g},"
+              f"{r['h_tilde']:.10g}" for r in rows]
     return "\n".join(head + lines) + "\n"

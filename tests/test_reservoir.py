@@ -116,6 +116,16 @@ def test_calibrated_fem_model_matches_the_fem_and_is_energy_consistent(study):
     np.testing.assert_allclose(dW, reservoir_fem.pressure(V, DESIGN), rtol=1e-6)
 
 
+def test_calibrated_fem_model_for_another_thickness():
+    """A 0.5 mm sheet (t/R = 1/48, outside the tables' 1/24..1/12: linear extrapolation in t/R)
+    against its own FEM (same element shape): 1 % bounds the measured 0.4 % of the
+    linearisation in t/R; the ellipse model is 30-40 % off here."""
+    thin = DESIGN.replace(t=0.5)
+    fem = inflate(SheetModel.from_design(thin, n_radial=40, n_thick=1), [DESIGN.V0 - STROKE, DESIGN.V0])
+    for s in fem.states:
+        assert reservoir_fem.pressure(s.volume, thin) == pytest.approx(s.pressure, rel=1e-2)
+
+
 def test_fem_model_is_selectable_in_the_design():
     fem_design = DESIGN.replace(reservoir_model="fem")
     p = reservoir.pressure(DESIGN.V0, fem_design)

@@ -134,18 +134,21 @@ def _git_commit() -> str:
 
 
 def _write_calibration(study, path) -> int:
+    """FEM tables at the design's thickness t and at 2t (twice the layers: same element shape)."""
+    from dataclasses import replace
     from datetime import datetime, timezone
 
     from studies.output import write_atomic
     from studies.reservoir import calibration_csv, calibration_rows
 
-    model = study.model()
-    rows = calibration_rows(model)
+    thin = study.model()
+    thick = replace(thin, t=2 * thin.t, n_thick=2 * thin.n_thick)
+    rows = calibration_rows(thin) + calibration_rows(thick)
     provenance = (f"FEM calibration of reduced/reservoir_fem.py, written "
                   f"{datetime.now(timezone.utc):%Y-%m-%d %H:%M} UTC at commit {_git_commit()} by\n"
                   f"softhand reservoir --write-calibration {Path(path).name} "
-                  f"--n-radial {model.n_radial} --n-thick {model.n_thick}")
-    write_atomic(path, calibration_csv(model, rows, provenance))
+                  f"--n-radial {thin.n_radial} --n-thick {thin.n_thick}")
+    write_atomic(path, calibration_csv([thin, thick], rows, provenance))
     print(f"wrote {len(rows)} rows to {path}")
     return 0
 
