@@ -64,7 +64,7 @@ class Solid:
     """
 
     def __init__(self, mesh, law, *, element=None, intorder: int = 2,
-                 formulation: str | None = None, chunk: int = 8192):
+                 formulation: str | None = None, chunk: int = 2048):
         self.mesh, self.law = mesh, law
         self.element = element or ElementTetP2()
         self.sbasis = Basis(mesh, self.element, intorder=intorder)
