@@ -39,14 +39,22 @@ def _outward(mesh, facets):
     return np.ascontiguousarray(tri, dtype=np.int32)
 
 
-def run_ngsolve(mesh, steps: int, intorder: int, *, tol: float = 1e-10, max_iter: int = 40):
-    """Plain Newton over ``steps`` equal load steps; halves the step on divergence (as ours)."""
+def run_ngsolve(mesh, steps: int, intorder: int, *, tol: float = 1e-10, max_iter: int = 40,
+                budget: int | None = None):
+    """Plain Newton over ``steps`` equal load steps; halves the step on divergence (as ours).
+
+    budget: stop after this many Newton iterations (per-iteration times only; tip is None).
+    """
     import ngsolve as ng
     with ng.TaskManager():
-        return _run(ng, mesh, steps, intorder, tol, max_iter)
+        return _run(ng, mesh, steps, intorder, tol, max_iter, budget)
 
 
-def _run(ng, mesh, steps, intorder, tol, max_iter):
+class _Budget(Exception):
+    pass
+
+
+def _run(ng, mesh, steps, intorder, tol, max_iter, budget):
     t_start = time.perf_counter()
     m = ngsolve_mesh(mesh)
     fes = ng.VectorH1(m, order=2, dirichlet="base")
@@ -66,13 +74,18 @@ def _run(ng, mesh, steps, intorder, tol, max_iter):
     res, work = gfu.vec.CreateVector(), gfu.vec.CreateVector()
     free = fes.FreeDofs()
     scale = np.linalg.norm(np.asarray(f.vec)[np.asarray(list(free), dtype=bool)])
-    stats = dict(assembly=0.0, solve=0.0, iterations=0, per_step=[])
+    stats = dict(assembly=0.0, solve=0.0, iterations=0, per_step=[], budget=budget)
     t, dt = 0.0, 1.0 / steps
     while t < 1.0 - 1e-12:
         tn = min(1.0, t + dt)
         backup = gfu.vec.CreateVector()
         backup.data = gfu.vec
-        its = _newton(a, f, gfu, res, work, free, tn, tol * tn * scale, max_iter, stats)
+        try:
+            its = _newton(a, f, gfu, res, work, free, tn, tol * tn * scale, max_iter, stats)
+        except _Budget:
+            return dict(steps=len(stats["per_step"]), iterations=stats["iterations"],
+                        per_step=stats["per_step"], assembly=stats["assembly"], solve=stats["solve"],
+                        total=time.perf_counter() - t_start, tip=None)
         if its is None:
             gfu.vec.data = backup
             dt *= 0.5
@@ -108,6 +121,8 @@ def _newton(a, f, gfu, res, work, free, t, tol, max_iter, stats):
         stats["assembly"] += t1 - t0
         stats["solve"] += time.perf_counter() - t1
         stats["iterations"] += 1
+        if stats["budget"] is not None and stats["iterations"] >= stats["budget"]:
+            raise _Budget
     return None
 
 
