@@ -128,26 +128,37 @@ class PlanarChain:
 
 @dataclass
 class ChainConstraint:
-    """Nodes of a finite-element vector tied to the links of a :class:`PlanarChain`.
+    """Nodes of a finite-element vector carried by the links of a :class:`PlanarChain`.
 
     The full vector u (size ``n_dofs``; any layout, e.g. displacements then pressures)
-    is parametrised by y = (u[free], q): tied nodes move with their link, ``fixed``
-    entries are zero, the rest are free.
+    is parametrised by y = (w, q) with w = the entries that are neither tied nor fixed.
+    Every node listed in ``nodes`` follows a link: its displacement is the link's rigid
+    motion plus its own unknowns (co-rotated parametrisation),
+
+        u_n = (x_k(q; X_n) - X_n, 0) + w_n,
+
+    and a ``tied`` node has no w_n: it moves rigidly with its link. Entries in ``fixed``
+    are zero; they must not move with the chain (z components, or nodes on link 0).
+    Carrying the free nodes along keeps a large rotation of the distal links from
+    shearing the elements next to the tied ones in a Newton update (an update of q then
+    moves a whole segment rigidly, not by the linearised rotation).
     """
 
     chain: PlanarChain
     n_dofs: int               #: size of the full vector
-    tied: np.ndarray          #: (m, 3) indices of the tied nodes' x, y, z displacement DOFs
-    links: np.ndarray         #: (m,) the link each tied node belongs to
-    X: np.ndarray             #: (m, 2) reference x-y position of each tied node [mm]
+    nodes: np.ndarray         #: (m, 3) indices of the x, y, z displacement DOFs of each node
+    links: np.ndarray         #: (m,) the link each node follows
+    X: np.ndarray             #: (m, 2) reference x-y position of each node [mm]
+    tied: np.ndarray          #: (m,) True: the node moves rigidly with its link
     fixed: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=int))  #: zero DOFs
 
     def __post_init__(self):
-        self.tied = np.asarray(self.tied, dtype=int).reshape(-1, 3)
+        self.nodes = np.asarray(self.nodes, dtype=int).reshape(-1, 3)
         self.links = np.asarray(self.links, dtype=int)
         self.X = np.asarray(self.X, dtype=float).reshape(-1, 2)
+        self.tied = np.asarray(self.tied, dtype=bool)
         slaved = np.zeros(self.n_dofs, dtype=bool)
-        slaved[self.tied.ravel()] = True
+        slaved[self.nodes[self.tied].ravel()] = True
         slaved[np.asarray(self.fixed, dtype=int)] = True
         self.free = np.flatnonzero(~slaved)
 
@@ -167,18 +178,19 @@ class ChainConstraint:
         u = np.zeros(self.n_dofs)
         u[self.free] = y[:len(self.free)]
         x, _, _ = self.chain.point_map(self.q(y), self.links, self.X)
-        u[self.tied[:, :2]] = x - self.X
+        u[self.nodes[:, :2]] += x - self.X
         return u
 
     def operator(self, y) -> sp.csr_matrix:
         """T' = du/dy at y, shape (n_dofs, n_reduced); its pattern does not depend on y."""
         n_f, n_s = len(self.free), self.chain.n_s
         _, J, _ = self.chain.point_map(self.q(y), self.links, self.X)
-        rows_t = np.repeat(self.tied[:, :2], n_s, axis=1).ravel()       # (m, 2 n_s)
-        cols_t = np.tile(n_f + np.arange(n_s), 2 * len(self.links))
+        moving = self.links > 0                       # link-0 nodes have J = 0
+        rows_t = np.repeat(self.nodes[moving, :2], n_s, axis=1).ravel()
+        cols_t = np.tile(n_f + np.arange(n_s), 2 * int(moving.sum()))
         rows = np.concatenate((self.free, rows_t))
         cols = np.concatenate((np.arange(n_f), cols_t))
-        vals = np.concatenate((np.ones(n_f), J.ravel()))
+        vals = np.concatenate((np.ones(n_f), J[moving].ravel()))
         return sp.csr_matrix((vals, (rows, cols)), shape=(self.n_dofs, self.n_reduced))
 
     def reduce(self, y, R, K=None):
@@ -188,7 +200,7 @@ class ChainConstraint:
         if K is None:
             return r
         _, _, H = self.chain.point_map(self.q(y), self.links, self.X)
-        G = np.einsum("majl,ma->jl", H, R[self.tied[:, :2]])
+        G = np.einsum("majl,ma->jl", H, R[self.nodes[:, :2]])
         n_f, n_s = len(self.free), self.chain.n_s
         idx = n_f + np.arange(n_s)
         geo = sp.csr_matrix((G.ravel(), (np.repeat(idx, n_s), np.tile(idx, n_s))),
@@ -202,5 +214,6 @@ class ChainConstraint:
 
         ``R`` is the full residual (internal minus external force); shape (n_s + 1, 2).
         """
-        return -np.stack([np.bincount(self.links, R[self.tied[:, c]],
+        t = self.tied
+        return -np.stack([np.bincount(self.links[t], R[self.nodes[t, c]],
                                       minlength=self.chain.n_s + 1) for c in (0, 1)], axis=1)

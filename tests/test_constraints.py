@@ -88,11 +88,12 @@ def test_dead_tip_force_on_a_spring_hinged_link_matches_the_closed_form():
 
 
 def _random_constraint(n_nodes=40):
-    """A vector of n_nodes * 3 + 5 DOFs; the first nodes tied to random links."""
-    m = 24
-    tied = np.arange(3 * m).reshape(m, 3)
+    """A vector of n_nodes * 3 + 5 DOFs; the first 24 nodes follow links, half of them tied."""
+    m = LINKS.size
+    nodes = np.arange(3 * m).reshape(m, 3)
     fixed = np.array([3 * n_nodes - 1, 3 * n_nodes + 2])      # one displacement, one 'pressure'
-    return ChainConstraint(CHAIN, 3 * n_nodes + 5, tied, LINKS, POINTS, fixed)
+    return ChainConstraint(CHAIN, 3 * n_nodes + 5, nodes, LINKS, POINTS,
+                           np.arange(m) % 2 == 0, fixed)
 
 
 def test_reduced_residual_and_tangent_are_derivatives_of_the_reduced_energy():

@@ -1,0 +1,327 @@
+r"""The finger FEM: a fiber-reinforced rubber tube held by a hinged rigid shell, under pressure.
+
+Model (DESIGN.md, "The FEM models"; the paper's section II-B):
+
+* the NBR tube of :mod:`meshes.finger` (inner radius a, wall b, length l0 with an end cap
+  of thickness ``cap`` at the tip), half model on the bending plane z = 0;
+* nearly incompressible Neo-Hookean rubber (mu_sf, kappa = ``kappa_ratio`` mu) in the
+  mean-dilatation P2-P0 formulation of :mod:`fem.solid`, plus a tension-only fiber family
+  (the Kevlar windings) along the hoop direction e_phi = (0, -z, y)/r, stiffness
+  ``fiber_ratio`` mu, everywhere in the wall (the cap too);
+* oil pressure P on the cavity: the closed-cavity load P dV/du with its symmetric load
+  stiffness P d2V/du2, V the cavity volume of :class:`fem.loads.CavityVolume` (closed by
+  the symmetry plane z = 0 and the fixed inlet plane x = 0);
+* the shell: a :class:`fem.constraints.PlanarChain` with hinges at (``hinge_s``, d) in the
+  finger frame (the hinge plate at y = +d), link 0 fixed; the tube's base face is clamped
+  to link 0 and the outer-surface band ``tie<k>`` moves rigidly with link k
+  (:class:`fem.constraints.ChainConstraint`);
+* unknowns y = (free displacements, hinge angles q); theta = sum(q); the hand's base
+  inclination theta0_hat only rotates the result (:func:`to_hand_frame`).
+
+Which part of the outer surface the shell holds is a modelling choice
+(:class:`FingerOptions` ``tie``): ``"ring"`` ties a band of width ``tie_width`` in the
+middle of each link (the shell clamps the tube at rings and lets it bend between
+them), ``"full"`` ties each link's whole length except ``hinge_gap`` around each hinge
+(a closed shell that lets the tube deform only at the hinges). docs/finger.md compares
+them.
+
+Generalised forces on the links (contact with an object, its weight) are passed to
+:meth:`FingerModel.residual_tangent` as ``link_load(q) -> (Q, dQ/dq)``; see
+:meth:`fem.constraints.PlanarChain.point_load`.
+"""
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+import scipy.sparse as sp
+from skfem import Basis, ElementTetP2, ElementVector
+
+from fem import kinematics as kin
+from fem.constraints import ChainConstraint, PlanarChain
+from fem.linsolve import make_solver
+from fem.loads import CavityVolume
+from fem.materials import Fibers, NeoHookean
+from fem.newton import NewtonOptions, NotConverged, PathOptions, newton, solve_path
+from fem.solid import Solid
+from meshes.finger import FingerTube, finger_tube_mesh
+from reduced.design import HandDesign
+from reduced.errors import InputError
+
+TIES = ("ring", "full")
+
+
+@dataclass(frozen=True, eq=False)
+class WindingFibers(Fibers):
+    r"""The tension-only winding fibers with a smooth onset ("toe") of width ``toe``.
+
+    .. math:: \psi = k\,G(\lambda_f - 1),\quad
+        G(e) = \begin{cases} 0 & e \le 0\\ e^3/(6\delta) & 0 < e < \delta\\
+        e^2/2 - \delta e/2 + \delta^2/6 & e \ge \delta \end{cases}
+
+    so the fiber stiffness k G'' rises linearly from 0 to k over 0 < e < delta (the slack of
+    wound threads) instead of jumping at lambda_f = 1. ``toe = 0`` is
+    :class:`fem.materials.Fibers` (stiff already at lambda_f = 1). The jump makes Newton
+    chatter where the hoop stretch is near 1, i.e. in much of the bent tube; docs/finger.md
+    shows the effect of delta on theta.
+    """
+
+    toe: float = 0.0  #: width delta of the onset in fiber strain
+
+    def take(self, elements):
+        return self if self.a0.ndim == 1 else WindingFibers(self.k, self.a0[:, elements], self.toe)
+
+    def _g(self, e):
+        """(G, G', G'') of the fiber strain e (see the class docstring)."""
+        d = self.toe
+        if d == 0:
+            on = e >= 0
+            return (np.where(on, 0.5 * e * e, 0.0), np.where(on, e, 0.0), on * 1.0)
+        ramp = np.clip(e, 0.0, d)
+        G = np.where(e < d, ramp ** 3 / (6 * d), 0.5 * e * e - 0.5 * d * e + d * d / 6)
+        G1 = np.where(e < d, ramp ** 2 / (2 * d), e - 0.5 * d)
+        return G, G1, ramp / d
+
+    def energy(self, F):
+        return self.k * self._g(self.stretch(F) - 1.0)[0]
+
+    def stress(self, F):
+        a0, f, lam, _ = self._kinematics(F)
+        return self.k * self._g(lam - 1.0)[1] / lam * np.einsum("a...,K...->aK...", f, a0)
+
+    def tangent(self, F):
+        a0, f, lam, _ = self._kinematics(F)
+        _, G1, G2 = self._g(lam - 1.0)
+        fa = np.einsum("a...,K...->aK...", f, a0)
+        aa = np.einsum("ab,K...,L...->aKbL...", np.eye(3), a0, a0)
+        return self.k * ((G2 / lam ** 2 - G1 / lam ** 3) * kin.outer(fa, fa) + G1 / lam * aa)
+
+
+@dataclass(frozen=True)
+class FingerOptions:
+    """Discretisation and modelling choices of the finger FEM."""
+
+    mesh_size: float = 3.0     #: target element size [mm]
+    tie: str = "ring"          #: which outer surface the links hold: "ring" or "full"
+    tie_width: float = 10.0    #: width of each link's tied ring, centred on the link [mm]
+    hinge_gap: float = 4.0     #: untied tube length around each hinge, tie = "full" [mm]
+    cap: float | None = None   #: end-cap thickness at the tip [mm]; None: the wall b
+    kappa_ratio: float = 1000.0  #: bulk over shear modulus of the rubber
+    fiber_ratio: float = 1000.0  #: fiber stiffness over mu (Kevlar >> rubber)
+    fiber_toe: float = 0.0     #: fiber strain over which the windings' stiffness sets in (0: a jump)
+
+    def __post_init__(self):
+        if self.tie not in TIES:
+            raise InputError("tie", self.tie, f"must be one of {', '.join(TIES)}")
+        for name in ("mesh_size", "tie_width", "hinge_gap", "kappa_ratio", "fiber_ratio"):
+            if not getattr(self, name) > 0:
+                raise InputError(name, getattr(self, name), "must be a positive number")
+
+
+def tie_bands(design: HandDesign, options: FingerOptions) -> tuple[tuple[float, float], ...]:
+    """(x_start, x_end) of the tube band each link holds [mm] (see :class:`FingerOptions`)."""
+    s = np.array((0.0, *design.hinge_s, design.l0))
+    if options.tie == "ring":
+        mid, half = 0.5 * (s[:-1] + s[1:]), 0.5 * options.tie_width
+        if options.tie_width >= np.diff(s).min():
+            raise InputError("tie_width", options.tie_width, "must be shorter than every link")
+        return tuple((float(m - half), float(m + half)) for m in mid)
+    gap = 0.5 * options.hinge_gap
+    if options.hinge_gap >= np.diff(s).min():
+        raise InputError("hinge_gap", options.hinge_gap, "must be shorter than every link")
+    start, end = s[:-1] + gap, s[1:] - gap
+    start[0], end[-1] = 0.0, design.l0
+    return tuple((float(a), float(b)) for a, b in zip(start, end))
+
+
+def hoop_directions(X: np.ndarray) -> np.ndarray:
+    """Fiber directions e_phi = (0, -z, y)/r around the tube axis (the x axis), X (3, ...)."""
+    a0 = np.stack([np.zeros_like(X[0]), -X[2], X[1]])
+    return a0 / np.maximum(np.hypot(X[1], X[2]), 1e-12)
+
+
+def to_hand_frame(points: np.ndarray, design: HandDesign) -> np.ndarray:
+    """Finger-frame (x, y) points (..., 2) -> the hand frame of :mod:`reduced.kinematics`.
+
+    The hinge plate's base point (0, d) goes to (base_offset, 0); the finger axis x to
+    the base link's direction, inclined theta0_hat outward from the downward vertical;
+    the finger frame's +y (towards the plate, the finger's closing side) points inward.
+    """
+    c, s = math.cos(design.theta0), math.sin(design.theta0)
+    M = np.array([[s, -c], [c, s]])
+    rel = np.asarray(points, dtype=float) - np.array([0.0, design.d])
+    return np.array([design.base_offset, 0.0]) + rel @ M.T
+
+
+@dataclass
+class FingerState:
+    """One converged state of the finger (finger frame, mm, MPa, rad)."""
+
+    P: float                       #: cavity pressure [MPa]
+    q: np.ndarray                  #: hinge angles theta_hat_i [rad]
+    dQ: float                      #: cavity volume change of the whole finger [mm^3]
+    radial_stretch_max: float      #: max hoop (fiber-direction) stretch; the paper's lambda_2
+    max_principal_stretch: float   #: max principal stretch over the quadrature points
+    max_von_mises: float           #: max Cauchy von Mises stress [MPa]
+    max_fiber_stress: float        #: max fiber stress k (lambda_f - 1) [MPa]
+    iterations: int                #: Newton iterations of this pressure step
+    y: np.ndarray = field(repr=False, default=None)  #: reduced unknowns (free u, q)
+
+    @property
+    def theta(self) -> float:
+        """Total bend angle theta = sum theta_hat_i (3) [rad]."""
+        return float(np.sum(self.q))
+
+
+class FingerModel:
+    """The built finger FEM: mesh, solid, shell constraint and pressure load."""
+
+    def __init__(self, design: HandDesign, options: FingerOptions = FingerOptions()):
+        self.design, self.options = design, options
+        cap = options.cap if options.cap is not None else design.b
+        self.tube = FingerTube(design.a, design.b, design.l0, cap, tie_bands(design, options))
+        self.mesh = finger_tube_mesh(self.tube, size=options.mesh_size)
+        X_q = Basis(self.mesh, ElementTetP2(), intorder=2).global_coordinates().value
+        mu = design.mu_sf
+        self.fibers = WindingFibers(options.fiber_ratio * mu, hoop_directions(np.asarray(X_q)),
+                                    options.fiber_toe)
+        self.law = NeoHookean(mu, options.kappa_ratio * mu) + self.fibers
+        self.solid = Solid(self.mesh, self.law)
+        self.cavity = CavityVolume(self.solid, self.mesh.boundaries["cavity"], symmetry_normal=0)
+        self.chain = PlanarChain(np.c_[design.hinge_s, np.full(design.n_s, design.d)])
+        self.constraint = self._tie()
+        self.V0 = self.cavity.volume(np.zeros(self.solid.ndofs))
+
+    def _tie(self) -> ChainConstraint:
+        """Every node follows the link over its x position; the tie bands' nodes are tied."""
+        basis = self.solid.sbasis
+        X = basis.doflocs
+        links = np.searchsorted(self.design.hinge_s, X[0], side="right")
+        tied = np.zeros(basis.N, dtype=bool)
+        for k in range(self.design.n_s + 1):
+            band = basis.get_dofs(f"tie{k}").all()
+            tied[band] = True
+            links[band] = k
+        fixed = np.concatenate((self.solid.dofs("base"), self.solid.dofs("symmetry", (2,))))
+        nodes = 3 * np.arange(basis.N)[:, None] + np.arange(3)
+        return ChainConstraint(self.chain, self.solid.ndofs, nodes, links, X[:2].T, tied, fixed)
+
+    @property
+    def ndofs(self) -> int:
+        """Unknowns of the reduced system (free displacements + hinge angles)."""
+        return self.constraint.n_reduced
+
+    def displacement(self, y) -> np.ndarray:
+        """The full displacement vector u = T(y)."""
+        return self.constraint.expand(y)
+
+    def residual_tangent(self, y, P: float, link_load=None):
+        """Reduced residual and tangent at pressure P [MPa].
+
+        ``link_load(q) -> (Q, dQdq)``: generalised external forces on the hinge angles
+        [N mm] and their derivative (e.g. from :meth:`PlanarChain.point_load`).
+        """
+        u = self.constraint.expand(y)
+        R, data = self.solid.residual_tangent_data(u)
+        R = R - P * self.cavity.gradient(u)
+        K = self.solid.scatter.csr(data - P * self.cavity.hessian_data(u))
+        r, Kr = self.constraint.reduce(y, R, K)
+        if link_load is not None:
+            Q, dQ = link_load(self.constraint.q(y))
+            n_f = len(self.constraint.free)
+            r[n_f:] -= Q
+            idx = n_f + np.arange(len(Q))
+            Kr = (Kr - sp.csr_matrix((np.ravel(dQ), (np.repeat(idx, len(Q)), np.tile(idx, len(Q)))),
+                                     shape=Kr.shape)).tocsr()
+        return r, Kr
+
+    def state(self, y, P: float, iterations: int = 0) -> FingerState:
+        """Outputs of the converged reduced state y at pressure P."""
+        u = self.constraint.expand(y)
+        F = self.solid.F(u)
+        eig = np.linalg.eigvalsh(np.moveaxis(kin.right_cauchy_green(F), (0, 1), (-2, -1)))
+        sigma = np.einsum("aK...,bK...->ab...", self.solid.first_piola(u), F) / kin.det(F)
+        dev = sigma - np.einsum("aa...->...", sigma) / 3.0 * kin.identity(sigma.shape[2:])
+        lam_f = self.fibers.stretch(F)
+        return FingerState(
+            P=float(P), q=np.array(self.constraint.q(y)),
+            dQ=2.0 * (self.cavity.volume(u) - self.V0),
+            radial_stretch_max=float(lam_f.max()),
+            max_principal_stretch=float(np.sqrt(eig.max())),
+            max_von_mises=float(np.sqrt(1.5 * np.einsum("ab...,ab...->...", dev, dev)).max()),
+            max_fiber_stress=float(self.fibers.k * np.clip(lam_f - 1.0, 0.0, None).max()),
+            iterations=int(iterations), y=np.array(y))
+
+    def link_poses(self, y) -> tuple[np.ndarray, np.ndarray]:
+        """Link poses in the finger frame: origins c_k (n_s+1, 2) [mm], angles phi_k [rad]."""
+        return self.chain.link_poses(self.constraint.q(y))
+
+    def vector_basis(self) -> Basis:
+        """The vector P2 basis of the displacement (for VTK output)."""
+        return Basis(self.mesh, ElementVector(ElementTetP2()), intorder=2)
+
+    def element_dilatation(self, y) -> np.ndarray:
+        """Mean dilatation J_bar per element (for the VTK stress of :mod:`fem.io`)."""
+        u = self.constraint.expand(y)
+        W = self.solid.W
+        return (W * kin.det(self.solid.F(u))).sum(axis=1) / W.sum(axis=1)
+
+
+@dataclass(frozen=True)
+class SweepStats:
+    """Cost of a pressure sweep."""
+
+    wall_seconds: float
+    assembly_seconds: float
+    solve_seconds: float
+    newton_iterations: int
+    cutbacks: int
+    solver: str
+
+
+def solve_pressures(model: FingerModel, pressures, *, link_load=None, y0=None, callback=None,
+                    newton_options: NewtonOptions = NewtonOptions(rtol=1e-9)):
+    """Follow increasing pressures [MPa] from the state y0 (default: unloaded, P = 0).
+
+    Each pressure starts from the secant extrapolation of the last two converged states
+    (the response is smooth in P); if Newton fails there, :func:`fem.newton.solve_path`
+    retries from the last converged state with load-step cut-back. Returns
+    ([FingerState], SweepStats); raises :class:`fem.newton.NotConverged` with the last
+    converged state when even the cut-back fails.
+    """
+    solver = make_solver(symmetric=True)
+    t0 = time.perf_counter()
+    history = [(0.0, model.constraint.zero() if y0 is None else np.array(y0, dtype=float))]
+    states, totals = [], np.zeros(4)  # assembly s, solve s, iterations, cutbacks
+    scale = model.design.mu_sf * model.design.a ** 2 * model.design.l0  # [N] residual scale
+    for P in (float(p) for p in pressures):
+        y, its = _solve_one(model, P, history, link_load, solver, newton_options, scale, totals)
+        if P != history[-1][0]:
+            history.append((P, y))
+        states.append(model.state(y, P, its))
+        if callback is not None:
+            callback(states[-1])
+    stats = SweepStats(time.perf_counter() - t0, totals[0], totals[1], int(totals[2]),
+                       int(totals[3]), solver.describe())
+    return states, stats
+
+
+def _solve_one(model, P, history, link_load, solver, options, scale, totals):
+    """The state at P from the converged (P_i, y_i) history; updates totals in place."""
+    fun = lambda y: model.residual_tangent(y, P, link_load)  # noqa: E731
+    (P1, y1) = history[-1]
+    if len(history) >= 2 and P != P1:
+        P2, y2 = history[-2]
+        guess = y1 + (P - P1) / (P1 - P2) * (y1 - y2)
+        try:
+            r = newton(fun, guess, options, solver=solver, scale=scale)
+            totals += (r.assembly_seconds, r.solve_seconds, r.iterations, 0)
+            return r.x, r.iterations
+        except NotConverged:
+            totals[3] += 1
+    path = solve_path(lambda y, t: model.residual_tangent(y, P1 + t * (P - P1), link_load), y1,
+                      PathOptions(steps=1, newton=options), solver=solver, scale_t=lambda t: scale)
+    totals += (path.assembly_seconds, path.solve_seconds, path.total_iterations, path.cutbacks)
+    return path.x[-1], path.total_iterations

@@ -1,0 +1,101 @@
+"""Free bending of the finger under pressure: the FEM against eqs. (28) and (2).
+
+:func:`run` builds the finger FEM (:mod:`fem.finger`), follows the pressures and returns
+one row per pressure with the reduced model's values next to the FEM's:
+
+* ``theta_reduced_deg``: eq. (28) (one finger, no reservoir) solved for theta at the same P;
+* ``dQ_reduced_mm3``: eq. (2) per finger, a^2 pi d theta, at the FEM's theta, so that it
+  checks the volume-angle relation on its own (the angle error is in the theta column).
+
+Optionally the path continues to ``peak_mpa`` (2.0 MPa: the pressure the paper's FEM
+says the finger withstands) and reports the peak stretch and stress there. No files and
+no printing here: the CLI (``softhand bend``) writes them.
+"""
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import asdict, dataclass, field
+
+import numpy as np
+
+from fem.finger import FingerModel, FingerOptions, FingerState, SweepStats, solve_pressures
+from reduced import finger as reduced_finger
+from reduced import hand
+from reduced.design import HandDesign
+from reduced.errors import InputError
+
+
+@dataclass(frozen=True)
+class BendingStudy:
+    design: HandDesign = field(default_factory=HandDesign)
+    pressures_mpa: tuple[float, ...] = tuple(np.round(np.arange(0.0, 0.81, 0.1), 10))
+    options: FingerOptions = field(default_factory=FingerOptions)
+    peak_mpa: float = 0.0  #: continue to this pressure after the sweep [MPa]; 0: no
+    peak_step_mpa: float = 0.2  #: pressure increment on the way to peak_mpa [MPa]
+
+    def __post_init__(self):
+        P = np.asarray(self.pressures_mpa, dtype=float)
+        if P.size == 0 or np.any(P < 0) or np.any(np.diff(P) <= 0):
+            raise InputError("pressure_mpa", list(P), "must be increasing values >= 0 MPa")
+        if self.peak_mpa and self.peak_mpa <= P[-1]:
+            raise InputError("peak_mpa", self.peak_mpa, f"must exceed the last pressure {P[-1]} MPa")
+
+
+@dataclass
+class BendingResult:
+    rows: list[dict]            #: one per pressure (see :func:`row`)
+    peak: dict | None           #: the state at peak_mpa, or None
+    ndofs: int                  #: unknowns of the reduced FEM system
+    nelements: int              #: quadratic tetrahedra in the half model
+    stats: SweepStats           #: cost of the sweep (without the peak run)
+    build_seconds: float        #: meshing (cached) and setting up the model
+    model: FingerModel = field(repr=False)
+    states: list[FingerState] = field(repr=False)
+
+    def summary(self) -> dict:
+        """Numbers and provenance for result.json."""
+        return {"rows": self.rows, "peak": self.peak, "ndofs": self.ndofs,
+                "nelements": self.nelements, "build_seconds": self.build_seconds,
+                "stats": asdict(self.stats), "options": asdict(self.model.options),
+                "design": self.model.design.to_dict(), "design_hash": self.model.design.hash()}
+
+
+def row(state: FingerState, design: HandDesign) -> dict:
+    """One output row: the FEM state and eqs. (28), (2) at the same pressure."""
+    theta_red = float(hand.bend_angle(state.P, design, reservoir=False)) if state.P > 0 else 0.0
+    dQ_red = float(reduced_finger.Q(state.theta, design) - reduced_finger.Q(0.0, design)) / design.n
+    return {
+        "P_MPa": state.P,
+        "theta_deg": math.degrees(state.theta),
+        "hinge_deg": [round(math.degrees(q), 4) for q in state.q],
+        "dQ_mm3": state.dQ,
+        "radial_stretch_max": state.radial_stretch_max,
+        "max_principal_stretch": state.max_principal_stretch,
+        "theta_reduced_deg": math.degrees(theta_red),
+        "dQ_reduced_mm3": dQ_red,
+        "max_von_mises_MPa": state.max_von_mises,
+        "newton_iterations": state.iterations,
+    }
+
+
+def run(study: BendingStudy, *, on_state=None) -> BendingResult:
+    """Run the bending study; ``on_state(model, state)`` after each converged pressure."""
+    t0 = time.perf_counter()
+    model = FingerModel(study.design, study.options)
+    build = time.perf_counter() - t0
+    callback = None if on_state is None else (lambda s: on_state(model, s))
+    states, stats = solve_pressures(model, study.pressures_mpa, callback=callback)
+    peak = None
+    if study.peak_mpa:
+        P_last = study.pressures_mpa[-1]
+        n = max(1, math.ceil((study.peak_mpa - P_last) / study.peak_step_mpa - 1e-9))
+        more, _ = solve_pressures(model, np.linspace(P_last, study.peak_mpa, n + 1)[1:],
+                                  y0=states[-1].y, callback=callback)
+        s = more[-1]
+        peak = {"P_MPa": s.P, "theta_deg": math.degrees(s.theta),
+                "max_principal_stretch": s.max_principal_stretch,
+                "max_von_mises_MPa": s.max_von_mises, "radial_stretch_max": s.radial_stretch_max,
+                "max_fiber_stress_MPa": s.max_fiber_stress}
+    return BendingResult([row(s, study.design) for s in states], peak, model.ndofs,
+                         model.mesh.nelements, stats, build, model, states)

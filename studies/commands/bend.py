@@ -1,0 +1,117 @@
+"""``softhand bend``: free bending of the finger FEM under pressure, against eqs. (28) and (2).
+
+Per pressure: P_MPa, theta_deg, hinge_deg, dQ_mm3, radial_stretch_max,
+max_principal_stretch, theta_reduced_deg (eq. (28) at the same P), dQ_reduced_mm3 (eq. (2)
+at the FEM's theta), max_von_mises_MPa, newton_iterations. Then, unless ``--peak-mpa 0``,
+the path goes on to 2.0 MPa and the peak stretch and stress there are reported.
+Files in ``--out DIR``: result.json, table.csv, the VTK series finger.pvd (+ .vtu).
+"""
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+from studies.args import add_design_option, add_json_option, design_from_args, parse_values, \
+    print_json, print_table
+
+HELP = "finger FEM: free bending under pressure vs the reduced model (eqs. 28, 2)"
+
+
+def configure(parser) -> None:
+    parser.add_argument("--pressure-mpa", metavar="RANGE", default="0:0.8:0.1",
+                        help="pressures [MPa]: start:stop:step (stop included) or a,b,c "
+                             "(default 0:0.8:0.1)")
+    parser.add_argument("--mesh-size-mm", metavar="H", type=float, default=None,
+                        help="element size [mm] (default 3)")
+    parser.add_argument("--tie", choices=("ring", "full"), default="ring",
+                        help="outer surface held by the links: a ring in each link's middle "
+                             "(default) or the whole link but a gap at the hinges")
+    parser.add_argument("--tie-width-mm", type=float, default=None,
+                        help="width of each ring for --tie ring [mm] (default 10)")
+    parser.add_argument("--peak-mpa", type=float, default=2.0,
+                        help="go on to this pressure and report peak stretch and stress "
+                             "(default 2.0; 0: skip)")
+    parser.add_argument("--plot", metavar="FILE.png", help="theta vs P: FEM points, eq. (28) line")
+    parser.add_argument("--out", metavar="DIR", default="results/bend",
+                        help="folder for result.json, table.csv and the VTK series")
+    add_design_option(parser)
+    add_json_option(parser)
+
+
+def _options(args):
+    from fem.finger import FingerOptions
+
+    given = {"mesh_size": args.mesh_size_mm, "tie_width": args.tie_width_mm}
+    return FingerOptions(tie=args.tie, **{k: v for k, v in given.items() if v is not None})
+
+
+def run(args) -> int:
+    from tqdm import tqdm
+
+    from fem.io import VtkSeries
+    from studies.bending import BendingStudy, run as run_study
+    from studies.output import write_csv, write_json
+
+    pressures = tuple(float(p) for p in parse_values(args.pressure_mpa, "--pressure-mpa"))
+    study = BendingStudy(design_from_args(args), pressures, _options(args),
+                         peak_mpa=args.peak_mpa if args.peak_mpa > pressures[-1] else 0.0)
+    out = Path(args.out)
+    series = VtkSeries(out / "finger.pvd")
+    n_steps = len(pressures) + (1 if study.peak_mpa else 0)
+    bar = tqdm(total=n_steps, desc="bend", unit="P", file=sys.stderr, leave=False)
+    basis = []
+
+    def on_state(model, state):
+        if not basis:
+            basis.append(model.vector_basis())
+        series.write(state.P, basis[0], model.displacement(state.y), model.law,
+                     J_bar=model.element_dilatation(state.y))
+        bar.set_postfix(P=f"{state.P:.2f}", theta=f"{state.theta * 57.29578:.1f}deg")
+        bar.update(0 if state.P > pressures[-1] and state.P < study.peak_mpa else 1)
+
+    try:
+        result = run_study(study, on_state=on_state)
+    finally:
+        bar.close()
+    summary = result.summary()
+    write_json(out / "result.json", summary)
+    write_csv(out / "table.csv", result.rows)
+    if args.plot:
+        plot_bending(args.plot, result.rows, study.design)
+    if args.json:
+        print_json(summary)
+    else:
+        print_table(result.rows)
+        s = result.stats
+        print(f"# {result.ndofs} unknowns, {result.nelements} P2 tets (half model), "
+              f"{s.newton_iterations} Newton iterations, {s.wall_seconds:.1f} s; {s.solver}")
+        if result.peak:
+            p = result.peak
+            print(f"# at {p['P_MPa']:.2f} MPa: theta {p['theta_deg']:.1f} deg, max principal "
+                  f"stretch {p['max_principal_stretch']:.3f}, max von Mises "
+                  f"{p['max_von_mises_MPa']:.2f} MPa, hoop stretch {p['radial_stretch_max']:.4f}")
+        print(f"# files in {out}")
+    return 0
+
+
+def plot_bending(path, rows: list[dict], design) -> None:
+    """theta vs P: FEM points and the eq. (28) curve (the no-reservoir line of Fig. 7)."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    import numpy as np
+
+    from reduced import hand
+    from studies.output import save_figure
+
+    P = np.array([r["P_MPa"] for r in rows])
+    Pl = np.linspace(0.0, max(P.max(), 1e-3), 101)
+    fig, ax = plt.subplots(figsize=(5.5, 4))
+    ax.plot(Pl, np.degrees(hand.bend_angle(Pl, design, reservoir=False)), "k:",
+            label="eq. (28), no reservoir")
+    ax.plot(P, [r["theta_deg"] for r in rows], "o", label="finger FEM")
+    ax.set_xlabel("pressure P [MPa]")
+    ax.set_ylabel("bend angle θ [deg]")
+    ax.legend()
+    ax.grid(alpha=0.3)
+    save_figure(fig, path)
