@@ -174,13 +174,25 @@ def fig8(case: WeightsCase, pressures_mpa, depth_offsets_mm=(0.0, 10.0, 20.0)) -
             upper = model.solve(P + case.dP_mpa, start=state)
             w = weight_vector(state, upper)
             rows.append({"depth_mm": model.depth, "w": w.tolist(),
-                         **state_row(state, w, case.mass_kg, case.design)})
+                         **state_row(state, w, case.mass_kg, case.design),
+                         "F_v_reduced_paper_w_N": paper_w_F_v(state.P, state.theta, case)})
     return rows
 
 
+def paper_w_F_v(P: float, theta: float, case: WeightsCase) -> float | None:
+    """Eq. (25) -> (29) with the paper's w for this diameter, normalised (None if it has none)."""
+    w = grasp.PAPER_WEIGHTS.get(float(case.diameter_mm))
+    if w is None:
+        return None
+    return reduced_F_v(P, theta, case.mass_kg, np.array(w) / np.sum(w), case.design)
+
+
 def fig8_errors(rows: list[dict]) -> dict:
-    """RMS and largest |F_v_reduced - F_v_fem| [kgf] over the points of :func:`fig8`."""
-    e = np.array([r["F_v_error_kgf"] for r in rows if r["F_v_error_kgf"] is not None])
-    if e.size == 0:
-        return {"rms_error_kgf": None, "max_abs_error_kgf": None}
-    return {"rms_error_kgf": float(np.sqrt(np.mean(e ** 2))), "max_abs_error_kgf": float(np.abs(e).max())}
+    """RMS and largest |F_v(eq. 25) - F_v_fem| [kgf] over the points of :func:`fig8`, with the
+    FEM's own w at each point and (``paper_w_*``) with the paper's w when it has one."""
+    out = {}
+    for prefix, key in (("", "F_v_reduced_N"), ("paper_w_", "F_v_reduced_paper_w_N")):
+        e = np.array([(r[key] - r["F_v_fem_N"]) / grasp.KGF for r in rows if r.get(key) is not None])
+        out[f"{prefix}rms_error_kgf"] = float(np.sqrt(np.mean(e ** 2))) if e.size else None
+        out[f"{prefix}max_abs_error_kgf"] = float(np.abs(e).max()) if e.size else None
+    return out

@@ -24,15 +24,17 @@ def plot_weights(path, result) -> None:
     D = np.array([r["diameter_mm"] for r in result.rows])
     W = np.array([r["w"] for r in result.rows])
     fig, ax = plt.subplots(figsize=(6, 4))
+    free = np.array([sum(r.get("contact_force_N", [1.0])) == 0 for r in result.rows])
     for i in range(W.shape[1]):
         line, = ax.plot(D, W[:, i], "o-", label=f"w{i + 1}")
+        ax.plot(D[free], W[free, i], "o", mfc="white", color=line.get_color())  # no contact
         if result.check:
             ax.plot(result.check["diameter_mm"], result.check["w_fem"][i], "x", ms=9, color=line.get_color())
     ax.set_xlabel("object diameter D [mm]")
     ax.set_ylabel("hinge weight w_i")
     ax.axhline(0.0, color="0.7", lw=0.8)
     ax.legend(ncol=5, fontsize=8)
-    ax.set_title("grasp FEM: w(D) (x: FEM at an unseen D)")
+    ax.set_title("grasp FEM: w(D) (open marker: no contact; x: FEM at an unseen D)", fontsize=9)
     save_figure(fig, path)
 
 
