@@ -19,7 +19,7 @@ from meshes.convert import read_mesh
 from meshes.gmsh_io import GMSH_VERSION, Geometry, generate_msh
 
 #: bump when the way meshes are generated changes, to invalidate old cache entries
-FORMAT = 1
+FORMAT = 2  # 2: element size no longer capped by gmsh's default point sizes
 
 
 def cache_dir() -> Path:

@@ -4,7 +4,7 @@ A *geometry function* has the signature ``geometry(model, params, size) -> None`
 builds the CAD with ``model.occ`` (``model`` is ``gmsh.model``), synchronises, and names
 its parts with ``model.addPhysicalGroup(dim, tags, name=...)``; ``params`` is a frozen
 dataclass (or a mapping) of its dimensions in mm, ``size`` the target element size in mm
-(it may set finer local sizes itself). Only elements in physical groups are saved, so a
+(it may refine locally with gmsh mesh size fields; point sizes are ignored). Only elements in physical groups are saved, so a
 geometry without a group of its top dimension gets one named ``"domain"``.
 
 gmsh is imported only inside ``meshes/``; callers use :mod:`meshes.cache`.
@@ -54,6 +54,9 @@ def _set_options(size: float) -> None:
     gmsh.option.setNumber("General.Terminal", 0)
     gmsh.option.setNumber("General.NumThreads", 1)
     gmsh.option.setNumber("Mesh.MeshSizeMax", size)
+    # gmsh otherwise also caps sizes at the OCC points' default size (~ bounding box / 10),
+    # which made ``size`` ineffective above that; local refinement: use mesh size fields
+    gmsh.option.setNumber("Mesh.MeshSizeFromPoints", 0)
     gmsh.option.setNumber("Mesh.MshFileVersion", 4.1)
     gmsh.option.setNumber("Mesh.Binary", 1)
     gmsh.option.setNumber("Mesh.SaveAll", 0)
