@@ -10,8 +10,9 @@ Fields written (3D displacement bases ``ElementVector`` of P1/P2 tetrahedra):
 
 Quadratic meshes are written as **quadratic cells** (``tetra10``), so ParaView and pyvista
 draw the curved P2 geometry; the points are the P2 nodes (vertices and edge midpoints).
-Gradients are discontinuous between elements: a point value is the average over the
-elements sharing the node of the element's value at that node. Cauchy stress is
+Gradients are discontinuous between elements: point values are the lumped P1 L2 projection
+of the quadrature-point values onto the vertices (edge midpoints: the mean of their two
+vertices), so a field is never evaluated where the state is not known to be valid. Cauchy stress is
 :math:`σ = P F^T / J`; with ``J_bar`` (per element, the mean dilatation of a
 mean-dilatation solid) its volumetric part is :math:`U'(\bar J)\,I`, as in that formulation.
 
@@ -23,7 +24,7 @@ from pathlib import Path
 from xml.sax.saxutils import quoteattr
 
 import numpy as np
-from skfem import Basis
+from skfem import Basis, ElementTetP1
 
 from fem import kinematics as kin
 from meshes.atomic import atomic_path
@@ -43,13 +44,10 @@ def state_fields(basis: Basis, u: np.ndarray, law=None, *, J_bar=None) -> tuple[
     point_data = {"displacement": _nodal_vector(basis, u)}
     if law is None:
         return point_data, {}
-    at_nodes = Basis(basis.mesh, basis.elem,
-                     quadrature=(scalar.elem.doflocs.T, np.ones(scalar.elem.doflocs.shape[0])))
-    node_values = _measures(at_nodes, u, _per_element(law, basis.mesh.nelements), J_bar)
     qp_values = _measures(basis, u, _per_element(law, basis.mesh.nelements), J_bar)
-    dofs = scalar.element_dofs
-    for name, value in node_values.items():
-        point_data[name] = _average_to_nodes(value, dofs, scalar.N)
+    vertex_basis = basis.with_element(ElementTetP1())
+    for name, value in qp_values.items():
+        point_data[name] = _extend_to_nodes(_lumped_projection(value, vertex_basis), scalar)
     cell_data = {name: _average_cells(value, basis.dx) for name, value in qp_values.items()}
     return point_data, cell_data
 
@@ -136,14 +134,20 @@ def _per_element(law, nel: int):
     return law
 
 
-def _average_to_nodes(value: np.ndarray, dofs: np.ndarray, n: int) -> np.ndarray:
-    """Average element-node values (nel, nloc[, ncomp]) over the elements sharing a node."""
-    count = np.bincount(dofs.T.ravel(), minlength=n)
-    flat = value.reshape(dofs.T.size, -1)
-    summed = np.stack([np.bincount(dofs.T.ravel(), weights=flat[:, c], minlength=n)
-                       for c in range(flat.shape[1])], axis=1)
-    out = summed / np.maximum(count, 1)[:, None]
-    return out[:, 0] if value.ndim == 2 else out
+def _lumped_projection(value: np.ndarray, vertex_basis: Basis) -> np.ndarray:
+    """Vertex values of quadrature-point values (nel, nqp[, ncomp]) by the lumped P1 L2
+    projection: sum_e int phi_i f dV / sum_e int phi_i dV (exact for constants, no
+    evaluation outside the quadrature points, where the state is known to be valid)."""
+    n = vertex_basis.mesh.nvertices
+    phi = np.stack([vertex_basis.basis[i][0] for i in range(vertex_basis.Nbfun)])  # (nloc, nel, nqp)
+    weights = phi * np.asarray(vertex_basis.dx)[None]
+    vertices = vertex_basis.element_dofs.ravel()  # (nloc * nel,), matching weights' order
+    flat = value.reshape(value.shape[:2] + (-1,))
+    numerators = np.einsum("leq,eqc->lec", weights, flat).reshape(len(vertices), -1)
+    denominator = np.bincount(vertices, weights=weights.sum(axis=2).ravel(), minlength=n)
+    out = np.stack([np.bincount(vertices, weights=numerators[:, c], minlength=n)
+                    for c in range(numerators.shape[1])], axis=1) / denominator[:, None]
+    return out.reshape((n,) + value.shape[2:])
 
 
 def _average_cells(value: np.ndarray, dx: np.ndarray) -> np.ndarray:

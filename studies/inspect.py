@@ -102,16 +102,18 @@ def inspect(path: str | Path, *, field: str | None = None, step: int | None = No
     if field is None:
         raise InputError("field", None, f"no default field; allowed: {', '.join(field_names(mesh))}")
     values, location = field_values(mesh, field)
+    if not np.any(np.isfinite(values)):
+        raise InputError("field", field, "has no finite values in this file")
     centres = mesh.points if location == "point" else mesh.cell_centers().points
-    peak = np.asarray(centres[int(np.argmax(values))], dtype=float)
+    peak = np.asarray(centres[int(np.nanargmax(values))], dtype=float)
     if interactive and not _has_display():
         raise InputError("--interactive", True, "needs a display (DISPLAY is not set); "
                                                 "omit it to render off-screen")
     png = None if interactive and out is None else Path(out or _default_png(path, index, field))
     title = f"{Path(path).name}  step {index}/{n_steps - 1}  {field}"
     _render(mesh, values, location, title=title, png=png, interactive=interactive)
-    return FieldSummary(str(path), index, n_steps, field, location, float(values.min()),
-                        float(values.max()), tuple(peak.tolist()), None if png is None else str(png))
+    return FieldSummary(str(path), index, n_steps, field, location, float(np.nanmin(values)),
+                        float(np.nanmax(values)), tuple(peak.tolist()), None if png is None else str(png))
 
 
 def _render(mesh, values, location, *, title, png, interactive) -> None:
