@@ -27,9 +27,10 @@ def available() -> list[str]:
     """Backends importable here, fastest first."""
     out = []
     try:
-        import pypardiso  # noqa: F401
+        import pypardiso
+        pypardiso.PyPardisoSolver()  # raises ImportError when the MKL runtime is missing
         out.append("pardiso")
-    except ImportError:
+    except (ImportError, OSError):
         pass
     try:
         import scikits.umfpack  # noqa: F401
