@@ -22,7 +22,7 @@ def configure(parser) -> None:
                         help="pressures [MPa]: start:stop:step (stop included) or a,b,c "
                              "(default 0:0.8:0.1)")
     parser.add_argument("--mesh-size-mm", metavar="H", type=float, default=None,
-                        help="element size [mm] (default 3)")
+                        help="element size [mm] (default 4)")
     parser.add_argument("--tie", choices=("ring", "full"), default="ring",
                         help="outer surface held by the links: a ring in each link's middle "
                              "(default) or the whole link but a gap at the hinges")
@@ -31,7 +31,11 @@ def configure(parser) -> None:
     parser.add_argument("--peak-mpa", type=float, default=2.0,
                         help="go on to this pressure and report peak stretch and stress "
                              "(default 2.0; 0: skip)")
-    parser.add_argument("--plot", metavar="FILE.png", help="theta vs P: FEM points, eq. (28) line")
+    parser.add_argument("--hand", action="store_true",
+                        help="also the whole hand: P = p_finger - p_reservoir(V0 - n dQ) with the "
+                             "reservoir-sheet FEM, against eq. (27)")
+    parser.add_argument("--plot", metavar="FILE.png",
+                        help="theta vs P: FEM points, eqs. (28) (and (27) with --hand) as lines")
     parser.add_argument("--out", metavar="DIR", default="results/bend",
                         help="folder for result.json, table.csv and the VTK series")
     add_design_option(parser)
@@ -74,14 +78,23 @@ def run(args) -> int:
     finally:
         bar.close()
     summary = result.summary()
+    if args.hand:
+        from studies.compare import whole_hand
+        summary["hand"] = whole_hand(result.rows, study.design)
+        write_csv(out / "hand.csv", summary["hand"]["rows"])
     write_json(out / "result.json", summary)
     write_csv(out / "table.csv", result.rows)
     if args.plot:
-        plot_bending(args.plot, result.rows, study.design)
+        plot_bending(args.plot, result.rows, study.design, summary.get("hand"))
     if args.json:
         print_json(summary)
     else:
         print_table(result.rows)
+        if args.hand:
+            h = summary["hand"]
+            print_table(h["rows"])
+            print(f"# reservoir offset p_r(V0): FEM {h['offset_fem_MPa']:.4f} MPa, ellipse model "
+                  f"{h['offset_ellipse_MPa']:.4f} MPa, paper {h['offset_paper_MPa']} MPa")
         s = result.stats
         print(f"# {result.ndofs} unknowns, {result.nelements} P2 tets (half model), "
               f"{s.newton_iterations} Newton iterations, {s.wall_seconds:.1f} s; {s.solver}")
@@ -94,8 +107,8 @@ def run(args) -> int:
     return 0
 
 
-def plot_bending(path, rows: list[dict], design) -> None:
-    """theta vs P: FEM points and the eq. (28) curve (the no-reservoir line of Fig. 7)."""
+def plot_bending(path, rows: list[dict], design, hand_result: dict | None = None) -> None:
+    """theta vs P (Fig. 7): FEM points and eq. (28); with the hand, its FEM points and eq. (27)."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
@@ -109,7 +122,14 @@ def plot_bending(path, rows: list[dict], design) -> None:
     fig, ax = plt.subplots(figsize=(5.5, 4))
     ax.plot(Pl, np.degrees(hand.bend_angle(Pl, design, reservoir=False)), "k:",
             label="eq. (28), no reservoir")
-    ax.plot(P, [r["theta_deg"] for r in rows], "o", label="finger FEM")
+    ax.plot(P, [r["theta_deg"] for r in rows], "o", label="finger FEM (no reservoir)")
+    if hand_result is not None:
+        th = np.radians(np.linspace(0.0, max(r["theta_deg"] for r in rows), 101))
+        ax.plot(hand.pressure(th, design, reservoir=True), np.degrees(th), "k-",
+                label="eq. (27), with reservoir")
+        ax.plot([r["P_hand_fem_MPa"] for r in hand_result["rows"]],
+                [r["theta_deg"] for r in hand_result["rows"]], "s", mfc="none",
+                label="finger FEM + reservoir FEM")
     ax.set_xlabel("pressure P [MPa]")
     ax.set_ylabel("bend angle θ [deg]")
     ax.legend()
