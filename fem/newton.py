@@ -51,6 +51,10 @@ class NewtonOptions:
     max_backtracks: int = 6  #: trial steps before taking the last one
     armijo: float = 1e-4  #: "residual": sufficient-decrease constant c
 
+    def __post_init__(self):
+        if self.merit not in ("slope", "residual", "finite"):
+            raise ValueError(f"merit {self.merit!r} not in ('slope', 'residual', 'finite')")
+
 
 class NotConverged(RuntimeError):
     """Newton or the load stepping failed; carries what is needed to report and resume.
