@@ -24,7 +24,8 @@ def test_line_search_converges_where_plain_newton_diverges():
     # arctan(x) = 0 from x0 = 2: plain Newton overshoots to ever larger |x|
     with pytest.raises(NotConverged) as err:
         newton(ATAN, [2.0], NewtonOptions(line_search=False, max_iter=10))
-    assert len(err.value.history) == 11 and err.value.history[-1] > err.value.history[0]
+    # |x| grows each step until the iterations run out or the tangent 1/(1+x^2) underflows
+    assert len(err.value.history) >= 5 and err.value.history[-1] > err.value.history[0]
     r = newton(ATAN, [2.0])
     assert abs(r.x[0]) < 2e-8 and min(r.steps) < 1.0  # |x| ~ |R| <= rtol |R0|
 
