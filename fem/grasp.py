@@ -8,8 +8,10 @@ objects too big to pass between the open fingers -- until the open fingers' pads
 ``clearance`` from its surface. The fingers then close under the cavity pressure P.
 
 Contact: frictionless, rigid link pads against the analytic object (:mod:`fem.contact`),
-augmented Lagrangian with Uzawa updates until the largest penetration is below
-``gap_tol`` (its own convergence check: gap at convergence vs penalty). The object's
+augmented Lagrangian with Uzawa updates until the largest |gap| of a loaded pad is below
+``gap_tol`` (its own convergence check: gap at convergence vs penalty); the penalty grows
+tenfold whenever an update does not cut that gap by 4 (two nearly dependent contacts,
+e.g. both sides of a hinge, make plain Uzawa slow). The object's
 weight share m g / n (eq. (24)) acts tangentially on the touching pads, split by their
 normal forces. The mesh is the half tube (symmetry plane z = 0), so the model's links
 carry half of every physical load: the generalised forces passed to the finger are
@@ -43,7 +45,8 @@ class GraspOptions:
     palm_gap: float = 10.0    #: object top below the palm, when it fits between the open fingers [mm]
     clearance: float = 2.0    #: else: gap between the open fingers' pads and the object [mm]
     pad_offset: float = 0.0   #: grasping face beyond the hinge axes' line, towards the object [mm]
-    penalty: float = 100.0    #: contact penalty [N/mm]
+    penalty: float = 100.0    #: contact penalty to start with [N/mm]
+    max_penalty: float = 1e6  #: the penalty grows x10 while the penetration stagnates, up to this [N/mm]
     gap_tol: float = 1e-4     #: stop the Uzawa updates when every penetration is below [mm]
     share_tol: float = 1e-3   #: ... and the weight shares changed less than this
     max_updates: int = 20     #: Uzawa updates before giving up
@@ -106,6 +109,7 @@ class GraspState:
     F_v: float              #: F . n_out of the tip link: the normal force of eq. (29) [N]
     updates: int            #: Uzawa (augmented Lagrangian) updates
     iterations: int         #: Newton iterations
+    penalty: float          #: the contact penalty at convergence [N/mm]
     y: np.ndarray = field(repr=False, default=None)
 
     @property
@@ -133,19 +137,20 @@ class GraspModel:
         self.circle = Circle(tuple(to_finger_frame([0.0, self.depth], design)), 0.5 * diameter)
         self.weight = self.mass * design.g / design.n  #: the weight share, eq. (24) [N]
 
-    def load(self, q, multipliers, shares):
+    def load(self, q, multipliers, shares, penalty: float | None = None):
         """Physical contact load at hinge angles q (:class:`fem.contact.ContactLoad`)."""
-        return contact_load(gaps(self.pads, self.circle, q), self.options.penalty, multipliers,
+        penalty = self.options.penalty if penalty is None else penalty
+        return contact_load(gaps(self.pads, self.circle, q), penalty, multipliers,
                             weight=self.weight, shares=shares)
 
-    def _link_load(self, multipliers, shares):
+    def _link_load(self, multipliers, shares, penalty):
         def link_load(q):
-            L = self.load(q, multipliers, shares)
+            L = self.load(q, multipliers, shares, penalty)
             return 0.5 * L.Q, 0.5 * L.dQ  # the half model carries half the load
         return link_load
 
-    def _path(self, y, P0, P1, multipliers, shares, solver, steps):
-        link_load = self._link_load(multipliers, shares)
+    def _path(self, y, P0, P1, multipliers, shares, penalty, solver, steps):
+        link_load = self._link_load(multipliers, shares, penalty)
         d = self.design
         scale = d.mu_sf * d.a ** 2 * d.l0
         res = solve_path(lambda x, t: self.finger.residual_tangent(x, P0 + t * (P1 - P0), link_load),
@@ -163,27 +168,30 @@ class GraspModel:
             shares = start.N / start.N.sum() if start.N.sum() > 0 else np.zeros(n_links)
         solver = make_solver(symmetric=self.weight == 0.0)  # the tangential load is a follower
         its, steps = 0, self.options.steps if start is None else 1
+        penalty, last = self.options.penalty, np.inf
         for update in range(self.options.max_updates + 1):
-            y, n = self._path(y, P0, P, lam, shares, solver, steps)
+            y, n = self._path(y, P0, P, lam, shares, penalty, solver, steps)
             its, P0, steps = its + n, P, 1
-            L = self.load(self.finger.constraint.q(y), lam, shares)
+            L = self.load(self.finger.constraint.q(y), lam, shares, penalty)
             g = gaps(self.pads, self.circle, self.finger.constraint.q(y)).g
             new_shares = L.N / L.N.sum() if L.N.sum() > 0 else np.zeros(n_links)
-            penetration = float(np.max(-g[L.N > 0], initial=0.0))
+            penetration = float(np.max(np.abs(g[(L.N > 0) | (lam > 0)]), initial=0.0))
             if penetration <= self.options.gap_tol and \
                     np.max(np.abs(new_shares - shares)) <= self.options.share_tol:
-                return self._state(P, y, L, g, update, its)
-            lam, shares = L.N, new_shares
+                return self._state(P, y, L, g, update, its, penalty)
+            if penetration > 0.25 * last:  # slow Uzawa (near-dependent contacts): stiffen
+                penalty = min(10.0 * penalty, self.options.max_penalty)
+            lam, shares, last = L.N, new_shares, penetration
         raise NotConverged(f"contact: penetration {penetration:.3g} mm after "
                            f"{self.options.max_updates} augmented-Lagrangian updates", [], y)
 
-    def _state(self, P, y, L, g, updates, its) -> GraspState:
+    def _state(self, P, y, L, g, updates, its, penalty) -> GraspState:
         q = np.array(self.finger.constraint.q(y))
         M, _ = _frame(self.design)
         F = L.forces.sum(axis=0)
         n_tip = np.array([-math.sin(q.sum()), math.cos(q.sum())])  # tip pad normal, finger frame
         return GraspState(P=float(P), q=q, N=L.N, gap=g, F=M @ F, F_v=float(-F @ n_tip),
-                          updates=updates, iterations=its, y=np.array(y))
+                          updates=updates, iterations=its, penalty=penalty, y=np.array(y))
 
 
 @dataclass(frozen=True)

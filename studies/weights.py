@@ -27,7 +27,7 @@ from reduced.errors import InputError
 from studies.output import jsonable, write_json
 
 #: bump when the FEM or the result's fields change, to invalidate cached results
-CACHE_FORMAT = 1
+CACHE_FORMAT = 2
 #: the default element size of the grasp FEM [mm] (docs/grasp.md: w's mesh sensitivity)
 MESH_SIZE = 6.0
 
@@ -85,7 +85,8 @@ def state_row(state, w, mass: float, design: HandDesign) -> dict:
             "F_v_fem_N": state.F_v, "F_v_reduced_N": F_v_red,
             "F_v_error_kgf": None if F_v_red is None else (F_v_red - state.F_v) / grasp.KGF,
             "max_penetration_mm": float(np.max(-state.gap[state.N > 0], initial=0.0)),
-            "contact_updates": state.updates, "newton_iterations": state.iterations}
+            "contact_updates": state.updates, "contact_penalty_N_per_mm": state.penalty,
+            "newton_iterations": state.iterations}
 
 
 def compute(case: WeightsCase) -> dict:

@@ -65,6 +65,17 @@ def case_from_args(args):
 
 
 def run(args) -> int:
+    from fem.newton import NotConverged
+
+    try:
+        return _run(args)
+    except NotConverged as exc:  # the FEM's own failure: one line, exit 1
+        print(f"softhand weights: error: the grasp FEM did not converge: {str(exc)[:300]}",
+              file=sys.stderr)
+        return 1
+
+
+def _run(args) -> int:
     from dataclasses import replace
 
     case = case_from_args(args)
