@@ -168,7 +168,7 @@ class GraspModel:
             shares = start.N / start.N.sum() if start.N.sum() > 0 else np.zeros(n_links)
         solver = make_solver(symmetric=self.weight == 0.0)  # the tangential load is a follower
         its, steps = 0, self.options.steps if start is None else 1
-        penalty, last = self.options.penalty, np.inf
+        penalty, last = self.options.penalty if start is None else start.penalty, np.inf
         for update in range(self.options.max_updates + 1):
             y, n = self._path(y, P0, P, lam, shares, penalty, solver, steps)
             its, P0, steps = its + n, P, 1
