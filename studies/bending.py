@@ -20,6 +20,7 @@ from dataclasses import asdict, dataclass, field
 import numpy as np
 
 from fem.finger import FingerModel, FingerOptions, FingerState, SweepStats, solve_pressures
+from fem.newton import NotConverged
 from reduced import finger as reduced_finger
 from reduced import hand
 from reduced.design import HandDesign
@@ -86,16 +87,31 @@ def run(study: BendingStudy, *, on_state=None) -> BendingResult:
     build = time.perf_counter() - t0
     callback = None if on_state is None else (lambda s: on_state(model, s))
     states, stats = solve_pressures(model, study.pressures_mpa, callback=callback)
-    peak = None
-    if study.peak_mpa:
-        P_last = study.pressures_mpa[-1]
-        n = max(1, math.ceil((study.peak_mpa - P_last) / study.peak_step_mpa - 1e-9))
-        more, _ = solve_pressures(model, np.linspace(P_last, study.peak_mpa, n + 1)[1:],
-                                  y0=states[-1].y, callback=callback)
-        s = more[-1]
-        peak = {"P_MPa": s.P, "theta_deg": math.degrees(s.theta),
-                "max_principal_stretch": s.max_principal_stretch,
-                "max_von_mises_MPa": s.max_von_mises, "radial_stretch_max": s.radial_stretch_max,
-                "max_fiber_stress_MPa": s.max_fiber_stress}
+    peak = _peak(model, study, states[-1], on_state) if study.peak_mpa else None
     return BendingResult([row(s, study.design) for s in states], peak, model.ndofs,
                          model.mesh.nelements, stats, build, model, states)
+
+
+def _peak(model: FingerModel, study: BendingStudy, start: FingerState, on_state) -> dict:
+    """Continue from ``start`` to peak_mpa; the last converged state if Newton gives up."""
+    P_last = start.P
+    n = max(1, math.ceil((study.peak_mpa - P_last) / study.peak_step_mpa - 1e-9))
+    reached = [start]
+
+    def keep(state):
+        reached.append(state)
+        if on_state is not None:
+            on_state(model, state)
+
+    failure = None
+    try:
+        solve_pressures(model, np.linspace(P_last, study.peak_mpa, n + 1)[1:], y0=start.y,
+                        callback=keep)
+    except NotConverged as exc:
+        failure = str(exc).split(";")[0]
+    s = reached[-1]
+    return {"P_MPa": s.P, "theta_deg": math.degrees(s.theta),
+            "max_principal_stretch": s.max_principal_stretch,
+            "max_von_mises_MPa": s.max_von_mises, "radial_stretch_max": s.radial_stretch_max,
+            "max_fiber_stress_MPa": s.max_fiber_stress, "target_MPa": study.peak_mpa,
+            "failure": failure}

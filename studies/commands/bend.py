@@ -53,6 +53,7 @@ def run(args) -> int:
     from tqdm import tqdm
 
     from fem.io import VtkSeries
+    from fem.newton import NotConverged
     from studies.bending import BendingStudy, run as run_study
     from studies.output import write_csv, write_json
 
@@ -75,6 +76,10 @@ def run(args) -> int:
 
     try:
         result = run_study(study, on_state=on_state)
+    except NotConverged as exc:
+        print(f"softhand bend: error: {str(exc).split(';')[0]}; converged states are in {out}",
+              file=sys.stderr)
+        return 1
     finally:
         bar.close()
     summary = result.summary()
@@ -100,6 +105,9 @@ def run(args) -> int:
               f"{s.newton_iterations} Newton iterations, {s.wall_seconds:.1f} s; {s.solver}")
         if result.peak:
             p = result.peak
+            if p["failure"]:
+                print(f"# Newton gave up on the way to {p['target_MPa']} MPa ({p['failure']}); "
+                      f"last converged state:")
             print(f"# at {p['P_MPa']:.2f} MPa: theta {p['theta_deg']:.1f} deg, max principal "
                   f"stretch {p['max_principal_stretch']:.3f}, max von Mises "
                   f"{p['max_von_mises_MPa']:.2f} MPa, hoop stretch {p['radial_stretch_max']:.4f}")
