@@ -49,7 +49,8 @@ def configure(parser) -> None:
 def _scalar(text, field: str, *, positive: bool = True) -> float:
     values = parse_values(str(text), field)
     if values.size != 1 or (positive and not values[0] > 0) or values[0] < 0:
-        raise InputError(field, text, "must be one positive number" if positive else "must be one number >= 0")
+        raise InputError(field, text, "must be one positive number" if positive
+                         else "must be one number >= 0")
     return float(values[0])
 
 
