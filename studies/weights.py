@@ -18,6 +18,7 @@ import hashlib
 import json
 import math
 from dataclasses import asdict, dataclass, field, replace
+from pathlib import Path
 
 import numpy as np
 
@@ -89,23 +90,42 @@ def state_row(state, w, mass: float, design: HandDesign) -> dict:
             "newton_iterations": state.iterations}
 
 
-def compute(case: WeightsCase) -> dict:
-    """Run the grasp FEM for one case (no cache): the flat result."""
+def compute(case: WeightsCase, out=None) -> dict:
+    """Run the grasp FEM for one case (no cache): the flat result; with ``out`` (a folder)
+    also the two states' fields as the VTK series ``grasp.pvd`` (finger frame, half tube)."""
     from fem.finger import FingerModel, FingerOptions
     from fem.grasp import GraspModel, grasp_weights
 
     finger = FingerModel(case.design, FingerOptions(mesh_size=case.mesh_size_mm))
     model = GraspModel(finger, case.diameter_mm, mass=case.mass_kg, depth=case.depth_mm)
     r = grasp_weights(model, case.pressure_mpa, case.dP_mpa)
+    if out is not None:
+        _write_vtk(out, finger, (r.state, r.state_dP))
     return {"diameter_mm": case.diameter_mm, "mass_kg": case.mass_kg, "depth_mm": model.depth,
             "dP_MPa": case.dP_mpa, "w": r.w.tolist(), "w_sum": float(r.w.sum()),
             **state_row(r.state, r.w, case.mass_kg, case.design),
             "mesh_size_mm": case.mesh_size_mm, "ndofs": r.ndofs, "wall_seconds": r.wall_seconds}
 
 
-def weights(case: WeightsCase, *, cache: bool = True) -> dict:
-    """:func:`compute`, through the JSON cache keyed by :meth:`WeightsCase.key` (``cached`` says which)."""
+def _write_vtk(out, finger, states) -> None:
+    from fem.io import VtkSeries
+
+    series, basis = VtkSeries(Path(out) / "grasp.pvd"), finger.vector_basis()
+    for s in states:
+        series.write(s.P, basis, finger.displacement(s.y), finger.law,
+                     J_bar=finger.element_dilatation(s.y))
+
+
+def weights(case: WeightsCase, *, cache: bool = True, out=None) -> dict:
+    """:func:`compute`, through the JSON cache keyed by :meth:`WeightsCase.key` (``cached`` says
+    which); ``out``: a folder for result.json and the VTK series (always computes)."""
     path = cache_dir() / f"{case.key()}.json"
+    if out is not None:
+        result = compute(case, out)
+        write_json(Path(out) / "result.json", result)
+        if cache:
+            write_json(path, result)
+        return {**result, "cached": False}
     if cache and path.is_file():
         try:
             return {**json.loads(path.read_text()), "cached": True}

@@ -139,3 +139,16 @@ def test_weights_bad_input_is_one_line_exit_2(argv, field, capsys):
     assert main(argv) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and field in err
+
+
+def test_vtk_series_of_the_contact_states(grasp180, tmp_path):
+    import meshio
+
+    from studies.weights import _write_vtk
+
+    model, a, b, _ = grasp180
+    _write_vtk(tmp_path, model.finger, (a, b))
+    assert (tmp_path / "grasp.pvd").read_text().count("<DataSet") == 2
+    mesh = meshio.read(tmp_path / "grasp_0001.vtu")
+    u = mesh.point_data["displacement"]
+    assert u.shape[1] == 3 and np.isfinite(u).all() and np.abs(u).max() > 1.0  # mm: the finger moved

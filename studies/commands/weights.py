@@ -41,6 +41,8 @@ def configure(parser) -> None:
                                                         "the interpolated w against the FEM")
     parser.add_argument("--fig8", metavar="P1,P2,..", help="Fig. 8 analogue at these pressures [MPa]")
     parser.add_argument("--plot", metavar="FILE.png", help="draw w(D) or the Fig. 8 analogue")
+    parser.add_argument("--out", metavar="DIR", help="one diameter: write result.json and the VTK "
+                                                     "series grasp.pvd of both contact states (recomputes)")
     parser.add_argument("--no-cache", action="store_true", help="recompute, do not read or write the cache")
     add_design_option(parser)
     add_json_option(parser)
@@ -97,7 +99,7 @@ def _one(case, args) -> dict:
 
     if not args.no_cache:
         print("softhand weights: running the grasp FEM (or reading the cache)...", file=sys.stderr)
-    return weights(case, cache=not args.no_cache)
+    return weights(case, cache=not args.no_cache, out=args.out)
 
 
 def _print_one(result: dict) -> None:
