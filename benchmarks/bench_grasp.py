@@ -1,0 +1,44 @@
+"""Grasp FEM speed (issue 6): one ``softhand weights`` case (two contact states), by mesh.
+
+180 mm object, m = 0, P = 0.8 + 0.05 MPa, default placement. Prints, per element size, the
+unknowns, wall and CPU time of building the finger model and of the two contact solves,
+Newton iterations and augmented-Lagrangian updates. CPU time tells the cost when other jobs
+share the cores. No assertions: speed is measured, not tested.
+
+    python benchmarks/bench_grasp.py [--mesh-size-mm 10,6]
+"""
+from __future__ import annotations
+
+import argparse
+import time
+
+from fem.finger import FingerModel, FingerOptions
+from fem.grasp import GraspModel, grasp_weights
+from reduced.design import HandDesign
+
+
+def timed(fn):
+    """(result, wall [s], CPU [s]) of one call."""
+    w0, c0 = time.perf_counter(), time.process_time()
+    result = fn()
+    return result, time.perf_counter() - w0, time.process_time() - c0
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--mesh-size-mm", default="10,6")
+    args = parser.parse_args()
+    design = HandDesign()
+    for h in (float(x) for x in args.mesh_size_mm.split(",")):
+        finger, w_build, c_build = timed(lambda: FingerModel(design, FingerOptions(mesh_size=h)))
+        model = GraspModel(finger, 180.0)
+        r, wall, cpu = timed(lambda: grasp_weights(model, 0.8, 0.05))
+        its = r.state.iterations + r.state_dP.iterations
+        ups = r.state.updates + r.state_dP.updates
+        print(f"mesh {h:g} mm: {finger.ndofs} unknowns; build {w_build:.1f} s wall / {c_build:.1f} s CPU; "
+              f"two contact states {wall:.1f} s wall / {cpu:.1f} s CPU, {its} Newton iterations, "
+              f"{ups} AL updates")
+
+
+if __name__ == "__main__":
+    main()
