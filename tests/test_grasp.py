@@ -152,3 +152,18 @@ def test_vtk_series_of_the_contact_states(grasp180, tmp_path):
     mesh = meshio.read(tmp_path / "grasp_0001.vtu")
     u = mesh.point_data["displacement"]
     assert u.shape[1] == 3 and np.isfinite(u).all() and np.abs(u).max() > 1.0  # mm: the finger moved
+
+
+def test_grasp_cli_takes_w_from_the_fem_or_the_paper_by_name(tmp_path, monkeypatch, capsys):
+    import studies.weights as sw
+
+    w_fem = [-0.1, 0.1, 0.3, 0.3, 0.4]
+    monkeypatch.setenv("SOFTHAND_CACHE", str(tmp_path))
+    monkeypatch.setattr(sw, "compute", lambda case: {"w": w_fem, "diameter_mm": case.diameter_mm})
+    base = ["grasp", "--pressure-mpa", "1", "--theta-deg", "40", "--mass-kg", "2", "--json"]
+    assert main(base + ["--diameter-mm", "200"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["w"] == pytest.approx(w_fem) and out["w_source"].startswith("FEM: D = 200 mm")
+    assert main(base + ["--weights", "paper240"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["w"] == pytest.approx([-0.2, 0.0, 0.1, 0.3, 0.8]) and out["w_source"].startswith("paper")
