@@ -162,7 +162,7 @@ class FingerState:
     P: float                       #: cavity pressure [MPa]
     q: np.ndarray                  #: hinge angles theta_hat_i [rad]
     dQ: float                      #: cavity volume change of the whole finger [mm^3]
-    radial_stretch_max: float      #: max hoop (fiber-direction) stretch; the paper's lambda_2
+    radial_stretch_max: float      #: max hoop (fiber) stretch in the wall, cap excluded; the paper's lambda_2
     max_principal_stretch: float   #: max principal stretch over the quadrature points
     max_von_mises: float           #: max Cauchy von Mises stress [MPa]
     max_fiber_stress: float        #: max fiber stress k (lambda_f - 1) [MPa]
@@ -190,6 +190,8 @@ class FingerModel:
         self.law = NeoHookean(mu, options.kappa_ratio * mu) + self.fibers
         self.solid = Solid(self.mesh, self.law)
         self.cavity = CavityVolume(self.solid, self.mesh.boundaries["cavity"], symmetry_normal=0)
+        #: elements of the tube wall (not the end cap): where the windings are
+        self.wall = self.mesh.p[0, self.mesh.t[:4]].mean(axis=0) < design.l0 - cap
         self.chain = PlanarChain(np.c_[design.hinge_s, np.full(design.n_s, design.d)])
         self.constraint = self._tie()
         self.V0 = self.cavity.volume(np.zeros(self.solid.ndofs))
@@ -244,7 +246,7 @@ class FingerModel:
         eig = np.linalg.eigvalsh(np.moveaxis(kin.right_cauchy_green(F), (0, 1), (-2, -1)))
         sigma = np.einsum("aK...,bK...->ab...", self.solid.first_piola(u), F) / kin.det(F)
         dev = sigma - np.einsum("aa...->...", sigma) / 3.0 * kin.identity(sigma.shape[2:])
-        lam_f = self.fibers.stretch(F)
+        lam_f = self.fibers.stretch(F)[self.wall]  # the cap's "hoop" near the axis is no winding
         return FingerState(
             P=float(P), q=np.array(self.constraint.q(y)),
             dQ=2.0 * (self.cavity.volume(u) - self.V0),
