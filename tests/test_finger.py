@@ -108,3 +108,12 @@ def test_hand_frame_matches_the_reduced_kinematics(model):
     ours = to_hand_frame(model.chain.hinge_positions(q), DESIGN)
     theirs = kinematics.joint_positions(q, DESIGN)[1:-1]
     np.testing.assert_allclose(ours, theirs, atol=1e-10)
+
+
+@pytest.mark.parametrize("argv", [["--pressure-mpa", "0.4,0.2"], ["--pressure-mpa", "-0.1"],
+                                  ["--tie-width-mm", "40"]])
+def test_bend_rejects_bad_input_in_one_line(argv, capsys, tmp_path):
+    from studies.cli import main
+    assert main(["bend", *argv, "--out", str(tmp_path)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "error" in err
