@@ -116,6 +116,77 @@ def _reservoir_plot(result, design, path: Path) -> None:
     save_figure(fig, path)
 
 
+# ---------------------------------------------------------------------- w and Fig. 8 by grasp FEM
+GRASPS = ((180.0, 2.0, (0.6, 0.7, 0.8, 0.9)), (240.0, 6.0, (1.1, 1.2, 1.3, 1.4)))  #: D, m, P
+
+
+def weights_fem(ctx: Context, outdir: Path):
+    """w for the 180 mm / 2 kg and 240 mm / 6 kg objects by grasp FEM, against the paper's."""
+    from reduced.grasp import PAPER_WEIGHTS
+    from studies.weights import WeightsCase, weights
+
+    rows, numbers = [], {}
+    for D, mass, _ in GRASPS:
+        r = weights(WeightsCase(design=ctx.design, diameter_mm=D, mass_kg=mass),
+                    out=outdir / f"D{D:.0f}")
+        paper = np.asarray(PAPER_WEIGHTS[D])
+        rows.append({"diameter_mm": D, "mass_kg": mass, "P_MPa": r["P_MPa"],
+                     "theta_deg": r["theta_deg"], "w_fem": r["w"],
+                     "w_paper_normalised": (paper / paper.sum()).tolist(),
+                     "F_v_fem_N": r["F_v_fem_N"], "F_v_reduced_N": r["F_v_reduced_N"],
+                     "ndofs": r["ndofs"]})
+        numbers |= {f"w{i + 1}_{D:.0f}mm": v for i, v in enumerate(r["w"])}
+        numbers[f"max_abs_w_difference_{D:.0f}mm"] = float(np.max(np.abs(
+            np.asarray(r["w"]) - paper / paper.sum())))
+    write_csv(outdir / "weights.csv", rows)
+    text = f"""Hinge weight vectors w = Δθ̂/Δθ between two converged contact states (P, P + ΔP),
+normalised to Σw = 1, for the paper's two objects ([weights.csv](weights.csv); VTK series
+[D180/grasp.pvd](D180/grasp.pvd), [D240/grasp.pvd](D240/grasp.pvd)). The paper's vectors
+are shown normalised (its 180 mm vector sums to 1.40 as printed).
+
+{md_table(rows, ["diameter_mm", "mass_kg", "P_MPa", "theta_deg", "w_fem", "w_paper_normalised",
+                 "F_v_fem_N", "F_v_reduced_N", "ndofs"], digits=3)}
+"""
+    return text, numbers
+
+
+def fig8_fem(ctx: Context, outdir: Path):
+    """Fig. 8 analogue with FEM points: F_v by grasp FEM and by eq. (25) at the same (P, θ)."""
+    from reduced.grasp import KGF
+    from studies.reproduce_sections import PAPER_FIG8_ERROR_KGF
+    from studies.weights import WeightsCase, fig8, fig8_errors
+
+    fig, axes = figure(2)
+    summary, numbers = [], {}
+    for ax, (D, mass, pressures) in zip(axes, GRASPS):
+        chosen = (pressures[0], pressures[-1]) if ctx.quick else pressures
+        offsets = (0.0,) if ctx.quick else (0.0, 10.0, 20.0)
+        rows = fig8(WeightsCase(design=ctx.design, diameter_mm=D, mass_kg=mass), chosen, offsets)
+        write_csv(outdir / f"fig8_fem_{D:.0f}mm.csv", rows)
+        errors = fig8_errors(rows)
+        summary.append({"diameter_mm": D, "mass_kg": mass, "points": len(rows), **errors,
+                        "paper_error_vs_measurement_kgf": PAPER_FIG8_ERROR_KGF[D]})
+        numbers |= {f"{k}_{D:.0f}mm": v for k, v in errors.items() if v is not None}
+        theta = [r["theta_deg"] for r in rows]
+        ax.plot(theta, [r["F_v_fem_N"] / KGF for r in rows], "o", label="FEM")
+        ax.plot(theta, [r["F_v_reduced_N"] / KGF for r in rows], "x", label="eq. (25), FEM w")
+        ax.set(xlabel="bend angle θ [deg]", ylabel="F_v [kgf]", title=f"{mass:g} kg, {D:g} mm")
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=8)
+    save_figure(fig, outdir / "fig8_fem.png")
+    text = f"""Grasp FEM at the paper's grasp pressures ({'two pressures, one object depth' if ctx.quick
+else 'four pressures, three object depths'}); each point is a converged contact state, and
+eq. (25) → (29) is evaluated at the same (P, θ) with that state's FEM w and with the
+paper's w (CSV per object). Errors of eq. (25) against the FEM, next to the paper's
+errors against its measurements:
+
+{md_table(summary)}
+
+![Fig. 8 with FEM points](fig8_fem.png)
+"""
+    return text, numbers
+
+
 def write_sheet_vtk(result, outdir: Path) -> list[str]:
     """The deformed sheet per volume (r-z section and revolved to 3D) as .vtu files."""
     from fem.reservoir import sheet_vtk
@@ -141,6 +212,10 @@ SECTIONS: list[Section] = [
     Section("reservoir_fem", "Reservoir: FEM against the ellipse model",
             ("studies.reservoir:run", "fem.reservoir:sheet_vtk", "meshes.convert:write_vtu"),
             reservoir_fem),
+    Section("weights_fem", "w for the 180 mm and 240 mm objects by grasp FEM",
+            ("studies.weights:weights", "studies.weights:WeightsCase"), weights_fem),
+    Section("fig8_fem", "Fig. 8 analogue with grasp-FEM points",
+            ("studies.weights:fig8", "studies.weights:fig8_errors"), fig8_fem),
     Section("verify", "FEM verification against closed forms",
             ("studies.verify:run_case", "studies.verify:REGISTRY"), verify, in_quick=False),
 ]
