@@ -96,3 +96,18 @@ def reservoir(params: dict, design: HandDesign, outdir: Path) -> dict:
     return {**out, "mesh": {**(mesh or {"n_radial": result.study.n_radial,
                                         "n_thick": result.study.n_thick}), "dofs": fem.ndofs},
             "solver": {"newton_iterations": fem.newton_iterations, "wall_time_s": fem.wall_time}}
+
+
+def weights(params: dict, design: HandDesign, outdir: Path) -> dict:
+    """One grasp by FEM (:func:`studies.weights.weights`): w, theta, F_v by FEM and eq. (25)."""
+    from studies.weights import WeightsCase, weights as grasp_weights
+
+    names = {"diameter_mm": "diameter_mm", "mass_kg": "mass_kg", "pressure_mpa": "pressure_mpa",
+             "dP_mpa": "dP_mpa", "mesh_size_mm": "mesh_size_mm"}
+    case = WeightsCase(design=design, **{names[k]: float(v) for k, v in params.items()})
+    r = grasp_weights(case, out=outdir)
+    (outdir / "result.json").unlink(missing_ok=True)  # the runner writes its own result.json
+    keep = ("w", "w_sum", "theta_deg", "hinge_deg", "F_v_fem_N", "F_v_reduced_N", "contact_force_N")
+    return {**{k: r[k] for k in keep if r.get(k) is not None},
+            "mesh": {"mesh_size_mm": r["mesh_size_mm"], "dofs": r["ndofs"]},
+            "solver": {"newton_iterations": r["newton_iterations"], "wall_time_s": r["wall_seconds"]}}

@@ -46,6 +46,76 @@ def verify(ctx: Context, outdir: Path):
     return text, numbers
 
 
+# ---------------------------------------------------------------------- Fig. 7 with FEM points
+def fig7_fem(ctx: Context, outdir: Path):
+    """Free bending by finger FEM against eq. (28), and the whole hand against eq. (27)."""
+    from fem.finger import FingerOptions
+    from fem.io import VtkSeries
+    from reduced import hand, reservoir
+    from studies.bending import BendingStudy, run
+
+    d = ctx.design
+    step = 0.2 if ctx.quick else 0.1
+    pressures = tuple(np.round(np.arange(0.0, 0.8 + 1e-9, step), 10))
+    options = FingerOptions(mesh_size=6.0) if ctx.quick else FingerOptions()
+    series, basis = VtkSeries(outdir / "finger.pvd"), []
+    with progress_bar("  bending the finger", "P") as bar:
+        def on_state(model, state):
+            basis[:] = basis or [model.vector_basis()]
+            series.write(state.P, basis[0], model.displacement(state.y), model.law,
+                         J_bar=model.element_dilatation(state.y))
+            bar.update(1)
+
+        result = run(BendingStudy(d, pressures, options), on_state=on_state)
+    rows = result.rows
+    for r in rows:  # the whole hand: the finger's FEM pressure minus the reservoir's at its oil
+        theta = math.radians(r["theta_deg"])
+        p_r = float(reservoir.pressure(d.V0 - d.n * r["dQ_mm3"], d))
+        r["P_hand_MPa"] = r["P_MPa"] - p_r
+        r["P_hand_eq27_MPa"] = float(hand.pressure(theta, d, reservoir=True))
+    columns = ["P_MPa", "theta_deg", "theta_reduced_deg", "dQ_mm3", "dQ_reduced_mm3",
+               "radial_stretch_max", "max_principal_stretch", "P_hand_MPa", "P_hand_eq27_MPa"]
+    write_csv(outdir / "fig7_fem.csv", rows, columns + ["hinge_deg", "newton_iterations"])
+    _fig7_fem_plot(rows, d, outdir / "fig7_fem.png")
+    err = [r["theta_deg"] - r["theta_reduced_deg"] for r in rows]
+    numbers = {"theta_fem_at_max_P_deg": rows[-1]["theta_deg"],
+               "theta_eq28_at_max_P_deg": rows[-1]["theta_reduced_deg"],
+               "max_abs_theta_difference_deg": float(np.max(np.abs(err))),
+               "max_radial_stretch": float(max(r["radial_stretch_max"] for r in rows)),
+               "dofs": result.ndofs, "newton_iterations": result.stats.newton_iterations,
+               "fem_wall_time_s": result.stats.wall_seconds}
+    text = f"""The finger FEM (half model, rigid links on hinges, {result.ndofs} unknowns,
+{'CI mesh 6 mm' if ctx.quick else 'default mesh'}) at {len(rows)} pressures, against eq. (28)
+at the same pressure; the whole hand P = p_finger − p_r(V0 − n ΔQ_FEM) with the reduced
+reservoir model, against eq. (27) at the FEM angle ([fig7_fem.csv](fig7_fem.csv), VTK series
+[finger.pvd](finger.pvd)). Largest |θ_FEM − θ_eq.(28)| = {numbers['max_abs_theta_difference_deg']:.2f}°;
+largest radial stretch {numbers['max_radial_stretch']:.4f} (the model assumes 1).
+
+{md_table(rows, columns)}
+
+![Fig. 7 with FEM points](fig7_fem.png)
+"""
+    return text, numbers
+
+
+def _fig7_fem_plot(rows, design, path: Path) -> None:
+    from reduced import hand
+
+    theta_deg = np.arange(0.0, 90.0 + 1e-9, 1.0)
+    theta = np.radians(theta_deg)
+    fig, (ax,) = figure()
+    ax.plot(hand.pressure(theta, design, reservoir=True), theta_deg, "-", label="eq. (27), with reservoir")
+    ax.plot(hand.pressure(theta, design, reservoir=False), theta_deg, ":", label="eq. (28), without")
+    ax.plot([r["P_MPa"] for r in rows], [r["theta_deg"] for r in rows], "o", label="finger FEM")
+    ax.plot([r["P_hand_MPa"] for r in rows], [r["theta_deg"] for r in rows], "s", mfc="none",
+            label="FEM finger + reservoir")
+    ax.set(xlabel="pump pressure P [MPa]", ylabel="bend angle θ [deg]", title="Fig. 7 with FEM points",
+           xlim=(-0.15, None))
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8)
+    save_figure(fig, path)
+
+
 # ---------------------------------------------------------------------- reservoir vs ellipse
 def reservoir_fem(ctx: Context, outdir: Path):
     """The reservoir sheet by FEM against the paper's half-ellipse model (11)-(18)."""
@@ -209,6 +279,8 @@ def progress_bar(desc: str, unit: str):
 
 
 SECTIONS: list[Section] = [
+    Section("fig7_fem", "Fig. 7 with finger-FEM points, and the whole hand",
+            ("studies.bending:run", "studies.bending:BendingStudy", "fem.io:VtkSeries"), fig7_fem),
     Section("reservoir_fem", "Reservoir: FEM against the ellipse model",
             ("studies.reservoir:run", "fem.reservoir:sheet_vtk", "meshes.convert:write_vtu"),
             reservoir_fem),

@@ -60,6 +60,8 @@ KINDS: dict[str, Kind] = {
     "control": Kind("studies.kinds:control", ("theta_ref_deg", "mass_kg", "diameter_mm",
                                               "push_n", "push_at_s", "t_end_s")),
     "reservoir": Kind("studies.kinds:reservoir", ("theta_max_deg",), fem=True),
+    "weights": Kind("studies.kinds:weights", ("diameter_mm", "mass_kg", "pressure_mpa", "dP_mpa"),
+                    fem=True),
 }
 
 _TOP_KEYS = ("kind", "name", "description", "design", "mesh_size_mm", "sweep", "params")
