@@ -1,0 +1,30 @@
+"""Wall time and size of the finger FEM's default P-theta curve (0-0.8 MPa in 0.1 MPa steps).
+
+Run: ``python benchmarks/bench_finger.py [--mesh-size-mm H ...]``. Prints, per mesh size,
+the unknowns, tetrahedra, Newton iterations, assembly / linear-solve / total seconds and
+theta at the last pressure. Issue 5's target: the default mesh under 5 minutes.
+"""
+from __future__ import annotations
+
+import argparse
+
+from fem.finger import FingerOptions
+from studies.bending import BendingStudy, run
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--mesh-size-mm", type=float, nargs="+", default=[FingerOptions().mesh_size])
+    args = parser.parse_args()
+    print("h_mm  unknowns  tets  newton  assembly_s  solve_s  total_s  theta_0.8_deg")
+    for h in args.mesh_size_mm:
+        result = run(BendingStudy(options=FingerOptions(mesh_size=h)))
+        s = result.stats
+        print(f"{h:4g}  {result.ndofs:8d}  {result.nelements:4d}  {s.newton_iterations:6d}  "
+              f"{s.assembly_seconds:10.1f}  {s.solve_seconds:7.1f}  {s.wall_seconds:7.1f}  "
+              f"{result.rows[-1]['theta_deg']:13.3f}", flush=True)
+        print(f"# solver: {s.solver}; mesh and setup {result.build_seconds:.1f} s")
+
+
+if __name__ == "__main__":
+    main()
