@@ -162,11 +162,19 @@ printed (Σw = {w_paper.sum():.2f}, violating eq. (23)) and normalised to Σw = 
 The paper's flexibility claim is that the push under angle control (c) leaves a lower
 force than the push under pressure control (b). With these (P, θ) the model gives
 F_v(c) = {rows[2]['F_v_kgf']:.3f} and F_v(b) = {rows[1]['F_v_kgf']:.3f} kgf (w as printed):
-the ordering {"holds" if rows[2]['F_v_kgf'] < rows[1]['F_v_kgf'] else "does not hold"}.
+{_ordering_verdict(rows[1]['F_v_kgf'], rows[2]['F_v_kgf'])}
 A negative F_v means eq. (25) finds the finger pulled toward the object rather than
 pressing on it at that (P, θ).
 """
     return text, numbers
+
+
+def _ordering_verdict(F_b: float, F_c: float) -> str:
+    """Whether F_v(c) < F_v(b) is a statement about grasping forces at all."""
+    if F_b <= 0 and F_c <= 0:
+        return ("neither state presses on the object (both F_v <= 0), so the comparison "
+                "says nothing about flexibility.")
+    return f"the ordering {'holds' if F_c < F_b else 'does not hold'}."
 
 
 # ---------------------------------------------------------------------- Fig. 8, reduced
