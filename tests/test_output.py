@@ -1,11 +1,11 @@
 """Atomic writes: whole files or nothing, ordinary permissions."""
 import json
+import os
 import stat
 
 import numpy as np
 import pytest
 
-from studies import output
 from studies.output import write_atomic, write_csv, write_json
 
 
@@ -16,7 +16,9 @@ def test_write_json_round_trip_with_numpy(tmp_path):
 
 def test_files_get_ordinary_permissions_not_mkstemps_0600(tmp_path):
     path = write_atomic(tmp_path / "f.txt", "x")
-    assert stat.S_IMODE(path.stat().st_mode) == 0o666 & ~output._UMASK
+    umask = os.umask(0)
+    os.umask(umask)
+    assert stat.S_IMODE(path.stat().st_mode) == 0o666 & ~umask
 
 
 def test_failed_write_leaves_nothing_behind(tmp_path):
