@@ -208,12 +208,3 @@ class ChainConstraint:
         Kr = (B.T @ (K @ B) + geo).tocsr()
         Kr.sort_indices()
         return r, Kr
-
-    def link_forces(self, R) -> np.ndarray:
-        """Net in-plane force the body exerts on each link through its tied nodes [N].
-
-        ``R`` is the full residual (internal minus external force); shape (n_s + 1, 2).
-        """
-        t = self.tied
-        return -np.stack([np.bincount(self.links[t], R[self.nodes[t, c]],
-                                      minlength=self.chain.n_s + 1) for c in (0, 1)], axis=1)

@@ -46,7 +46,7 @@ from dataclasses import dataclass
 
 import numpy as np
 import scipy.sparse as sp
-from skfem import Basis, ElementTetP2, ElementVector
+from skfem import Basis, ElementTetP2
 
 from fem import kinematics as kin
 from fem.assembly import ElementScatter

@@ -14,7 +14,6 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-import numpy as np
 import skfem
 
 from meshes.cache import load_mesh
@@ -79,8 +78,3 @@ def _classify_surfaces(model, tube: Tube) -> dict[str, list[int]]:
 def tube_mesh(tube: Tube, *, size: float, order: int = 2) -> skfem.Mesh:
     """The cached mesh of ``tube`` with element size ``size`` [mm] (MeshTet2 for order 2)."""
     return load_mesh(tube_geometry, tube, size=size, order=order)
-
-
-def cylindrical(x: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """(r, phi, z) of points ``x`` with shape (3, ...)."""
-    return np.hypot(x[0], x[1]), np.arctan2(x[1], x[0]), x[2]
