@@ -17,6 +17,9 @@ incompressible solid converges in ~4 full steps although its displacement residu
 jumps by 1e3 after the first: any merit on it would cut those steps). A non-finite
 residual (inverted element) halves the step. The Jacobian evaluated at an accepted
 trial point is reused for the next iteration, so a full step costs one assembly.
+Given a cheaper ``residual(x) -> R`` (for the P2 solid a residual costs ~5 % of a
+residual + tangent), trial points evaluate only R and the tangent is assembled once, at
+the accepted point: a rejected trial then costs a residual, not a full assembly.
 
 Load stepping (:func:`solve_path`): t runs from 0 to 1; each step starts from the
 last converged state along a predictor direction, line-searched like a Newton
@@ -81,14 +84,15 @@ class NewtonResult:
 
 
 def newton(fun, x0, options: NewtonOptions = NewtonOptions(), *, solver=None, scale=None,
-           direction=None, on_accept=None) -> NewtonResult:
+           direction=None, on_accept=None, residual=None) -> NewtonResult:
     """Solve R(x) = 0 from x0; raises NotConverged with the residual history.
 
     fun(x) -> (R, K); solver: a :mod:`fem.linsolve` solver (default auto, unsymmetric);
     scale: reference for the relative tolerance (default ||R(x0)||);
     direction: search direction of the first iteration instead of -K^{-1} R (a load-step
     predictor, line-searched like a Newton step); on_accept(x): called with x0 and every
-    accepted iterate before fun is evaluated around it (e.g. :class:`fem.solid.MixedNewton`).
+    accepted iterate before fun is evaluated around it (e.g. :class:`fem.solid.MixedNewton`);
+    residual(x) -> R: optional, fun's residual alone, for the line search's trial points.
     """
     solver = solver or make_solver()
     t0 = time.perf_counter()
@@ -115,7 +119,7 @@ def newton(fun, x0, options: NewtonOptions = NewtonOptions(), *, solver=None, sc
         t_solve += time.perf_counter() - t1
         t1 = time.perf_counter()
         small = it > 0 and np.linalg.norm(dx) <= options.xtol * (1.0 + np.linalg.norm(x))
-        x, R, K, norm, s = _line_search(fun, x, dx, R, norm, options)
+        x, R, K, norm, s = _line_search(fun, x, dx, R, norm, options, residual)
         t_asm += time.perf_counter() - t1
         history.append(norm)
         steps.append(s)
@@ -126,31 +130,30 @@ def newton(fun, x0, options: NewtonOptions = NewtonOptions(), *, solver=None, sc
     raise NotConverged(f"no convergence in {options.max_iter} iterations (tol {tol:.2e})", history, x)
 
 
-def _line_search(fun, x, dx, R0, norm0, options):
+def _line_search(fun, x, dx, R0, norm0, options, residual=None):
     """Step length on x + s dx; returns the accepted (x, R, K, ||R||, s). See the module docstring."""
+    trial = fun if residual is None else (lambda xt: (residual(xt), None))
     g0 = float(R0 @ dx)  # slope of the energy along dx at s = 0 (< 0 for a descent direction)
     s, lo, glo, hi, ghi = 1.0, 0.0, g0, None, None
     for _ in range(options.max_backtracks + 1):
         xt = x + s * dx
         with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
-            R, K = fun(xt)
+            R, K = trial(xt)
         norm = float(np.linalg.norm(R))
-        if not options.line_search:
-            return xt, R, K, norm, s
+        if not options.line_search or (options.merit == "finite" and np.isfinite(norm)):
+            break
         if not np.isfinite(norm):  # e.g. an inverted element: shorten
             hi, ghi, s = s, None, 0.5 * (lo + s)
             continue
-        if options.merit == "finite":
-            return xt, R, K, norm, s
         if options.merit == "residual":
             if norm <= (1 - options.armijo * s) * norm0:
-                return xt, R, K, norm, s
+                break
             phi0, phis = norm0 ** 2, norm ** 2
             s = float(np.clip(s * s * phi0 / (phis - phi0 + 2 * s * phi0), 0.1 * s, 0.5 * s))
             continue
         g = float(R @ dx)
         if g0 >= 0 or abs(g) <= options.eta * abs(g0) or (g < 0 and hi is None):
-            return xt, R, K, norm, s  # slope small enough, or still descending at the full step
+            break  # slope small enough, or still descending at the full step
         if g < 0:
             lo, glo = s, g
         else:
@@ -158,7 +161,11 @@ def _line_search(fun, x, dx, R0, norm0, options):
         # regula falsi for the zero of the slope in [lo, hi], kept off the ends
         s_new = lo + (hi - lo) * glo / (glo - ghi) if ghi is not None else 0.5 * (lo + hi)
         s = float(np.clip(s_new, lo + 0.1 * (hi - lo), hi - 0.1 * (hi - lo)))
-    return xt, R, K, norm, s  # not sufficient: take the last trial, Newton may still recover
+    # accepted, or no sufficient step in max_backtracks: the last trial (Newton may still recover)
+    if K is None:
+        with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
+            R, K = fun(xt)
+    return xt, R, K, norm, s
 
 
 @dataclass(frozen=True)
@@ -190,12 +197,13 @@ class PathResult:
 
 
 def solve_path(fun_t, x0, options: PathOptions = PathOptions(), *, solver=None, scale_t=None,
-               callback=None, on_accept=None) -> PathResult:
+               callback=None, on_accept=None, residual_t=None) -> PathResult:
     """Follow R(x, t) = 0 for t from 0 (state x0) to 1; fun_t(x, t) -> (R, K).
 
     scale_t(t): optional reference residual norm for the relative tolerance at t
     (e.g. the norm of the external load); callback(t, x) after each converged step;
-    on_accept: passed to :func:`newton` (also called before each predictor).
+    on_accept: passed to :func:`newton` (also called before each predictor);
+    residual_t(x, t) -> R: optional, fun_t's residual alone (:func:`newton`'s ``residual``).
     """
     solver = solver or make_solver()
     res = PathResult([0.0], [np.array(x0, dtype=float)], [], 0, [])
@@ -207,7 +215,8 @@ def solve_path(fun_t, x0, options: PathOptions = PathOptions(), *, solver=None, 
         step = _predict(res, t, fun_t, solver, options.predictor)
         try:
             r = newton(lambda x: fun_t(x, t), res.x[-1], options.newton, solver=solver,
-                       scale=None if scale_t is None else scale_t(t), direction=step, on_accept=on_accept)
+                       scale=None if scale_t is None else scale_t(t), direction=step, on_accept=on_accept,
+                       residual=None if residual_t is None else (lambda x: residual_t(x, t)))
         except NotConverged as err:
             res.cutbacks += 1
             dt *= 0.5

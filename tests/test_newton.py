@@ -30,6 +30,24 @@ def test_line_search_converges_where_plain_newton_diverges():
     assert abs(r.x[0]) < 2e-8 and min(r.steps) < 1.0  # |x| ~ |R| <= rtol |R0|
 
 
+def test_residual_only_trials_give_the_same_iterates_with_one_tangent_per_iteration():
+    calls = {"fun": 0, "residual": 0}
+
+    def fun(x):
+        calls["fun"] += 1
+        return ATAN(x)
+
+    def residual(x):
+        calls["residual"] += 1
+        return np.arctan(x)
+
+    plain = newton(ATAN, [2.0])
+    r = newton(fun, [2.0], residual=residual)
+    assert r.history == plain.history and r.steps == plain.steps and min(r.steps) < 1.0
+    assert calls["fun"] == r.iterations + 1  # x0, then once per accepted iterate
+    assert calls["residual"] > r.iterations  # rejected trials cost residuals only
+
+
 def test_cut_back_and_last_converged_state():
     """arctan(x) = 2 t has a solution only for t < pi/4: the path stops just before it."""
     def fun_t(x, t):
@@ -101,3 +119,29 @@ def test_linear_solvers_agree_and_reuse_the_analysis(method, symmetric):
         A.data *= 1.1  # same pattern, new values
     assert solver.n_analyses == 1 and solver.n_solves == 2
     assert solver.name in solver.describe()
+
+
+def _path_laplacian(n, shift):
+    """Graph Laplacian of a path (free ends) + shift I: SPD, cond ~ 4 / shift for small shift."""
+    main = np.full(n, 2.0)
+    main[[0, -1]] = 1.0
+    return sp.diags([-np.ones(n - 1), main + shift, -np.ones(n - 1)], [-1, 0, 1], format="csr")
+
+
+@pytest.mark.skipif("pardiso" not in available(), reason="PARDISO (the fast extra) not installed")
+def test_mixed_precision_refines_to_double_accuracy_and_falls_back_when_ill_conditioned():
+    rng = np.random.default_rng(2)
+    b = rng.standard_normal(3000)
+    # cond ~ 4e3: each refinement step gains ~ cond * eps_single ~ 1e-4
+    K = _path_laplacian(3000, 1e-3)
+    mixed, double = make_solver("pardiso", symmetric=True), make_solver("pardiso", symmetric=True,
+                                                                          precision="double")
+    x, x_ref = mixed.solve(K, b), double.solve(K, b)
+    assert np.linalg.norm(K @ x - b) <= 1e-10 * np.linalg.norm(b)  # REFINE_RTOL
+    assert np.linalg.norm(x - x_ref) <= 1e-9 * np.linalg.norm(x_ref)  # <= cond * 1e-10 + round-off
+    assert mixed.precision == "mixed" and mixed.refinement_steps >= 2 and "mixed" in mixed.describe()
+    # cond ~ 4e9 > 1 / eps_single: the single-precision factor cannot converge; double takes over
+    K = _path_laplacian(3000, 1e-9)
+    x = mixed.solve(K, b)
+    assert mixed.precision == "double" and "stalled" in mixed.fallback and mixed.n_analyses == 2
+    assert np.linalg.norm(K @ x - b) <= 1e-6 * np.linalg.norm(b)  # backward stable: ~ cond * eps_double
