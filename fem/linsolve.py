@@ -11,6 +11,15 @@ ordering on A^T + A (the default COLAMD ordering is ~10x slower on these meshes)
 The symbolic analysis (ordering + symbolic factorisation) is done once per sparsity
 pattern and reused for every later matrix with the same pattern (PARDISO phase 11
 once, then phase 23 per solve). ``solver.name`` says which backend runs.
+
+Mixed precision (PARDISO, ``precision="mixed"``, the default): the matrix is factorised
+in single precision (half the factor's memory, ~1.8x faster on the 80k-DOF benchmark
+tangent: 0.68 s against 1.27 s) and the solution is refined in double precision,
+x <- x + LU^-1 (b - K x) with the residual in double, until
+``||b - K x|| <= REFINE_RTOL ||b||`` -- the accuracy of the double-precision solve (2e-11
+there). Each step gains a factor ~cond(K) eps_single (60x on that tangent, 4-5 steps).
+When the refinement stalls (an ill-conditioned K, e.g. kappa/mu = 1000 rubber) the
+solver falls back to double precision for good and says so in :meth:`describe`.
 """
 from __future__ import annotations
 
@@ -21,6 +30,9 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 METHODS = ("auto", "pardiso", "umfpack", "superlu")
+PRECISIONS = ("mixed", "double")
+REFINE_RTOL = 1e-10  #: mixed precision: relative residual the refinement must reach
+REFINE_MAX = 8  #: mixed precision: refinement steps before falling back to double
 
 
 def available() -> list[str]:
@@ -40,13 +52,18 @@ def available() -> list[str]:
     return out + ["superlu"]
 
 
-def make_solver(method: str = "auto", *, symmetric: bool = False) -> "LinearSolver":
-    """A solver object with ``solve(K, b) -> x``; ``symmetric``: K is symmetric (any sign)."""
+def make_solver(method: str = "auto", *, symmetric: bool = False, precision: str = "mixed") -> "LinearSolver":
+    """A solver object with ``solve(K, b) -> x``; ``symmetric``: K is symmetric (any sign);
+    ``precision``: "mixed" (PARDISO only; see the module docstring) or "double"."""
     if method not in METHODS:
         raise ValueError(f"linear solver {method!r} not in {METHODS}")
+    if precision not in PRECISIONS:
+        raise ValueError(f"precision {precision!r} not in {PRECISIONS}")
     if method == "auto":
         method = available()[0]
-    return {"pardiso": PardisoSolver, "umfpack": UmfpackSolver, "superlu": SuperLUSolver}[method](symmetric)
+    if method == "pardiso":
+        return PardisoSolver(symmetric, precision)
+    return {"umfpack": UmfpackSolver, "superlu": SuperLUSolver}[method](symmetric)
 
 
 class LinearSolver:
@@ -89,35 +106,96 @@ class LinearSolver:
 
 
 class PardisoSolver(LinearSolver):
-    """MKL PARDISO through pypardiso; symbolic analysis once per pattern."""
+    """MKL PARDISO through pypardiso; symbolic analysis once per pattern; mixed or double precision."""
 
     name = "pardiso"
 
-    def __init__(self, symmetric):
+    def __init__(self, symmetric, precision="mixed"):
         super().__init__(symmetric)
-        import pypardiso
-        self._ps = pypardiso.PyPardisoSolver(mtype=-2 if symmetric else 11)
+        self.precision = precision
+        self.refinement_steps = 0  #: mixed precision: refinement solves so far
+        self.fallback = None  #: why mixed precision was given up (None: it was not)
+        self._ps = self._handle(precision)
         self._upper = None
+
+    def _handle(self, precision):
+        import pypardiso
+        ps = pypardiso.PyPardisoSolver(mtype=-2 if self.symmetric else 11)
+        if precision == "mixed":  # explicit iparm (iparm[0] = 1) for the single-precision factor
+            settings = {1: 2, 9: 8, 10: 0, 12: 0} if self.symmetric else {1: 2, 9: 13, 10: 1, 12: 1}
+            ps.iparm[0], ps.iparm[27] = 1, 1  # user settings; single precision (a, b, x float32)
+            for i, v in settings.items():  # METIS ordering, pivot perturbation, scaling, matching
+                ps.iparm[i] = v
+        return ps
+
+    def describe(self) -> str:
+        line = super().describe()
+        if self.precision == "mixed":
+            return f"{line}, mixed precision ({self.refinement_steps} refinement steps)"
+        if self.fallback:
+            return f"{line}, double precision ({self.fallback})"
+        return line
 
     def _solve(self, K, b):
         same = self._same_pattern(K)
-        if self.symmetric:
-            if not same:  # positions of the upper triangle in K.data, once per pattern
-                rows = np.repeat(np.arange(K.shape[0]), np.diff(K.indptr))
-                sel = np.flatnonzero(K.indices >= rows)
-                indptr = np.zeros(K.shape[0] + 1, dtype=K.indptr.dtype)
-                np.cumsum(np.bincount(rows[sel], minlength=K.shape[0]), out=indptr[1:])
-                self._upper = (sel, K.indices[sel], indptr)
-            sel, ind, ptr = self._upper
-            K = sp.csr_matrix((K.data[sel], ind, ptr), shape=K.shape, copy=False)
-            K.has_sorted_indices = True
+        A = self._stored(K, same)
+        if self.precision == "mixed":
+            x = self._solve_mixed(K, A, b, same)
+            if x is not None:
+                return x
+            self.precision, self._ps, same = "double", self._handle("double"), False
+            self.n_analyses += 1
         b2 = np.asfortranarray(b.reshape(-1, 1))
         self._ps.set_iparm(12, 0)  # CSR, not transposed
         if not same:
             self._ps.set_phase(11)  # reordering + symbolic factorisation
-            self._ps._call_pardiso(K, b2)
+            self._ps._call_pardiso(A, b2)
         self._ps.set_phase(23)  # numerical factorisation + solve
-        return self._ps._call_pardiso(K, b2).ravel()
+        return self._ps._call_pardiso(A, b2).ravel()
+
+    def _stored(self, K, same):
+        """The matrix PARDISO gets: K, or its upper triangle in symmetric mode."""
+        if not self.symmetric:
+            return K
+        if not same or self._upper is None:  # positions of the upper triangle in K.data, once per pattern
+            rows = np.repeat(np.arange(K.shape[0]), np.diff(K.indptr))
+            sel = np.flatnonzero(K.indices >= rows)
+            indptr = np.zeros(K.shape[0] + 1, dtype=K.indptr.dtype)
+            np.cumsum(np.bincount(rows[sel], minlength=K.shape[0]), out=indptr[1:])
+            self._upper = (sel, K.indices[sel], indptr)
+        sel, ind, ptr = self._upper
+        A = sp.csr_matrix((K.data[sel], ind, ptr), shape=K.shape, copy=False)
+        A.has_sorted_indices = True
+        return A
+
+    def _solve_mixed(self, K, A, b, same):
+        """Single-precision factor + double-precision refinement; None when it stalls."""
+        A32 = sp.csr_matrix((A.data.astype(np.float32), A.indices, A.indptr), shape=A.shape, copy=False)
+        work = np.zeros((len(b), 1), dtype=np.float32, order="F")
+        if not same:
+            self._ps.set_phase(11)
+            self._ps._call_pardiso(A32, work)
+        self._ps.set_phase(22)  # numerical factorisation only
+        self._ps._call_pardiso(A32, work)
+        self._ps.set_phase(33)  # solves with the stored factor
+        bnorm = float(np.linalg.norm(b))
+        x, r, last = np.zeros_like(b), b, bnorm
+        for _ in range(REFINE_MAX):
+            if last <= REFINE_RTOL * bnorm:
+                return x
+            work[:, 0] = r
+            x = x + self._ps._call_pardiso(A32, work).ravel()
+            self.refinement_steps += 1
+            r = b - K @ x
+            norm = float(np.linalg.norm(r))
+            if not norm < 0.5 * last:  # stalled or diverging: single precision is not enough for K
+                self.fallback = f"mixed precision stalled at relative residual {norm / bnorm:.1e}"
+                return None
+            last = norm
+        if last <= REFINE_RTOL * bnorm:
+            return x
+        self.fallback = f"mixed precision reached only {last / bnorm:.1e} in {REFINE_MAX} steps"
+        return None
 
 
 class UmfpackSolver(LinearSolver):
