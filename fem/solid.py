@@ -36,9 +36,12 @@ converges in ~4-5 full steps for kappa/mu = 1e2..1e5 alike (tests/test_solid.py)
 where the displacement iteration needs cut-backs or diverges (kappa/mu >= 1e4).
 
 Kernels: F, P and A are evaluated once per iterate at all quadrature points; the
-element matrices come from two batched matrix products over all basis pairs and
-are scattered by :class:`fem.assembly.ElementScatter` into a CSR pattern built
-once. Elements are processed in chunks (memory), never one by one.
+element matrices come from two batched matrix products over all basis pairs,
+written in a block layout that needs no transposed copy into one buffer for the
+whole mesh (kept between iterates: nel (3 nloc)^2 doubles, 117 MB at 80k DOFs), and
+scattered by :class:`fem.assembly.ElementScatter` into a CSR pattern built once, in
+one pass. Elements are processed in chunks (memory of the intermediates), never one
+by one.
 """
 from __future__ import annotations
 
@@ -181,21 +184,28 @@ class Solid:
 
     def _assemble(self, u, tangent, anchor=None):
         R = np.zeros(self.ndofs)
-        data = np.zeros(self.scatter.nnz) if tangent else None
+        Ke = self._element_matrix_buffer() if tangent else None
         for c in self._chunks:
             p_geo = None if anchor is None else anchor.pressure(u, c, self.scatter.vector_dofs(c))
-            re, Ke = self._element_kernels(u, c, tangent, p_geo)
+            re = self._element_kernels(u, c, None if Ke is None else Ke[c], p_geo)
             self.scatter.add_vector(R, re, c)
-            if tangent:
-                self.scatter.add_matrix(data, Ke, c, cache=True)
-        return R, data
+        return R, (self.scatter.block_matrix_data(Ke) if tangent else None)
 
-    def _element_kernels(self, u, c, tangent, p_geo=None):
-        """Element residuals (ne, 3nloc) and matrices (ne, 3nloc, 3nloc) of chunk c."""
+    def _element_matrix_buffer(self) -> np.ndarray:
+        """The element matrices of the whole mesh, block layout (see :func:`element_matrices`)."""
+        if getattr(self, "_ke", None) is None:
+            nel, _, nloc, _ = self.G.shape
+            self._ke = np.empty((nel, nloc, 3, 3, nloc))
+        return self._ke
+
+    def _element_kernels(self, u, c, Ke=None, p_geo=None):
+        """Element residuals (ne, 3nloc) of chunk c; with Ke (its slice of the element matrix
+        buffer), the element matrices are written into it."""
         F = self.F(u, c)
         dev = self._dev.take(c)
         G, W = self.G[c], self.W[c]
         P = dev.stress(F)
+        tangent = Ke is not None
         A = dev.tangent(F) if tangent else None
         if self._vol is not None:
             cof = kin.cofactor(F)
@@ -208,12 +218,13 @@ class Solid:
         GW = G * W[:, :, None, None]
         re = np.einsum("akeq,eqnk->ena", P, GW, optimize=True).reshape(len(W), -1)
         if not tangent:
-            return re, None
-        Ke = element_matrices(A, G, GW)
-        if self._vol is not None:
-            b = np.einsum("akeq,eqnk->ena", cof, GW, optimize=True).reshape(len(W), -1)
-            Ke += (self._vol.ddU(Jbar) / Ve)[:, None, None] * b[:, :, None] * b[:, None, :]
-        return re, Ke
+            return re
+        element_matrices(A, G, GW, out=Ke)
+        if self._vol is not None:  # + U''/V_e b_e b_e^T, b[e, n, a]
+            b = np.einsum("akeq,eqnk->ena", cof, GW, optimize=True)
+            cb = (self._vol.ddU(Jbar) / Ve)[:, None, None] * b
+            Ke += cb[:, :, :, None, None] * b.transpose(0, 2, 1)[:, None, None, :, :]
+        return re
 
 
 @dataclass(frozen=True)
@@ -250,15 +261,18 @@ class MixedNewton:
         self.anchor = self.solid.anchor(self.expand(x))
 
 
-def element_matrices(A: np.ndarray, G: np.ndarray, GW: np.ndarray) -> np.ndarray:
-    """K[e, (n,a), (m,b)] = sum_q GW[e,q,n,k] A[a,k,b,l,e,q] G[e,q,m,l], shape (ne, 3nloc, 3nloc).
+def element_matrices(A: np.ndarray, G: np.ndarray, GW: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
+    """K[e, n, a, b, m] = sum_q sum_kl GW[e,q,n,k] A[a,k,b,l,e,q] G[e,q,m,l]: the stiffness between
+    row dof (node n, component a) and column dof (node m, component b), shape (ne, nloc, 3, 3, nloc).
 
-    Two batched matrix products over all basis pairs (no loop over elements or points):
-    D[eq, (a k b), m] = A[eq, (a k b), l] G[eq, m, l], then K[e, n, (a b m)] = GW[e, n, (q k)] D.
+    Two batched matrix products over all basis pairs (no loop over elements or points), in an
+    order whose results need no transposed copy: D[eq, (k a b), m] = A[eq, (k a b), l] G[eq, m, l],
+    then K[e, n, (a b m)] = GW[e, n, (q k)] D[e, (q k), (a b m)]. ``out``: where to write K.
     """
     ne, nq, nloc, _ = G.shape
-    Ab = np.ascontiguousarray(A.transpose(4, 5, 0, 1, 2, 3)).reshape(ne * nq, 27, 3)
-    D = np.matmul(Ab, G.reshape(ne * nq, nloc, 3).transpose(0, 2, 1))  # [eq, (a k b), m]
-    D = D.reshape(ne, nq, 3, 3, 3, nloc).transpose(0, 1, 3, 2, 4, 5).reshape(ne, nq * 3, 9 * nloc)
-    K = np.matmul(GW.transpose(0, 2, 1, 3).reshape(ne, nloc, nq * 3), D)  # [e, n, (a b m)]
-    return K.reshape(ne, nloc, 3, 3, nloc).transpose(0, 1, 2, 4, 3).reshape(ne, 3 * nloc, 3 * nloc)
+    Ab = np.ascontiguousarray(A.transpose(4, 5, 1, 0, 2, 3)).reshape(ne * nq, 27, 3)  # [eq, (k a b), l]
+    D = np.matmul(Ab, G.reshape(ne * nq, nloc, 3).transpose(0, 2, 1))  # [eq, (k a b), m]
+    GWt = np.ascontiguousarray(GW.transpose(0, 2, 1, 3)).reshape(ne, nloc, nq * 3)  # [e, n, (q k)]
+    K = np.empty((ne, nloc, 3, 3, nloc)) if out is None else out
+    np.matmul(GWt, D.reshape(ne, nq * 3, 9 * nloc), out=K.reshape(ne, nloc, 9 * nloc))
+    return K
