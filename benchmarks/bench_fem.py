@@ -66,9 +66,13 @@ def run_ours(mesh, steps: int, solver_name: str, intorder: int, predictor: str):
         R, K = solid.residual_tangent(red.expand(x))
         return red.vector(R - t * f_ext), red.restrict(K)
 
+    def residual_t(x, t):  # the line search's trial points need no tangent
+        return red.vector(solid.residual(red.expand(x)) - t * f_ext)
+
     scale = np.linalg.norm(red.vector(f_ext))
     opts = PathOptions(steps=steps, grow=1.0, predictor=predictor, newton=NewtonOptions(rtol=1e-10, atol=0.0))
-    res = solve_path(fun_t, np.zeros(len(red.keep)), opts, solver=solver, scale_t=lambda t: t * scale)
+    res = solve_path(fun_t, np.zeros(len(red.keep)), opts, solver=solver, scale_t=lambda t: t * scale,
+                     residual_t=residual_t)
     total = time.perf_counter() - t0
     u = red.expand(res.x[-1])
     return dict(dofs=solid.ndofs, steps=len(res.t) - 1, iterations=res.total_iterations,

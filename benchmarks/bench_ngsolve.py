@@ -4,9 +4,11 @@ NGSolve's best practice for this problem: the energy as a ``Variation`` (symboli
 linearisation), sparse Cholesky on the free dofs, plain Newton, the same load steps
 and quadrature degree as ours. Times are measured the same way: assembly (energy
 linearisation + residual) and solve (factorisation + solve) per Newton iteration.
+Threads: all cores, or ``OMP_NUM_THREADS`` when set (MKL, i.e. PARDISO, reads it too).
 """
 from __future__ import annotations
 
+import os
 import time
 
 import numpy as np
@@ -46,6 +48,9 @@ def run_ngsolve(mesh, steps: int, intorder: int, *, tol: float = 1e-10, max_iter
     budget: stop after this many Newton iterations (per-iteration times only; tip is None).
     """
     import ngsolve as ng
+    threads = int(os.environ.get("OMP_NUM_THREADS", "0"))  # as MKL (PARDISO) does for ours
+    if threads > 0:
+        ng.SetNumThreads(threads)
     with ng.TaskManager():
         return _run(ng, mesh, steps, intorder, tol, max_iter, budget)
 
