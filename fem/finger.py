@@ -7,7 +7,12 @@ Model (DESIGN.md, "The FEM models"; the paper's section II-B):
 * nearly incompressible Neo-Hookean rubber (mu_sf, kappa = ``kappa_ratio`` mu) in the
   mean-dilatation P2-P0 formulation of :mod:`fem.solid`, plus a tension-only fiber family
   (the Kevlar windings) along the hoop direction e_phi = (0, -z, y)/r, stiffness
-  ``fiber_ratio`` mu, everywhere in the wall (the cap too);
+  ``fiber_ratio`` mu, everywhere in the wall (the cap too). The windings' energy is
+  integrated with its own rule (:class:`Windings`, degree ``fiber_intorder``, default the
+  14-point degree-5 rule whose points include the edge midpoints): the 4-point rule of the
+  rubber samples the tension-only switch only inside the elements and misses the taut
+  layer at the cavity wall, which made theta converge from above, non-monotonically, with
+  the number of elements through the wall (docs/finger.md, mesh convergence);
 * oil pressure P on the cavity: the closed-cavity load P dV/du with its symmetric load
   stiffness P d2V/du2, V the cavity volume of :class:`fem.loads.CavityVolume` (closed by
   the symmetry plane z = 0 and the fixed inlet plane x = 0);
@@ -38,6 +43,8 @@ from dataclasses import dataclass, field
 import numpy as np
 import scipy.sparse as sp
 from skfem import Basis, ElementTetP2, ElementVector
+from skfem.quadrature import get_quadrature
+from skfem.refdom import RefTet
 
 from fem import kinematics as kin
 from fem.constraints import ChainConstraint, PlanarChain
@@ -104,6 +111,8 @@ class FingerOptions:
     """Discretisation and modelling choices of the finger FEM."""
 
     mesh_size: float = 4.0     #: target element size [mm] (docs/finger.md: mesh convergence)
+    edge_ratio: float = 1.0    #: element size at the ring edges and cap corner / mesh_size (1: uniform)
+    edge_reach: float = 5.0    #: distance over which the size grows back to mesh_size [mm]
     tie: str = "ring"          #: which outer surface the links hold: "ring" or "full"
     tie_width: float = 10.0    #: width of each link's tied ring, centred on the link [mm]
     hinge_gap: float = 4.0     #: untied tube length around each hinge, tie = "full" [mm]
@@ -111,11 +120,17 @@ class FingerOptions:
     kappa_ratio: float = 1000.0  #: bulk over shear modulus of the rubber
     fiber_ratio: float = 1000.0  #: fiber stiffness over mu (Kevlar >> rubber)
     fiber_toe: float = 0.0     #: fiber strain over which the windings' stiffness sets in (0: a jump)
+    fiber_intorder: int = 5    #: degree of the quadrature rule of the windings' energy (2: the rubber's)
 
     def __post_init__(self):
         if self.tie not in TIES:
             raise InputError("tie", self.tie, f"must be one of {', '.join(TIES)}")
-        for name in ("mesh_size", "tie_width", "hinge_gap", "kappa_ratio", "fiber_ratio"):
+        if not get_quadrature(RefTet, self.fiber_intorder)[1].min() > 0:
+            raise InputError("fiber_intorder", self.fiber_intorder,
+                             "must name a tetrahedral rule with positive weights (e.g. 2, 5, 6)")
+        if not 0 < self.edge_ratio <= 1:
+            raise InputError("edge_ratio", self.edge_ratio, "must be in (0, 1]")
+        for name in ("mesh_size", "edge_reach", "tie_width", "hinge_gap", "kappa_ratio", "fiber_ratio"):
             if not getattr(self, name) > 0:
                 raise InputError(name, getattr(self, name), "must be a positive number")
 
@@ -137,9 +152,69 @@ def tie_bands(design: HandDesign, options: FingerOptions) -> tuple[tuple[float, 
 
 
 def hoop_directions(X: np.ndarray) -> np.ndarray:
-    """Fiber directions e_phi = (0, -z, y)/r around the tube axis (the x axis), X (3, ...)."""
-    a0 = np.stack([np.zeros_like(X[0]), -X[2], X[1]])
-    return a0 / np.maximum(np.hypot(X[1], X[2]), 1e-12)
+    """Fiber directions e_phi = (0, -z, y)/r around the tube axis (the x axis), X (3, ...).
+
+    On the axis itself (points of the end cap, r = 0) the hoop is undefined; e_z is used.
+    """
+    r = np.hypot(X[1], X[2])
+    on_axis = r < 1e-12
+    a0 = np.stack([np.zeros_like(X[0]), np.where(on_axis, 1.0, -X[2]), X[1]])
+    return a0 / np.where(on_axis, 1.0, r)
+
+
+class Windings:
+    r"""The windings' energy :math:`\int k G(\lambda_f - 1)\,dV` (:class:`WindingFibers`),
+    residual and tangent, integrated with their own quadrature rule of degree ``intorder``.
+
+    Why a rule of its own: the fiber energy is a kinked function of the hoop strain, and
+    the taut fibers sit in a thin layer at the cavity wall (bending contracts the hoop,
+    the pressure expands it; at the optimum the hoop strain is largest at the inner
+    radius). The rubber's 4-point rule samples it only at points inside each element, so
+    the hoop strain at the cavity wall can go positive unseen, the more so the fewer
+    elements the wall has; the 14-point degree-5 rule includes the edge midpoints.
+
+    With f = F a0 = a0 + sum_n u_n g_n (g_n = grad N_n . a0) and c1 = k (G''/lam^2 -
+    G'/lam^3), c2 = k G'/lam: r_na = sum_q w k G'/lam f_a g_n and
+    K_(na)(mb) = sum_q w (c1 f_a g_n f_b g_m + c2 delta_ab g_n g_m): two batched products,
+    far cheaper than the general anisotropic tangent of :mod:`fem.solid`.
+    """
+
+    def __init__(self, mesh, fibers_k: float, toe: float, intorder: int, scatter, chunk=2048):
+        basis = Basis(mesh, ElementTetP2(), intorder=intorder)
+        self.law = WindingFibers(fibers_k, hoop_directions(np.asarray(basis.global_coordinates().value)), toe)
+        a0 = self.law.a0                                                    # (3, nel, nq)
+        grads = np.stack([basis.basis[i][0].grad for i in range(basis.Nbfun)])  # (nloc, 3, nel, nq)
+        self.g = np.einsum("nkeq,keq->eqn", grads, a0)                      # (nel, nq, nloc)
+        self.W = np.asarray(basis.dx)                                       # (nel, nq)
+        self.scatter = scatter
+        nel = self.W.shape[0]
+        self.chunks = [slice(i, min(i + chunk, nel)) for i in range(0, nel, chunk)]
+
+    def stretch(self, u: np.ndarray, elements=slice(None)):
+        """(f = F a0 (3, ne, nq), fiber stretch lam (ne, nq)) at the rule's points."""
+        ue = u[self.scatter.vector_dofs(elements)].reshape(*self.g[elements].shape[::2], 3)
+        f = self.law.a0[:, elements] + np.einsum("ena,eqn->aeq", ue, self.g[elements], optimize=True)
+        return f, np.sqrt(np.einsum("aeq,aeq->eq", f, f))
+
+    def energy(self, u: np.ndarray) -> float:
+        """Stored energy of the windings [N mm]."""
+        lam = self.stretch(u)[1]
+        return float(np.sum(self.W * self.law.k * self.law._g(lam - 1.0)[0]))
+
+    def add_residual_tangent(self, u: np.ndarray, R: np.ndarray, data: np.ndarray) -> None:
+        """R += the windings' internal force; data (the CSR data of ``scatter``) += tangent."""
+        k = self.law.k
+        for c in self.chunks:
+            f, lam = self.stretch(u, c)
+            _, G1, G2 = self.law._g(lam - 1.0)
+            g, W = self.g[c], self.W[c]
+            v = np.einsum("aeq,eqn->eqna", f, g).reshape(*W.shape, -1)      # (ne, nq, 3 nloc)
+            self.scatter.add_vector(R, np.einsum("eq,eqi->ei", W * k * G1 / lam, v), c)
+            c1, c2 = W * k * (G2 / lam ** 2 - G1 / lam ** 3), W * k * G1 / lam
+            Ke = np.matmul(v.transpose(0, 2, 1) * c1[:, None, :], v)
+            S = np.matmul(g.transpose(0, 2, 1) * c2[:, None, :], g)         # (ne, nloc, nloc)
+            Ke += np.einsum("enm,ab->enamb", S, np.eye(3)).reshape(Ke.shape)
+            self.scatter.add_matrix(data, Ke, c, cache=True)
 
 
 def to_hand_frame(points: np.ndarray, design: HandDesign) -> np.ndarray:
@@ -163,6 +238,7 @@ class FingerState:
     q: np.ndarray                  #: hinge angles theta_hat_i [rad]
     dQ: float                      #: cavity volume change of the whole finger [mm^3]
     radial_stretch_max: float      #: max hoop (fiber) stretch in the wall, cap excluded; the paper's lambda_2
+    radial_stretch_q99: float      #: hoop stretch exceeded in 1 % of the wall's volume
     max_principal_stretch: float   #: max principal stretch over the quadrature points
     max_von_mises: float           #: max Cauchy von Mises stress [MPa]
     max_fiber_stress: float        #: max fiber stress k (lambda_f - 1) [MPa]
@@ -181,14 +257,19 @@ class FingerModel:
     def __init__(self, design: HandDesign, options: FingerOptions = FingerOptions()):
         self.design, self.options = design, options
         cap = options.cap if options.cap is not None else design.b
-        self.tube = FingerTube(design.a, design.b, design.l0, cap, tie_bands(design, options))
+        self.tube = FingerTube(design.a, design.b, design.l0, cap, tie_bands(design, options),
+                               options.edge_ratio, options.edge_reach)
         self.mesh = finger_tube_mesh(self.tube, size=options.mesh_size)
-        X_q = Basis(self.mesh, ElementTetP2(), intorder=2).global_coordinates().value
         mu = design.mu_sf
+        rubber = NeoHookean(mu, options.kappa_ratio * mu)
+        self.solid = Solid(self.mesh, rubber)
+        self.windings = Windings(self.mesh, options.fiber_ratio * mu, options.fiber_toe,
+                                 options.fiber_intorder, self.solid.scatter)
+        X_q = self.solid.sbasis.global_coordinates().value
+        #: the windings at the rubber's quadrature points (stress outputs, VTK)
         self.fibers = WindingFibers(options.fiber_ratio * mu, hoop_directions(np.asarray(X_q)),
                                     options.fiber_toe)
-        self.law = NeoHookean(mu, options.kappa_ratio * mu) + self.fibers
-        self.solid = Solid(self.mesh, self.law)
+        self.law = rubber + self.fibers
         self.cavity = CavityVolume(self.solid, self.mesh.boundaries["cavity"], symmetry_normal=0)
         #: elements of the tube wall (not the end cap): where the windings are
         self.wall = self.mesh.p[0, self.mesh.t[:4]].mean(axis=0) < design.l0 - cap
@@ -210,6 +291,11 @@ class FingerModel:
         nodes = 3 * np.arange(basis.N)[:, None] + np.arange(3)
         return ChainConstraint(self.chain, self.solid.ndofs, nodes, links, X[:2].T, tied, fixed)
 
+    def energy(self, y) -> float:
+        """Stored energy of the half model (rubber + windings) [N mm]."""
+        u = self.constraint.expand(y)
+        return self.solid.energy(u) + self.windings.energy(u)
+
     @property
     def ndofs(self) -> int:
         """Unknowns of the reduced system (free displacements + hinge angles)."""
@@ -227,6 +313,7 @@ class FingerModel:
         """
         u = self.constraint.expand(y)
         R, data = self.solid.residual_tangent_data(u)
+        self.windings.add_residual_tangent(u, R, data)
         R = R - P * self.cavity.gradient(u)
         K = self.solid.scatter.csr(data - P * self.cavity.hessian_data(u))
         r, Kr = self.constraint.reduce(y, R, K)
@@ -244,13 +331,17 @@ class FingerModel:
         u = self.constraint.expand(y)
         F = self.solid.F(u)
         eig = np.linalg.eigvalsh(np.moveaxis(kin.right_cauchy_green(F), (0, 1), (-2, -1)))
-        sigma = np.einsum("aK...,bK...->ab...", self.solid.first_piola(u), F) / kin.det(F)
+        P1 = self.solid.first_piola(u) + self.fibers.stress(F)
+        sigma = np.einsum("aK...,bK...->ab...", P1, F) / kin.det(F)
         dev = sigma - np.einsum("aa...->...", sigma) / 3.0 * kin.identity(sigma.shape[2:])
-        lam_f = self.fibers.stretch(F)[self.wall]  # the cap's "hoop" near the axis is no winding
+        lam_f = self.windings.stretch(u)[1][self.wall]  # the cap's "hoop" near the axis is no winding
+        order = np.argsort(lam_f, axis=None)
+        share = np.cumsum(self.windings.W[self.wall].ravel()[order])
         return FingerState(
             P=float(P), q=np.array(self.constraint.q(y)),
             dQ=2.0 * (self.cavity.volume(u) - self.V0),
             radial_stretch_max=float(lam_f.max()),
+            radial_stretch_q99=float(lam_f.ravel()[order][np.searchsorted(share, 0.99 * share[-1])]),
             max_principal_stretch=float(np.sqrt(eig.max())),
             max_von_mises=float(np.sqrt(1.5 * np.einsum("ab...,ab...->...", dev, dev)).max()),
             max_fiber_stress=float(self.fibers.k * np.clip(lam_f - 1.0, 0.0, None).max()),

@@ -14,6 +14,12 @@ Physical groups: volume ``wall``; surfaces ``cavity`` (inner cylinder and the ca
 inner face), ``base`` (x = 0), ``tip`` (x = length), ``symmetry`` (z = 0),
 ``tie<k>`` (the outer surface inside band k, held by link k) and ``outer`` (the rest
 of the outer cylinder). The groups are disjoint.
+
+Grading (``edge_ratio`` < 1): the stress is singular along the circles where a tie band
+ends on the outer surface (a kinematic constraint edge) and along the cavity's corner
+at the cap; there the element size is ``edge_ratio * size``, growing linearly back to
+``size`` over ``edge_reach`` mm (gmsh Distance + Threshold fields). Both enter the mesh
+cache key with the other fields of :class:`FingerTube`.
 """
 from __future__ import annotations
 
@@ -34,10 +40,14 @@ class FingerTube:
     length: float                         #: overall length, cap included [mm]
     cap: float                            #: end-cap thickness at the tip [mm]
     bands: tuple[tuple[float, float], ...]  #: (x_start, x_end) of each link's tie band [mm]
+    edge_ratio: float = 1.0               #: element size at the singular edges / size (1: uniform)
+    edge_reach: float = 5.0               #: distance over which the size grows back to size [mm]
 
     def __post_init__(self):
         if not (self.a > 0 and self.b > 0 and 0 < self.cap < self.length):
             raise ValueError(f"need a, b > 0 and 0 < cap < length: {self}")
+        if not (0 < self.edge_ratio <= 1 and self.edge_reach > 0):
+            raise ValueError(f"need 0 < edge_ratio <= 1 and edge_reach > 0: {self}")
         edges = np.ravel(self.bands)
         if np.any(np.diff(edges) <= 0) or edges[0] < 0 or edges[-1] > self.length:
             raise ValueError(f"bands must be disjoint, increasing, within [0, length]: {self}")
@@ -68,6 +78,38 @@ def finger_geometry(model, tube: FingerTube, size: float) -> None:
     for name, tags in _classify_surfaces(model, tube).items():
         if tags:
             model.addPhysicalGroup(2, tags, name=name)
+    if tube.edge_ratio < 1:
+        _grade(model, _singular_edges(model, tube), size * tube.edge_ratio, size, tube.edge_reach)
+
+
+def _singular_edges(model, tube: FingerTube) -> list[int]:
+    """Curves x = const on the outer surface at the tie bands' ends, and the cavity's cap corner."""
+    eps = 1e-6 * tube.length
+    ends, corner = np.ravel(tube.bands), tube.length - tube.cap
+    tags = []
+    for _, tag in model.getEntities(1):
+        x0, y0, z0, x1, y1, z1 = model.getBoundingBox(1, tag)
+        r = max(abs(y0), abs(y1), abs(z1))
+        if abs(x1 - x0) < eps and r > 0.5 * tube.a and (
+                (abs(r - tube.a - tube.b) < eps and np.any(np.abs(ends - x0) < eps))
+                or (abs(r - tube.a) < eps and abs(x0 - corner) < eps)):
+            tags.append(tag)
+    return tags
+
+
+def _grade(model, curves: list[int], fine: float, coarse: float, reach: float) -> None:
+    """Background size field: ``fine`` on ``curves``, growing linearly to ``coarse`` at ``reach``."""
+    field = model.mesh.field
+    dist = field.add("Distance")
+    field.setNumbers(dist, "CurvesList", curves)
+    field.setNumber(dist, "Sampling", 100)
+    ramp = field.add("Threshold")
+    field.setNumber(ramp, "InField", dist)
+    field.setNumber(ramp, "SizeMin", fine)
+    field.setNumber(ramp, "SizeMax", coarse)
+    field.setNumber(ramp, "DistMin", 0.0)
+    field.setNumber(ramp, "DistMax", reach)
+    field.setAsBackgroundMesh(ramp)
 
 
 def _classify_surfaces(model, tube: FingerTube) -> dict[str, list[int]]:

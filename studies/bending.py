@@ -72,6 +72,7 @@ def row(state: FingerState, design: HandDesign) -> dict:
         "hinge_deg": [round(math.degrees(q), 4) for q in state.q],
         "dQ_mm3": state.dQ,
         "radial_stretch_max": state.radial_stretch_max,
+        "radial_stretch_q99": state.radial_stretch_q99,
         "max_principal_stretch": state.max_principal_stretch,
         "theta_reduced_deg": math.degrees(theta_red),
         "dQ_reduced_mm3": dQ_red,

@@ -23,6 +23,12 @@ def configure(parser) -> None:
                              "(default 0:0.8:0.1)")
     parser.add_argument("--mesh-size-mm", metavar="H", type=float, default=None,
                         help="element size [mm] (default 4)")
+    parser.add_argument("--edge-ratio", metavar="R", type=float, default=None,
+                        help="element size at the ring edges and the cavity's cap corner over H "
+                             "(graded mesh; 1: uniform; default: see docs/finger.md)")
+    parser.add_argument("--fiber-intorder", metavar="N", type=int, default=None,
+                        help="degree of the windings' quadrature rule (default 5; 2: the "
+                             "rubber's 4-point rule, which misses the taut cavity wall)")
     parser.add_argument("--tie", choices=("ring", "full"), default="ring",
                         help="outer surface held by the links: a ring in each link's middle "
                              "(default) or the whole link but a gap at the hinges")
@@ -45,7 +51,8 @@ def configure(parser) -> None:
 def _options(args):
     from fem.finger import FingerOptions
 
-    given = {"mesh_size": args.mesh_size_mm, "tie_width": args.tie_width_mm}
+    given = {"mesh_size": args.mesh_size_mm, "tie_width": args.tie_width_mm,
+             "edge_ratio": args.edge_ratio, "fiber_intorder": args.fiber_intorder}
     return FingerOptions(tie=args.tie, **{k: v for k, v in given.items() if v is not None})
 
 
