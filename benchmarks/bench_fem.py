@@ -56,6 +56,7 @@ def run_ours(mesh, steps: int, solver_name: str, intorder: int, predictor: str):
     fixed = solid.dofs("base")
     red = Restriction(solid.ndofs, solid.free_dofs(fixed))
     f_ext = dead_load(solid, "inner", pressure=P_IN) + dead_load(solid, "tip", traction=T_END)
+    f_free = red.vector(f_ext)
     setup = time.perf_counter() - t0
     solver = make_solver(solver_name, symmetric=True)
 
@@ -63,11 +64,11 @@ def run_ours(mesh, steps: int, solver_name: str, intorder: int, predictor: str):
 
     def fun_t(x, t):
         calls[0] += 1
-        R, K = solid.residual_tangent(red.expand(x))
-        return red.vector(R - t * f_ext), red.restrict(K)
+        R, K = solid.residual_tangent(red.expand(x), restriction=red)  # straight into the free-dof pattern
+        return R - t * f_free, K
 
     def residual_t(x, t):  # the line search's trial points need no tangent
-        return red.vector(solid.residual(red.expand(x)) - t * f_ext)
+        return red.vector(solid.residual(red.expand(x))) - t * f_free
 
     scale = np.linalg.norm(red.vector(f_ext))
     opts = PathOptions(steps=steps, grow=1.0, predictor=predictor, newton=NewtonOptions(rtol=1e-10, atol=0.0))

@@ -10,6 +10,8 @@ over elements, no COO-to-CSR conversion per Newton iterate.
 """
 from __future__ import annotations
 
+import weakref
+
 import numpy as np
 import scipy.sparse as sp
 
@@ -99,13 +101,19 @@ class ElementScatter:
         """
         pos = self._cache.get("blocks")
         if pos is None:
-            nel, nloc = self.dofs.shape
-            pos = np.empty((nel, nloc, 3, 3, nloc), dtype=np.intp)
-            for i in range(0, nel, 2048):  # in batches: int64 positions of all elements at once are big
-                c = slice(i, min(i + 2048, nel))
-                pos[c] = self.positions(c).reshape(-1, nloc, 3, nloc, 3).transpose(0, 1, 2, 4, 3)
-            self._cache["blocks"] = pos
+            pos = self._cache["blocks"] = self.block_positions()
         return np.bincount(pos.ravel(), weights=Ke.ravel(), minlength=self.nnz)
+
+    def block_positions(self, mapping: np.ndarray | None = None) -> np.ndarray:
+        """CSR data positions (nel, nloc, 3, 3, nloc) of the block layout of :meth:`block_matrix_data`;
+        with ``mapping`` (an array over this pattern's positions), mapping[position] instead."""
+        nel, nloc = self.dofs.shape
+        pos = np.empty((nel, nloc, 3, 3, nloc), dtype=np.intp)
+        for i in range(0, nel, 2048):  # in batches: int64 positions of all elements at once are big
+            c = slice(i, min(i + 2048, nel))
+            p = self.positions(c).reshape(-1, nloc, 3, nloc, 3).transpose(0, 1, 2, 4, 3)
+            pos[c] = p if mapping is None else mapping[p]
+        return pos
 
     def add_vector(self, out: np.ndarray, re: np.ndarray, elements) -> None:
         """out += scatter of element vectors re (ne, 3nloc)."""
@@ -122,7 +130,9 @@ class Restriction:
     """Rows and columns ``keep`` (sorted, unique) of square CSR matrices; index map built once per pattern.
 
     ``restrict(K)`` is a gather of K.data (no sparse slicing per Newton iterate);
-    ``expand(x, fill)`` puts a reduced vector back into a full one.
+    :meth:`block_matrix_data` scatters element matrices straight into the restricted
+    pattern (no full matrix, no gather: what :meth:`fem.solid.Solid.residual_tangent`
+    does with ``restriction=``); ``expand(x, fill)`` puts a reduced vector back into a full one.
     """
 
     def __init__(self, n: int, keep: np.ndarray):
@@ -131,26 +141,45 @@ class Restriction:
         self._new = np.full(n, -1, dtype=np.int64)
         self._new[self.keep] = np.arange(len(self.keep))
         self._pattern = None
+        self._blocks = weakref.WeakKeyDictionary()  # ElementScatter -> its block positions, restricted
 
-    def _build(self, K):
-        rows = np.repeat(np.arange(self.n), np.diff(K.indptr))
-        sel = np.flatnonzero((self._new[rows] >= 0) & (self._new[K.indices] >= 0))
+    def _use_pattern(self, indptr, indices):
+        """The index map of the full pattern (indptr, indices), built when it changes."""
+        p = self._pattern
+        if p is not None and np.array_equal(p[0], indptr) and np.array_equal(p[1], indices):
+            return p
+        rows = np.repeat(np.arange(self.n), np.diff(indptr))
+        sel = np.flatnonzero((self._new[rows] >= 0) & (self._new[indices] >= 0))
         new_rows = self._new[rows[sel]]  # nondecreasing, and columns stay sorted: keep is sorted
-        indptr = np.zeros(len(self.keep) + 1, dtype=np.int64)
-        np.cumsum(np.bincount(new_rows, minlength=len(self.keep)), out=indptr[1:])
-        indices = self._new[K.indices[sel]]
-        self._pattern = (K.indptr.copy(), K.indices.copy(), sel, indptr, indices)
+        new_indptr = np.zeros(len(self.keep) + 1, dtype=np.int64)
+        np.cumsum(np.bincount(new_rows, minlength=len(self.keep)), out=new_indptr[1:])
+        new_indices = self._new[indices[sel]]
+        # the index type scipy would choose anyway: it would otherwise convert both arrays on every call
+        itype = np.int32 if len(sel) < 2 ** 31 else np.int64
+        self._pattern = (indptr.copy(), indices.copy(), sel, new_indptr.astype(itype), new_indices.astype(itype))
+        return self._pattern
+
+    def _csr(self, data, p) -> sp.csr_matrix:
+        Kr = sp.csr_matrix((data, p[4], p[3]), shape=(len(self.keep),) * 2, copy=False)
+        Kr.has_sorted_indices = True
+        return Kr
 
     def restrict(self, K: sp.spmatrix) -> sp.csr_matrix:
         """K[keep][:, keep] as CSR."""
         K = K.tocsr()
-        p = self._pattern
-        if p is None or not (np.array_equal(p[0], K.indptr) and np.array_equal(p[1], K.indices)):
-            self._build(K)
-            p = self._pattern
-        Kr = sp.csr_matrix((K.data[p[2]], p[4], p[3]), shape=(len(self.keep),) * 2, copy=False)
-        Kr.has_sorted_indices = True
-        return Kr
+        p = self._use_pattern(K.indptr, K.indices)
+        return self._csr(K.data[p[2]], p)
+
+    def block_matrix(self, scatter: ElementScatter, Ke: np.ndarray) -> sp.csr_matrix:
+        """K[keep][:, keep] of the matrix ``scatter.block_matrix_data(Ke)`` would assemble, scattered
+        directly into the restricted pattern (entries of removed rows/columns go to a dropped bin)."""
+        p = self._use_pattern(scatter.indptr, scatter.indices)
+        pos = self._blocks.get(scatter)
+        if pos is None:
+            mapping = np.full(scatter.nnz, len(p[2]), dtype=np.intp)  # the dropped bin
+            mapping[p[2]] = np.arange(len(p[2]))
+            pos = self._blocks[scatter] = scatter.block_positions(mapping)
+        return self._csr(np.bincount(pos.ravel(), weights=Ke.ravel(), minlength=len(p[2]) + 1)[:-1], p)
 
     def vector(self, R: np.ndarray) -> np.ndarray:
         """R[keep]."""

@@ -52,7 +52,7 @@ import scipy.sparse as sp
 from skfem import Basis, ElementTetP2
 
 from fem import kinematics as kin
-from fem.assembly import ElementScatter
+from fem.assembly import ElementScatter, Restriction
 
 FORMULATIONS = ("mean_dilatation", "displacement")
 
@@ -150,8 +150,13 @@ class Solid:
         """Stiffness d^2 Pi/du^2, CSR with the fixed pattern (symmetric); see ``anchor`` below."""
         return self.scatter.csr(self._assemble(u, tangent=True, anchor=anchor)[1])
 
-    def residual_tangent(self, u: np.ndarray, anchor: "PressureAnchor | None" = None):
+    def residual_tangent(self, u: np.ndarray, anchor: "PressureAnchor | None" = None,
+                         restriction: "Restriction | None" = None):
         """(residual, tangent CSR) in one pass over the elements.
+
+        restriction: a :class:`fem.assembly.Restriction` (e.g. to the free dofs): returns
+        (R[keep], K[keep][:, keep]), the tangent scattered straight into the restricted
+        pattern (no full matrix and no gather per Newton iterate).
 
         anchor: for the mean-dilatation formulation, the mixed (u, p) Newton iteration:
         the element pressure in the geometric stiffness p_e d^2J/dF^2 is the pressure
@@ -161,6 +166,9 @@ class Solid:
         :class:`MixedNewton`), where the plain displacement iteration needs many more
         and diverges for kappa/mu >~ 1e4.
         """
+        if restriction is not None:
+            R, Ke = self._assemble(u, tangent=True, anchor=anchor, scatter=False)
+            return restriction.vector(R), restriction.block_matrix(self.scatter, Ke)
         R, data = self._assemble(u, tangent=True, anchor=anchor)
         return R, self.scatter.csr(data)
 
@@ -182,14 +190,17 @@ class Solid:
             b.append(np.einsum("akeq,eqnk->ena", kin.cofactor(F), GW, optimize=True).reshape(len(W), -1))
         return PressureAnchor(u.copy(), np.concatenate(p0), np.concatenate(c0), np.concatenate(b))
 
-    def _assemble(self, u, tangent, anchor=None):
+    def _assemble(self, u, tangent, anchor=None, scatter=True):
+        """(R, CSR data of the tangent or None); scatter=False: (R, the element matrix buffer)."""
         R = np.zeros(self.ndofs)
         Ke = self._element_matrix_buffer() if tangent else None
         for c in self._chunks:
             p_geo = None if anchor is None else anchor.pressure(u, c, self.scatter.vector_dofs(c))
             re = self._element_kernels(u, c, None if Ke is None else Ke[c], p_geo)
             self.scatter.add_vector(R, re, c)
-        return R, (self.scatter.block_matrix_data(Ke) if tangent else None)
+        if not tangent or not scatter:
+            return R, Ke
+        return R, self.scatter.block_matrix_data(Ke)
 
     def _element_matrix_buffer(self) -> np.ndarray:
         """The element matrices of the whole mesh, block layout (see :func:`element_matrices`)."""

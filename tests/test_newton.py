@@ -103,6 +103,19 @@ def test_restriction_equals_slicing():
     assert np.array_equal(red.vector(red.expand(x, 5.0)), x) and red.expand(x, 5.0).sum() == pytest.approx(x.sum() + 100)
 
 
+def test_assembly_into_the_restricted_pattern_equals_slicing_the_full_tangent():
+    mesh = fe.MeshTet.init_tensor(*(np.linspace(0, 1, 4),) * 3).with_defaults()
+    solid = Solid(mesh, NeoHookean(1.0, 100.0))
+    red = Restriction(solid.ndofs, solid.free_dofs(solid.dofs("left")))
+    u = 0.005 * np.random.default_rng(1).standard_normal(solid.ndofs)
+    for v in (u, 2 * u):  # second call: the cached restricted positions
+        R, K = solid.residual_tangent(v)
+        Rr, Kr = solid.residual_tangent(v, restriction=red)
+        K_ref = K.tocsc()[red.keep][:, red.keep]
+        assert abs(Kr - K_ref).max() <= 1e-14 * abs(K).max() and Kr.shape == K_ref.shape
+        assert np.array_equal(Rr, R[red.keep])
+
+
 @pytest.mark.parametrize("method", available())
 @pytest.mark.parametrize("symmetric", [True, False])
 def test_linear_solvers_agree_and_reuse_the_analysis(method, symmetric):
