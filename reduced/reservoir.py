@@ -118,4 +118,14 @@ def pressure(V, design: HandDesign):
     return model(design.reservoir_model)(np.asarray(V, float), design)
 
 
+def state(V, design: HandDesign) -> dict:
+    """The reservoir at oil volume V [mm^3]: its pressure ``p_reservoir_MPa`` (any model) and,
+    for the ellipse model only, the apex height ``h_mm`` (14) and sheet stretch ``lambda_r``
+    (16) -- quantities of that geometry, which another model (e.g. "fem") does not assume."""
+    out = {"p_reservoir_MPa": pressure(V, design)}
+    if design.reservoir_model == "ellipse":
+        out.update(h_mm=height(V, design), lambda_r=stretch(V, design))
+    return out
+
+
 register_model("ellipse", ellipse_pressure)

@@ -16,7 +16,7 @@ from reduced.errors import InputError
 def curve(params: dict, design: HandDesign, outdir: Path) -> dict:
     """One point of the free-finger curve: eq. (27) with and (28) without reservoir.
 
-    ``theta_deg`` -> P_MPa, P_no_reservoir_MPa, V_mm3, h_mm, lambda_r;
+    ``theta_deg`` -> P_MPa, P_no_reservoir_MPa, V_mm3, p_reservoir_MPa (+ h_mm, lambda_r: ellipse model);
     ``pressure_mpa`` -> theta_deg, theta_no_reservoir_deg (the inverse).
     """
     from reduced import hand, reservoir
@@ -28,8 +28,7 @@ def curve(params: dict, design: HandDesign, outdir: Path) -> dict:
         V = reservoir.oil_volume(theta, design)
         return {"P_MPa": hand.pressure(theta, design, reservoir=True),
                 "P_no_reservoir_MPa": hand.pressure(theta, design, reservoir=False),
-                "V_mm3": V, "h_mm": reservoir.height(V, design),
-                "lambda_r": reservoir.stretch(V, design)}
+                "V_mm3": V, **{k: float(v) for k, v in reservoir.state(V, design).items()}}
     P = params["pressure_mpa"]
     return {"theta_deg": math.degrees(hand.bend_angle(P, design, reservoir=True)),
             "theta_no_reservoir_deg": math.degrees(hand.bend_angle(P, design, reservoir=False))}

@@ -21,11 +21,22 @@ def test_curve_by_angle(capsys):
     out = run_json(capsys, "curve", "--theta-deg", "0:90:10")
     rows = out["rows"]
     assert [r["theta_deg"] for r in rows] == pytest.approx(np.arange(0, 91, 10))  # stop included
-    assert set(rows[0]) == {"theta_deg", "P_MPa", "P_no_reservoir_MPa", "h_mm", "V_mm3", "lambda_r"}
+    assert set(rows[0]) == {"theta_deg", "P_MPa", "P_no_reservoir_MPa", "V_mm3", "p_reservoir_MPa", "h_mm",
+                            "lambda_r"}
+    for r in rows:  # eq. (27): P = p_finger - p_r, and p_finger is eq. (28)'s pressure
+        assert r["P_MPa"] == pytest.approx(r["P_no_reservoir_MPa"] - r["p_reservoir_MPa"], abs=1e-12)
     assert rows[0]["P_no_reservoir_MPa"] == 0.0 and rows[0]["P_MPa"] < 0
     assert rows[0]["V_mm3"] == D.V0
     assert rows[5]["P_MPa"] == pytest.approx(float(hand.pressure(math.radians(50), D)), rel=1e-12)
     assert out["design"]["V0_mm3"] == D.V0
+
+
+def test_curve_with_the_fem_reservoir_model_has_no_ellipse_columns(capsys, tmp_path):
+    design = tmp_path / "fem.toml"
+    design.write_text('reservoir_model = "fem"\n')
+    rows = run_json(capsys, "curve", "--theta-deg", "0,30", "--design", str(design))["rows"]
+    assert set(rows[0]) == {"theta_deg", "P_MPa", "P_no_reservoir_MPa", "V_mm3", "p_reservoir_MPa"}
+    assert rows[0]["p_reservoir_MPa"] == pytest.approx(-rows[0]["P_MPa"], abs=1e-12)  # theta = 0: no finger
 
 
 def test_curve_by_pressure_and_table(capsys):

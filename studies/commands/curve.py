@@ -1,7 +1,7 @@
 """``softhand curve``: pump pressure <-> bend angle of the free hand, eqs. (27) and (28).
 
 ``--theta-deg RANGE`` gives, per angle, the pressure with and without the reservoir and the
-reservoir's state (V (15), h (14), lambda_r (16)); ``--pressure-mpa RANGE`` gives, per
+reservoir's state (V (15), its pressure p_r, and for the ellipse model h (14), lambda_r (16)); ``--pressure-mpa RANGE`` gives, per
 pressure, the bend angle with and without the reservoir. ``--plot FILE.png`` draws the
 analogue of the paper's Fig. 7. Only numpy and the reduced model are imported unless a plot
 is asked for.
@@ -30,15 +30,14 @@ def configure(parser) -> None:
 
 
 def rows_at_angles(theta_deg: np.ndarray, design: HandDesign) -> list[dict]:
-    """Per bend angle [deg]: P with / without reservoir [MPa], reservoir V [mm^3], h [mm], lambda_r."""
+    """Per bend angle [deg]: P with / without reservoir [MPa], the reservoir's V [mm^3] and
+    :func:`reduced.reservoir.state` (p_r; h, lambda_r for the ellipse model)."""
     theta = hand.check_theta(np.radians(theta_deg))
-    P = hand.pressure(theta, design)
-    P_free = hand.pressure(theta, design, reservoir=False)
     V = reservoir.oil_volume(theta, design)
-    h, lam = reservoir.height(V, design), reservoir.stretch(V, design)
-    return [{"theta_deg": float(t), "P_MPa": float(p), "P_no_reservoir_MPa": float(q),
-             "h_mm": float(hh), "V_mm3": float(v), "lambda_r": float(lr)}
-            for t, p, q, hh, v, lr in zip(theta_deg, P, P_free, h, V, lam)]
+    columns = {"theta_deg": theta_deg, "P_MPa": hand.pressure(theta, design),
+               "P_no_reservoir_MPa": hand.pressure(theta, design, reservoir=False), "V_mm3": V,
+               **reservoir.state(V, design)}
+    return [{k: float(v[i]) for k, v in columns.items()} for i in range(len(theta_deg))]
 
 
 def rows_at_pressures(P: np.ndarray, design: HandDesign) -> list[dict]:
