@@ -173,12 +173,13 @@ class Restriction:
     def block_matrix(self, scatter: ElementScatter, Ke: np.ndarray) -> sp.csr_matrix:
         """K[keep][:, keep] of the matrix ``scatter.block_matrix_data(Ke)`` would assemble, scattered
         directly into the restricted pattern (entries of removed rows/columns go to a dropped bin)."""
-        p = self._use_pattern(scatter.indptr, scatter.indices)
-        pos = self._blocks.get(scatter)
-        if pos is None:
+        cached = self._blocks.get(scatter)  # a scatter's pattern never changes: no comparison per call
+        if cached is None:
+            p = self._use_pattern(scatter.indptr, scatter.indices)
             mapping = np.full(scatter.nnz, len(p[2]), dtype=np.intp)  # the dropped bin
             mapping[p[2]] = np.arange(len(p[2]))
-            pos = self._blocks[scatter] = scatter.block_positions(mapping)
+            cached = self._blocks[scatter] = (scatter.block_positions(mapping), p)
+        pos, p = cached
         return self._csr(np.bincount(pos.ravel(), weights=Ke.ravel(), minlength=len(p[2]) + 1)[:-1], p)
 
     def vector(self, R: np.ndarray) -> np.ndarray:

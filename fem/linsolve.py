@@ -23,6 +23,7 @@ solver falls back to double precision for good and says so in :meth:`describe`.
 """
 from __future__ import annotations
 
+import os
 import time
 
 import numpy as np
@@ -39,8 +40,7 @@ def available() -> list[str]:
     """Backends importable here, fastest first."""
     out = []
     try:
-        import pypardiso
-        pypardiso.PyPardisoSolver()  # raises ImportError when the MKL runtime is missing
+        _pardiso_handle()  # raises ImportError when the MKL runtime is missing
         out.append("pardiso")
     except (ImportError, OSError):
         pass
@@ -64,6 +64,15 @@ def make_solver(method: str = "auto", *, symmetric: bool = False, precision: str
     if method == "pardiso":
         return PardisoSolver(symmetric, precision)
     return {"umfpack": UmfpackSolver, "superlu": SuperLUSolver}[method](symmetric)
+
+
+def _pardiso_handle(**kwargs):
+    """A new pypardiso solver. pypardiso looks for MKL by a recursive glob of the environment
+    (~0.2 s) unless PYPARDISO_MKL_RT names the library: the first handle's library is put there."""
+    import pypardiso
+    ps = pypardiso.PyPardisoSolver(**kwargs)
+    os.environ.setdefault("PYPARDISO_MKL_RT", ps.libmkl._name)
+    return ps
 
 
 class LinearSolver:
@@ -119,8 +128,7 @@ class PardisoSolver(LinearSolver):
         self._upper = None
 
     def _handle(self, precision):
-        import pypardiso
-        ps = pypardiso.PyPardisoSolver(mtype=-2 if self.symmetric else 11)
+        ps = _pardiso_handle(mtype=-2 if self.symmetric else 11)
         if precision == "mixed":  # explicit iparm (iparm[0] = 1) for the single-precision factor
             settings = {1: 2, 9: 8, 10: 0, 12: 0} if self.symmetric else {1: 2, 9: 13, 10: 1, 12: 1}
             ps.iparm[0], ps.iparm[27] = 1, 1  # user settings; single precision (a, b, x float32)
