@@ -111,8 +111,8 @@ class FingerOptions:
     """Discretisation and modelling choices of the finger FEM."""
 
     mesh_size: float = 4.0     #: target element size [mm] (docs/finger.md: mesh convergence)
-    edge_ratio: float = 1.0    #: element size at the ring edges and cap corner / mesh_size (1: uniform)
-    edge_reach: float = 5.0    #: distance over which the size grows back to mesh_size [mm]
+    edge_ratio: float = 0.5    #: element size at the ring edges and cap corner / mesh_size (1: uniform)
+    edge_reach: float = 3.0    #: distance over which the size grows back to mesh_size [mm]
     tie: str = "ring"          #: which outer surface the links hold: "ring" or "full"
     tie_width: float = 10.0    #: width of each link's tied ring, centred on the link [mm]
     hinge_gap: float = 4.0     #: untied tube length around each hinge, tie = "full" [mm]
