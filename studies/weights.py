@@ -28,7 +28,7 @@ from reduced.errors import InputError
 from studies.output import jsonable, write_json
 
 #: bump when the FEM or the result's fields change, to invalidate cached results
-CACHE_FORMAT = 2
+CACHE_FORMAT = 3  # 3: the finger's windings on their own degree-5 rule, mesh graded at the ring edges
 #: the default element size of the grasp FEM [mm] (docs/grasp.md: w's mesh sensitivity)
 MESH_SIZE = 6.0
 
