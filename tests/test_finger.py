@@ -12,7 +12,7 @@ from reduced import hand, kinematics
 from reduced.design import HandDesign
 
 DESIGN = HandDesign()
-CI = FingerOptions(mesh_size=6.0, edge_ratio=1.0)  # uniform, 9.7k unknowns; theta 2.3 % below the limit
+CI = FingerOptions(mesh_size=6.0, edge_ratio=1.0)  # uniform, 9.7k unknowns; theta ~3 % low (docs)
 PRESSURES = (0.4, 0.8)
 
 
@@ -88,7 +88,7 @@ def test_windings_quadrature_resolves_the_taut_cavity_wall(sweep):
     the edge midpoints) and on the 15-point rule (points on the face centroids): both sample
     the cavity wall, where the windings are taut, and agree to within how the coarse mesh
     samples the taut/slack switch (1.5 % measured). The rubber's interior 4-point rule is
-    ~13 % off: the cause of the earlier mesh non-convergence (docs/finger.md)."""
+    14 % off at 0.8 MPa (docs/finger.md): the cause of the earlier mesh non-convergence."""
     other = FingerModel(DESIGN, replace(CI, fiber_intorder=6))
     states, _ = solve_pressures(other, [PRESSURES[0]])
     assert states[0].theta == pytest.approx(sweep[0].theta, rel=0.03)
