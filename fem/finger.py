@@ -270,7 +270,7 @@ class FingerModel:
         self.fibers = WindingFibers(options.fiber_ratio * mu, hoop_directions(np.asarray(X_q)),
                                     options.fiber_toe)
         self.law = rubber + self.fibers
-        self.cavity = CavityVolume(self.solid, self.mesh.boundaries["cavity"], symmetry_normal=0)
+        self.cavity = _cavity(self.solid, self.mesh, options)
         #: elements of the tube wall (not the end cap): where the windings are
         self.wall = self.mesh.p[0, self.mesh.t[:4]].mean(axis=0) < design.l0 - cap
         self.chain = PlanarChain(np.c_[design.hinge_s, np.full(design.n_s, design.d)])
@@ -360,6 +360,19 @@ class FingerModel:
         u = self.constraint.expand(y)
         W = self.solid.W
         return (W * kin.det(self.solid.F(u))).sum(axis=1) / W.sum(axis=1)
+
+
+def _cavity(solid, mesh, options: FingerOptions) -> CavityVolume:
+    """The cavity volume load; a curved facet too distorted to map (seen on some graded meshes:
+    scikit-fem cannot invert its isoparametric map) becomes one clear line instead of a traceback."""
+    try:
+        return CavityVolume(solid, mesh.boundaries["cavity"], symmetry_normal=0)
+    except Exception as err:  # skfem raises a bare Exception from MappingIsoparametric.invF
+        if "Newton iteration didn't converge" not in str(err):
+            raise
+        raise InputError("mesh_size", options.mesh_size,
+                         f"gives a curved element too distorted to map with edge_ratio {options.edge_ratio}; "
+                         "try another mesh size or edge_ratio 1 (uniform)") from None
 
 
 @dataclass(frozen=True)
