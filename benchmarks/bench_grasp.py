@@ -26,7 +26,7 @@ def timed(fn):
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--mesh-size-mm", default="10,6")
+    parser.add_argument("--mesh-size-mm", default="6,4", help="finger element sizes [mm] (the default graded meshes)")
     args = parser.parse_args()
     design = HandDesign()
     for h in (float(x) for x in args.mesh_size_mm.split(",")):
