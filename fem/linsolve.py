@@ -18,8 +18,8 @@ tangent: 0.68 s against 1.27 s) and the solution is refined in double precision,
 x <- x + LU^-1 (b - K x) with the residual in double, until
 ``||b - K x|| <= REFINE_RTOL ||b||`` -- the accuracy of the double-precision solve (2e-11
 there). Each step gains a factor ~cond(K) eps_single (60x on that tangent, 4-5 steps).
-When the refinement stalls (an ill-conditioned K, e.g. kappa/mu = 1000 rubber) the
-solver falls back to double precision for good and says so in :meth:`describe`.
+When the refinement stalls or is too slow to reach it in REFINE_MAX steps (an
+ill-conditioned K, e.g. kappa/mu = 1000 rubber with fibers) the solver falls back to double precision for good and says so in :meth:`describe`.
 """
 from __future__ import annotations
 
@@ -188,7 +188,7 @@ class PardisoSolver(LinearSolver):
         self._ps.set_phase(33)  # solves with the stored factor
         bnorm = float(np.linalg.norm(b))
         x, r, last = np.zeros_like(b), b, bnorm
-        for _ in range(REFINE_MAX):
+        for step in range(REFINE_MAX):
             if last <= REFINE_RTOL * bnorm:
                 return x
             work[:, 0] = r
@@ -198,6 +198,11 @@ class PardisoSolver(LinearSolver):
             norm = float(np.linalg.norm(r))
             if not norm < 0.5 * last:  # stalled or diverging: single precision is not enough for K
                 self.fallback = f"mixed precision stalled at relative residual {norm / bnorm:.1e}"
+                return None
+            left = REFINE_MAX - (step + 1)
+            if norm * (norm / last) ** left > REFINE_RTOL * bnorm:  # too slow to get there in time
+                self.fallback = (f"mixed precision too slow (relative residual {norm / bnorm:.1e}, "
+                                 f"{norm / last:.2f} per step)")
                 return None
             last = norm
         if last <= REFINE_RTOL * bnorm:
