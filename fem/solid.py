@@ -85,6 +85,7 @@ class Solid:
         self.ndofs = self.scatter.n
         nel = self.G.shape[0]
         self._chunks = [slice(i, min(i + chunk, nel)) for i in range(0, nel, chunk)]
+        self._ke = None  # the element matrix buffer, allocated at the first tangent
 
     # -- dofs ---------------------------------------------------------------------------
     def dofs(self, facets=None, components=(0, 1, 2)) -> np.ndarray:
@@ -204,7 +205,7 @@ class Solid:
 
     def _element_matrix_buffer(self) -> np.ndarray:
         """The element matrices of the whole mesh, block layout (see :func:`element_matrices`)."""
-        if getattr(self, "_ke", None) is None:
+        if self._ke is None:
             nel, _, nloc, _ = self.G.shape
             self._ke = np.empty((nel, nloc, 3, 3, nloc))
         return self._ke
