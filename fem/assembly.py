@@ -130,7 +130,7 @@ class Restriction:
     """Rows and columns ``keep`` (sorted, unique) of square CSR matrices; index map built once per pattern.
 
     ``restrict(K)`` is a gather of K.data (no sparse slicing per Newton iterate);
-    :meth:`block_matrix_data` scatters element matrices straight into the restricted
+    :meth:`block_matrix` scatters element matrices straight into the restricted
     pattern (no full matrix, no gather: what :meth:`fem.solid.Solid.residual_tangent`
     does with ``restriction=``); ``expand(x, fill)`` puts a reduced vector back into a full one.
     """
