@@ -3,9 +3,10 @@
 Vector dofs are interleaved as scikit-fem's ``ElementVector`` numbers them:
 dof ``3 * s + a`` is component ``a`` of scalar dof ``s``. The pattern is built at
 the scalar level (100 node pairs per P2 tetrahedron instead of 900) and expanded
-to 3x3 blocks by index arithmetic, so building it is cheap and the per-element
-positions are stored as one small int32 array. Assembling a matrix is then one
-``np.bincount`` per chunk of elements into the CSR data array: no Python loop
+to 3x3 blocks by index arithmetic, so building it is cheap. The CSR positions of
+all elements' matrices are computed once (:meth:`ElementScatter.block_matrix_data`,
+or per restriction, :meth:`Restriction.block_matrix`); assembling a matrix is then
+one ``np.bincount`` over the whole mesh into the CSR data array: no Python loop
 over elements, no COO-to-CSR conversion per Newton iterate.
 """
 from __future__ import annotations
@@ -39,8 +40,6 @@ class ElementScatter:
         self._spos = inverse.reshape(nel, nloc, nloc).astype(np.int64)
         self._ip, self._deg = ip, deg
         self.indptr, self.indices = self._vector_pattern(ip, deg, s_cols)
-        itype = np.int32 if self.nnz < 2 ** 31 else np.int64
-        self._itype = itype
         self._cache = {}
 
     @staticmethod
@@ -74,20 +73,10 @@ class ElementScatter:
         return (3 * self.dofs[elements][:, :, None] + np.arange(3)).reshape(
             self.dofs[elements].shape[0], -1)
 
-    def add_matrix(self, data: np.ndarray, Ke: np.ndarray, elements, *, cache: bool = False) -> None:
-        """data += scatter of element matrices Ke (ne, 3nloc, 3nloc) of the given elements.
-
-        cache: keep the positions of this element set (a slice) for later calls (memory:
-        (3 nloc)^2 int32 per element), which saves their recomputation every Newton iterate.
-        """
-        if cache:
-            key = (elements.start, elements.stop)
-            if key not in self._cache:
-                self._cache[key] = self.positions(elements).astype(self._itype)
-            pos = self._cache[key]
-        else:
-            pos = self.positions(elements)
-        data += np.bincount(pos.ravel(), weights=Ke.ravel(), minlength=self.nnz)
+    def add_matrix(self, data: np.ndarray, Ke: np.ndarray, elements) -> None:
+        """data += scatter of element matrices Ke (ne, 3nloc, 3nloc) of the given elements
+        (e.g. facet loads; whole-mesh volume terms go through :meth:`block_matrix_data`)."""
+        data += np.bincount(self.positions(elements).ravel(), weights=Ke.ravel(), minlength=self.nnz)
 
     def block_matrix_data(self, Ke: np.ndarray) -> np.ndarray:
         """CSR data of the sum of ALL elements' matrices given in the block layout
