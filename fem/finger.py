@@ -113,6 +113,7 @@ class FingerOptions:
     mesh_size: float = 4.0     #: target element size [mm] (docs/finger.md: mesh convergence)
     edge_ratio: float = 0.5    #: element size at the ring edges and cap corner / mesh_size (1: uniform)
     edge_reach: float = 3.0    #: distance over which the size grows back to mesh_size [mm]
+    mesh_refine: int = 0       #: split every element this many times (nested meshes, h / 2**n)
     tie: str = "ring"          #: which outer surface the links hold: "ring" or "full"
     tie_width: float = 10.0    #: width of each link's tied ring, centred on the link [mm]
     hinge_gap: float = 4.0     #: untied tube length around each hinge, tie = "full" [mm]
@@ -130,6 +131,8 @@ class FingerOptions:
                              "must name a tetrahedral rule with positive weights (e.g. 2, 5, 6)")
         if not 0 < self.edge_ratio <= 1:
             raise InputError("edge_ratio", self.edge_ratio, "must be in (0, 1]")
+        if self.mesh_refine not in range(0, 4):
+            raise InputError("mesh_refine", self.mesh_refine, "must be 0, 1, 2 or 3")
         for name in ("mesh_size", "edge_reach", "tie_width", "hinge_gap", "kappa_ratio", "fiber_ratio"):
             if not getattr(self, name) > 0:
                 raise InputError(name, getattr(self, name), "must be a positive number")
@@ -268,7 +271,7 @@ class FingerModel:
         cap = options.cap if options.cap is not None else design.b
         self.tube = FingerTube(design.a, design.b, design.l0, cap, tie_bands(design, options),
                                options.edge_ratio, options.edge_reach)
-        self.mesh = finger_tube_mesh(self.tube, size=options.mesh_size)
+        self.mesh = finger_tube_mesh(self.tube, size=options.mesh_size, refine=options.mesh_refine)
         mu = design.mu_sf
         rubber = NeoHookean(mu, options.kappa_ratio * mu)
         self.solid = Solid(self.mesh, rubber)

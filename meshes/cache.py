@@ -28,29 +28,31 @@ def cache_dir() -> Path:
     return Path(root) / "meshes"
 
 
-def mesh_key(geometry: Geometry, params, *, size: float, order: int) -> str:
+def mesh_key(geometry: Geometry, params, *, size: float, order: int, refine: int = 0) -> str:
     """A stable hex digest naming this mesh."""
     fields = dataclasses.asdict(params) if dataclasses.is_dataclass(params) else dict(params)
     blob = json.dumps({
         "geometry": f"{geometry.__module__}.{geometry.__qualname__}",
         "params": fields, "size": float(size), "order": int(order),
+        **({"refine": int(refine)} if refine else {}),
         "gmsh": GMSH_VERSION, "format": FORMAT,
     }, sort_keys=True, default=repr)
     return hashlib.sha256(blob.encode()).hexdigest()[:20]
 
 
-def cached_msh(geometry: Geometry, params, *, size: float, order: int = 2,
+def cached_msh(geometry: Geometry, params, *, size: float, order: int = 2, refine: int = 0,
                folder: str | Path | None = None) -> Path:
     """The ``.msh`` file of this geometry; generated with gmsh only if not cached yet."""
-    name = f"{geometry.__name__}-{mesh_key(geometry, params, size=size, order=order)}.msh"
+    name = f"{geometry.__name__}-{mesh_key(geometry, params, size=size, order=order, refine=refine)}.msh"
     path = Path(folder) if folder is not None else cache_dir()
     path = path / name
     if not path.is_file():
-        generate_msh(geometry, params, path, size=size, order=order)
+        generate_msh(geometry, params, path, size=size, order=order, refine=refine)
     return path
 
 
-def load_mesh(geometry: Geometry, params, *, size: float, order: int = 2,
+def load_mesh(geometry: Geometry, params, *, size: float, order: int = 2, refine: int = 0,
               folder: str | Path | None = None) -> skfem.Mesh:
     """A scikit-fem mesh (named boundaries/subdomains) of this geometry, through the cache."""
-    return read_mesh(cached_msh(geometry, params, size=size, order=order, folder=folder))
+    return read_mesh(cached_msh(geometry, params, size=size, order=order, refine=refine,
+                                folder=folder))

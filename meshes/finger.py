@@ -144,6 +144,7 @@ def _band_of(tube: FingerTube, x: float) -> str:
     return "outer"
 
 
-def finger_tube_mesh(tube: FingerTube, *, size: float) -> skfem.MeshTet2:
-    """The cached quadratic (curved) tetrahedral mesh of ``tube``, element size ``size`` [mm]."""
-    return load_mesh(finger_geometry, tube, size=size, order=2)
+def finger_tube_mesh(tube: FingerTube, *, size: float, refine: int = 0) -> skfem.MeshTet2:
+    """The cached quadratic (curved) tetrahedral mesh of ``tube``, element size ``size`` [mm],
+    each element then split ``refine`` times (size / 2**refine; see :func:`meshes.gmsh_io.generate_msh`)."""
+    return load_mesh(finger_geometry, tube, size=size, order=2, refine=refine)

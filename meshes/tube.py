@@ -75,6 +75,7 @@ def _classify_surfaces(model, tube: Tube) -> dict[str, list[int]]:
     return groups
 
 
-def tube_mesh(tube: Tube, *, size: float, order: int = 2) -> skfem.Mesh:
-    """The cached mesh of ``tube`` with element size ``size`` [mm] (MeshTet2 for order 2)."""
-    return load_mesh(tube_geometry, tube, size=size, order=order)
+def tube_mesh(tube: Tube, *, size: float, order: int = 2, refine: int = 0) -> skfem.Mesh:
+    """The cached mesh of ``tube`` with element size ``size`` [mm] (MeshTet2 for order 2),
+    each element split ``refine`` times (see :func:`meshes.gmsh_io.generate_msh`)."""
+    return load_mesh(tube_geometry, tube, size=size, order=order, refine=refine)

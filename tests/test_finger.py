@@ -144,7 +144,7 @@ def test_hand_frame_matches_the_reduced_kinematics(model):
 
 
 @pytest.mark.parametrize("argv", [["--pressure-mpa", "0.4,0.2"], ["--pressure-mpa", "-0.1"],
-                                  ["--tie-width-mm", "40"]])
+                                  ["--tie-width-mm", "40"], ["--refine", "4"]])
 def test_bend_rejects_bad_input_in_one_line(argv, capsys, tmp_path):
     from studies.cli import main
     assert main(["bend", *argv, "--out", str(tmp_path)]) == 2

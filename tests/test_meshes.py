@@ -44,6 +44,21 @@ def test_tube_groups_measure_the_closed_form(sector, fraction):
         assert np.allclose(mesh.p[1, mesh.facets[:, mesh.boundaries["symmetry"]]], 0.0)
 
 
+def test_refine_splits_every_tetrahedron_into_eight_on_the_curved_surfaces():
+    tube = Tube(4.0, 9.0, 6.0, cap=1.5, sector="half")
+    coarse, fine = (tube_mesh(tube, size=3.0, refine=n) for n in (0, 1))
+    assert fine.t.shape[1] == 8 * coarse.t.shape[1]
+    assert set(fine.boundaries) == set(coarse.boundaries)
+    for name, r in (("inner", 4.0), ("outer", 9.0)):  # new vertices lie on the cylinders
+        p = fine.p[:, np.unique(fine.facets[:, fine.boundaries[name]])]
+        on_wall = p[2] < 6.0 - 1e-9 if name == "inner" else slice(None)  # not the cap face
+        assert np.allclose(np.hypot(p[0], p[1])[on_wall], r, atol=1e-9)
+    # the same solid, described better: the outer area's error falls by ~2^4 (curved P2 facets)
+    exact = 0.5 * 2 * np.pi * 9.0 * 7.5
+    errors = [abs(measure(m, m.boundaries["outer"]) - exact) for m in (coarse, fine)]
+    assert errors[1] < errors[0] / 8
+
+
 def test_linear_order_gives_straight_tetrahedra():
     mesh = tube_mesh(Tube(4.0, 9.0, 3.0, sector="quarter"), size=2.0, order=1)
     assert type(mesh) is skfem.MeshTet1 and "inner" in mesh.boundaries

@@ -26,6 +26,9 @@ def configure(parser) -> None:
     parser.add_argument("--edge-ratio", metavar="R", type=float, default=None,
                         help="element size at the ring edges and the cavity's cap corner over H "
                              "(default 0.5, growing back to H over 3 mm; 1: uniform)")
+    parser.add_argument("--refine", metavar="N", type=int, default=None,
+                        help="split every element N times after meshing (nested meshes with "
+                             "element size H / 2**N, for convergence studies; default 0)")
     parser.add_argument("--fiber-intorder", metavar="N", type=int, default=None,
                         help="degree of the windings' quadrature rule (default 5; 2: the "
                              "rubber's 4-point rule, which misses the taut cavity wall)")
@@ -52,7 +55,8 @@ def _options(args):
     from fem.finger import FingerOptions
 
     given = {"mesh_size": args.mesh_size_mm, "tie_width": args.tie_width_mm,
-             "edge_ratio": args.edge_ratio, "fiber_intorder": args.fiber_intorder}
+             "edge_ratio": args.edge_ratio, "fiber_intorder": args.fiber_intorder,
+             "mesh_refine": args.refine}
     return FingerOptions(tie=args.tie, **{k: v for k, v in given.items() if v is not None})
 
 
