@@ -87,23 +87,41 @@ class PlanarChain:
         P = np.concatenate((np.zeros((1, 2)), p))
         return P - np.einsum("ijk,kj->ki", rotation(phi), H), phi
 
-    def point_map(self, q, links, X):
+    def point_map(self, q, links, X, order: int = 2):
         """Current position of points X (m, 2) on links (m,), with derivatives in q.
 
-        Returns x (m, 2), J = dx/dq (m, 2, n_s) and H = d2x/dq2 (m, 2, n_s, n_s).
+        Returns x (m, 2), J = dx/dq (m, 2, n_s) and H = d2x/dq2 (m, 2, n_s, n_s); with
+        ``order`` 0 or 1, the derivatives above that order are None.
         """
         links = np.asarray(links, dtype=int)
         X = np.asarray(X, dtype=float).reshape(-1, 2)
         c, phi = self.link_poses(q)
         x = c[links] + np.einsum("ijm,mj->mi", rotation(phi[links]), X)
+        if order == 0:
+            return x, None, None
         p = self.hinge_positions(q)
         j = np.arange(self.n_s)
         moved = j[None, :] < links[:, None]                      # hinge j+1 moves link k
         arm = x[:, None, :] - p[None, :, :]                      # (m, n_s, 2)
         J = np.einsum("ab,mjb->maj", OMEGA, arm) * moved[:, None, :]
+        if order == 1:
+            return x, J, None
         jl = np.maximum(j[:, None], j[None, :])                  # (n_s, n_s)
         H = -np.moveaxis(arm[:, jl, :], -1, 1) * (jl[None, None] < links[:, None, None, None])
         return x, J, H
+
+    def force_hessian(self, q, links, x, f) -> np.ndarray:
+        """sum_m f_m . d2x_m/dq2 (n_s, n_s) for forces f (m, 2) at the current points x (m, 2)
+        of links (m,), without forming d2x/dq2: entry (j, l) is -sum over the points of
+        links > max(j, l) of f_m . (x_m - p_max(j, l)), a suffix sum over the links."""
+        links = np.asarray(links, dtype=int)
+        n = self.n_s + 1
+        fx = np.bincount(links, weights=np.einsum("ma,ma->m", f, x), minlength=n)
+        fs = np.stack([np.bincount(links, weights=f[:, a], minlength=n) for a in range(2)], axis=1)
+        beyond = lambda v: np.cumsum(v[::-1], axis=0)[::-1][1:]  # noqa: E731  sum over links > k
+        A = beyond(fx) - np.einsum("ka,ka->k", self.hinge_positions(q), beyond(fs))
+        j = np.arange(self.n_s)
+        return -A[np.maximum(j[:, None], j[None, :])]
 
     def point_load(self, q, links, X, f, dfdx=None):
         """Generalised force Q = sum J^T f of point forces f (m, 2) on link points X.
@@ -112,9 +130,9 @@ class PlanarChain:
         position (a penalty contact). Returns Q (n_s,) [N mm] and dQ/dq (n_s, n_s).
         """
         f = np.asarray(f, dtype=float).reshape(-1, 2)
-        _, J, H = self.point_map(q, links, X)
+        x, J, _ = self.point_map(q, links, X, order=1)
         Q = np.einsum("maj,ma->j", J, f)
-        dQ = np.einsum("majl,ma->jl", H, f)
+        dQ = self.force_hessian(q, links, x, f)
         if dfdx is not None:
             dQ = dQ + np.einsum("maj,mab,mbl->jl", J, dfdx, J)
         return Q, dQ
@@ -177,14 +195,14 @@ class ChainConstraint:
         """The full vector u = T(y)."""
         u = np.zeros(self.n_dofs)
         u[self.free] = y[:len(self.free)]
-        x, _, _ = self.chain.point_map(self.q(y), self.links, self.X)
+        x, _, _ = self.chain.point_map(self.q(y), self.links, self.X, order=0)
         u[self.nodes[:, :2]] += x - self.X
         return u
 
     def operator(self, y) -> sp.csr_matrix:
         """T' = du/dy at y, shape (n_dofs, n_reduced); its pattern does not depend on y."""
         n_f, n_s = len(self.free), self.chain.n_s
-        _, J, _ = self.chain.point_map(self.q(y), self.links, self.X)
+        _, J, _ = self.chain.point_map(self.q(y), self.links, self.X, order=1)
         moving = self.links > 0                       # link-0 nodes have J = 0
         rows_t = np.repeat(self.nodes[moving, :2], n_s, axis=1).ravel()
         cols_t = np.tile(n_f + np.arange(n_s), 2 * int(moving.sum()))
@@ -193,18 +211,66 @@ class ChainConstraint:
         vals = np.concatenate((np.ones(n_f), J[moving].ravel()))
         return sp.csr_matrix((vals, (rows, cols)), shape=(self.n_dofs, self.n_reduced))
 
-    def reduce(self, y, R, K=None):
-        """Reduced residual T'^T R and, with K, tangent T'^T K T' + sum_n R_n . T''_n."""
-        B = self.operator(y)
-        r = B.T @ R
+    def reduce(self, y, R, K=None, K_qq=None):
+        """Reduced residual T'^T R and, with K (CSR), tangent T'^T K T' + sum_n R_n . T''_n
+        (+ K_qq, an (n_s, n_s) term of loads on the hinge angles).
+
+        With T' = [S_f | J_m] (S_f selects the free entries; J_m, nonzero on the x, y rows of
+        the moving nodes, is dx/dq): K_ff is a gather of K.data, K_fq = (K J_m)_f and
+        K_qf = (K^T J_m)_f^T are sparse-times-dense products with n_s columns, K_qq =
+        J_m^T K J_m. All four go into a pattern built once per pattern of K (a full n_s
+        coupling for every entry that couples to a moving node), so the tangent's pattern,
+        and with it the direct solver's symbolic analysis, never changes (a sparse
+        triple product drops entries that happen to be zero).
+        """
+        x, J, _ = self.chain.point_map(self.q(y), self.links, self.X, order=1)
+        moving = self.links > 0                       # link-0 nodes have J = 0
+        n_s = self.chain.n_s
+        rows_m = self.nodes[moving, :2].ravel()
+        Jm = J[moving].reshape(-1, n_s)               # rows ordered like rows_m
+        r = np.concatenate((R[self.free], R[rows_m] @ Jm))
         if K is None:
             return r
-        _, _, H = self.chain.point_map(self.q(y), self.links, self.X)
-        G = np.einsum("majl,ma->jl", H, R[self.nodes[:, :2]])
-        n_f, n_s = len(self.free), self.chain.n_s
-        idx = n_f + np.arange(n_s)
-        geo = sp.csr_matrix((G.ravel(), (np.repeat(idx, n_s), np.tile(idx, n_s))),
-                            shape=(self.n_reduced, self.n_reduced))
-        Kr = (B.T @ (K @ B) + geo).tocsr()
-        Kr.sort_indices()
+        pat = self._reduced_pattern(K.tocsr(), rows_m)
+        KJ = pat["cols"](K.data) @ Jm                  # (n_dofs, n_s) = K J_m
+        KtJ = pat["rows"](K.data).T @ Jm               # (n_dofs, n_s) = K^T J_m
+        Kqq = Jm.T @ KJ[rows_m] + self.chain.force_hessian(self.q(y), self.links, x, R[self.nodes[:, :2]])
+        if K_qq is not None:
+            Kqq = Kqq + K_qq
+        src = np.concatenate((K.data, KJ[pat["fq"]].ravel(), KtJ[pat["qf"]].ravel(), Kqq.ravel()))
+        Kr = sp.csr_matrix((src[pat["ids"]], pat["indices"], pat["indptr"]),
+                           shape=(self.n_reduced, self.n_reduced))
+        Kr.has_sorted_indices = True
         return r, Kr
+
+    def _reduced_pattern(self, K: sp.csr_matrix, rows_m: np.ndarray) -> dict:
+        """The reduced tangent's fixed pattern and where each entry comes from (cached per K pattern)."""
+        cached = getattr(self, "_pattern", None)
+        if cached is not None and (cached["key"][0] is K.indices or (
+                np.array_equal(cached["key"][0], K.indices) and np.array_equal(cached["key"][1], K.indptr))):
+            return cached
+        n_f, n_s = len(self.free), self.chain.n_s
+        marker = sp.csr_matrix((np.arange(1.0, K.nnz + 1), K.indices, K.indptr), shape=K.shape)
+
+        def gather(sub):  # a function K.data -> sub-matrix of K with sub's (fixed) pattern
+            sub = sub.tocsr()
+            pos, ind, ptr, shape = sub.data.astype(np.intp) - 1, sub.indices, sub.indptr, sub.shape
+            return lambda data: sp.csr_matrix((data[pos], ind, ptr), shape=shape)
+
+        cols, rows = marker[:, rows_m], marker[rows_m, :]
+        ff = marker[self.free][:, self.free].tocoo()
+        fq = np.flatnonzero(np.diff(cols.tocsr()[self.free].indptr))         # free rows coupled to q
+        qf = np.flatnonzero(np.diff(rows.tocsc()[:, self.free].indptr))      # free columns coupled to q
+        j = np.arange(n_s)
+        off = [K.nnz, K.nnz + len(fq) * n_s, K.nnz + (len(fq) + len(qf)) * n_s]
+        i_idx = np.concatenate((ff.row, np.repeat(fq, n_s), n_f + np.tile(j, len(qf)), n_f + np.repeat(j, n_s)))
+        j_idx = np.concatenate((ff.col, n_f + np.tile(j, len(fq)), np.repeat(qf, n_s), n_f + np.tile(j, n_s)))
+        ids = np.concatenate((ff.data - 1, off[0] + np.arange(len(fq) * n_s),
+                              off[1] + np.arange(len(qf) * n_s), off[2] + np.arange(n_s * n_s)))
+        template = sp.csr_matrix((ids + 1.0, (i_idx, j_idx)), shape=(self.n_reduced,) * 2)
+        template.sort_indices()
+        self._pattern = {
+            "key": (K.indices, K.indptr), "cols": gather(cols), "rows": gather(rows),
+            "fq": self.free[fq], "qf": self.free[qf], "ids": template.data.astype(np.intp) - 1,
+            "indices": template.indices, "indptr": template.indptr}
+        return self._pattern

@@ -41,7 +41,6 @@ import time
 from dataclasses import dataclass, field
 
 import numpy as np
-import scipy.sparse as sp
 from skfem import Basis, ElementTetP2, ElementVector
 from skfem.quadrature import get_quadrature
 from skfem.refdom import RefTet
@@ -207,6 +206,19 @@ class Windings:
         lam = self.stretch(u)[1]
         return float(np.sum(self.W * self.law.k * self.law._g(lam - 1.0)[0]))
 
+    def _chunk(self, u, c):
+        """(f (3, ne, nq), lam, G', G'', v (ne, nq, (n a)) = f_a g_n) of chunk c."""
+        f, lam = self.stretch(u, c)
+        _, G1, G2 = self.law._g(lam - 1.0)
+        v = np.einsum("aeq,eqn->eqna", f, self.g[c]).reshape(*lam.shape, -1)
+        return f, lam, G1, G2, v
+
+    def add_residual(self, u: np.ndarray, R: np.ndarray) -> None:
+        """R += the windings' internal force."""
+        for c in self.chunks:
+            _, lam, G1, _, v = self._chunk(u, c)
+            self.scatter.add_vector(R, np.einsum("eq,eqi->ei", self.W[c] * self.law.k * G1 / lam, v), c)
+
     def add_residual_tangent(self, u: np.ndarray, R: np.ndarray, data: np.ndarray) -> None:
         """R += the windings' internal force; data (the CSR data of ``scatter``) += tangent."""
         k = self.law.k
@@ -214,10 +226,8 @@ class Windings:
         if self._ke is None:
             self._ke = np.empty((nel, nloc, 3, 3, nloc))
         for c in self.chunks:
-            f, lam = self.stretch(u, c)
-            _, G1, G2 = self.law._g(lam - 1.0)
+            f, lam, G1, G2, v = self._chunk(u, c)
             g, W = self.g[c], self.W[c]
-            v = np.einsum("aeq,eqn->eqna", f, g).reshape(*W.shape, -1)      # (ne, nq, (n a))
             self.scatter.add_vector(R, np.einsum("eq,eqi->ei", W * k * G1 / lam, v), c)
             c1, c2 = W * k * (G2 / lam ** 2 - G1 / lam ** 3), W * k * G1 / lam
             vt = np.einsum("aeq,eqn->eqan", f, g).reshape(*W.shape, -1)     # (ne, nq, (b m))
@@ -328,15 +338,21 @@ class FingerModel:
         self.windings.add_residual_tangent(u, R, data)
         R = R - P * self.cavity.gradient(u)
         K = self.solid.scatter.csr(data - P * self.cavity.hessian_data(u))
-        r, Kr = self.constraint.reduce(y, R, K)
-        if link_load is not None:
-            Q, dQ = link_load(self.constraint.q(y))
-            n_f = len(self.constraint.free)
-            r[n_f:] -= Q
-            idx = n_f + np.arange(len(Q))
-            Kr = (Kr - sp.csr_matrix((np.ravel(dQ), (np.repeat(idx, len(Q)), np.tile(idx, len(Q)))),
-                                     shape=Kr.shape)).tocsr()
+        Q, dQ = (None, None) if link_load is None else link_load(self.constraint.q(y))
+        r, Kr = self.constraint.reduce(y, R, K, None if dQ is None else -np.asarray(dQ))
+        if Q is not None:
+            r[len(self.constraint.free):] -= Q
         return r, Kr
+
+    def residual(self, y, P: float, link_load=None) -> np.ndarray:
+        """The reduced residual of :meth:`residual_tangent` alone (a line search's trial points)."""
+        u = self.constraint.expand(y)
+        R = self.solid.residual(u)
+        self.windings.add_residual(u, R)
+        r = self.constraint.reduce(y, R - P * self.cavity.gradient(u))
+        if link_load is not None:
+            r[len(self.constraint.free):] -= link_load(self.constraint.q(y))[0]
+        return r
 
     def state(self, y, P: float, iterations: int = 0) -> FingerState:
         """Outputs of the converged reduced state y at pressure P."""
@@ -434,6 +450,7 @@ def _solve_one(model, P, history, link_load, solver, options, scale, totals):
     """
     P1, y1 = history[-1]
     path = solve_path(lambda y, t: model.residual_tangent(y, P1 + t * (P - P1), link_load), y1,
-                      PathOptions(steps=1, newton=options), solver=solver, scale_t=lambda t: scale)
+                      PathOptions(steps=1, newton=options), solver=solver, scale_t=lambda t: scale,
+                      residual_t=lambda y, t: model.residual(y, P1 + t * (P - P1), link_load))
     totals += (path.assembly_seconds, path.solve_seconds, path.total_iterations, path.cutbacks)
     return path.x[-1], path.total_iterations

@@ -155,7 +155,8 @@ class GraspModel:
         scale = d.mu_sf * d.a ** 2 * d.l0
         res = solve_path(lambda x, t: self.finger.residual_tangent(x, P0 + t * (P1 - P0), link_load),
                          y, PathOptions(steps=steps, newton=self.options.newton),
-                         solver=solver, scale_t=lambda t: scale)
+                         solver=solver, scale_t=lambda t: scale,
+                         residual_t=lambda x, t: self.finger.residual(x, P0 + t * (P1 - P0), link_load))
         return res.x[-1], res.total_iterations
 
     def solve(self, P: float, *, start: GraspState | None = None) -> GraspState:

@@ -146,16 +146,23 @@ class CavityVolume:
         return -self.f.vector(g)
 
     def hessian_data(self, u) -> np.ndarray:
-        """d^2V/du^2 as CSR data in the solid's pattern (symmetric)."""
+        """d^2V/du^2 as CSR data in the solid's pattern (symmetric).
+
+        The second-derivative term factorises: y_b eps_bac eps_JKL N_J = Y_ac M_KL with the
+        skew matrices Y = [y]_x (y = D x) and M = [N]_x, so per point it is Y_ac s_nm with
+        s_nm = grad phi_n . M grad phi_m (no 3^4 tensor per point and node pair).
+        """
         x, F = self.f.fields(u)
         W, phi, G, N = self.f.W, self.f.phi, self.f.G, self.f.N
         y = np.einsum("ab,beq->aeq", self.D, x)
-        DC = np.einsum("ab,bjKeq->ajKeq", self.D, _dcofN(F, N))  # D dcofN
+        DC = np.einsum("ab,bjKeq->eqajK", self.D, _dcofN(F, N))  # D dcofN, points first
         # phi_i . D dcof[grad phi_j] N  (i = (n, a), j = (m, c))
-        H1 = np.einsum("eqn,acKeq,eqmK,eq->enamc", phi, DC, G, W, optimize=True)
-        # x . D d2cof[grad phi_i, grad phi_j] N = y_b eps_bac eps_JKL dN_n[K] dN_m[L] N_J
-        E = np.einsum("beq,bac,JKL,Jeq->acKLeq", y, EPS, EPS, N, optimize=True)
-        H2 = np.einsum("acKLeq,eqnK,eqmL,eq->enamc", E, G, G, W, optimize=True)
+        H1 = np.einsum("eqn,eqacm->enamc", phi * W[:, :, None], np.matmul(DC, G.transpose(0, 1, 3, 2)[:, :, None]))
+        # x . D d2cof[grad phi_i, grad phi_j] N = Y_ac (grad phi_n . M grad phi_m)
+        Y = np.einsum("bac,beq->eqac", EPS, y)
+        M = np.einsum("JKL,Jeq->eqKL", EPS, N)
+        S = np.matmul(G, np.matmul(M, G.transpose(0, 1, 3, 2)))             # (e, q, n, m)
+        H2 = np.einsum("eqac,eqnm->enamc", Y * W[:, :, None, None], S, optimize=True)
         H = H1 + H1.transpose(0, 3, 4, 1, 2) + H2
         return -self.f.matrix_data(H)
 

@@ -120,3 +120,32 @@ def test_operator_pattern_does_not_depend_on_the_state():
     c = _random_constraint()
     B0, B1 = c.operator(c.zero()), c.operator(RNG.normal(size=c.n_reduced))
     assert np.array_equal(B0.indptr, B1.indptr) and np.array_equal(B0.indices, B1.indices)
+
+
+def test_force_hessian_equals_the_contraction_with_the_second_derivatives():
+    x, _, H = CHAIN.point_map(Q0, LINKS, POINTS)
+    f = RNG.normal(size=POINTS.shape)
+    np.testing.assert_allclose(CHAIN.force_hessian(Q0, LINKS, x, f), np.einsum("majl,ma->jl", H, f),
+                               rtol=1e-12, atol=1e-12 * np.abs(x).max() * np.abs(f).max())
+
+
+def test_reduced_tangent_is_the_triple_product_in_a_fixed_pattern_even_for_unsymmetric_K():
+    """T'^T K T' + sum R . T'' against sparse products, with an unsymmetric K whose values
+    vanish in places (a sparse product drops those entries; the reduced pattern must not)."""
+    c = _random_constraint()
+    n, n_f = c.n_dofs, len(c.free)
+    A = sp.random(n, n, density=0.1, random_state=2, format="csr") + sp.eye(n, format="csr")
+    patterns = []
+    for y, zero_some in ((c.zero(), True), (RNG.normal(scale=0.3, size=c.n_reduced), False)):
+        K = A.copy()
+        K.data = RNG.normal(size=K.nnz) * (RNG.uniform(size=K.nnz) > 0.3 if zero_some else 1.0)
+        R = RNG.normal(size=n)
+        r, Kr = c.reduce(y, R, K)
+        B = c.operator(y)
+        _, _, H = CHAIN.point_map(c.q(y), c.links, c.X)
+        ref = (B.T @ K @ B).toarray()
+        ref[n_f:, n_f:] += np.einsum("majl,ma->jl", H, R[c.nodes[:, :2]])
+        np.testing.assert_allclose(Kr.toarray(), ref, rtol=1e-12, atol=1e-12 * np.abs(ref).max())
+        np.testing.assert_allclose(r, B.T @ R, rtol=1e-12, atol=1e-12 * np.abs(R).max())
+        patterns.append((Kr.indptr.copy(), Kr.indices.copy()))
+    assert all(np.array_equal(a, b) for a, b in zip(*patterns))

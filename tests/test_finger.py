@@ -59,6 +59,15 @@ def test_windings_kernel_equals_the_general_solid_kernel(model):
     assert w.energy(u) == pytest.approx(general.energy(u), rel=1e-12)
 
 
+def test_residual_alone_is_the_residual_of_residual_tangent(model):
+    """The line search's residual-only path (no tangent) gives the same reduced residual,
+    with a pressure and a load on the hinge angles."""
+    y = 0.02 * np.random.default_rng(1).standard_normal(model.ndofs)
+    load = lambda q: (3.0 * q + 1.0, 3.0 * np.eye(len(q)))  # noqa: E731
+    r_full, _ = model.residual_tangent(y, 0.5, load)
+    assert np.abs(model.residual(y, 0.5, load) - r_full).max() <= 1e-12 * np.abs(r_full).max()
+
+
 def test_no_pressure_no_bending(model):
     r, _ = model.residual_tangent(model.constraint.zero(), 0.0)
     assert np.abs(r).max() < 1e-12
