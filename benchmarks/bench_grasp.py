@@ -26,11 +26,11 @@ def timed(fn):
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--mesh-size-mm", default="6,4", help="finger element sizes [mm] (the default graded meshes)")
+    parser.add_argument("--mesh-size-mm", default="6,4", help="finger element sizes [mm] (graded meshes, as softhand weights uses)")
     args = parser.parse_args()
     design = HandDesign()
     for h in (float(x) for x in args.mesh_size_mm.split(",")):
-        finger, w_build, c_build = timed(lambda: FingerModel(design, FingerOptions(mesh_size=h)))
+        finger, w_build, c_build = timed(lambda: FingerModel(design, FingerOptions(mesh_size=h, edge_ratio=0.5, mesh_refine=0)))
         model = GraspModel(finger, 180.0)
         r, wall, cpu = timed(lambda: grasp_weights(model, 0.8, 0.05))
         its = r.state.iterations + r.state_dP.iterations

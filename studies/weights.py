@@ -90,13 +90,21 @@ def state_row(state, w, mass: float, design: HandDesign) -> dict:
             "newton_iterations": state.iterations}
 
 
+def finger_options(case: WeightsCase):
+    """The grasp FEM's finger mesh: graded (element size mesh_size_mm, half that at the ring
+    edges), not refined; pinned here so that it does not follow the free-bending default."""
+    from fem.finger import FingerOptions
+
+    return FingerOptions(mesh_size=case.mesh_size_mm, edge_ratio=0.5, edge_reach=3.0, mesh_refine=0)
+
+
 def compute(case: WeightsCase, out=None) -> dict:
     """Run the grasp FEM for one case (no cache): the flat result; with ``out`` (a folder)
     also the two states' fields as the VTK series ``grasp.pvd`` (finger frame, half tube)."""
-    from fem.finger import FingerModel, FingerOptions
+    from fem.finger import FingerModel
     from fem.grasp import GraspModel, grasp_weights
 
-    finger = FingerModel(case.design, FingerOptions(mesh_size=case.mesh_size_mm))
+    finger = FingerModel(case.design, finger_options(case))
     model = GraspModel(finger, case.diameter_mm, mass=case.mass_kg, depth=case.depth_mm)
     r = grasp_weights(model, case.pressure_mpa, case.dP_mpa)
     if out is not None:
@@ -181,10 +189,10 @@ def run(study: WeightsStudy, *, cache: bool = True, progress=None) -> WeightsRes
 def fig8(case: WeightsCase, pressures_mpa, depth_offsets_mm=(0.0, 10.0, 20.0)) -> list[dict]:
     """The Fig. 8 analogue for one object: at each depth (default depth + offset) the
     pressures in turn; each point a FEM contact state with its own w (P, P + dP)."""
-    from fem.finger import FingerModel, FingerOptions
+    from fem.finger import FingerModel
     from fem.grasp import GraspModel, weight_vector
 
-    finger = FingerModel(case.design, FingerOptions(mesh_size=case.mesh_size_mm))
+    finger = FingerModel(case.design, finger_options(case))
     base = GraspModel(finger, case.diameter_mm, mass=case.mass_kg).depth
     rows = []
     for offset in depth_offsets_mm:
