@@ -22,13 +22,13 @@ def configure(parser) -> None:
                         help="pressures [MPa]: start:stop:step (stop included) or a,b,c "
                              "(default 0:0.8:0.1)")
     parser.add_argument("--mesh-size-mm", metavar="H", type=float, default=None,
-                        help="element size [mm] away from the ring edges (default 4)")
+                        help="element size [mm] of gmsh's mesh, before --refine (default 6)")
     parser.add_argument("--edge-ratio", metavar="R", type=float, default=None,
                         help="element size at the ring edges and the cavity's cap corner over H "
-                             "(default 0.5, growing back to H over 3 mm; 1: uniform)")
+                             "(default 1: uniform; e.g. 0.5: half, growing back to H over 3 mm)")
     parser.add_argument("--refine", metavar="N", type=int, default=None,
                         help="split every element N times after meshing (nested meshes with "
-                             "element size H / 2**N, for convergence studies; default 0)")
+                             "element size H / 2**N; default 1; 0: the CI mesh)")
     parser.add_argument("--fiber-intorder", metavar="N", type=int, default=None,
                         help="degree of the windings' quadrature rule (default 5; 2: the "
                              "rubber's 4-point rule, which misses the taut cavity wall)")
