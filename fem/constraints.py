@@ -179,6 +179,7 @@ class ChainConstraint:
         slaved[self.nodes[self.tied].ravel()] = True
         slaved[np.asarray(self.fixed, dtype=int)] = True
         self.free = np.flatnonzero(~slaved)
+        self._pattern = None  # the reduced tangent's pattern (see _reduced_pattern), built at first use
 
     @property
     def n_reduced(self) -> int:
@@ -231,7 +232,8 @@ class ChainConstraint:
         r = np.concatenate((R[self.free], R[rows_m] @ Jm))
         if K is None:
             return r
-        pat = self._reduced_pattern(K.tocsr(), rows_m)
+        K = K.tocsr()  # K.data below must be in CSR order
+        pat = self._reduced_pattern(K, rows_m)
         KJ = pat["cols"](K.data) @ Jm                  # (n_dofs, n_s) = K J_m
         KtJ = pat["rows"](K.data).T @ Jm               # (n_dofs, n_s) = K^T J_m
         Kqq = Jm.T @ KJ[rows_m] + self.chain.force_hessian(self.q(y), self.links, x, R[self.nodes[:, :2]])
@@ -245,7 +247,7 @@ class ChainConstraint:
 
     def _reduced_pattern(self, K: sp.csr_matrix, rows_m: np.ndarray) -> dict:
         """The reduced tangent's fixed pattern and where each entry comes from (cached per K pattern)."""
-        cached = getattr(self, "_pattern", None)
+        cached = self._pattern
         if cached is not None and (cached["key"][0] is K.indices or (
                 np.array_equal(cached["key"][0], K.indices) and np.array_equal(cached["key"][1], K.indptr))):
             return cached
