@@ -12,9 +12,10 @@ from __future__ import annotations
 import argparse
 import time
 
-from fem.finger import FingerModel, FingerOptions
+from fem.finger import FingerModel
 from fem.grasp import GraspModel, grasp_weights
 from reduced.design import HandDesign
+from studies.weights import finger_options
 
 
 def timed(fn):
@@ -30,7 +31,7 @@ def main() -> None:
     args = parser.parse_args()
     design = HandDesign()
     for h in (float(x) for x in args.mesh_size_mm.split(",")):
-        finger, w_build, c_build = timed(lambda: FingerModel(design, FingerOptions(mesh_size=h, edge_ratio=0.5, mesh_refine=0)))
+        finger, w_build, c_build = timed(lambda: FingerModel(design, finger_options(h)))
         model = GraspModel(finger, 180.0)
         r, wall, cpu = timed(lambda: grasp_weights(model, 0.8, 0.05))
         its = r.state.iterations + r.state_dP.iterations

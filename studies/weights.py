@@ -90,12 +90,12 @@ def state_row(state, w, mass: float, design: HandDesign) -> dict:
             "newton_iterations": state.iterations}
 
 
-def finger_options(case: WeightsCase):
+def finger_options(mesh_size_mm: float):
     """The grasp FEM's finger mesh: graded (element size mesh_size_mm, half that at the ring
     edges), not refined; pinned here so that it does not follow the free-bending default."""
     from fem.finger import FingerOptions
 
-    return FingerOptions(mesh_size=case.mesh_size_mm, edge_ratio=0.5, edge_reach=3.0, mesh_refine=0)
+    return FingerOptions(mesh_size=mesh_size_mm, edge_ratio=0.5, edge_reach=3.0, mesh_refine=0)
 
 
 def compute(case: WeightsCase, out=None) -> dict:
@@ -104,7 +104,7 @@ def compute(case: WeightsCase, out=None) -> dict:
     from fem.finger import FingerModel
     from fem.grasp import GraspModel, grasp_weights
 
-    finger = FingerModel(case.design, finger_options(case))
+    finger = FingerModel(case.design, finger_options(case.mesh_size_mm))
     model = GraspModel(finger, case.diameter_mm, mass=case.mass_kg, depth=case.depth_mm)
     r = grasp_weights(model, case.pressure_mpa, case.dP_mpa)
     if out is not None:
@@ -192,7 +192,7 @@ def fig8(case: WeightsCase, pressures_mpa, depth_offsets_mm=(0.0, 10.0, 20.0)) -
     from fem.finger import FingerModel
     from fem.grasp import GraspModel, weight_vector
 
-    finger = FingerModel(case.design, finger_options(case))
+    finger = FingerModel(case.design, finger_options(case.mesh_size_mm))
     base = GraspModel(finger, case.diameter_mm, mass=case.mass_kg).depth
     rows = []
     for offset in depth_offsets_mm:
