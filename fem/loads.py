@@ -35,10 +35,10 @@ from __future__ import annotations
 
 import numpy as np
 import scipy.sparse as sp
-from skfem import FacetBasis
 
 from fem import kinematics as kin
 from fem.kinematics import EPS
+from fem.mapping import facet_basis
 
 
 class _Facets:
@@ -46,8 +46,8 @@ class _Facets:
 
     def __init__(self, solid, facets, intorder: int | None = None):
         self.solid = solid
-        fb = FacetBasis(solid.mesh, solid.element, facets=facets,
-                        intorder=intorder if intorder is not None else 4)
+        fb = facet_basis(solid.mesh, solid.element, facets=facets,
+                         intorder=intorder if intorder is not None else 4)
         nloc = fb.Nbfun
         self.elements = np.asarray(fb.tind)
         self.N = np.asarray(fb.normals)  # (3, nf, nq), outward of the solid

@@ -148,3 +148,120 @@ def finger_tube_mesh(tube: FingerTube, *, size: float, refine: int = 0) -> skfem
     """The cached quadratic (curved) tetrahedral mesh of ``tube``, element size ``size`` [mm],
     each element then split ``refine`` times (size / 2**refine; see :func:`meshes.gmsh_io.generate_msh`)."""
     return load_mesh(finger_geometry, tube, size=size, order=2, refine=refine)
+
+
+def layered_radii(a: float, b: float, first: float, ratio: float) -> np.ndarray:
+    """Radii of the wall's layers from the cavity (r = a) out to r = a + b: thicknesses
+    growing geometrically by ``ratio`` from about ``first``, scaled to fill the wall exactly."""
+    n = 1
+    while first * np.sum(ratio ** np.arange(n)) < 0.999 * b:
+        n += 1
+    t = first * ratio ** np.arange(n)
+    return a + np.concatenate(([0.0], np.cumsum(t * b / t.sum())))
+
+
+def _halve(v: np.ndarray, times: int) -> np.ndarray:
+    """Insert the midpoints of a sorted array ``times`` times (nested subdivision)."""
+    for _ in range(times):
+        v = np.sort(np.concatenate((v, 0.5 * (v[1:] + v[:-1]))))
+    return v
+
+
+def layered_tube_mesh(tube: FingerTube, *, n_phi: int, layer_first: float, layer_ratio: float,
+                      axial_size: float, core_rings: int = 1, refine: int = 0) -> skfem.MeshTet2:
+    """A structured, layered quadratic tetrahedral mesh of ``tube`` (no gmsh).
+
+    The half cross-section (z >= 0) is a polar grid: ``n_phi`` sectors over 180 deg; in the
+    wall, layers whose thickness grows geometrically from ``layer_first`` at the cavity
+    (ratio ``layer_ratio``); in the end cap, also ``core_rings`` rings inside r = a around
+    the axis. It is extruded along x in slices of at most ``axial_size`` that start and end
+    at every cut of :meth:`FingerTube.cuts` (band ends, cavity end), and every prism is split
+    into three tetrahedra by the lowest-index rule (conforming). Mid-edge nodes are the
+    midpoints in (x, r, phi), so every layer is a true cylinder and the cavity, the outer
+    surface and the cap are exact up to the P2 interpolation. ``refine`` halves every
+    spacing (sectors, layers, rings, slices) that many times: nested meshes.
+
+    Why this mesh: the bend angle's discretisation error is dominated by the axial spacing
+    (the ring edges), while the cross-section needs few elements (docs/finger.md: mesh
+    convergence); an unstructured mesh refines all three directions together.
+    Boundaries as in :func:`finger_geometry`.
+    """
+    if not (n_phi >= 2 and core_rings >= 1 and layer_first > 0 and layer_ratio >= 1 and axial_size > 0):
+        raise ValueError("need n_phi >= 2, core_rings >= 1, layer_first > 0, layer_ratio >= 1, "
+                         f"axial_size > 0; got {n_phi}, {core_rings}, {layer_first}, {layer_ratio}, {axial_size}")
+    a, b, length = tube.a, tube.b, tube.length
+    x_end = length - tube.cap
+    wall = _halve(layered_radii(a, b, layer_first, layer_ratio), refine)
+    rings = np.concatenate((_halve(np.linspace(0.0, a, core_rings + 1), refine)[1:-1], wall))
+    n_phi *= 2 ** refine
+    cuts = tube.cuts()
+    x = np.concatenate([cuts[:1]] + [np.linspace(c0, c1, int(np.ceil((c1 - c0) / axial_size - 1e-9)) + 1)[1:]
+                                     for c0, c1 in zip(cuts[:-1], cuts[1:])])
+    x = _halve(x, refine)
+
+    # the half cross-section: node 0 on the axis, node 1 + i (n_phi + 1) + j on ring i, angle j
+    na = n_phi + 1
+    rho2 = np.concatenate(([0.0], np.repeat(rings, na)))
+    phi2 = np.concatenate(([0.0], np.tile(np.linspace(0.0, np.pi, na), len(rings))))
+    j = np.arange(n_phi)
+    tris, core = [np.stack([np.zeros(n_phi, dtype=np.int64), 1 + j, 2 + j], axis=1)], [np.ones(n_phi, bool)]
+    for i in range(len(rings) - 1):
+        q0, q1 = 1 + i * na + j, 1 + (i + 1) * na + j
+        tris += [np.stack([q0, q0 + 1, q1 + 1], axis=1), np.stack([q0, q1 + 1, q1], axis=1)]
+        core += [np.full(n_phi, rings[i + 1] <= a + 1e-12)] * 2
+    tris, core = np.sort(np.vstack(tris), axis=1), np.concatenate(core)  # sorted: conforming splits
+
+    # extrude: slice k joins planes k and k + 1 (the core only inside the cap)
+    n2 = len(rho2)
+    k = np.arange(len(x) - 1)
+    in_cap = x[:-1] >= x_end - 1e-9
+    prisms = [(kk * n2 + tri) for kk, tri in ((kk, tris if in_cap[kk] else tris[~core]) for kk in k)]
+    lo = np.concatenate(prisms)                        # (n_prisms, 3): a0 < b0 < c0
+    hi = lo + n2
+    t = np.concatenate([np.stack([lo[:, 0], lo[:, 1], lo[:, 2], hi[:, 2]]),
+                        np.stack([lo[:, 0], lo[:, 1], hi[:, 1], hi[:, 2]]),
+                        np.stack([lo[:, 0], hi[:, 0], hi[:, 1], hi[:, 2]])], axis=1)
+    used, t = np.unique(t, return_inverse=True)
+    t = t.reshape(4, -1)
+    X, R, PHI = np.repeat(x, n2)[used], np.tile(rho2, len(x))[used], np.tile(phi2, len(x))[used]
+    p = _cylindrical(X, R, PHI)
+    d = p[:, t[1:]] - p[:, t[:1]]
+    flip = np.einsum("ij,ij->j", d[:, 0], np.cross(d[:, 1], d[:, 2], axis=0)) < 0
+    t[2, flip], t[3, flip] = t[3, flip], t[2, flip].copy()
+
+    # P2: mid-edge nodes at the (x, r, phi) midpoints (an edge to the axis keeps its other phi)
+    m1 = skfem.MeshTet1(p, t)
+    straight = skfem.MeshTet2.from_mesh(m1)
+    e0, e1 = m1.edges
+    if not np.allclose(straight.doflocs[:, p.shape[1]:], 0.5 * (p[:, e0] + p[:, e1])):
+        raise RuntimeError("scikit-fem's P2 node order is not vertices, then edges in mesh.edges order")
+    phim = np.where(R[e0] == 0, PHI[e1], np.where(R[e1] == 0, PHI[e0], 0.5 * (PHI[e0] + PHI[e1])))
+    doflocs = np.hstack((p, _cylindrical(0.5 * (X[e0] + X[e1]), 0.5 * (R[e0] + R[e1]), phim)))
+    mesh = skfem.MeshTet2(doflocs, straight.t)
+
+    # boundaries, from the vertices' (x, r, phi)
+    bf = mesh.boundary_facets()
+    fx, fr, fphi = (v[mesh.facets[:, bf]] for v in (X, R, PHI))
+    tol = 1e-9 * length
+    sym = np.all((fr < tol) | (np.abs(fphi) < 1e-12) | (np.abs(fphi - np.pi) < 1e-12), axis=0)
+    groups = {
+        "symmetry": sym,
+        "base": ~sym & np.all(fx < tol, axis=0),
+        "tip": ~sym & np.all(np.abs(fx - length) < tol, axis=0),
+        "cavity": ~sym & ((np.all(np.abs(fr - a) < tol, axis=0) & (fx.max(axis=0) <= x_end + tol))
+                          | (np.all(np.abs(fx - x_end) < tol, axis=0) & np.all(fr <= a + tol, axis=0))),
+    }
+    outer = ~sym & np.all(np.abs(fr - a - b) < tol, axis=0)
+    xc = fx.mean(axis=0)
+    for n, (x0, x1) in enumerate(tube.bands):
+        groups[f"tie{n}"] = outer & (xc > x0) & (xc < x1)
+    groups["outer"] = outer & ~np.any([groups[f"tie{n}"] for n in range(len(tube.bands))], axis=0)
+    count = np.sum(list(groups.values()), axis=0)
+    if not np.all(count == 1):
+        raise RuntimeError(f"{np.sum(count != 1)} boundary facets in no group or in several")
+    return skfem.MeshTet2(doflocs, mesh.t, _boundaries={name: bf[sel] for name, sel in groups.items()})
+
+
+def _cylindrical(x, r, phi) -> np.ndarray:
+    """Points (3, n) of the finger frame from cylindrical coordinates about the x axis."""
+    return np.array([x, r * np.cos(phi), r * np.sin(phi)])

@@ -125,3 +125,70 @@ def test_a_file_that_is_not_a_mesh_is_one_line_input_error(tmp_path, content):
     assert "\n" not in str(err.value) and "bad.msh" in str(err.value)
     with pytest.raises(InputError):
         read_mesh(tmp_path / "missing.msh")
+
+
+# -- the layered finger mesh (meshes.finger.layered_tube_mesh) --------------------------------
+def layered(refine=0, **kw):
+    from meshes.finger import FingerTube, layered_tube_mesh
+    tube = FingerTube(4.0, 5.0, 180.0, 5.0, ((10.0, 20.0), (40.0, 50.0), (70.0, 80.0)))
+    opts = dict(n_phi=4, layer_first=0.2, layer_ratio=2.0, axial_size=5.0, refine=refine) | kw
+    return tube, layered_tube_mesh(tube, **opts)
+
+
+def facet_measure(mesh, name):
+    from fem.mapping import facet_basis
+    return float(facet_basis(mesh, skfem.ElementTetP2(), facets=mesh.boundaries[name], intorder=4).dx.sum())
+
+
+@pytest.mark.parametrize("refine", [0, 1])
+def test_layered_mesh_measures_the_closed_form(refine):
+    """Volume, cavity and ring areas of the half tube against their closed forms (the P2
+    curved geometry is exact up to its interpolation error, 4th order in the sector angle); every
+    element right-handed everywhere; every boundary facet in exactly one group."""
+    tube, mesh = layered(refine)
+    a, ro, cav = tube.a, tube.a + tube.b, tube.length - tube.cap
+    tol = 1e-3 / 16 ** refine  # P2 arcs of 45 / 2**refine deg: 4th order in the sector angle
+    basis = skfem.Basis(mesh, skfem.ElementTetP2(), intorder=5)  # positive weights
+    assert basis.dx.min() > 0
+    volume = np.pi / 2 * ((ro ** 2 - a ** 2) * cav + ro ** 2 * tube.cap)
+    assert basis.dx.sum() == pytest.approx(volume, rel=tol)
+    assert facet_measure(mesh, "cavity") == pytest.approx(np.pi * a * cav + np.pi * a ** 2 / 2, rel=tol)
+    for k in range(3):
+        assert facet_measure(mesh, f"tie{k}") == pytest.approx(np.pi * ro * 10.0, rel=tol)
+    assert facet_measure(mesh, "base") == pytest.approx(np.pi / 2 * (ro ** 2 - a ** 2), rel=tol)
+    assert facet_measure(mesh, "tip") == pytest.approx(np.pi / 2 * ro ** 2, rel=tol)
+    assert facet_measure(mesh, "symmetry") == pytest.approx(2 * tube.b * cav + 2 * ro * tube.cap, rel=1e-9)
+
+
+def test_layered_refinement_is_nested_with_eight_times_the_wall_elements():
+    """Halving every spacing splits each wall element into 8 (the cap's core, a polar grid
+    around the axis, into more); the fine mesh's vertices include every coarse P2 node."""
+    tube, coarse = layered(0)
+    _, fine = layered(1)
+    def wall(m):
+        return np.sum(m.p[0, m.t].mean(axis=0) < tube.length - tube.cap)
+    assert wall(fine) == 8 * wall(coarse)
+    # every coarse P2 node (vertices and curved mid-edge nodes) is a vertex of the fine mesh
+    ours = {tuple(v) for v in np.round(fine.p.T, 9)}
+    assert all(tuple(v) in ours for v in np.round(coarse.doflocs.T, 9))
+
+
+def test_layered_wall_layers_grow_geometrically_and_fill_the_wall():
+    from meshes.finger import layered_radii
+    r = layered_radii(4.0, 5.0, 0.2, 2.0)
+    t = np.diff(r)
+    assert r[0] == 4.0 and r[-1] == pytest.approx(9.0) and np.allclose(t[1:] / t[:-1], 2.0)
+
+
+def test_robust_facet_map_equals_scikit_fem_where_both_work():
+    """On a curved mesh scikit-fem can map, the better-started inverse gives the same facet
+    quadrature (points, weights, normals); on the thin layered elements it also converges."""
+    from fem.mapping import facet_basis
+    mesh = skfem.MeshTet2.init_ball()
+    ours = facet_basis(mesh, skfem.ElementTetP2(), intorder=4)
+    theirs = skfem.FacetBasis(mesh, skfem.ElementTetP2(), intorder=4)
+    np.testing.assert_allclose(ours.dx, theirs.dx, rtol=1e-10, atol=1e-14)
+    np.testing.assert_allclose(ours.normals.value, theirs.normals.value, atol=1e-10)
+    _, thin = layered(axial_size=20.0)
+    with pytest.raises(Exception, match="Newton"):
+        skfem.FacetBasis(thin, skfem.ElementTetP2(), facets=thin.boundaries["cavity"], intorder=4)
