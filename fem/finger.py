@@ -52,11 +52,12 @@ from fem.loads import CavityVolume
 from fem.materials import Fibers, NeoHookean
 from fem.newton import NewtonOptions, PathOptions, solve_path
 from fem.solid import Solid
-from meshes.finger import FingerTube, finger_tube_mesh
+from meshes.finger import FingerTube, finger_tube_mesh, layered_tube_mesh
 from reduced.design import HandDesign
 from reduced.errors import InputError
 
 TIES = ("ring", "full")
+MESHERS = ("layered", "gmsh")
 
 
 @dataclass(frozen=True, eq=False)
@@ -109,13 +110,20 @@ class WindingFibers(Fibers):
 class FingerOptions:
     """Discretisation and modelling choices of the finger FEM."""
 
-    #: the default mesh is the CI mesh (uniform, 6 mm) with every tetrahedron split into 8 once
-    #: (72k unknowns): theta(0.8 MPa) 1.8 % below the extrapolation of the nested levels
-    #: 0 / 1 / 2 (docs/finger.md: mesh convergence); level 0 is 4.3 % below
-    mesh_size: float = 6.0     #: target element size of gmsh's mesh, before mesh_refine [mm]
-    edge_ratio: float = 1.0    #: element size at the ring edges and cap corner / mesh_size (1: uniform)
-    edge_reach: float = 3.0    #: distance over which the size grows back to mesh_size [mm]
-    mesh_refine: int = 1       #: split every element this many times (nested meshes, h / 2**n)
+    #: the default mesh is layered (meshes.finger.layered_tube_mesh): 4 sectors over the half
+    #: circumference, 5 wall layers from 0.2 mm at the cavity, axial slices of at most 2.5 mm
+    #: (38k unknowns); theta(0.8 MPa) 0.3 % below the extrapolated value (docs/finger.md: mesh
+    #: convergence). "gmsh": an unstructured mesh of size mesh_size (the CI mesh: 6 mm, uniform,
+    #: unrefined; 3.6 % below)
+    mesher: str = "layered"    #: "layered" (structured, no gmsh) or "gmsh"
+    n_phi: int = 4             #: layered: sectors over the half circumference (180 deg)
+    layer_first: float = 0.2   #: layered: thickness of the wall layer at the cavity [mm]
+    layer_ratio: float = 2.0   #: layered: growth of the layer thickness towards the outside
+    axial_size: float = 2.5   #: layered: largest slice length along the finger [mm]
+    mesh_size: float = 6.0     #: gmsh: target element size, before mesh_refine [mm]
+    edge_ratio: float = 1.0    #: gmsh: element size at the ring edges and cap corner / mesh_size (1: uniform)
+    edge_reach: float = 3.0    #: gmsh: distance over which the size grows back to mesh_size [mm]
+    mesh_refine: int = 0       #: split every element / halve every spacing this many times (nested meshes)
     tie: str = "ring"          #: which outer surface the links hold: "ring" or "full"
     tie_width: float = 10.0    #: width of each link's tied ring, centred on the link [mm]
     hinge_gap: float = 4.0     #: untied tube length around each hinge, tie = "full" [mm]
@@ -126,6 +134,12 @@ class FingerOptions:
     fiber_intorder: int = 5    #: degree of the quadrature rule of the windings' energy (2: the rubber's)
 
     def __post_init__(self):
+        if self.mesher not in MESHERS:
+            raise InputError("mesher", self.mesher, f"must be one of {', '.join(MESHERS)}")
+        if not (isinstance(self.n_phi, int) and self.n_phi >= 2):
+            raise InputError("n_phi", self.n_phi, "must be an integer >= 2")
+        if not self.layer_ratio >= 1:
+            raise InputError("layer_ratio", self.layer_ratio, "must be >= 1")
         if self.tie not in TIES:
             raise InputError("tie", self.tie, f"must be one of {', '.join(TIES)}")
         if not get_quadrature(RefTet, self.fiber_intorder)[1].min() > 0:
@@ -135,7 +149,7 @@ class FingerOptions:
             raise InputError("edge_ratio", self.edge_ratio, "must be in (0, 1]")
         if self.mesh_refine not in range(0, 4):
             raise InputError("mesh_refine", self.mesh_refine, "must be 0, 1, 2 or 3")
-        for name in ("mesh_size", "edge_reach", "tie_width", "hinge_gap", "kappa_ratio", "fiber_ratio"):
+        for name in ("layer_first", "axial_size", "mesh_size", "edge_reach", "tie_width", "hinge_gap", "kappa_ratio", "fiber_ratio"):
             if not getattr(self, name) > 0:
                 raise InputError(name, getattr(self, name), "must be a positive number")
 
@@ -284,10 +298,14 @@ class FingerModel:
         cap = options.cap if options.cap is not None else design.b
         self.tube = FingerTube(design.a, design.b, design.l0, cap, tie_bands(design, options),
                                options.edge_ratio, options.edge_reach)
-        self.mesh = finger_tube_mesh(self.tube, size=options.mesh_size, refine=options.mesh_refine)
+        self.mesh = _mesh(self.tube, options)
         mu = design.mu_sf
         rubber = NeoHookean(mu, options.kappa_ratio * mu)
         self.solid = Solid(self.mesh, rubber)
+        if not np.all(self.solid.W > 0):
+            raise InputError("mesh", _describe_mesh(options),
+                             "has curved elements turned inside out (negative Jacobian); "
+                             "try another mesh size, edge_ratio 1 (uniform) or the layered mesher")
         self.windings = Windings(self.mesh, options.fiber_ratio * mu, options.fiber_toe,
                                  options.fiber_intorder, self.solid.scatter)
         X_q = self.solid.sbasis.global_coordinates().value
@@ -393,17 +411,34 @@ class FingerModel:
         return (W * kin.det(self.solid.F(u))).sum(axis=1) / W.sum(axis=1)
 
 
+def _mesh(tube: FingerTube, options: FingerOptions):
+    if options.mesher == "layered":
+        return layered_tube_mesh(tube, n_phi=options.n_phi, layer_first=options.layer_first,
+                                 layer_ratio=options.layer_ratio, axial_size=options.axial_size,
+                                 refine=options.mesh_refine)
+    return finger_tube_mesh(tube, size=options.mesh_size, refine=options.mesh_refine)
+
+
+def _describe_mesh(options: FingerOptions) -> str:
+    if options.mesher == "layered":
+        return (f"layered n_phi={options.n_phi} layer_first={options.layer_first} "
+                f"layer_ratio={options.layer_ratio} axial_size={options.axial_size} refine={options.mesh_refine}")
+    return (f"gmsh mesh_size={options.mesh_size} edge_ratio={options.edge_ratio} "
+            f"refine={options.mesh_refine}")
+
+
 def _cavity(solid, mesh, options: FingerOptions) -> CavityVolume:
-    """The cavity volume load; a curved facet too distorted to map (seen on some graded meshes:
-    scikit-fem cannot invert its isoparametric map) becomes one clear line instead of a traceback."""
+    """The cavity volume load; a curved facet whose element map cannot be inverted (a badly
+    distorted element that still has a positive Jacobian at the quadrature points) becomes
+    one clear line instead of a traceback."""
     try:
         return CavityVolume(solid, mesh.boundaries["cavity"], symmetry_normal=0)
-    except Exception as err:  # skfem raises a bare Exception from MappingIsoparametric.invF
-        if "Newton iteration didn't converge" not in str(err):
+    except RuntimeError as err:  # fem.mapping.RobustIsoparametric.invF
+        if "inverse isoparametric map" not in str(err):
             raise
-        raise InputError("mesh_size", options.mesh_size,
-                         f"gives a curved element too distorted to map with edge_ratio {options.edge_ratio}; "
-                         "try another mesh size or edge_ratio 1 (uniform)") from None
+        raise InputError("mesh", _describe_mesh(options),
+                         "has a curved element too distorted to map; try another mesh size, "
+                         "edge_ratio 1 (uniform) or the layered mesher") from None
 
 
 @dataclass(frozen=True)
@@ -427,7 +462,10 @@ def solve_pressures(model: FingerModel, pressures, *, link_load=None, y0=None, c
     ([FingerState], SweepStats); raises :class:`fem.newton.NotConverged` with the last
     converged state when even the cut-back fails.
     """
-    solver = make_solver(symmetric=True)
+    # double precision: single-precision PARDISO plus refinement gains only ~0.06-0.16 per
+    # refinement step on the finger (fibers 1000 mu stiffer than the rubber), so "mixed" always
+    # fell back after one wasted factorisation (fem.linsolve)
+    solver = make_solver(symmetric=True, precision="double")
     t0 = time.perf_counter()
     history = [(0.0, model.constraint.zero() if y0 is None else np.array(y0, dtype=float))]
     states, totals = [], np.zeros(4)  # assembly s, solve s, iterations, cutbacks

@@ -57,7 +57,7 @@ def fig7_fem(ctx: Context, outdir: Path):
     d = ctx.design
     step = 0.2 if ctx.quick else 0.1
     pressures = tuple(np.round(np.arange(0.0, 0.8 + 1e-9, step), 10))
-    options = FingerOptions(mesh_size=6.0, edge_ratio=1.0, mesh_refine=0) if ctx.quick else FingerOptions()
+    options = FingerOptions(mesher="gmsh", mesh_size=6.0, edge_ratio=1.0, mesh_refine=0) if ctx.quick else FingerOptions()
     series, basis = VtkSeries(outdir / "finger.pvd"), []
     with progress_bar("  bending the finger", "P") as bar:
         def on_state(model, state):

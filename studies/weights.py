@@ -95,7 +95,7 @@ def finger_options(mesh_size_mm: float):
     edges), not refined; pinned here so that it does not follow the free-bending default."""
     from fem.finger import FingerOptions
 
-    return FingerOptions(mesh_size=mesh_size_mm, edge_ratio=0.5, edge_reach=3.0, mesh_refine=0)
+    return FingerOptions(mesher="gmsh", mesh_size=mesh_size_mm, edge_ratio=0.5, edge_reach=3.0, mesh_refine=0)
 
 
 def compute(case: WeightsCase, out=None) -> dict:

@@ -21,7 +21,7 @@ P, DP = 0.45, 0.05  # MPa; the fingers touch the 180 mm object from 0.3 MPa on (
 
 @pytest.fixture(scope="module")
 def grasp180():
-    model = GraspModel(FingerModel(DESIGN, FingerOptions(mesh_size=CI_MESH, edge_ratio=1.0, mesh_refine=0)), 180.0)  # uniform
+    model = GraspModel(FingerModel(DESIGN, FingerOptions(mesher="gmsh", mesh_size=CI_MESH, edge_ratio=1.0, mesh_refine=0)), 180.0)  # uniform
     a = model.solve(P)
     return model, a, model.solve(P + DP, start=a), model.solve(P + DP / 2, start=a)
 

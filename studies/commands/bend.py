@@ -21,14 +21,19 @@ def configure(parser) -> None:
     parser.add_argument("--pressure-mpa", metavar="RANGE", default="0:0.8:0.1",
                         help="pressures [MPa]: start:stop:step (stop included) or a,b,c "
                              "(default 0:0.8:0.1)")
+    parser.add_argument("--mesher", choices=("layered", "gmsh"), default=None,
+                        help="layered: structured mesh, thin layers at the cavity (default); "
+                             "gmsh: unstructured (implied by --mesh-size-mm or --edge-ratio)")
+    parser.add_argument("--axial-size-mm", metavar="DX", type=float, default=None,
+                        help="layered mesh: largest slice length along the finger [mm] (default 2.5)")
     parser.add_argument("--mesh-size-mm", metavar="H", type=float, default=None,
-                        help="element size [mm] of gmsh's mesh, before --refine (default 6)")
+                        help="gmsh mesh: element size [mm], before --refine (default 6)")
     parser.add_argument("--edge-ratio", metavar="R", type=float, default=None,
                         help="element size at the ring edges and the cavity's cap corner over H "
                              "(default 1: uniform; e.g. 0.5: half, growing back to H over 3 mm)")
     parser.add_argument("--refine", metavar="N", type=int, default=None,
-                        help="split every element N times after meshing (nested meshes with "
-                             "element size H / 2**N; default 1; 0: the CI mesh)")
+                        help="halve every spacing (layered) or split every element (gmsh) N times: "
+                             "nested meshes (default 0; gmsh with 6 mm and 0: the CI mesh)")
     parser.add_argument("--fiber-intorder", metavar="N", type=int, default=None,
                         help="degree of the windings' quadrature rule (default 5; 2: the "
                              "rubber's 4-point rule, which misses the taut cavity wall)")
@@ -53,10 +58,18 @@ def configure(parser) -> None:
 
 def _options(args):
     from fem.finger import FingerOptions
+    from reduced.errors import InputError
 
-    given = {"mesh_size": args.mesh_size_mm, "tie_width": args.tie_width_mm,
-             "edge_ratio": args.edge_ratio, "fiber_intorder": args.fiber_intorder,
-             "mesh_refine": args.refine}
+    mesher = args.mesher or ("gmsh" if args.mesh_size_mm is not None or args.edge_ratio is not None
+                             else None)
+    if mesher == "layered" and (args.mesh_size_mm is not None or args.edge_ratio is not None):
+        raise InputError("--mesh-size-mm/--edge-ratio", args.mesh_size_mm or args.edge_ratio,
+                         "apply to --mesher gmsh only")
+    if mesher == "gmsh" and args.axial_size_mm is not None:
+        raise InputError("--axial-size-mm", args.axial_size_mm, "applies to --mesher layered only")
+    given = {"mesher": mesher, "mesh_size": args.mesh_size_mm, "tie_width": args.tie_width_mm,
+             "axial_size": args.axial_size_mm, "edge_ratio": args.edge_ratio,
+             "fiber_intorder": args.fiber_intorder, "mesh_refine": args.refine}
     return FingerOptions(tie=args.tie, **{k: v for k, v in given.items() if v is not None})
 
 
