@@ -16,6 +16,7 @@ from studies.studyfile import load_study
 
 ROOT = Path(__file__).resolve().parent.parent
 
+N_SLOW = 24  # cases of the killed-run test
 SLOW_KIND = '''
 import time
 def case(params, design, outdir):
@@ -54,8 +55,10 @@ def test_dask_local_cluster_gives_the_same_results_as_the_process_pool(tmp_path)
 @pytest.mark.parametrize("sig", [signal.SIGKILL, signal.SIGINT])
 def test_killed_run_resumes_with_only_the_missing_cases(tmp_path, monkeypatch, sig):
     (tmp_path / "slowkind.py").write_text(SLOW_KIND)
+    # 24 cases of 0.25 s on 2 workers: 3 s, so the signal after the 3rd lands mid-run even on
+    # a loaded machine (with 12 cases a loaded CI run once finished before the signal)
     path = write_study(tmp_path, 'kind = "slowkind:case"\n[params]\nsleep_s = 0.25\n'
-                       '[sweep]\nx = "1:12:1"\n')
+                       f'[sweep]\nx = "1:{N_SLOW}:1"\n')
     study, root = load_study(path), tmp_path / "res"
     env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(tmp_path), str(ROOT)])}
     proc = subprocess.Popen([sys.executable, "-m", "studies.cli", "study", "run", str(path),
@@ -76,14 +79,14 @@ def test_killed_run_resumes_with_only_the_missing_cases(tmp_path, monkeypatch, s
     assert {p.name for p in folders} == set(before)
     assert all(json.loads(b)["status"] == "done" for b in before.values())
     assert all((sdir / k / "field.txt").stat().st_size == 100000 for k in before)
-    assert 3 <= len(before) < 12
+    assert 3 <= len(before) < N_SLOW
 
     monkeypatch.syspath_prepend(str(tmp_path))
     summary = run_study(study, results_root=root, workers=1, progress=False)
-    assert summary.ok and summary.reused == len(before) and summary.computed == 12 - len(before)
+    assert summary.ok and summary.reused == len(before) and summary.computed == N_SLOW - len(before)
     assert all((sdir / k / RESULT).read_bytes() == b for k, b in before.items())
     assert not (sdir / ".tmp").exists()
-    assert len(status(study, root)["done"]) == 12
+    assert len(status(study, root)["done"]) == N_SLOW
 
 
 def test_a_failing_case_is_recorded_and_the_others_finish(tmp_path, capsys):
