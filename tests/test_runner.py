@@ -52,6 +52,15 @@ def test_dask_local_cluster_gives_the_same_results_as_the_process_pool(tmp_path)
     assert all(r[2]["P_no_reservoir_MPa"] == 0.0 for r in rows if r[1] == 0.0)
 
 
+def _default_sigint():
+    """The child's SIGINT disposition back to the default. An ignored SIGINT is inherited
+    across exec and Python then installs no KeyboardInterrupt handler; in two fresh-clone
+    runs of the full suite the child ran to the end (exit 0) despite the SIGINT, never when
+    run alone. Python's own record showed no change in pytest's handler, so the suspect is a
+    C library ignoring SIGINT at the OS level; with this the full suite passes."""
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+
+
 @pytest.mark.parametrize("sig", [signal.SIGKILL, signal.SIGINT])
 def test_killed_run_resumes_with_only_the_missing_cases(tmp_path, monkeypatch, sig):
     (tmp_path / "slowkind.py").write_text(SLOW_KIND)
@@ -64,14 +73,14 @@ def test_killed_run_resumes_with_only_the_missing_cases(tmp_path, monkeypatch, s
     proc = subprocess.Popen([sys.executable, "-m", "studies.cli", "study", "run", str(path),
                              "--workers", "2", "--results", str(root), "--no-progress"],
                             env=env, start_new_session=True, stdout=subprocess.PIPE,
-                            stderr=subprocess.PIPE)
+                            stderr=subprocess.PIPE, preexec_fn=_default_sigint)
     sdir = study_dir(study, root)
     deadline = time.monotonic() + 60
     while len(list(sdir.glob(f"*/{RESULT}"))) < 3 and time.monotonic() < deadline:
         time.sleep(0.05)
     os.killpg(proc.pid, sig)
-    proc.communicate(timeout=60)
-    assert proc.returncode == (-signal.SIGKILL if sig == signal.SIGKILL else 130)
+    _, err = proc.communicate(timeout=60)
+    assert proc.returncode == (-signal.SIGKILL if sig == signal.SIGKILL else 130), err.decode()[-2000:]
 
     # every case folder that exists is complete and readable
     before = {p.parent.name: p.read_bytes() for p in sdir.glob(f"*/{RESULT}")}
