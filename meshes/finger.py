@@ -213,10 +213,9 @@ def layered_tube_mesh(tube: FingerTube, *, n_phi: int, layer_first: float, layer
 
     # extrude: slice k joins planes k and k + 1 (the core only inside the cap)
     n2 = len(rho2)
-    k = np.arange(len(x) - 1)
     in_cap = x[:-1] >= x_end - 1e-9
-    prisms = [(kk * n2 + tri) for kk, tri in ((kk, tris if in_cap[kk] else tris[~core]) for kk in k)]
-    lo = np.concatenate(prisms)                        # (n_prisms, 3): a0 < b0 < c0
+    lo = np.concatenate([k * n2 + (tris if in_cap[k] else tris[~core]) for k in range(len(x) - 1)])
+    # lo: (n_prisms, 3) bottom vertices a0 < b0 < c0; one Python step per slice, not per element
     hi = lo + n2
     t = np.concatenate([np.stack([lo[:, 0], lo[:, 1], lo[:, 2], hi[:, 2]]),
                         np.stack([lo[:, 0], lo[:, 1], hi[:, 1], hi[:, 2]]),
