@@ -4,8 +4,9 @@ changed at a time.
 
 On gmsh's nested meshes theta converged at an apparent order of 1.25 in h. If one model
 ingredient caused it, changing that ingredient would change the relative increase of theta
-from level 0 to level 1 (2.6 % for the default model) a lot. None does (2-4 % for all but
-the two-sided windings, which lock); the cause was the mesh (docs/finger.md, "What the error
+from level 0 to level 1 (2.6 % for the default model) a lot. None does (+1.5 ... +4 %; the
+rubber's 4-point rule for the windings -4.9 %, from above; the two-sided windings lock,
++43 %); the cause was the mesh (docs/finger.md, "What the error
 was": the axial spacing, cancelled in part by the cross-section's error of opposite sign).
 
 Variants: the rubber's bulk modulus (``kappa``: volumetric locking, the P0 pressure), the
