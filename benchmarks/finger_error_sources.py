@@ -4,7 +4,7 @@ changed at a time.
 
 On gmsh's nested meshes theta converged at an apparent order of 1.25 in h. If one model
 ingredient caused it, changing that ingredient would change the relative increase of theta
-from level 0 to level 1 (2.6 % for the default model) a lot. None does (+1.5 ... +4 %; the
+from level 0 to level 1 (2.6 % for the default model) a lot. None does (+1.4 ... +4 %; the
 rubber's 4-point rule for the windings -4.9 %, from above; the two-sided windings lock,
 +43 %); the cause was the mesh (docs/finger.md, "What the error
 was": the axial spacing, cancelled in part by the cross-section's error of opposite sign).
