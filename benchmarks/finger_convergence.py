@@ -63,13 +63,14 @@ def theta_case(path: Path, options: FingerOptions, prepare=None) -> dict:
     return result
 
 
-def level(family: str, n: int, out: Path, **changes) -> dict:
-    """theta(0.8 MPa) on level n of a family, from DIR if it was computed before."""
+def level(family: str, n: int, out: Path, variant: tuple[str, dict] | None = None) -> dict:
+    """theta(0.8 MPa) on level n of a family (layered: optionally a named cross-section
+    ``variant`` of :data:`CROSS_SECTION`), from DIR if it was computed before."""
     if family == "gmsh":
         return {"level": n, **theta_case(out / f"level{n}.json", replace(BASE, mesh_refine=n))}
-    name = "-".join([f"layered-level{n}", *changes])
-    options = replace(LAYERED, axial_size=LAYERED.axial_size / 2 ** n, **next(iter(changes.values()), {}))
-    return {"level": n, **theta_case(out / f"{name}.json", options)}
+    suffix, changes = (f"-{variant[0]}", variant[1]) if variant else ("", {})
+    options = replace(LAYERED, axial_size=LAYERED.axial_size / 2 ** n, **changes)
+    return {"level": n, **theta_case(out / f"layered-level{n}{suffix}.json", options)}
 
 
 def main() -> None:
@@ -101,7 +102,7 @@ def main() -> None:
                 print(f"  level {r['level']}: {100 * (r['theta_deg'] / limit - 1):+.2f} %")
     if args.cross_section and args.family == "layered":
         for name, changes in CROSS_SECTION:
-            r = level("layered", 2, args.out, **{name: changes})
+            r = level("layered", 2, args.out, (name, changes))
             against = f", {100 * (r['theta_deg'] / limit - 1):+.2f} % vs the extrapolation" if limit else ""
             print(f"level 2, {name}: {r['ndofs']} unknowns, theta {r['theta_deg']:.4f} deg{against}", flush=True)
 
