@@ -124,9 +124,11 @@ class Restriction:
     does with ``restriction=``); ``expand(x, fill)`` puts a reduced vector back into a full one.
     """
 
-    def __init__(self, n: int, keep: np.ndarray):
+    def __init__(self, n: int, keep: np.ndarray, values: np.ndarray | float = 0.0):
         self.n = n
         self.keep = np.unique(np.asarray(keep, dtype=np.int64))
+        #: the full vector's entries outside ``keep`` (prescribed displacements), filled by expand
+        self.values = np.array(np.broadcast_to(values, (n,)), dtype=float)
         self._new = np.full(n, -1, dtype=np.int64)
         self._new[self.keep] = np.arange(len(self.keep))
         self._pattern = None
@@ -175,8 +177,9 @@ class Restriction:
         """R[keep]."""
         return R[self.keep]
 
-    def expand(self, x: np.ndarray, fill: np.ndarray | float = 0.0) -> np.ndarray:
-        """Full vector equal to ``fill`` outside ``keep`` and to ``x`` on it."""
-        out = np.array(np.broadcast_to(fill, (self.n,)), dtype=float)
+    def expand(self, x: np.ndarray, fill: np.ndarray | float | None = None) -> np.ndarray:
+        """Full vector equal to ``fill`` (default: the prescribed ``values``) outside ``keep``
+        and to ``x`` on it."""
+        out = np.array(np.broadcast_to(self.values if fill is None else fill, (self.n,)), dtype=float)
         out[self.keep] = x
         return out

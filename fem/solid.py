@@ -106,6 +106,25 @@ class Solid:
         """Reference coordinates (3, n_scalar) of the scalar dofs."""
         return self.sbasis.doflocs
 
+    def reaction(self, u: np.ndarray, facets, *, about=None, external=None):
+        """Resultant force [N] (3,) that the supports on ``facets`` exert on the body, and its
+        moment [N mm] (3,) about the point ``about`` (None: no moment), at equilibrium state u.
+
+        The support's force on a dof is minus the residual of the free body there,
+        f_int - f_ext (``external``: the external force vector on those dofs, e.g. a follower
+        pressure's share, if any acts there), summed per component; the moment uses the
+        deformed positions X + u of the facets' dofs.
+        """
+        dofs = self.dofs(facets)
+        f = self.residual(u) if external is None else self.residual(u) - external
+        forces = f[dofs].reshape(-1, 3)
+        resultant = forces.sum(axis=0)
+        if about is None:
+            return resultant, None
+        scalar = dofs.reshape(-1, 3)[:, 0] // 3
+        x = self.dof_locations[:, scalar].T + self.nodal(u)[:, scalar].T - np.asarray(about, float)
+        return resultant, np.cross(x, forces).sum(axis=0)
+
     # -- kinematics -------------------------------------------------------------------
     def F(self, u: np.ndarray, elements=slice(None)) -> np.ndarray:
         """Deformation gradient (3, 3, ne, nqp) at the quadrature points of the elements."""
@@ -258,14 +277,21 @@ class PressureAnchor:
 class MixedNewton:
     """Glue for :func:`fem.newton.newton`: ``on_accept`` re-anchors the element pressures.
 
-    Usage::
+    ``expand(x)`` must return the **full** displacement at the unknowns x, prescribed values
+    included: the pressures are linearised at that state, and an anchor taken at a state
+    with the prescribed displacements missing (zeros) makes Newton converge only linearly.
+    A :class:`fem.assembly.Restriction` built with ``values=`` expands that way. Usage::
 
-        mixed = MixedNewton(solid, expand=lambda x: red.expand(x))
+        red = Restriction(solid.ndofs, free, values=u_prescribed)
+        mixed = MixedNewton(solid, red.expand)
         fun = lambda x: ... solid.residual_tangent(red.expand(x), anchor=mixed.anchor) ...
         newton(fun, x0, on_accept=mixed.accept)   # or solve_path(..., on_accept=mixed.accept)
+
+    For prescribed values that grow with the load factor t, pass an ``expand`` that applies
+    the current t (see ``studies/verify_solid.py``).
     """
 
-    def __init__(self, solid: Solid, expand=lambda x: x):
+    def __init__(self, solid: Solid, expand):
         self.solid, self.expand, self.anchor = solid, expand, None
 
     def accept(self, x) -> None:

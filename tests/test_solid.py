@@ -191,3 +191,63 @@ def test_plane_strain_tube_pressure_field_has_no_locking_oscillation():
     # P0 pressure on a 4 x 8 mesh: O(h) error, a few % of the 0.44 MPa range; no oscillation
     assert rms["mean_dilatation"] < 0.05 * P, rms
     assert rms["displacement"] > 10 * rms["mean_dilatation"], rms
+
+
+MU = 1.0  #: shear modulus of the stretched box [MPa]
+
+
+def stretch_box(lam: float, kappa: float, values_known: bool):
+    """The unit-cross-section box of length 2 stretched to lam by a prescribed end displacement
+    (one mixed-Newton solve from rest); symmetry planes x = 0, y = 0, z = 0 (with_defaults names
+    left/bottom/front for x, y, z = 0 and back for z = 2). -> (solid, u, Newton iterations)."""
+    from fem.newton import newton
+
+    mesh = box(n=(1, 1, 2))
+    solid = Solid(mesh, NeoHookean(MU, kappa))
+    end = solid.dofs("back", (2,))
+    fixed = np.unique(np.concatenate([solid.dofs("left", (0,)), solid.dofs("bottom", (1,)),
+                                      solid.dofs("front", (2,)), end]))
+    u_D = np.zeros(solid.ndofs)
+    u_D[end] = (lam - 1.0) * 2.0
+    red = Restriction(solid.ndofs, solid.free_dofs(fixed), values=u_D if values_known else 0.0)
+    expand = lambda x: red.expand(x, u_D)  # noqa: E731 - the state the residual is taken at
+    mixed = MixedNewton(solid, red.expand)  # values_known=False: the anchor misses u_D
+
+    def fun(x):
+        return solid.residual_tangent(expand(x), anchor=mixed.anchor, restriction=red)
+
+    x0 = np.zeros(len(red.keep))
+    r = newton(fun, x0, NewtonOptions(rtol=1e-10, max_iter=40, merit="finite"),
+               solver=make_solver(), on_accept=mixed.accept)
+    return solid, expand(r.x), r.history
+
+
+def test_mixed_newton_with_prescribed_displacements_converges_quadratically():
+    """An anchor taken at the full state (prescribed values included) keeps Newton quadratic
+    (one step to stretch 1.5 at kappa = 1000 mu, from rest); one that misses them, as ``expand`` with
+    zeros for the fixed dofs did, does not converge at all."""
+    from fem.newton import NotConverged
+
+    _, _, history = stretch_box(1.5, 1000.0 * MU, values_known=True)
+    h = np.array(history) / history[0]
+    assert len(h) <= 13, history                       # from rest, line-searched, one step
+    assert h[-1] < 1e-10 and h[-1] < 10 * h[-2] ** 1.8, history  # the last step: quadratic
+    with pytest.raises(NotConverged):  # the anchor at u with u_D = 0: Newton wanders off
+        stretch_box(1.5, 1000.0 * MU, values_known=False)
+
+
+def test_reaction_force_and_moment_are_the_uniaxial_closed_form():
+    """The support's resultant on the stretched end is P11 A0 (homogeneous uniaxial tension,
+    exact in P2), and its moment about the origin is c x F with c the end face's deformed
+    centre (a uniform traction has no moment about its centroid)."""
+    from studies.closed_forms import uniaxial_lateral_stretch, uniaxial_nominal_stress
+
+    lam, kappa = 1.5, 1000.0 * MU
+    solid, u, _ = stretch_box(lam, kappa, values_known=True)
+    force, moment = solid.reaction(u, "back", about=(0.0, 0.0, 0.0))
+    F = uniaxial_nominal_stress(lam, MU, kappa) * 1.0  # A0 = 1 x 1 mm^2
+    lat = uniaxial_lateral_stretch(lam, MU, kappa)
+    np.testing.assert_allclose(force, [0.0, 0.0, F], rtol=1e-7, atol=1e-9)  # Newton rtol 1e-10
+    c = np.array([0.5 * lat, 0.5 * lat, 2.0 * lam])
+    np.testing.assert_allclose(moment, np.cross(c, [0.0, 0.0, F]), rtol=1e-7, atol=1e-8)
+    assert solid.reaction(u, "back")[1] is None
