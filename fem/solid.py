@@ -110,10 +110,10 @@ class Solid:
         """Resultant force [N] (3,) that the supports on ``facets`` exert on the body, and its
         moment [N mm] (3,) about the point ``about`` (None: no moment), at equilibrium state u.
 
-        The support's force on a dof is minus the residual of the free body there,
-        f_int - f_ext (``external``: the external force vector on those dofs, e.g. a follower
-        pressure's share, if any acts there), summed per component; the moment uses the
-        deformed positions X + u of the facets' dofs.
+        The support's force on a dof is the residual of the body without it, f_int - f_ext
+        (``external``: the external force vector f_ext, e.g. a follower pressure's, if any acts
+        on those dofs), summed per component; the moment uses the deformed positions X + u
+        of the facets' dofs.
         """
         dofs = self.dofs(facets)
         f = self.residual(u) if external is None else self.residual(u) - external
