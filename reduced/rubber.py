@@ -1,0 +1,340 @@
+r"""Incompressible rubber: strain energies W(lambda1, lambda2, lambda3) and their derivatives.
+
+One place for the hyperelastic models, pure NumPy and vectorised over any array shape.
+The reduced model evaluates them on its kinematics (finger: lambda, 1, 1/lambda;
+reservoir: lambda, lambda, 1/lambda^2); ``softhand material fit`` on the test modes; the
+FEM (:mod:`fem.materials`) builds its isochoric stress and tangent tensors from the
+invariant derivatives of the same objects, at the isochoric stretches J^{-1/3} lambda_i.
+
+Models (I1 = sum lambda_i^2, I2 = sum_{i<j} lambda_i^2 lambda_j^2, both at J = 1):
+
+.. math::
+    W_\text{NH} &= \tfrac{\mu}{2}(I_1 - 3), \qquad
+    W_\text{MR} = C_{10}(I_1 - 3) + C_{01}(I_2 - 3), \\
+    W_\text{Yeoh} &= C_{10}(I_1 - 3) + C_{20}(I_1 - 3)^2 + C_{30}(I_1 - 3)^3, \qquad
+    W_\text{Gent} = -\tfrac{\mu J_m}{2}\ln\Big(1 - \frac{I_1 - 3}{J_m}\Big), \\
+    W_\text{Ogden} &= \sum_p \frac{\mu_p}{\alpha_p}(\lambda_1^{\alpha_p} + \lambda_2^{\alpha_p}
+        + \lambda_3^{\alpha_p} - 3) \quad\text{(Ogden's 1972 convention)}.
+
+Initial shear moduli: mu, 2 (C10 + C01), 2 C10, mu, (1/2) sum mu_p alpha_p.
+
+Every model gives ``energy``, ``dW`` (dW/dlambda_i, shape (3, ...)) and ``d2W``
+(d2W/dlambda_i dlambda_j, (3, 3, ...)), exact; invariant models also ``dI``
+((W_1, W_2)) and ``d2I`` ((W_11, W_12, W_22)). Test modes (incompressible, nominal
+stress = force per reference area, in the stretched direction):
+
+* ``uniaxial``: (lambda, lambda^-1/2, lambda^-1/2), P = dW/dlambda;
+* ``equibiaxial``: (lambda, lambda, lambda^-2), P = (1/2) dW/dlambda (per direction);
+* ``pure-shear`` (planar tension): (lambda, 1, 1/lambda), P = dW/dlambda.
+
+The parameter names are public (TOML keys and ``--json``): NH ``mu_MPa``; MR ``C10_MPa``,
+``C01_MPa``; Yeoh ``C10_MPa``, ``C20_MPa``, ``C30_MPa``; Gent ``mu_MPa``, ``Jm``; Ogden
+``mu1_MPa``, ``alpha1``, ``mu2_MPa``, ``alpha2``, ... Units: MPa.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, fields, replace
+
+import numpy as np
+
+from .errors import InputError
+
+MODES = ("uniaxial", "equibiaxial", "pure-shear")
+
+
+class Rubber:
+    """Base of the models: principal-stretch interface, modes, parameters by public name."""
+
+    model = ""  #: the name in design files (``model = "..."``)
+
+    # -- parameters ----------------------------------------------------------------------
+    def parameters(self) -> dict:
+        """Public name -> value."""
+        return {_PUBLIC[f.name]: float(getattr(self, f.name)) for f in fields(self)}
+
+    def scaled(self, factor: float) -> "Rubber":
+        """The same shape of W with every modulus [MPa] times ``factor``."""
+        return replace(self, **{f.name: factor * getattr(self, f.name) for f in fields(self)
+                                if _PUBLIC[f.name].endswith("_MPa")})
+
+    @property
+    def mu0(self) -> float:
+        """Initial shear modulus [MPa]."""
+        raise NotImplementedError
+
+    # -- modes ---------------------------------------------------------------------------
+    def mode_energy(self, mode: str, lam):
+        """W along a test mode at stretch lam [MPa]."""
+        return self.energy(*stretches(mode, lam))
+
+    def nominal_stress(self, mode: str, lam):
+        """Nominal stress [MPa] of a test mode at stretch lam (see the module docstring)."""
+        lam = np.asarray(lam, float)
+        dl, share = _path_rates(mode, lam)
+        return np.einsum("i...,i...->...", self.dW(*stretches(mode, lam)), dl) / share
+
+    def drucker_hessian(self, l1, l2, l3):
+        r"""Hessian of w(e1, e2) = W(e^e1, e^e2, e^{-e1-e2}) in the log strains, (2, 2, ...).
+
+        Positive definite <=> Drucker stable (d sigma : d epsilon > 0, incompressible)."""
+        l = np.stack(np.broadcast_arrays(*map(np.asarray, (l1, l2, l3))))
+        g, H = self.dW(*l), self.d2W(*l)
+        out = np.empty((2, 2) + l.shape[1:])
+        for a in range(2):
+            for b in range(2):
+                out[a, b] = (H[a, b] * l[a] * l[b] - H[a, 2] * l[a] * l[2] - H[b, 2] * l[b] * l[2]
+                             + H[2, 2] * l[2] ** 2 + g[2] * l[2] + (a == b) * g[a] * l[a])
+        return out
+
+
+def stretches(mode: str, lam):
+    """Principal stretches (l1, l2, l3) of an incompressible test mode at stretch lam."""
+    lam = np.asarray(lam, float)
+    if mode == "uniaxial":
+        return lam, lam**-0.5, lam**-0.5
+    if mode == "equibiaxial":
+        return lam, lam, lam**-2.0
+    if mode == "pure-shear":
+        return lam, np.ones_like(lam), 1.0 / lam
+    raise InputError("mode", mode, f"must be one of {', '.join(MODES)}")
+
+
+def _path_rates(mode, lam):
+    """(d l_i / d lam (3, ...), number of stretched directions sharing dW/dlam)."""
+    one, zero = np.ones_like(lam), np.zeros_like(lam)
+    if mode == "uniaxial":
+        return np.stack([one, -0.5 * lam**-1.5, -0.5 * lam**-1.5]), 1.0
+    if mode == "equibiaxial":
+        return np.stack([one, one, -2.0 * lam**-3.0]), 2.0
+    stretches(mode, lam)  # raises for an unknown mode
+    return np.stack([one, zero, -lam**-2.0]), 1.0
+
+
+class InvariantRubber(Rubber):
+    """W(I1, I2): the principal-stretch derivatives follow by the chain rule."""
+
+    def energy(self, l1, l2, l3):
+        return self.W(*invariants(l1, l2, l3))
+
+    def dW(self, l1, l2, l3):
+        l = np.stack(np.broadcast_arrays(*map(np.asarray, (l1, l2, l3)))).astype(float)
+        W1, W2 = self.dI(*invariants(*l))
+        sq = l**2
+        return 2.0 * l * (W1 + W2 * (sq.sum(axis=0) - sq))
+
+    def d2W(self, l1, l2, l3):
+        l = np.stack(np.broadcast_arrays(*map(np.asarray, (l1, l2, l3)))).astype(float)
+        I1, I2 = invariants(*l)
+        W1, W2 = self.dI(I1, I2)
+        W11, W12, W22 = self.d2I(I1, I2)
+        sq = l**2
+        a = 2.0 * l                                  # dI1/dl_i
+        b = 2.0 * l * (sq.sum(axis=0) - sq)          # dI2/dl_i
+        eye = np.eye(3).reshape((3, 3) + (1,) * (l.ndim - 1))
+        d2I2 = 4.0 * l[:, None] * l[None, :] * (1.0 - eye) + eye * (2.0 * (sq.sum(axis=0) - sq))[:, None]
+        return (W11 * a[:, None] * a[None, :] + W12 * (a[:, None] * b[None, :] + b[:, None] * a[None, :])
+                + W22 * b[:, None] * b[None, :] + W1 * 2.0 * eye + W2 * d2I2)
+
+
+def invariants(l1, l2, l3):
+    """(I1, I2) of the principal stretches (I2 = sum_{i<j} l_i^2 l_j^2)."""
+    s1, s2, s3 = (np.asarray(x, float) ** 2 for x in (l1, l2, l3))
+    return s1 + s2 + s3, s1 * s2 + s2 * s3 + s3 * s1
+
+
+@dataclass(frozen=True)
+class NeoHookean(InvariantRubber):
+    """W = mu/2 (I1 - 3)."""
+
+    mu: float  #: shear modulus [MPa]
+    model = "neo-hookean"
+
+    @property
+    def mu0(self):
+        return self.mu
+
+    def W(self, I1, I2):
+        return 0.5 * self.mu * (I1 - 3.0)
+
+    def dI(self, I1, I2):
+        return 0.5 * self.mu * np.ones_like(I1), np.zeros_like(I1)
+
+    def d2I(self, I1, I2):
+        zero = np.zeros_like(I1)
+        return zero, zero, zero
+
+
+@dataclass(frozen=True)
+class MooneyRivlin(InvariantRubber):
+    """W = C10 (I1 - 3) + C01 (I2 - 3)."""
+
+    C10: float  #: [MPa]
+    C01: float  #: [MPa]
+    model = "mooney-rivlin"
+
+    @property
+    def mu0(self):
+        return 2.0 * (self.C10 + self.C01)
+
+    def W(self, I1, I2):
+        return self.C10 * (I1 - 3.0) + self.C01 * (I2 - 3.0)
+
+    def dI(self, I1, I2):
+        one = np.ones_like(I1)
+        return self.C10 * one, self.C01 * one
+
+    def d2I(self, I1, I2):
+        zero = np.zeros_like(I1)
+        return zero, zero, zero
+
+
+@dataclass(frozen=True)
+class Yeoh(InvariantRubber):
+    """W = C10 (I1 - 3) + C20 (I1 - 3)^2 + C30 (I1 - 3)^3."""
+
+    C10: float  #: [MPa]
+    C20: float = 0.0  #: [MPa]
+    C30: float = 0.0  #: [MPa]
+    model = "yeoh"
+
+    @property
+    def mu0(self):
+        return 2.0 * self.C10
+
+    def W(self, I1, I2):
+        x = I1 - 3.0
+        return x * (self.C10 + x * (self.C20 + x * self.C30))
+
+    def dI(self, I1, I2):
+        x = I1 - 3.0
+        return self.C10 + x * (2.0 * self.C20 + 3.0 * self.C30 * x), np.zeros_like(x)
+
+    def d2I(self, I1, I2):
+        x = I1 - 3.0
+        zero = np.zeros_like(x)
+        return 2.0 * self.C20 + 6.0 * self.C30 * x, zero, zero
+
+
+@dataclass(frozen=True)
+class Gent(InvariantRubber):
+    """W = -mu Jm / 2 ln(1 - (I1 - 3)/Jm); nan beyond the chain-locking limit I1 - 3 >= Jm."""
+
+    mu: float  #: initial shear modulus [MPa]
+    Jm: float  #: locking parameter: the largest I1 - 3 [-]
+    model = "gent"
+
+    @property
+    def mu0(self):
+        return self.mu
+
+    def _g(self, I1):
+        g = 1.0 - (np.asarray(I1, float) - 3.0) / self.Jm
+        return np.where(g > 0.0, g, np.nan)
+
+    def W(self, I1, I2):
+        return -0.5 * self.mu * self.Jm * np.log(self._g(I1))
+
+    def dI(self, I1, I2):
+        return 0.5 * self.mu / self._g(I1), np.zeros_like(np.asarray(I1, float))
+
+    def d2I(self, I1, I2):
+        zero = np.zeros_like(np.asarray(I1, float))
+        return 0.5 * self.mu / (self.Jm * self._g(I1) ** 2), zero, zero
+
+
+@dataclass(frozen=True)
+class Ogden(Rubber):
+    """W = sum_p mu_p / alpha_p (l1^alpha_p + l2^alpha_p + l3^alpha_p - 3)."""
+
+    mu: tuple  #: mu_p [MPa]
+    alpha: tuple  #: alpha_p [-], nonzero
+    model = "ogden"
+
+    def __post_init__(self):
+        object.__setattr__(self, "mu", tuple(float(m) for m in self.mu))
+        object.__setattr__(self, "alpha", tuple(float(a) for a in self.alpha))
+
+    @property
+    def mu0(self):
+        return 0.5 * sum(m * a for m, a in zip(self.mu, self.alpha))
+
+    def parameters(self):
+        out = {}
+        for p, (m, a) in enumerate(zip(self.mu, self.alpha), start=1):
+            out[f"mu{p}_MPa"], out[f"alpha{p}"] = m, a
+        return out
+
+    def scaled(self, factor):
+        return Ogden(tuple(factor * m for m in self.mu), self.alpha)
+
+    def energy(self, l1, l2, l3):
+        l = np.stack(np.broadcast_arrays(*map(np.asarray, (l1, l2, l3)))).astype(float)
+        return sum(m / a * ((l**a).sum(axis=0) - 3.0) for m, a in zip(self.mu, self.alpha))
+
+    def dW(self, l1, l2, l3):
+        l = np.stack(np.broadcast_arrays(*map(np.asarray, (l1, l2, l3)))).astype(float)
+        return sum(m * l ** (a - 1.0) for m, a in zip(self.mu, self.alpha))
+
+    def d2W(self, l1, l2, l3):
+        l = np.stack(np.broadcast_arrays(*map(np.asarray, (l1, l2, l3)))).astype(float)
+        diag = sum(m * (a - 1.0) * l ** (a - 2.0) for m, a in zip(self.mu, self.alpha))
+        eye = np.eye(3).reshape((3, 3) + (1,) * (l.ndim - 1))
+        return eye * diag[:, None]
+
+
+#: dataclass field -> public parameter name
+_PUBLIC = {"mu": "mu_MPa", "C10": "C10_MPa", "C01": "C01_MPa", "C20": "C20_MPa",
+           "C30": "C30_MPa", "Jm": "Jm"}
+MODELS = {cls.model: cls for cls in (NeoHookean, MooneyRivlin, Yeoh, Gent, Ogden)}
+
+
+def parameter_names(model: str, terms: int = 3) -> tuple[str, ...]:
+    """The public parameter names of a model (``terms``: Ogden's number of terms)."""
+    if model == "ogden":
+        return tuple(k for p in range(1, terms + 1) for k in (f"mu{p}_MPa", f"alpha{p}"))
+    cls = _model_class(model)
+    return tuple(_PUBLIC[f.name] for f in fields(cls))
+
+
+def _model_class(model):
+    if model not in MODELS:
+        raise InputError("model", model, f"must be one of {', '.join(MODELS)}")
+    return MODELS[model]
+
+
+def from_parameters(model: str, values: dict, *, source: str = "material") -> Rubber:
+    """A validated model from its public parameter names (as in ``[finger.material]``)."""
+    cls = _model_class(model)
+    for key, value in values.items():
+        if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+            raise InputError(f"{source}.{key}", value, "must be a finite number")
+    if model == "ogden":
+        terms = sum(1 for k in values if k.startswith("mu") and k.endswith("_MPa"))
+        names = parameter_names(model, max(terms, 1))
+    else:
+        names = parameter_names(model)
+    unknown = set(values) - set(names)
+    if unknown:
+        raise InputError(f"{source}.{sorted(unknown)[0]}", values[sorted(unknown)[0]],
+                         f"unknown parameter of model {model!r}; allowed: {', '.join(names)}")
+    required = names if model != "yeoh" else ("C10_MPa",)
+    missing = [k for k in required if k not in values]
+    if missing:
+        raise InputError(f"{source}.{missing[0]}", None, f"missing; model {model!r} needs "
+                         f"{', '.join(names)}")
+    if model == "ogden":
+        mus = [values[f"mu{p}_MPa"] for p in range(1, terms + 1)]
+        alphas = [values[f"alpha{p}"] for p in range(1, terms + 1)]
+        if any(a == 0 for a in alphas):
+            raise InputError(f"{source}.alpha", alphas, "Ogden exponents must be nonzero")
+        rubber = Ogden(tuple(mus), tuple(alphas))
+    else:
+        field_of = {v: k for k, v in _PUBLIC.items()}
+        rubber = cls(**{field_of[k]: float(v) for k, v in values.items()})
+    if not rubber.mu0 > 0:
+        raise InputError(f"{source}", rubber.parameters(),
+                         f"initial shear modulus {rubber.mu0:.6g} MPa must be positive")
+    if model == "gent" and not rubber.Jm > 0:
+        raise InputError(f"{source}.Jm", rubber.Jm, "must be positive")
+    return rubber
