@@ -1,0 +1,266 @@
+r"""Fit a rubber model (:mod:`reduced.rubber`) to nominal stress vs stretch test data.
+
+Data: a CSV file with the columns ``mode`` (``uniaxial``, ``equibiaxial``, ``pure-shear``;
+any mix), ``stretch`` [-] and ``stress_MPa`` (nominal stress: force per reference area,
+in the stretched direction). Lines starting with ``#`` are comments.
+
+Least squares in the stress itself (MPa), all rows with equal weight:
+
+.. math:: S(p) = \sum_i (P^{model}_{m_i}(\lambda_i; p) - P_i)^2 .
+
+NH, Mooney-Rivlin and Yeoh are linear in their parameters: solved directly. Gent and
+Ogden are fitted by :func:`scipy.optimize.least_squares` from several starts (Ogden:
+exponents on a grid, the moduli for each by linear least squares; Gent: locking
+parameters on a grid) and refined. Standard errors and correlations come from the
+Jacobian at the optimum as in :func:`reduced.fit.diagnose`: Cov = S/(N - k) (J^T J)^{-1}.
+Ogden's terms are reported in ascending alpha_p (W does not depend on their order).
+
+Drucker stability (incompressible): the Hessian of W in the log strains
+(:meth:`reduced.rubber.Rubber.drucker_hessian`) must be positive definite. It is checked
+in uniaxial, equibiaxial and pure-shear deformation at stretches over a stated range
+(tension above 1, compression below), by default 1/lambda_max .. lambda_max of the data.
+"""
+from __future__ import annotations
+
+import csv
+import math
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+from scipy.optimize import least_squares
+
+from . import rubber
+from .errors import InputError
+from .fit import FitOptions, diagnose, jacobian
+
+#: ``--model`` -> (rubber model, Ogden terms)
+FIT_MODELS = {"neo-hookean": ("neo-hookean", 0), "mooney-rivlin": ("mooney-rivlin", 0),
+              "yeoh": ("yeoh", 0), "gent": ("gent", 0), "ogden2": ("ogden", 2),
+              "ogden3": ("ogden", 3)}
+_MODE_ALIASES = {"uniaxial": "uniaxial", "ut": "uniaxial", "equibiaxial": "equibiaxial",
+                 "biaxial": "equibiaxial", "et": "equibiaxial", "eb": "equibiaxial",
+                 "pure-shear": "pure-shear", "pure_shear": "pure-shear", "ps": "pure-shear",
+                 "planar": "pure-shear"}
+COLUMNS = ("mode", "stretch", "stress_MPa")
+
+
+@dataclass(frozen=True)
+class StressData:
+    """Test points: mode per row, stretch [-], nominal stress [MPa]."""
+
+    mode: np.ndarray
+    stretch: np.ndarray
+    stress: np.ndarray
+    source: str = "data"
+
+    def __len__(self):
+        return int(self.stretch.size)
+
+    def predict(self, material: rubber.Rubber) -> np.ndarray:
+        out = np.empty(len(self))
+        for m in np.unique(self.mode):
+            rows = self.mode == m
+            out[rows] = material.nominal_stress(m, self.stretch[rows])
+        return out
+
+
+def read_test_data(path) -> StressData:
+    """Read the CSV (see the module docstring); one InputError naming file, line, column."""
+    path = Path(path)
+    try:
+        text = path.read_text(encoding="utf-8-sig")
+    except (FileNotFoundError, IsADirectoryError):
+        raise InputError("--data", str(path), "no such file; give a CSV file") from None
+    except UnicodeDecodeError:
+        raise InputError("--data", str(path), "is not a UTF-8 text (CSV) file") from None
+    lines = [(i, line) for i, line in enumerate(text.splitlines(), start=1)
+             if line.strip() and not line.lstrip().startswith("#")]
+    if len(lines) < 2:
+        raise InputError("--data", str(path), f"needs a header row ({','.join(COLUMNS)}) and data rows")
+    rows = [(i, [c.strip() for c in cells]) for (i, _), cells in zip(lines, csv.reader(l for _, l in lines))]
+    header = rows[0][1]
+    if sorted(header) != sorted(COLUMNS):
+        raise InputError(f"{path.name}: columns", ",".join(header), f"must be {','.join(COLUMNS)}")
+    mode, lam, stress = [], [], []
+    for line, cells in rows[1:]:
+        if len(cells) != len(header):
+            raise InputError(f"{path.name}: line {line}", ",".join(cells),
+                             f"has {len(cells)} cells; the header has {len(header)}")
+        cell = dict(zip(header, cells))
+        name = _MODE_ALIASES.get(cell["mode"].lower())
+        if name is None:
+            raise InputError(f"{path.name}: line {line}, column mode", cell["mode"],
+                             f"must be one of {', '.join(rubber.MODES)}")
+        mode.append(name)
+        lam.append(_number(path.name, line, "stretch", cell["stretch"], positive=True))
+        stress.append(_number(path.name, line, "stress_MPa", cell["stress_MPa"]))
+    return StressData(np.array(mode), np.array(lam), np.array(stress), path.name)
+
+
+def _number(name, line, col, text, positive=False):
+    try:
+        value = float(text)
+    except ValueError:
+        value = math.nan
+    if not math.isfinite(value) or (positive and not value > 0):
+        raise InputError(f"{name}: line {line}, column {col}", text,
+                         "must be a positive number" if positive else "must be a finite number")
+    return value
+
+
+@dataclass(frozen=True)
+class MaterialFit:
+    """A fitted rubber model with its uncertainty and how it matches the data."""
+
+    fit_model: str  #: the ``--model`` name (ogden2, ogden3, ...)
+    material: rubber.Rubber
+    names: tuple  #: public parameter names
+    values: np.ndarray
+    stderr: np.ndarray
+    correlation: np.ndarray
+    residuals: np.ndarray  #: model - data [MPa]
+    data: StressData
+    warnings: tuple = ()
+
+    def rms_by_mode(self) -> dict:
+        return {m: float(np.sqrt(np.mean(self.residuals[self.data.mode == m] ** 2)))
+                for m in rubber.MODES if np.any(self.data.mode == m)}
+
+    @property
+    def rms(self) -> float:
+        return float(np.sqrt(np.mean(self.residuals**2)))
+
+
+def model_residual_fn(fit_model: str, data: StressData):
+    """(names, x -> residuals [MPa], x -> material) of a ``--model`` on the data."""
+    if fit_model not in FIT_MODELS:
+        raise InputError("--model", fit_model, f"must be one of {', '.join(FIT_MODELS)}")
+    model, terms = FIT_MODELS[fit_model]
+    names = rubber.parameter_names(model, terms)
+
+    def material(x):
+        if model == "ogden":
+            return rubber.Ogden(tuple(x[0::2]), tuple(x[1::2]))
+        field = {"mu_MPa": "mu", "C10_MPa": "C10", "C01_MPa": "C01", "C20_MPa": "C20",
+                 "C30_MPa": "C30", "Jm": "Jm"}
+        return rubber.MODELS[model](**{field[k]: float(v) for k, v in zip(names, x)})
+
+    return names, (lambda x: data.predict(material(x)) - data.stress), material
+
+
+def fit_material(data: StressData, fit_model: str, options: FitOptions = FitOptions()) -> MaterialFit:
+    """Least-squares fit of ``fit_model`` to the data with standard errors (see the module)."""
+    names, residual, material = model_residual_fn(fit_model, data)
+    if len(data) <= len(names):
+        raise InputError("--data", f"{len(data)} points",
+                         f"need more points than the {len(names)} parameters of {fit_model}")
+    model = FIT_MODELS[fit_model][0]
+    if model in ("neo-hookean", "mooney-rivlin", "yeoh"):
+        x = _linear_fit(data, names, material)
+        lo, hi = np.full(x.size, -np.inf), np.full(x.size, np.inf)
+    elif model == "gent":
+        x, lo, hi = _gent_fit(data, residual)
+    else:
+        x, lo, hi = _ogden_fit(data, names, residual)
+        order = np.argsort(x[1::2])  # terms in ascending alpha (W does not depend on the order)
+        x = np.column_stack([x[0::2][order], x[1::2][order]]).ravel()
+    J = jacobian(residual, x, lo, hi, options.rel_step)
+    r = residual(x)
+    diag = diagnose(names, J, r, x, options)
+    return MaterialFit(fit_model, material(x), names, x, diag.stderr, diag.correlation, r, data,
+                       diag.warnings)
+
+
+def _linear_fit(data, names, material):
+    """Stress is linear in the parameters: the columns are the stresses of unit parameters."""
+    k = len(names)
+    A = np.column_stack([data.predict(material(np.eye(k)[j])) for j in range(k)])
+    return np.linalg.lstsq(A, data.stress, rcond=None)[0]
+
+
+def _refine(residual, x0, lo, hi):
+    sol = least_squares(residual, x0, bounds=(lo, hi), method="trf", x_scale="jac",
+                        ftol=1e-14, xtol=1e-14, gtol=1e-14, max_nfev=2000)
+    return sol.x, float(sol.fun @ sol.fun)
+
+
+def _gent_fit(data, residual):
+    """Starts: Jm on a log grid above the data's largest I1 - 3, mu linear for each."""
+    I1 = sum(s**2 for s in _stretch_triples(data))
+    jm_min = float(np.max(I1) - 3.0) * (1.0 + 1e-9) + 1e-12
+    lo, hi = np.array([1e-12, jm_min]), np.array([np.inf, np.inf])
+    starts = []
+    for jm in jm_min * np.geomspace(1.01, 1e4, 41):
+        unit = residual(np.array([1.0, jm])) + data.stress  # stress of mu = 1
+        mu = max(float(unit @ data.stress / (unit @ unit)), 1e-6)
+        r = mu * unit - data.stress
+        starts.append((float(r @ r), np.array([mu, jm])))
+    return _best_refined(residual, starts, lo, hi, 3), lo, hi
+
+
+def _best_refined(residual, starts, lo, hi, count):
+    """Refine the ``count`` best (S, x0) starts; the x of the smallest S."""
+    best = None
+    for _, x0 in sorted(starts, key=lambda s: s[0])[:count]:
+        x, S = _refine(residual, x0, lo, hi)
+        if np.isfinite(S) and (best is None or S < best[1]):
+            best = (x, S)
+    return best[0]
+
+
+def _ogden_fit(data, names, residual):
+    """Starts: exponent sets from a grid, moduli by linear least squares; the best few refined."""
+    n = len(names) // 2
+    grid = [-4.0, -2.0, -1.0, 0.5, 1.0, 1.5, 2.0, 3.0, 4.0, 6.0, 8.0]
+    sets = [np.array(c) for c in _combinations(grid, n)]
+    starts = []
+    for alpha in sets:
+        A = np.column_stack([data.predict(rubber.Ogden((1.0,), (a,))) for a in alpha])
+        mu = np.linalg.lstsq(A, data.stress, rcond=None)[0]
+        x = np.empty(2 * n)
+        x[0::2], x[1::2] = mu, alpha
+        r = A @ mu - data.stress
+        starts.append((float(r @ r), x))
+    lo, hi = np.full(2 * n, -np.inf), np.full(2 * n, np.inf)
+    lo[1::2], hi[1::2] = -20.0, 20.0
+    return _best_refined(residual, starts, lo, hi, 5), lo, hi
+
+
+def _combinations(grid, n):
+    if n == 0:
+        yield ()
+        return
+    for i, a in enumerate(grid):
+        for rest in _combinations(grid[i + 1:], n - 1):
+            yield (a, *rest)
+
+
+def _stretch_triples(data):
+    l = np.empty((3, len(data)))
+    for m in np.unique(data.mode):
+        rows = data.mode == m
+        l[:, rows] = rubber.stretches(m, data.stretch[rows])
+    return l
+
+
+def drucker_check(material: rubber.Rubber, stretch_range: tuple[float, float], n: int = 200) -> dict:
+    """Drucker stability in the three modes at n log-spaced stretches of ``stretch_range``.
+
+    Returns {"stable", "range", "first_unstable": {"mode", "stretch"} or None, "skipped"}:
+    points where W is not defined (beyond Gent's locking) are skipped and counted."""
+    lo, hi = stretch_range
+    lam = np.geomspace(lo, hi, n)
+    first, skipped = None, 0
+    for mode in rubber.MODES:
+        H = material.drucker_hessian(*rubber.stretches(mode, lam))
+        ok = np.all(np.isfinite(H), axis=(0, 1))
+        skipped += int(np.sum(~ok))
+        eig = np.full(lam.shape, np.inf)
+        eig[ok] = np.linalg.eigvalsh(np.moveaxis(H[:, :, ok], -1, 0))[:, 0]
+        bad = np.flatnonzero(eig <= 0)
+        if bad.size and first is None:
+            near = bad[np.argmin(np.abs(np.log(lam[bad])))]  # the one nearest the reference
+            first = {"mode": mode, "stretch": float(lam[near])}
+    return {"stable": first is None, "range": [float(lo), float(hi)], "first_unstable": first,
+            "skipped": skipped}
