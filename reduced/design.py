@@ -12,6 +12,27 @@ Ambiguities of the paper resolved here (see ``docs/conventions.md``):
 * ``t`` is the reservoir sheet thickness (Table I reuses ``w``, the weight vector's name).
 * Hinge positions, the finger base placement and g are not in the paper; they are
   explicit parameters with documented defaults.
+
+Rubber. The paper's rubber is Neo-Hookean with the shear moduli ``mu_sf_MPa`` (finger)
+and ``mu_sr_MPa`` (reservoir sheet). A design file may give another strain energy per
+part (:mod:`reduced.rubber`) as a table::
+
+    [finger.material]
+    model = "yeoh"            # neo-hookean | mooney-rivlin | yeoh | gent | ogden
+    C10_MPa = 0.18
+    C20_MPa = -1.4e-3
+    C30_MPa = 4.0e-5
+
+    [reservoir.material]
+    model = "mooney-rivlin"
+    C10_MPa = 0.5
+    C01_MPa = 0.075
+
+The parameter names are those of ``softhand material fit``. With a material table,
+``mu_sf_MPa`` / ``mu_sr_MPa`` become that material's initial shear modulus (computed; a
+value in the same file that disagrees is overridden, with a warning), and setting them
+later (``softhand fit --params mu_sf_MPa``, a study sweep) scales every modulus of the
+material, keeping the shape of W.
 """
 from __future__ import annotations
 
@@ -20,9 +41,11 @@ import hashlib
 import json
 import math
 import tomllib
+import warnings
 from dataclasses import dataclass
 from pathlib import Path
 
+from . import rubber
 from .errors import InputError
 
 #: Reservoir models the reduced layer knows; extended when a new one is added.
@@ -58,6 +81,10 @@ class HandDesign:
     base_offset: float = 60.0
     g: float = 9.80665  #: gravitational acceleration [N/kg]
     reservoir_model: str = "ellipse"  #: reduced reservoir model, one of RESERVOIR_MODELS
+    #: finger rubber's strain energy (its shape; scaled to mu_sf); None: Neo-Hookean
+    finger_material: rubber.Rubber | None = None
+    #: reservoir sheet's strain energy (its shape; scaled to mu_sr); None: Neo-Hookean
+    reservoir_material: rubber.Rubber | None = None
 
     def __post_init__(self):
         object.__setattr__(self, "hinge_s", tuple(float(s) for s in self.hinge_s))
@@ -86,6 +113,10 @@ class HandDesign:
         if self.reservoir_model not in RESERVOIR_MODELS:
             raise InputError("reservoir_model", self.reservoir_model,
                              f"must be one of {', '.join(RESERVOIR_MODELS)}")
+        if self.reservoir_model == "fem" and not self.reservoir_is_neo_hookean:
+            raise InputError("reservoir_model", "fem", "the FEM-calibrated reservoir table holds a "
+                             f"Neo-Hookean sheet, not {self.reservoir_material.model}; use "
+                             "reservoir_model = \"ellipse\" with this [reservoir.material]")
 
     def check_volume(self, theta_max: float) -> None:
         """Raise if V0 cannot supply the oil the fingers take at bend ``theta_max`` [rad] (eq. (15))."""
@@ -96,6 +127,26 @@ class HandDesign:
                              f"{math.degrees(theta_max):.1f} deg")
 
     # ------------------------------------------------------------------ derived
+    @property
+    def finger_rubber(self) -> rubber.Rubber:
+        """The finger tube's strain energy, with initial shear modulus mu_sf."""
+        return _scaled(self.finger_material, self.mu_sf)
+
+    @property
+    def reservoir_rubber(self) -> rubber.Rubber:
+        """The reservoir sheet's strain energy, with initial shear modulus mu_sr."""
+        return _scaled(self.reservoir_material, self.mu_sr)
+
+    @property
+    def finger_is_neo_hookean(self) -> bool:
+        """True if the finger rubber is Neo-Hookean (the paper's eqs. (5), (9), (10))."""
+        return _is_neo_hookean(self.finger_material)
+
+    @property
+    def reservoir_is_neo_hookean(self) -> bool:
+        """True if the reservoir sheet is Neo-Hookean (the paper's eqs. (11), (17), (18))."""
+        return _is_neo_hookean(self.reservoir_material)
+
     @property
     def link_lengths(self) -> tuple[float, ...]:
         """Lengths of the n_s + 1 rigid links along the hinge plate, base link first [mm]."""
@@ -108,15 +159,26 @@ class HandDesign:
 
     # ------------------------------------------------------------------ I/O
     def to_dict(self) -> dict:
-        """Public (unit-suffixed) keys -> values, as in a design TOML file."""
-        return {key: _to_public(name, getattr(self, name)) for name, key in _KEY_OF.items()}
+        """Public (unit-suffixed) keys -> values, as in a design TOML file; a part with a
+        material table adds ``{"finger": {"material": {"model": ..., parameters}}}``."""
+        out = {key: _to_public(name, getattr(self, name)) for name, key in _KEY_OF.items()}
+        for part in PARTS:
+            if getattr(self, f"{part}_material") is not None:
+                material = getattr(self, f"{part}_rubber")
+                out[part] = {"material": {"model": material.model, **material.parameters()}}
+        return out
 
     def to_toml(self) -> str:
         """The design as a TOML document that :func:`load_design` reads back."""
         lines = ["# softhand hand design; units in the key names"]
+        tables = []
         for key, value in self.to_dict().items():
-            lines.append(f"{key} = {json.dumps(value)}")
-        return "\n".join(lines) + "\n"
+            if key in PARTS:
+                tables += ["", f"[{key}.material]"] + [f"{k} = {json.dumps(v)}"
+                                                      for k, v in value["material"].items()]
+            else:
+                lines.append(f"{key} = {json.dumps(value)}")
+        return "\n".join(lines + tables) + "\n"
 
     def hash(self) -> str:
         """Short stable hash of the design's values (provenance, cache keys)."""
@@ -133,6 +195,37 @@ _KEY_OF = {
 }
 _FIELD_OF = {key: name for name, key in _KEY_OF.items()}
 PUBLIC_KEYS = tuple(_KEY_OF.values())
+#: parts that may carry a ``[<part>.material]`` table, and the modulus key it sets
+PARTS = ("finger", "reservoir")
+_MODULUS_OF = {"finger": "mu_sf", "reservoir": "mu_sr"}
+
+
+def _scaled(material, mu0: float) -> rubber.Rubber:
+    if material is None:
+        return rubber.NeoHookean(mu0)
+    return material if material.mu0 == mu0 else material.scaled(mu0 / material.mu0)
+
+
+def _is_neo_hookean(material) -> bool:
+    return material is None or isinstance(material, rubber.NeoHookean)
+
+
+def _material_changes(part: str, table, source: str, values: dict) -> dict:
+    """Changes of the design fields from a ``[<part>.material]`` table."""
+    if not isinstance(table, dict) or set(table) != {"material"} or not isinstance(table["material"], dict):
+        raise InputError(f"{source}: {part}", table, f"must hold only a [{part}.material] table")
+    params = dict(table["material"])
+    model = params.pop("model", None)
+    if not isinstance(model, str):
+        raise InputError(f"{source}: {part}.material.model", model,
+                         f"must be one of {', '.join(rubber.MODELS)}")
+    material = rubber.from_parameters(model, params, source=f"{source}: {part}.material")
+    name = _MODULUS_OF[part]
+    given = values.get(_KEY_OF[name])
+    if _is_number(given) and not math.isclose(given, material.mu0, rel_tol=1e-9):
+        warnings.warn(f"{source}: {_KEY_OF[name]} = {given} is overridden by [{part}.material], "
+                      f"whose initial shear modulus is {material.mu0:.6g} MPa")
+    return {f"{part}_material": material, name: material.mu0}
 
 
 def _positive(key: str, value) -> None:
@@ -179,10 +272,16 @@ def design_from_dict(values: dict, base: HandDesign | None = None, *, source: st
     base = base if base is not None else HandDesign()
     changes = {}
     for key, value in values.items():
+        if key in PARTS:
+            continue
         if key not in _FIELD_OF:
             raise InputError(f"{source}: {key}", value,
-                             f"unknown key; allowed: {', '.join(PUBLIC_KEYS)}")
+                             f"unknown key; allowed: {', '.join(PUBLIC_KEYS)}, "
+                             "[finger.material], [reservoir.material]")
         changes[_FIELD_OF[key]] = _from_public(key, value)
+    for part in PARTS:
+        if part in values:
+            changes.update(_material_changes(part, values[part], source, values))
     return dataclasses.replace(base, **changes)
 
 

@@ -13,6 +13,16 @@ Kevlar windings keep lambda_2 = 1 and the rubber is incompressible, so lambda_3 
 .. math:: W_f = \int \frac{\mu_{sf}}{2}(\lambda_f^2 + \lambda_f^{-2} - 2)\, l_0 \rho\, dr\, d\phi,
           \qquad \frac{dW_f}{d\theta} = \mu_{sf}\,\zeta_f(\theta)   \quad (9), (10).
 
+Other rubber (``design.finger_rubber``, :mod:`reduced.rubber`): the same kinematics
+lambda_1 = lambda_f, lambda_2 = 1, lambda_3 = 1/lambda_f (pure shear, planar tension) give
+
+.. math:: W_f = \int \hat W(\lambda_f)\, l_0 \rho\, dr\, d\phi, \qquad
+          \frac{dW_f}{d\theta} = \int \hat W'(\lambda_f)\, c\; l_0 \rho\, dr\, d\phi,
+          \qquad \hat W(\lambda) = W(\lambda, 1, 1/\lambda),
+
+with W'(lambda) the pure-shear nominal stress; for Neo-Hookean it is mu (lambda - lambda^-3)
+and :func:`finger_force` is mu_sf zeta_f, computed by the paper's closed form (10).
+
 Numerics. The integrand depends on phi only through sin phi and sin(pi - phi) = sin phi, so
 the phi-integral over [0, 2 pi] is twice the one over [-pi/2, pi/2]. Both integrals use
 tensor Gauss-Legendre rules (no adaptive quadrature). With x = c theta the integrands are
@@ -126,6 +136,19 @@ def zeta_f_small_angle(theta, design: HandDesign):
 
 
 def strain_energy(theta, design: HandDesign, orders: tuple[int, int] = ORDERS):
-    """Eq. (5) with (7), (8): strain energy W_f of one finger tube [N*mm] at bend theta [rad]."""
+    """Eq. (5) with (7), (8): strain energy W_f of one finger tube [N*mm] at bend theta [rad]
+    (any rubber; Neo-Hookean by the paper's integrand)."""
     _check_stretch(theta, design)
-    return design.mu_sf * _integrate(_energy_kernel, theta, design, orders, 0)
+    if design.finger_is_neo_hookean:
+        return design.mu_sf * _integrate(_energy_kernel, theta, design, orders, 0)
+    rubber = design.finger_rubber
+    return _integrate(lambda x: rubber.mode_energy("pure-shear", 1.0 + x), theta, design, orders, 0)
+
+
+def finger_force(theta, design: HandDesign, orders: tuple[int, int] = ORDERS):
+    """dW_f/dtheta [N*mm/rad] of one finger tube, any rubber: mu_sf zeta_f (10) for Neo-Hookean."""
+    if design.finger_is_neo_hookean:
+        return design.mu_sf * zeta_f(theta, design, orders)
+    _check_stretch(theta, design)
+    rubber = design.finger_rubber
+    return _integrate(lambda x: rubber.nominal_stress("pure-shear", 1.0 + x), theta, design, orders, 1)

@@ -43,8 +43,9 @@ def check_theta(theta) -> np.ndarray:
 
 
 def finger_pressure(theta, design: HandDesign):
-    """Eq. (28): P = mu_sf zeta_f / (a^2 pi d) [MPa], the hand without reservoir, theta [rad]."""
-    return design.mu_sf * finger.zeta_f(theta, design) / (design.a**2 * math.pi * design.d)
+    """Eq. (28): P = mu_sf zeta_f / (a^2 pi d) [MPa], the hand without reservoir, theta [rad];
+    for another rubber mu_sf zeta_f is dW_f/dtheta (:func:`reduced.finger.finger_force`)."""
+    return finger.finger_force(theta, design) / (design.a**2 * math.pi * design.d)
 
 
 def pressure(theta, design: HandDesign, reservoir: bool = True):

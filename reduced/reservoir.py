@@ -14,6 +14,11 @@ with the analytic chain rule d lambda_r / d theta = L'(h) / (2R) * 3 / (2 pi R^2
 The reservoir's gauge pressure is p_r(V) = dW_r/dV, hence
 mu_sr zeta_r(theta) / (n a^2 pi d) = -p_r(V(theta)).
 
+Other rubber (``design.reservoir_rubber``, :mod:`reduced.rubber`): the same equi-biaxial
+membrane kinematics (lambda_r, lambda_r, 1/lambda_r^2) give W_r = W(lambda_r, lambda_r,
+lambda_r^-2) pi R^2 t and p_r = (dW/dlambda_r)(d lambda_r/dV) pi R^2 t, where dW/dlambda_r is
+twice the equibiaxial nominal stress; for Neo-Hookean 2 mu (lambda - lambda^-5), eq. (18).
+
 Reservoir models. :func:`pressure` dispatches on ``design.reservoir_model`` through a small
 registry: ``"ellipse"`` (this module) is built in; another model registers a function
 ``pressure_fn(V, design) -> p_r [MPa]`` with :func:`register_model`. A model name that is
@@ -84,15 +89,21 @@ def zeta_r(theta, design: HandDesign):
 def strain_energy(V, design: HandDesign):
     """Eq. (11) with (12): strain energy W_r [N*mm] of the sheet holding V [mm^3] (ellipse model)."""
     lam = stretch(V, design)
+    if not design.reservoir_is_neo_hookean:
+        return design.reservoir_rubber.mode_energy("equibiaxial", lam) * np.pi * design.R**2 * design.t
     return 0.5 * design.mu_sr * (2.0 * lam**2 + lam**-4 - 3.0) * np.pi * design.R**2 * design.t
 
 
 def ellipse_pressure(V, design: HandDesign):
-    """p_r(V) = dW_r/dV [MPa] of the ellipse model: mu_sr 2 (lam - lam^-5) (dlam/dV) pi R^2 t."""
+    """p_r(V) = dW_r/dV [MPa] of the ellipse model: mu_sr 2 (lam - lam^-5) (dlam/dV) pi R^2 t
+    (Neo-Hookean), dW/dlam (dlam/dV) pi R^2 t for another rubber."""
     V = np.asarray(V, float)
     if np.any(V <= 0.0):
         raise InputError("V_mm3", float(np.min(V)), "reservoir volume must be positive")
     lam = stretch(V, design)
+    if not design.reservoir_is_neo_hookean:
+        dW = 2.0 * design.reservoir_rubber.nominal_stress("equibiaxial", lam)  # dW/dlambda_r
+        return dW * dstretch_dV(V, design) * np.pi * design.R**2 * design.t
     return design.mu_sr * 2.0 * (lam - lam**-5) * dstretch_dV(V, design) * np.pi * design.R**2 * design.t
 
 
