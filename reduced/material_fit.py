@@ -22,7 +22,6 @@ in uniaxial, equibiaxial and pure-shear deformation at stretches over a stated r
 """
 from __future__ import annotations
 
-import csv
 import math
 from dataclasses import dataclass
 from pathlib import Path
@@ -31,6 +30,7 @@ import numpy as np
 from scipy.optimize import least_squares
 
 from . import rubber
+from .csvdata import _read_rows
 from .errors import InputError
 from .fit import FitOptions, diagnose, jacobian
 
@@ -68,22 +68,11 @@ class StressData:
 def read_test_data(path) -> StressData:
     """Read the CSV (see the module docstring); one InputError naming file, line, column."""
     path = Path(path)
-    try:
-        text = path.read_text(encoding="utf-8-sig")
-    except (FileNotFoundError, IsADirectoryError):
-        raise InputError("--data", str(path), "no such file; give a CSV file") from None
-    except UnicodeDecodeError:
-        raise InputError("--data", str(path), "is not a UTF-8 text (CSV) file") from None
-    lines = [(i, line) for i, line in enumerate(text.splitlines(), start=1)
-             if line.strip() and not line.lstrip().startswith("#")]
-    if len(lines) < 2:
-        raise InputError("--data", str(path), f"needs a header row ({','.join(COLUMNS)}) and data rows")
-    rows = [(i, [c.strip() for c in cells]) for (i, _), cells in zip(lines, csv.reader(l for _, l in lines))]
-    header = rows[0][1]
+    header, rows = _read_rows(path)
     if sorted(header) != sorted(COLUMNS):
         raise InputError(f"{path.name}: columns", ",".join(header), f"must be {','.join(COLUMNS)}")
     mode, lam, stress = [], [], []
-    for line, cells in rows[1:]:
+    for line, cells in rows:
         if len(cells) != len(header):
             raise InputError(f"{path.name}: line {line}", ",".join(cells),
                              f"has {len(cells)} cells; the header has {len(header)}")
