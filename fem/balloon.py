@@ -22,6 +22,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from fem.axisym import AxisymSolid, RevolvedVolume
+from fem.hyperelastic import rubber_law
 from fem.materials import NeoHookean
 from fem.volume_path import PathOptions, follow_volume
 from meshes.shell import shell_mesh
@@ -40,6 +41,12 @@ class ThickSphere:
     n_radial: int = 1  #: Q2 elements through the wall
     n_polar: int = 8  #: Q2 elements from the pole to the equator
     pressure_space: str = "P1"  #: dilatation/pressure space per element, "P1" or "P0"
+    #: a :mod:`reduced.rubber` model (its initial shear modulus replaces mu); None: Neo-Hookean
+    material: object = None
+
+    @property
+    def shear_modulus(self) -> float:
+        return self.mu if self.material is None else self.material.mu0
 
 
 def closed_form_pressure(lambda_a, A: float, B: float, mu: float):
@@ -50,10 +57,31 @@ def closed_form_pressure(lambda_a, A: float, B: float, mu: float):
     return 2.0 * mu * (f(lam_b) - f(lam_a))
 
 
+def closed_form_pressure_general(lambda_a, A: float, B: float, material):
+    r"""Exact p [MPa] of an incompressible thick sphere of any :mod:`reduced.rubber` model:
+
+    .. math:: p = \int_{\lambda_b}^{\lambda_a} \frac{\hat W'(\lambda)}{\lambda^3 - 1}\,d\lambda,
+              \qquad \hat W(\lambda) = W(\lambda, \lambda, \lambda^{-2}),
+
+    (radial equilibrium with the equibiaxial hoop state at every radius; for Neo-Hookean it
+    is :func:`closed_form_pressure`), by adaptive quadrature. Thin wall (B - A = H << A):
+    p -> (H / A) W'(lambda) / lambda^2."""
+    from scipy.integrate import quad
+
+    dW = lambda lam: 2.0 * float(material.nominal_stress("equibiaxial", lam))  # noqa: E731
+    out = []
+    for lam_a in np.atleast_1d(np.asarray(lambda_a, dtype=float)):
+        lam_b = np.cbrt(1.0 + (lam_a**3 - 1.0) * (A / B) ** 3)
+        out.append(quad(lambda lam: dW(lam) / (lam**3 - 1.0), lam_b, lam_a, epsabs=0, epsrel=1e-12)[0])
+    return np.array(out)
+
+
 def inflate_sphere(sphere: ThickSphere, lambda_a):
     """FEM pressure [MPa] at the inner stretches ``lambda_a`` (increasing, > 1), and the solver path."""
     mesh = shell_mesh(sphere.A, sphere.B, n_radial=sphere.n_radial, n_polar=sphere.n_polar)
-    law = NeoHookean(sphere.mu, sphere.kappa_ratio * sphere.mu)
+    mu = sphere.shear_modulus
+    law = (NeoHookean(mu, sphere.kappa_ratio * mu) if sphere.material is None
+           else rubber_law(sphere.material, sphere.kappa_ratio * mu))
     solid = AxisymSolid(mesh, law, pressure=sphere.pressure_space)
     cavity = RevolvedVolume(solid, mesh.boundaries["inner"])
     b = solid.basis
@@ -61,6 +89,6 @@ def inflate_sphere(sphere: ThickSphere, lambda_a):
     V_ref = cavity.value(np.zeros(solid.ndofs))
     targets = V_ref * np.asarray(lambda_a, dtype=float) ** 3
     opts = PathOptions(first_step=0.01 * V_ref, max_step=0.3 * V_ref,
-                       atol=1e-12 * law.kappa * sphere.B**2)
+                       atol=1e-12 * sphere.kappa_ratio * mu * sphere.B**2)
     hits, path = follow_volume(solid, cavity, fixed, targets, options=opts, volume_scale=V_ref)
     return np.array([s.pressure for s in hits]), path

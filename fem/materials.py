@@ -21,7 +21,10 @@ Laws (J = det F, I1 = tr C, C = F^T F, F^{-T} = cof F / J):
 
 Laws add up (``NeoHookean(...) + Fibers(...)``). A law with a volumetric part
 offers ``split() -> (deviatoric_law, volumetric)``; the solid uses it for the
-locking-free mean-dilatation (P2-P0) formulation, see :mod:`fem.solid`.
+locking-free mean-dilatation (P2-P0) formulation, see :mod:`fem.solid`. A sum splits
+into the sum of its parts' deviatoric laws and its one volumetric part, so
+``NeoHookeanIsochoric(mu) + Volumetric(kappa)`` is split like ``NeoHookean(mu, kappa)``
+(two volumetric parts are refused). Other rubber models: :mod:`fem.hyperelastic`.
 Small-strain limits: NH -> Hooke with shear modulus mu and bulk modulus kappa;
 cNH -> Hooke with Lame constants lambda, mu.
 """
@@ -58,6 +61,10 @@ class Volumetric(Law):
     r"""Volumetric energy U(J) = kappa/2 (J - 1)^2, used alone or by the mean-dilatation solid."""
 
     kappa: float  #: bulk modulus [MPa]
+
+    def split(self):
+        """All volumetric: ``law + Volumetric(kappa)`` then splits into (law, this)."""
+        return None, self
 
     def U(self, J):
         """U(J) [MPa]."""
@@ -220,8 +227,11 @@ class Sum(Law):
     def split(self):
         devs, vols = zip(*(p.split() for p in self.parts))
         vols = [v for v in vols if v is not None]
+        devs = tuple(d for d in devs if d is not None)
         if len(vols) > 1:
             raise ValueError("at most one volumetric part per material")
+        if not devs:
+            raise ValueError("a material needs a deviatoric (isochoric) part besides its volumetric one")
         return Sum(devs), (vols[0] if vols else None)
 
     def energy(self, F):

@@ -20,6 +20,8 @@ REGISTRY: dict[str, str] = {
     "convergence": "studies.verify_solid:tube_convergence",
     "newton": "studies.verify_solid:tangent_and_newton",
     "balloon": "studies.verify_balloon:balloon",
+    "modes": "studies.verify_materials:homogeneous_modes",
+    "balloon_models": "studies.verify_materials:balloon_models",
 }
 
 
