@@ -49,7 +49,8 @@ from fem import kinematics as kin
 from fem.constraints import ChainConstraint, PlanarChain
 from fem.linsolve import make_solver
 from fem.loads import CavityVolume
-from fem.materials import Fibers, NeoHookean
+from fem.hyperelastic import rubber_law
+from fem.materials import Fibers
 from fem.newton import NewtonOptions, PathOptions, solve_path
 from fem.solid import Solid
 from meshes.finger import FingerTube, finger_tube_mesh, layered_tube_mesh
@@ -300,7 +301,7 @@ class FingerModel:
                                options.edge_ratio, options.edge_reach)
         self.mesh = _mesh(self.tube, options)
         mu = design.mu_sf
-        rubber = NeoHookean(mu, options.kappa_ratio * mu)
+        rubber = rubber_law(design.finger_rubber, options.kappa_ratio * mu)
         self.solid = Solid(self.mesh, rubber)
         if not np.all(self.solid.W > 0):
             raise InputError("mesh", _describe_mesh(options),

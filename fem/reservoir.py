@@ -28,7 +28,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from fem.axisym import AxisymSolid, RevolvedVolume
-from fem.materials import NeoHookean
+from fem.hyperelastic import rubber_law
+from reduced.rubber import NeoHookean, Rubber
 from fem.volume_path import PathOptions, follow_volume
 from meshes.reservoir import sheet_mesh
 
@@ -46,17 +47,26 @@ class SheetModel:
     n_radial: int = 40  #: Q2 elements along the radius
     n_thick: int = 2  #: Q2 elements through the thickness
     clamp_ratio: float = 3.0  #: radial element size at the axis / at the clamp
+    #: the rubber's strain energy (:mod:`reduced.rubber`; scaled to mu); None: Neo-Hookean
+    material: Rubber | None = None
 
     @classmethod
     def from_design(cls, design, **mesh) -> "SheetModel":
         """Geometry and material of a :class:`reduced.design.HandDesign`; mesh keywords as given."""
-        return cls(R=design.R, t=design.t, mu=design.mu_sr, **mesh)
+        material = None if design.reservoir_is_neo_hookean else design.reservoir_rubber
+        return cls(R=design.R, t=design.t, mu=design.mu_sr, material=material, **mesh)
+
+    @property
+    def rubber(self) -> Rubber:
+        """The sheet's strain energy with initial shear modulus mu."""
+        m = self.material
+        return NeoHookean(self.mu) if m is None else m.scaled(self.mu / m.mu0)
 
     def build(self):
         """(solid, volume functional, fixed DOFs)."""
         mesh = sheet_mesh(self.R, self.t, n_radial=self.n_radial, n_thick=self.n_thick,
                           clamp_ratio=self.clamp_ratio)
-        solid = AxisymSolid(mesh, NeoHookean(self.mu, self.kappa_ratio * self.mu))
+        solid = AxisymSolid(mesh, rubber_law(self.rubber, self.kappa_ratio * self.mu))
         volume = RevolvedVolume(solid, mesh.boundaries["wet"])
         b = solid.basis
         fixed = np.concatenate([b.get_dofs("clamp").all(), b.get_dofs("axis").all("u^1")])

@@ -135,6 +135,10 @@ def _git_commit() -> str:
 
 def _write_calibration(study, path) -> int:
     """FEM tables at the design's thickness t and at 2t (twice the layers: same element shape)."""
+    if not study.design.reservoir_is_neo_hookean:
+        raise InputError("--write-calibration", str(path), "the calibration table of the 'fem' "
+                         "reservoir model is for a Neo-Hookean sheet; this design's sheet is "
+                         f"{study.design.reservoir_material.model}")
     from dataclasses import replace
     from datetime import datetime, timezone
 
@@ -179,7 +183,8 @@ def plot_reservoir(path, result) -> None:
     ax[1].axvspan(*result.verdict["V_range_mm3"], color="0.9", label="operating range")
     ax[1].set(xlabel="V [mm^3]", ylabel="p_r [MPa]", title="reservoir pressure p(V)")
     theta = np.linspace(0, math.pi / 2, 91)
-    for name, style in (("ellipse", "--"), ("fem", "-")):
+    models = (("ellipse", "--"), ("fem", "-")) if d.reservoir_is_neo_hookean else (("ellipse", "--"),)
+    for name, style in models:  # the FEM-calibrated table is Neo-Hookean only
         P = hand.pressure(theta, d.replace(reservoir_model=name))
         ax[2].plot(np.degrees(theta), P, style, label=f"reservoir model '{name}'")
     ax[2].plot(np.degrees(theta), hand.pressure(theta, d, reservoir=False), ":", label="no reservoir")
