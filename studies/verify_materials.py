@@ -10,15 +10,17 @@ boundary conditions, stretched by lambda along x:
 nominal stress from the reaction against the incompressible closed form of
 :mod:`reduced.rubber`. The state is homogeneous (exact in P2), so what remains is the
 compressibility of the FEM material: kappa = 1e4 mu0 changes the stress by O(mu0/kappa),
-measured below 2e-4 relative; tolerance 1e-3.
+measured 2.7e-5 to 2.7e-4 relative; tolerance 1e-3.
 
 ``balloon_models``: a thin sphere (A = 10 mm, B = 10.2 mm: H/A = 0.02) inflated under
 volume control (axisymmetric Q2/P1disc, :mod:`fem.balloon`) against the exact
 incompressible thick-sphere pressure :func:`fem.balloon.closed_form_pressure_general`, at
-stretches before and past the pressure maximum, and the maximum itself for Mooney-Rivlin
-and Gent (parabola through the three sampled points around it, 0.05 apart in stretch).
-Tolerance 1 % as for the Neo-Hookean balloon: O(mu/kappa) compressibility and the curved
-cells' geometry.
+stretches before and past the pressure maximum, and the (first, local) maximum itself for
+Mooney-Rivlin and Gent (parabola through the three sampled points around it, 0.05 apart in
+stretch). Tolerance 1 % as for the Neo-Hookean balloon. What remains is the FEM material's
+compressibility, O(sigma/kappa): the stiffening models (Yeoh, Gent) reach hoop stresses of
+40 mu0 at stretch 3, hence kappa = 1e4 mu0 here (at 1e3 mu0 they were 5 % off there), and
+the curved cells' geometry.
 """
 from __future__ import annotations
 
@@ -81,10 +83,12 @@ def balloon_models(quick: bool) -> list[Check]:
     checks = []
     for name in names:
         material = MATERIALS[name]
-        sphere = ThickSphere(A=10.0, B=10.2, n_radial=1, n_polar=6 if quick else 8, material=material)
+        sphere = ThickSphere(A=10.0, B=10.2, n_radial=1, n_polar=6 if quick else 8,
+                             kappa_ratio=1e4, material=material)
         p, _ = inflate_sphere(sphere, lam)
         exact = closed_form_pressure_general(lam, sphere.A, sphere.B, material)
-        shown = [0, int(np.argmax(exact)), len(lam) - 1]
+        peak = _first_peak(exact)
+        shown = [0] + ([peak] if peak is not None else []) + [len(lam) - 1]
         checks += [Check("balloon_models", f"{name} p at lambda_a = {lam[k]:g} [MPa]",
                          float(exact[k]), float(p[k]), 1e-2) for k in shown]
         if name in ("mooney-rivlin", "gent"):
@@ -98,7 +102,15 @@ def _exact_maximum(sphere, material) -> float:
     return -minimize_scalar(f, bounds=(1.05, 2.5), method="bounded", options={"xatol": 1e-10}).fun
 
 
+def _first_peak(p):
+    """Index of the first interior local maximum of the samples p, or None."""
+    rise = np.flatnonzero((p[1:-1] > p[:-2]) & (p[1:-1] >= p[2:]))
+    return int(rise[0]) + 1 if rise.size else None
+
+
 def _sampled_maximum(lam, p) -> float:
-    k = int(np.clip(np.argmax(p), 1, len(p) - 2))
+    k = _first_peak(p)
+    if k is None:
+        return float("nan")
     c = np.polyfit(lam[k - 1:k + 2], p[k - 1:k + 2], 2)
     return float(np.polyval(c, -c[1] / (2 * c[0])))

@@ -88,3 +88,17 @@ def test_thick_sphere_pressure_for_any_model():
     mr, H = MODELS["mooney-rivlin"], 1e-4
     thin = H / 10.0 * 2 * mr.nominal_stress("equibiaxial", lam) / lam**2
     np.testing.assert_allclose(closed_form_pressure_general(lam, 10.0, 10.0 + H, mr), thin, rtol=1e-4)
+
+
+def test_reservoir_sheet_takes_the_designs_material():
+    from fem.reservoir import SheetModel
+    from reduced.design import HandDesign
+
+    mr = rubber.MooneyRivlin(0.46, 0.115)
+    model = SheetModel.from_design(HandDesign().replace(reservoir_material=mr, mu_sr=mr.mu0), n_radial=4,
+                                   n_thick=1)
+    solid, _, _ = model.build()
+    assert solid.iso == IsochoricRubber(mr) and solid.vol == Volumetric(1000.0 * mr.mu0)
+    assert SheetModel.from_design(HandDesign()).material is None  # Neo-Hookean: the closed form
+    doubled = SheetModel.from_design(HandDesign().replace(reservoir_material=mr, mu_sr=2 * mr.mu0))
+    assert doubled.rubber.parameters() == pytest.approx({"C10_MPa": 0.92, "C01_MPa": 0.23})

@@ -88,3 +88,15 @@ def test_malformed_csv_is_one_line_and_exit_2(tmp_path, capsys, text, message):
     assert main(["material", "fit", "--data", str(path), "--model", "yeoh"]) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and message in err and err.startswith("softhand material: error:")
+
+
+def test_treloar_data_agree_with_ogdens_1972_parameters():
+    """Ogden fitted his three terms to Treloar's experiment: up to stretch 7 (his range) the
+    shipped numbers stay within 0.15 MPa of his curves (pure shear, from a second source,
+    within 0.06 MPa, the size of its two-decimal rounding plus the fit's own error)."""
+    g = 0.0980665
+    ogden = rubber.Ogden((6.3 * g, 0.012 * g, -0.1 * g), (1.3, 5.0, -2.0))
+    data = mf.read_test_data("studies/data/treloar1944.csv")
+    gap = np.abs(data.predict(ogden) - data.stress)
+    assert gap[data.stretch <= 7.0].max() < 0.15
+    assert gap[data.mode == "pure-shear"].max() < 0.06
