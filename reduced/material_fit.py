@@ -2,7 +2,9 @@ r"""Fit a rubber model (:mod:`reduced.rubber`) to nominal stress vs stretch test
 
 Data: a CSV file with the columns ``mode`` (``uniaxial``, ``equibiaxial``, ``pure-shear``;
 any mix), ``stretch`` [-] and ``stress_MPa`` (nominal stress: force per reference area,
-in the stretched direction). Lines starting with ``#`` are comments.
+in the stretched direction); ``lambda`` and ``nominal_stress_MPa`` are accepted as other
+names of the last two, ``biaxial``, ``planar`` (and ``ut``, ``et``, ``ps``) of the modes.
+Lines starting with ``#`` are comments.
 
 Least squares in the stress itself (MPa), all rows with equal weight:
 
@@ -13,7 +15,9 @@ Ogden are fitted by :func:`scipy.optimize.least_squares` from several starts (Og
 exponents on a grid, the moduli for each by linear least squares; Gent: locking
 parameters on a grid) and refined. Standard errors and correlations come from the
 Jacobian at the optimum as in :func:`reduced.fit.diagnose`: Cov = S/(N - k) (J^T J)^{-1}.
-Ogden's terms are reported in ascending alpha_p (W does not depend on their order).
+Ogden's terms are reported in ascending alpha_p (W does not depend on their order). A
+standard error never drops below :data:`PRECISION` of its parameter's scale: with
+data without scatter the statistical error is round-off, the solver's precision is not.
 
 Drucker stability (incompressible): the Hessian of W in the log strains
 (:meth:`reduced.rubber.Rubber.drucker_hessian`) must be positive definite. It is checked
@@ -43,6 +47,12 @@ _MODE_ALIASES = {"uniaxial": "uniaxial", "ut": "uniaxial", "equibiaxial": "equib
                  "pure-shear": "pure-shear", "pure_shear": "pure-shear", "ps": "pure-shear",
                  "planar": "pure-shear"}
 COLUMNS = ("mode", "stretch", "stress_MPa")
+_COLUMN_ALIASES = {"mode": "mode", "stretch": "stretch", "lambda": "stretch",
+                   "stress_mpa": "stress_MPa", "nominal_stress_mpa": "stress_MPa"}
+#: relative precision to which the solvers determine a parameter (of its value, or of mu0 for
+#: a modulus near zero); added in quadrature to the standard errors, so that data without
+#: scatter (S ~ round-off) do not report errors below what the numbers can resolve
+PRECISION = 1e-10
 
 
 @dataclass(frozen=True)
@@ -68,9 +78,10 @@ class StressData:
 def read_test_data(path) -> StressData:
     """Read the CSV (see the module docstring); one InputError naming file, line, column."""
     path = Path(path)
-    header, rows = _read_rows(path)
+    given, rows = _read_rows(path)
+    header = [_COLUMN_ALIASES.get(c.lower(), c) for c in given]
     if sorted(header) != sorted(COLUMNS):
-        raise InputError(f"{path.name}: columns", ",".join(header), f"must be {','.join(COLUMNS)}")
+        raise InputError(f"{path.name}: columns", ",".join(given), f"must be {','.join(COLUMNS)}")
     mode, lam, stress = [], [], []
     for line, cells in rows:
         if len(cells) != len(header):
@@ -157,8 +168,10 @@ def fit_material(data: StressData, fit_model: str, options: FitOptions = FitOpti
     J = jacobian(residual, x, lo, hi, options.rel_step)
     r = residual(x)
     diag = diagnose(names, J, r, x, options)
-    return MaterialFit(fit_model, material(x), names, x, diag.stderr, diag.correlation, r, data,
-                       diag.warnings)
+    fitted = material(x)
+    scale = np.array([max(abs(v), fitted.mu0 if k.endswith("_MPa") else 1.0) for k, v in zip(names, x)])
+    stderr = np.hypot(diag.stderr, PRECISION * scale)
+    return MaterialFit(fit_model, fitted, names, x, stderr, diag.correlation, r, data, diag.warnings)
 
 
 def _linear_fit(data, names, material):
