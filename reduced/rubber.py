@@ -297,6 +297,16 @@ def parameter_names(model: str, terms: int = 3) -> tuple[str, ...]:
     return tuple(_PUBLIC[f.name] for f in fields(cls))
 
 
+_MODEL_ALIASES = {"neohookean": "neo-hookean", "nh": "neo-hookean", "mooneyrivlin": "mooney-rivlin",
+                  "mr": "mooney-rivlin"}
+
+
+def canonical_model(model: str) -> str:
+    """The model's name as in :data:`MODELS` (case, '_' or ' ' for '-', a few short names)."""
+    name = str(model).strip().lower().replace("_", "-").replace(" ", "-")
+    return _MODEL_ALIASES.get(name.replace("-", ""), name)
+
+
 def _model_class(model):
     if model not in MODELS:
         raise InputError("model", model, f"must be one of {', '.join(MODELS)}")
@@ -304,16 +314,20 @@ def _model_class(model):
 
 
 def from_parameters(model: str, values: dict, *, source: str = "material") -> Rubber:
-    """A validated model from its public parameter names (as in ``[finger.material]``)."""
+    """A validated model from its public parameter names (as in ``[finger.material]``; names
+    and the model are matched regardless of case)."""
+    model = canonical_model(model)
     cls = _model_class(model)
     for key, value in values.items():
         if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
             raise InputError(f"{source}.{key}", value, "must be a finite number")
     if model == "ogden":
-        terms = sum(1 for k in values if k.startswith("mu") and k.endswith("_MPa"))
+        terms = sum(1 for k in values if k.lower().startswith("mu") and k.lower().endswith("_mpa"))
         names = parameter_names(model, max(terms, 1))
     else:
         names = parameter_names(model)
+    canonical = {n.lower(): n for n in names}
+    values = {canonical.get(k.lower(), k): v for k, v in values.items()}
     unknown = set(values) - set(names)
     if unknown:
         raise InputError(f"{source}.{sorted(unknown)[0]}", values[sorted(unknown)[0]],

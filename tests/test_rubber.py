@@ -100,6 +100,8 @@ def test_parameters_round_trip_and_validation():
         assert back == m and back.parameters() == m.parameters()
         assert back.scaled(2.0).mu0 == pytest.approx(2 * m.mu0)
     assert rubber.from_parameters("yeoh", {"C10_MPa": 0.5}) == rubber.Yeoh(0.5)
+    assert rubber.from_parameters("Mooney_Rivlin", {"c10_mpa": 0.5, "C01_MPa": 0.1}) == rubber.MooneyRivlin(0.5, 0.1)
+    assert rubber.from_parameters("Ogden", {"MU1_MPa": 1.0, "Alpha1": 2.0}) == rubber.Ogden((1.0,), (2.0,))
     with pytest.raises(InputError, match="unknown parameter"):
         rubber.from_parameters("mooney-rivlin", {"C10_MPa": 0.5, "C02_MPa": 1})
     with pytest.raises(InputError, match="missing"):
