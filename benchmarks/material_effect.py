@@ -2,11 +2,12 @@
 Neo-Hookean against Yeoh and Mooney-Rivlin with the same initial shear modulus (1.15 MPa,
 the paper's), the same material in finger and sheet.
 
-Run: ``python benchmarks/material_effect.py [--fem] [--plot FILE.png]``. Yeoh has the shape
+Run: ``python benchmarks/material_effect.py [--fem] [--fem-finger] [--plot FILE.png]``. Yeoh has the shape
 of its fit to Treloar's data (studies/data/treloar1944.csv), scaled to mu0 = 1.15 MPa;
 Mooney-Rivlin has C01/C10 = 0.25 (an illustrative ratio; the fit to Treloar gives C01 ~ 0).
-``--fem`` adds the reservoir sheet's FEM p(V) (about a minute per material). Prints
-Markdown tables.
+``--fem`` adds the reservoir sheet's FEM p(V) (about a minute per material),
+``--fem-finger`` the finger FEM's theta(P) without reservoir on the CI mesh (gmsh, 6 mm;
+a few minutes per material). Prints Markdown tables.
 """
 from __future__ import annotations
 
@@ -40,8 +41,11 @@ def designs() -> dict:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--fem", action="store_true", help="also the reservoir sheet's FEM p(V)")
+    parser.add_argument("--fem-finger", action="store_true", help="also the finger FEM's theta(P)")
     parser.add_argument("--plot", metavar="FILE.png", help="theta(P) and p(V) per material")
     args = parser.parse_args()
+    if args.fem_finger:
+        finger_fem_table(designs())
     cases = designs()
     for name, m in materials().items():
         print(f"# {name}: " + ", ".join(f"{k} = {v:.6g}" for k, v in m.parameters().items()))
@@ -69,6 +73,22 @@ def main() -> None:
         print(f"| {name} | " + " | ".join(cells) + " |")
     if args.plot:
         plot(args.plot, cases, fem)
+
+
+def finger_fem_table(cases) -> None:
+    """theta(P) of one finger without reservoir: FEM (CI mesh) and eq. (28), per material."""
+    from fem.finger import FingerOptions
+    from studies.bending import BendingStudy, run
+
+    print("\n| material | " + " | ".join(f"theta({p:g} MPa) [deg] FEM / eq. (28)" for p in PRESSURES)
+          + " | largest principal stretch at 2.0 MPa (FEM) |")
+    print("|---" * (len(PRESSURES) + 2) + "|")
+    for name, d in cases.items():
+        result = run(BendingStudy(design=d, pressures_mpa=PRESSURES,
+                                  options=FingerOptions(mesher="gmsh", mesh_size=6.0)))
+        cells = [f"{r['theta_deg']:.2f} / {r['theta_reduced_deg']:.2f}" for r in result.rows]
+        print(f"| {name} | " + " | ".join(cells) + f" | {result.rows[-1]['max_principal_stretch']:.3f} |",
+              flush=True)
 
 
 def plot(path, cases, fem) -> None:
