@@ -33,7 +33,7 @@ FEM_RTOL = 2e-5
 VOLATILE = {"wall_seconds", "build_seconds", "assembly_seconds", "solve_seconds", "seconds",
             "stats", "solver", "versions", "provenance", "elapsed_s", "files", "out",
             "code_version", "python", "time_s", "cache", "path", "newton_iterations",
-            "cutbacks", "contact_updates", "cache_file", "wall_time_s"}
+            "cutbacks", "contact_updates", "cache_file", "wall_time_s", "data"}
 
 #: name -> (argv, tolerance); CI-sized meshes, each case a few seconds
 CASES = {
