@@ -143,6 +143,13 @@ class GraspModel:
         return contact_load(gaps(self.pads, self.circle, q), penalty, multipliers,
                             weight=self.weight, shares=shares)
 
+    def state_load(self, state: GraspState):
+        """The contact load of a converged state: its normal forces N and weight shares
+        (penalty 0 and multipliers N reproduce N exactly), with the forces and their points."""
+        shares = state.N / state.N.sum() if state.N.sum() > 0 else np.zeros(len(state.N))
+        return contact_load(gaps(self.pads, self.circle, state.q), 0.0, state.N,
+                            weight=self.weight, shares=shares)
+
     def _link_load(self, multipliers, shares, penalty):
         def link_load(q):
             L = self.load(q, multipliers, shares, penalty)

@@ -2,10 +2,11 @@ r"""VTK output of a solid's state: ``.vtu`` per state, ``.pvd`` over load steps.
 
 Fields written (3D displacement bases ``ElementVector`` of P1/P2 tetrahedra):
 
-* point data: ``displacement`` [mm], ``principal_stretches`` (λ1 ≥ λ2 ≥ λ3, the square
-  roots of the eigenvalues of :math:`C = F^T F`), ``cauchy_stress`` [MPa] (the 9 components,
-  row-major), ``von_mises`` [MPa] (:math:`\sqrt{3/2\, s:s}`, s = dev σ), ``J`` and, when the
-  law has a fiber family, ``fiber_stretch`` :math:`|F a_0|`;
+* point data: ``displacement_mm``, ``principal_stretches`` (λ1 ≥ λ2 ≥ λ3, the square
+  roots of the eigenvalues of :math:`C = F^T F`), ``cauchy_stress_MPa`` (the 9 components,
+  row-major), ``von_mises_MPa`` (:math:`\sqrt{3/2\, s:s}`, s = dev σ), ``J`` and, when the
+  law has a fiber family, ``fiber_stretch`` :math:`|F a_0|` (the name carries the unit;
+  stretches and J have none);
 * cell data: the same stress-like quantities averaged over each element's quadrature points.
 
 Quadratic meshes are written as **quadratic cells** (``tetra10``), so ParaView and pyvista
@@ -16,7 +17,10 @@ vertices), so a field is never evaluated where the state is not known to be vali
 :math:`σ = P F^T / J`; with ``J_bar`` (per element, the mean dilatation of a
 mean-dilatation solid) its volumetric part is :math:`U'(\bar J)\,I`, as in that formulation.
 
-All files are written atomically (temporary name + rename).
+A *scene* (:func:`write_scene`, :class:`SceneSeries`) is a ``.vtm`` multiblock file of
+named blocks (:class:`fem.scene.Block`: the tube, the links, the object, ...), each a
+``.vtu`` in a folder next to it; a :class:`SceneSeries` lists one scene per load step in
+a ``.pvd``. All files are written atomically (temporary name + rename).
 """
 from __future__ import annotations
 
@@ -41,7 +45,7 @@ CELL_TYPES = {
 def state_fields(basis: Basis, u: np.ndarray, law=None, *, J_bar=None) -> tuple[dict, dict]:
     """(point_data, cell_data) of displacement ``u`` on the vector ``basis`` (see module doc)."""
     scalar = basis.split(u)[0][1]
-    point_data = {"displacement": _nodal_vector(basis, u)}
+    point_data = {"displacement_mm": _nodal_vector(basis, u)}
     if law is None:
         return point_data, {}
     qp_values = _measures(basis, u, _per_element(law, basis.mesh.nelements), J_bar)
@@ -82,6 +86,40 @@ class VtkSeries:
         return vtu
 
 
+def write_scene(path: str | Path, blocks, field_data: dict | None = None) -> Path:
+    """Write the blocks (:class:`fem.scene.Block`) as ``<stem>/<name>.vtu`` and the ``.vtm``
+    listing them by name; every block gets ``field_data`` (numbers, e.g. the pressure)."""
+    path = Path(path)
+    rows = []
+    for index, block in enumerate(blocks):
+        name = f"{path.stem}/{block.name}.vtu"
+        write_vtu(path.parent / name, block.points, block.cells, point_data=block.point_data,
+                  cell_data=block.cell_data, field_data=field_data)
+        rows.append(f'    <DataSet index="{index}" name={quoteattr(block.name)} file={quoteattr(name)}/>\n')
+    text = ('<?xml version="1.0"?>\n<VTKFile type="vtkMultiBlockDataSet" version="1.0">\n'
+            f"  <vtkMultiBlockDataSet>\n{''.join(rows)}  </vtkMultiBlockDataSet>\n</VTKFile>\n")
+    with atomic_path(path) as tmp:
+        tmp.write_text(text)
+    return path
+
+
+class SceneSeries:
+    """A ``.pvd`` of scenes over load steps (like :class:`VtkSeries`), the ``.vtm`` of step k
+    and its blocks in the folder ``<stem>/`` next to it: ``<stem>_<k>.vtm``, ``<stem>_<k>/*.vtu``."""
+
+    def __init__(self, pvd_path: str | Path):
+        self.path = Path(pvd_path)
+        self.entries: list[tuple[float, str]] = []
+
+    def write(self, time: float, blocks, field_data: dict | None = None) -> Path:
+        """Write the scene at load parameter ``time`` (the pressure [MPa], or the volume [mm³])."""
+        name = f"{self.path.stem}/{self.path.stem}_{len(self.entries):04d}.vtm"
+        write_scene(self.path.parent / name, blocks, {"step": len(self.entries), **(field_data or {})})
+        self.entries.append((float(time), name))
+        write_pvd(self.path, self.entries)
+        return self.path.parent / name
+
+
 def write_pvd(path: str | Path, entries: list[tuple[float, str]]) -> Path:
     """A ParaView collection file listing (time, file name relative to the .pvd)."""
     rows = "".join(f'    <DataSet timestep="{t!r}" part="0" file={quoteattr(name)}/>\n'
@@ -103,8 +141,8 @@ def _measures(basis: Basis, u, law, J_bar) -> dict:
     eig = np.linalg.eigvalsh(np.moveaxis(C, (0, 1), (-2, -1)))
     out = {
         "principal_stretches": np.sqrt(np.clip(eig, 0.0, None))[..., ::-1],
-        "cauchy_stress": np.moveaxis(sigma, (0, 1), (-2, -1)).reshape(J.shape + (9,)),
-        "von_mises": np.sqrt(1.5 * np.einsum("ab...,ab...->...", s, s)),
+        "cauchy_stress_MPa": np.moveaxis(sigma, (0, 1), (-2, -1)).reshape(J.shape + (9,)),
+        "von_mises_MPa": np.sqrt(1.5 * np.einsum("ab...,ab...->...", s, s)),
         "J": J,
     }
     fibers = [p for p in getattr(law, "parts", (law,)) if hasattr(p, "stretch")]

@@ -120,8 +120,9 @@ class ReservoirResult:
     wall_time: float  #: [s]
 
 
-def _surface(solid, u, z0):
-    """Node indices of the surface z = z0 of the reference mesh, sorted by r, with their DOFs."""
+def surface_nodes(solid, u, z0):
+    """(r0, r, z) [mm] of the nodes of the reference surface z = z0, sorted by r0: reference
+    radius, current radius and current height."""
     b = solid.basis
     rdofs, zdofs = np.arange(0, b.N, 2), np.arange(1, b.N, 2)
     X = b.doflocs
@@ -132,8 +133,8 @@ def _surface(solid, u, z0):
 
 
 def _state(model: SheetModel, solid, s) -> SheetState:
-    _, r, z = _surface(solid, s.u, 0.0)
-    r0m, rm, zm = _surface(solid, s.u, model.t / 2)
+    _, r, z = surface_nodes(solid, s.u, 0.0)
+    r0m, rm, zm = surface_nodes(solid, s.u, model.t / 2)
     arc = np.hypot(np.gradient(rm, r0m), np.gradient(zm, r0m))
     hoop = np.where(r0m > 0, rm / np.where(r0m > 0, r0m, 1.0), arc)
     hoop[0] = arc[0]  # on the axis the hoop stretch equals the meridional one
@@ -175,14 +176,11 @@ def inflate(model: SheetModel, volumes, *, options: PathOptions | None = None,
         wall_time=time.perf_counter() - start)
 
 
-def sheet_vtk(solid, state: SheetState, *, n_phi: int = 48):
-    """Two VTK datasets (points, cells, point_data) of a deformed sheet.
-
-    1. the r–z section on its Q2 mesh (``quad9``): reference points (r, z, 0) with the
-       ``displacement`` (u_r, u_z, 0) and the ``hoop_stretch`` (Warp By Vector shows it);
-    2. the wet and dry surfaces revolved about the axis into ``quad`` cells, in deformed
-       position, with the ``height`` z, for viewing the 3D dome.
-    """
+def sheet_vtk(solid, state: SheetState):
+    """The r–z section of a deformed sheet (points, cells, point_data) on its Q2 mesh
+    (``quad9``): reference points (r, z, 0) with the ``displacement_mm`` (u_r, u_z, 0) and
+    the ``hoop_stretch`` (Warp By Vector shows it). The sheet revolved in 3D is
+    :func:`fem.scene.sheet_block`."""
     from skfem import Basis, ElementQuad2
 
     scalar = Basis(solid.mesh, ElementQuad2())
@@ -190,20 +188,5 @@ def sheet_vtk(solid, state: SheetState, *, n_phi: int = 48):
     u = state.u.reshape(-1, 2).T  # interleaved (u_r, u_z) per scalar DOF
     hoop = np.where(X[0] > 0, (X[0] + u[0]) / np.where(X[0] > 0, X[0], 1.0), np.nan)
     hoop[np.isnan(hoop)] = state.lambda_hoop[0]
-    section = (np.c_[X.T, np.zeros(X.shape[1])], {"quad9": scalar.element_dofs.T},
-               {"displacement": np.c_[u.T, np.zeros(X.shape[1])], "hoop_stretch": hoop})
-    points, quads, height = [], [], []
-    phi = np.linspace(0.0, 2 * np.pi, n_phi, endpoint=False)
-    for z0 in (0.0, float(solid.mesh.p[1].max())):  # wet and dry surfaces
-        _, r, z = _surface(solid, state.u, z0)
-        base = sum(len(p) for p in points)
-        points.append(np.stack([np.outer(r, np.cos(phi)).ravel(), np.outer(r, np.sin(phi)).ravel(),
-                                np.repeat(z, n_phi)], axis=1))
-        height.append(np.repeat(z, n_phi))
-        i, j = np.meshgrid(np.arange(len(r) - 1), np.arange(n_phi), indexing="ij")
-        jn = (j + 1) % n_phi
-        quads.append(base + np.stack([i * n_phi + j, (i + 1) * n_phi + j, (i + 1) * n_phi + jn,
-                                      i * n_phi + jn], axis=-1).reshape(-1, 4))
-    revolved = (np.concatenate(points), {"quad": np.concatenate(quads)},
-                {"height": np.concatenate(height)})
-    return section, revolved
+    return (np.c_[X.T, np.zeros(X.shape[1])], {"quad9": scalar.element_dofs.T},
+            {"displacement_mm": np.c_[u.T, np.zeros(X.shape[1])], "hoop_stretch": hoop})

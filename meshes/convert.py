@@ -59,8 +59,10 @@ def read_mesh(path: str | Path) -> skfem.Mesh:
 
 
 def write_vtu(path: str | Path, points: np.ndarray, cells: dict[str, np.ndarray], *,
-              point_data: dict | None = None, cell_data: dict | None = None) -> Path:
-    """Write a ``.vtu`` atomically; ``cells`` maps a meshio cell type to (ncells, nnodes)."""
+              point_data: dict | None = None, cell_data: dict | None = None,
+              field_data: dict | None = None) -> Path:
+    """Write a ``.vtu`` atomically; ``cells`` maps a meshio cell type to (ncells, nnodes);
+    ``field_data``: numbers of the whole dataset (e.g. the pressure), as VTK FieldData."""
     mesh = meshio.Mesh(
         np.asarray(points, dtype=float),
         [(cell_type, np.asarray(conn)) for cell_type, conn in cells.items()],
@@ -69,7 +71,18 @@ def write_vtu(path: str | Path, points: np.ndarray, cells: dict[str, np.ndarray]
     )
     with atomic_path(path) as tmp:
         meshio.write(tmp, mesh, file_format="vtu")
+        if field_data:  # meshio reads VTK FieldData but does not write it
+            tmp.write_text(tmp.read_text().replace(
+                "<UnstructuredGrid>", "<UnstructuredGrid>" + _field_data_xml(field_data), 1))
     return Path(path)
+
+
+def _field_data_xml(field_data: dict) -> str:
+    arrays = "".join(
+        f'<DataArray type="Float64" Name="{name}" NumberOfTuples="{np.size(value)}" '
+        f'format="ascii">{" ".join(repr(float(v)) for v in np.ravel(value))}</DataArray>'
+        for name, value in field_data.items())
+    return f"<FieldData>{arrays}</FieldData>"
 
 
 def _read_meshio(path: str | Path):

@@ -1,13 +1,17 @@
-"""Render a VTK state (``.vtu``, or one step of a ``.pvd``) with pyvista.
+"""Render a VTK result (a ``.vtm`` scene, a ``.vtu``, or one step of a ``.pvd``) with pyvista.
 
-This is the one module of the project that imports pyvista. Rendering is off-screen by
-default (no display needed); the picture shows the mesh deformed by its ``displacement``
-(true scale) coloured by a field, with a scalar bar and a title.
+This is the one module of the project that imports pyvista (and imageio, for animations).
+Rendering is off-screen by default (no display needed). The picture shows the *body* (the
+finger's ``tube``, the reservoir's ``sheet``, or a plain file's mesh) deformed by its
+``displacement_mm`` (true scale) and coloured by a field, with a colour bar labelled with
+the field's unit; its undeformed shape as a faint ghost; the links and hinges of a finger;
+the object of a grasp; the contact forces as arrows ending at the pads, labelled in N.
+The title gives the file, the step and the pressure (and bend angle or volume).
 
-A field is named as in the file (``von_mises``, ``J``, ...); a vector or tensor field is
-shown by its magnitude, or by one component with ``NAME[i]`` (e.g.
-``principal_stretches[0]``, the largest stretch). Point data are preferred to cell data
-of the same name.
+A field is named as in the file (``von_mises_MPa``, ``J``, ...; :func:`describe` lists
+them); a vector or tensor field is shown by its magnitude, or by one component with
+``NAME[i]`` (e.g. ``principal_stretches[0]``, the largest stretch). Point data are
+preferred to cell data of the same name.
 """
 from __future__ import annotations
 
@@ -24,26 +28,29 @@ import pyvista as pv
 
 from meshes.atomic import atomic_path
 from reduced.errors import InputError
+from studies.inspect_style import (VIEWS, body_name, camera, colour_label, default_field,
+                                   title_of)
 
-SUFFIXES = (".vtu", ".pvd", ".vtk")
-DEFAULT_FIELDS = ("von_mises", "displacement")
+SUFFIXES = (".vtu", ".vtm", ".pvd", ".vtk")
+ANIMATIONS = (".gif", ".mp4")
 
 
 @dataclass(frozen=True)
 class FieldSummary:
     file: str      #: the file rendered
-    step: int      #: index of the step in a .pvd (0 for a .vtu)
-    n_steps: int   #: steps in the file (1 for a .vtu)
+    step: int      #: index of the step in a .pvd (0 otherwise)
+    n_steps: int   #: steps in the file (1 for a .vtu/.vtm)
     field: str     #: field shown (with [i] for a component)
     location: str  #: "point" or "cell"
     minimum: float
     maximum: float
     peak_at: tuple[float, float, float]  #: reference position of the maximum [mm]
-    png: str | None  #: picture written, or None (interactive only)
+    png: str | None  #: picture (or animation) written, or None (interactive only)
 
 
-def load_state(path: str | Path, step: int | None = None) -> tuple[pv.DataSet, int, int]:
-    """(mesh, step index, number of steps) of a ``.vtu``/``.vtk`` or a step of a ``.pvd``."""
+def load_scene(path: str | Path, step: int | None = None) -> tuple[pv.MultiBlock, int, int]:
+    """(named blocks, step index, number of steps) of a VTK file; a single dataset is one
+    block named after the file."""
     path = Path(path)
     if path.suffix not in SUFFIXES or not path.is_file():
         raise InputError("file", str(path), f"must be an existing {'/'.join(SUFFIXES)} file")
@@ -51,21 +58,34 @@ def load_state(path: str | Path, step: int | None = None) -> tuple[pv.DataSet, i
     with pv.vtk_verbosity("off"), _quiet_logging():
         try:
             reader = pv.get_reader(str(path))
-            times = list(reader.time_values) if path.suffix == ".pvd" else [0.0]
-        except Exception as exc:  # VTK reports bad files through many exception types
-            raise InputError("file", str(path), f"must be a readable VTK file: {_first_line(exc)}") from None
-        index = _step_index(step, len(times))
-        try:
+            n = len(reader.time_values) if path.suffix == ".pvd" else 1
+            index = _step_index(step, n)
             if path.suffix == ".pvd":
                 reader.set_active_time_point(index)
-            mesh = reader.read()
-        except Exception as exc:
+            data = reader.read()
+        except InputError:
+            raise
+        except Exception as exc:  # VTK reports bad files through many exception types
             raise InputError("file", str(path), f"must be a readable VTK file: {_first_line(exc)}") from None
-    if isinstance(mesh, pv.MultiBlock):
-        mesh = mesh.combine() if mesh.n_blocks else pv.UnstructuredGrid()
-    if mesh.n_points == 0:
+    scene = _flatten(data, path.stem)
+    if not any(b.n_points for b in scene):
         raise InputError("file", str(path), "must be a VTK file with a mesh (found no points)")
-    return mesh, index, len(times)
+    return scene, index, n
+
+
+def _flatten(data, name: str) -> pv.MultiBlock:
+    """Nested multiblocks (a .pvd step of a .vtm) -> one level of named non-empty datasets."""
+    out = pv.MultiBlock()
+    if not isinstance(data, pv.MultiBlock):
+        out[name] = data
+        return out
+    for key, block in zip(data.keys(), data):
+        if isinstance(block, pv.MultiBlock):
+            for k, b in zip(*(lambda f: (f.keys(), list(f)))(_flatten(block, key))):
+                out[k] = b
+        elif block is not None and block.n_points:
+            out[key if len(data) > 1 else name] = block
+    return out
 
 
 def field_values(mesh: pv.DataSet, name: str) -> tuple[np.ndarray, str]:
@@ -94,48 +114,171 @@ def field_names(mesh: pv.DataSet) -> list[str]:
     return list(dict.fromkeys([*mesh.point_data.keys(), *mesh.cell_data.keys()]))
 
 
+def describe(path: str | Path, step: int | None = None) -> list[dict]:
+    """Every array of every block: block, name, location (point/cell/field), components."""
+    scene, _, _ = load_scene(path, step)
+    rows = []
+    for name, block in zip(scene.keys(), scene):
+        for location in ("point", "cell", "field"):
+            for key, value in getattr(block, f"{location}_data").items():
+                value = np.asarray(value)
+                rows.append({"block": name, "field": key, "location": location,
+                             "components": 1 if value.ndim == 1 else int(value.shape[1])})
+    return rows
+
+
 def inspect(path: str | Path, *, field: str | None = None, step: int | None = None,
-            out: str | Path | None = None, interactive: bool = False) -> FieldSummary:
+            out: str | Path | None = None, view: str | None = None,
+            interactive: bool = False) -> FieldSummary:
     """Render ``path`` coloured by ``field``; write ``out`` (PNG) unless only interactive."""
-    mesh, index, n_steps = load_state(path, step)
-    field = field or next((f for f in DEFAULT_FIELDS if f in field_names(mesh)), None)
-    if field is None:
-        raise InputError("field", None, f"no default field; allowed: {', '.join(field_names(mesh))}")
-    values, location = field_values(mesh, field)
-    if not np.any(np.isfinite(values)):
-        raise InputError("field", field, "has no finite values in this file")
-    centres = mesh.points if location == "point" else mesh.cell_centers().points
+    scene, index, n_steps = load_scene(path, step)
+    body = scene[body_name(scene.keys())]
+    field = field or default_field(field_names(body))
+    values, location = _checked_values(body, field)
+    centres = body.points if location == "point" else body.cell_centers().points
     peak = np.asarray(centres[int(np.nanargmax(values))], dtype=float)
     if interactive and not _has_display():
         raise InputError("--interactive", True, "needs a display (DISPLAY is not set); "
                                                 "omit it to render off-screen")
     png = None if interactive and out is None else Path(out or _default_png(path, index, field))
-    title = f"{Path(path).name}  step {index}/{n_steps - 1}  {field}"
-    _render(mesh, values, location, title=title, png=png, interactive=interactive)
+    plotter = _plotter(interactive=interactive)
+    _draw(plotter, scene, field, title=title_of(path, scene, index, n_steps), view=view)
+    if png is not None:
+        with atomic_path(png) as tmp:
+            plotter.screenshot(str(tmp))
+    if interactive:
+        plotter.show()
+    plotter.close()
     return FieldSummary(str(path), index, n_steps, field, location, float(np.nanmin(values)),
                         float(np.nanmax(values)), tuple(peak.tolist()), None if png is None else str(png))
 
 
-def _render(mesh, values, location, *, title, png, interactive) -> None:
-    shown = mesh.copy()
-    shown.clear_data()
-    if "displacement" in mesh.point_data:
-        shown.points = mesh.points + np.asarray(mesh.point_data["displacement"], dtype=float)
-    getattr(shown, f"{location}_data")["field"] = values
+def animate(path: str | Path, out: str | Path, *, field: str | None = None,
+            view: str | None = None, fps: float = 4.0) -> FieldSummary:
+    """Render every step of a ``.pvd`` with one camera and colour range into a GIF or MP4."""
+    import imageio.v2 as imageio
+
+    out = Path(out)
+    if out.suffix not in ANIMATIONS:
+        raise InputError("--animate", str(out), f"must end in {' or '.join(ANIMATIONS)}")
+    if Path(path).suffix != ".pvd":
+        raise InputError("file", str(path), "must be a .pvd series to animate")
+    scenes = [load_scene(path, k) for k in range(load_scene(path)[2])]
+    bodies = [s[body_name(s.keys())] for s, _, _ in scenes]
+    field = field or default_field(field_names(bodies[-1]))
+    ranges = np.array([[np.nanmin(v), np.nanmax(v)] for v in (_checked_values(b, field)[0] for b in bodies)])
+    clim = (float(ranges[:, 0].min()), float(ranges[:, 1].max()))
+    plotter = _plotter(window_size=(800, 600))
+    frames = []
+    for scene, index, n in scenes[::-1]:  # the last (largest) state first: it sets the camera
+        plotter.clear()
+        _draw(plotter, scene, field, title=title_of(path, scene, index, n), view=view, clim=clim,
+              keep_camera=bool(frames))
+        frames.append(plotter.screenshot(return_img=True))
+    plotter.close()
+    frames = frames[::-1]
+    with atomic_path(out) as tmp:
+        if out.suffix == ".gif":
+            imageio.mimsave(tmp, frames, format="GIF", duration=1000.0 / fps, loop=0)
+        else:
+            try:
+                imageio.mimsave(tmp, frames, fps=fps)
+            except Exception as exc:  # no ffmpeg plugin
+                raise InputError("--animate", str(out), f"MP4 needs imageio-ffmpeg "
+                                 f"(pip install imageio-ffmpeg): {_first_line(exc)}") from None
+    return FieldSummary(str(path), len(scenes) - 1, len(scenes), field, "point", clim[0], clim[1],
+                        (np.nan,) * 3, str(out))
+
+
+def _checked_values(body, field):
+    if field is None:
+        raise InputError("field", None, f"no default field; allowed: {', '.join(field_names(body))}")
+    values, location = field_values(body, field)
+    if not np.any(np.isfinite(values)):
+        raise InputError("field", field, "has no finite values in this file")
+    return values, location
+
+
+def _plotter(*, interactive=False, window_size=(1200, 900)) -> pv.Plotter:
     with pv.vtk_verbosity("off"):
-        plotter = pv.Plotter(off_screen=not interactive, window_size=(1024, 768))
-        plotter.add_mesh(shown, scalars="field", cmap="viridis", show_edges=False,
-                         scalar_bar_args={"title": title.rsplit("  ", 1)[-1], "width": 0.6,
-                                          "position_x": 0.2, "position_y": 0.02, "fmt": "%.4g"})
-        plotter.add_text(title, font_size=10)
-        plotter.view_isometric()
-        plotter.camera.zoom(0.8)
-        if png is not None:
-            with atomic_path(png) as tmp:
-                plotter.screenshot(str(tmp))
-        if interactive:
-            plotter.show()
-        plotter.close()
+        plotter = pv.Plotter(off_screen=not interactive, window_size=window_size)
+    plotter.set_background("white")
+    return plotter
+
+
+def _draw(plotter, scene, field, *, title, view, clim=None, keep_camera=False, hand=True) -> None:
+    """Add the scene's actors: ghost, coloured body, links, hinges, object, force arrows;
+    with ``hand`` the hand's other fingers (copies turned about the hand's axis y)."""
+    names = scene.keys()
+    body_key = body_name(names)
+    body = scene[body_key]
+    values, location = field_values(body, field)
+    shown = _deformed(body)
+    shown.clear_data()
+    getattr(shown, f"{location}_data")["field"] = values
+    plotter.add_mesh(_surface(body), color="grey", opacity=0.12)
+    parts = [(_surface(shown), {"scalars": "field", "cmap": "viridis", "clim": clim or _clim(values)})]
+    for name, block in zip(names, scene):
+        if name.startswith("link_"):
+            parts.append((block.extract_surface(algorithm="dataset_surface"), {"color": "#b0b4bb"}))
+        elif name.startswith("hinge_"):
+            parts.append((block.extract_surface(algorithm="dataset_surface"), {"color": "#4a4f57"}))
+        elif name == "object":
+            plotter.add_mesh(block, color="#e0a060", opacity=0.3, smooth_shading=True)
+        elif name == "contact_forces":
+            _draw_forces(plotter, block)
+    n = int(np.asarray(body.field_data["n_fingers"]).ravel()[0]) if "n_fingers" in body.field_data and hand else 1
+    actors = [plotter.add_mesh(mesh.rotate_y(360.0 * k / n, point=(0.0, 0.0, 0.0), inplace=False)
+                               if k else mesh, show_scalar_bar=False, **style)
+              for k in range(n) for mesh, style in parts]
+    plotter.add_scalar_bar(colour_label(field), mapper=actors[0].mapper, vertical=True, position_x=0.86, position_y=0.12,
+                           width=0.05, height=0.7, color="black", fmt="%.3g", title_font_size=14,
+                           label_font_size=13)
+    plotter.add_text(title, font_size=10, color="black")
+    if not keep_camera:
+        camera(plotter, view, sheet=body_key == "sheet")
+
+
+def _clim(values) -> tuple[float, float]:
+    """Colour range: min to max, but to the 95th percentile when a few peaks (e.g. at the
+    edges of the ties) would leave the rest of the body in one colour; the bar's top
+    colour then stands for 'this or more'."""
+    lo, hi, q = np.nanmin(values), np.nanmax(values), np.nanpercentile(values, 95.0)
+    return float(lo), float(q if hi - lo > 2.0 * (q - lo) > 0 else hi)
+
+
+def _draw_forces(plotter, forces) -> None:
+    """Arrows of the force of the object on each touching pad, tip at the pad, length
+    proportional to the force (the largest 40 mm), labelled in N."""
+    f = np.asarray(forces.point_data["force_N"], dtype=float)
+    size = np.linalg.norm(f, axis=1)
+    touching = size > 1e-6 * max(size.max(), 1e-300)
+    if not touching.any():
+        return
+    scale = 40.0 / size.max()
+    tails = forces.points[touching] - scale * f[touching]
+    arrows = pv.PolyData(tails)
+    arrows["vectors"] = scale * f[touching]
+    glyphs = arrows.glyph(orient="vectors", scale="vectors", factor=1.0,
+                          geom=pv.Arrow(tip_length=0.25, tip_radius=0.12, shaft_radius=0.04))
+    plotter.add_mesh(glyphs, color="#d62728", name="forces")
+    plotter.add_point_labels(tails, [f"{s:.3g} N" for s in size[touching]], font_size=14,
+                             text_color="#d62728", shape=None, show_points=False,
+                             always_visible=True, name="force_labels")
+
+
+def _deformed(mesh):
+    shown = mesh.copy()
+    for name in ("displacement_mm", "displacement"):
+        if name in mesh.point_data:
+            shown.points = mesh.points + np.asarray(mesh.point_data[name], dtype=float)
+            break
+    return shown
+
+
+def _surface(mesh):
+    """The outer surface (quadratic cells tessellated), for fast, smooth drawing."""
+    return mesh.extract_surface(nonlinear_subdivision=2, algorithm="dataset_surface") if isinstance(mesh, pv.UnstructuredGrid) else mesh
 
 
 def _sniff(path: Path) -> None:
@@ -144,7 +287,7 @@ def _sniff(path: Path) -> None:
         head = f.read(256).lstrip()
     if not (head.startswith(b"<?xml") or head.startswith(b"<VTKFile")
             or head.startswith(b"# vtk DataFile")):
-        raise InputError("file", str(path), "must be a VTK file (XML .vtu/.pvd or legacy .vtk)")
+        raise InputError("file", str(path), "must be a VTK file (XML .vtu/.vtm/.pvd or legacy .vtk)")
 
 
 @contextlib.contextmanager
@@ -179,3 +322,7 @@ def _default_png(path, index: int, field: str) -> Path:
 def _has_display() -> bool:
     return sys.platform in ("win32", "darwin") or bool(os.environ.get("DISPLAY")
                                                         or os.environ.get("WAYLAND_DISPLAY"))
+
+
+__all__ = ["FieldSummary", "VIEWS", "animate", "describe", "field_names", "field_values",
+           "inspect", "load_scene"]

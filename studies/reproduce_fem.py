@@ -50,7 +50,8 @@ def verify(ctx: Context, outdir: Path):
 def fig7_fem(ctx: Context, outdir: Path):
     """Free bending by finger FEM against eq. (28), and the whole hand against eq. (27)."""
     from fem.finger import FingerOptions
-    from fem.io import VtkSeries
+    from fem.io import SceneSeries
+    from fem.scene import finger_scene
     from reduced import hand, reservoir
     from studies.bending import BendingStudy, run
 
@@ -58,12 +59,10 @@ def fig7_fem(ctx: Context, outdir: Path):
     step = 0.2 if ctx.quick else 0.1
     pressures = tuple(np.round(np.arange(0.0, 0.8 + 1e-9, step), 10))
     options = FingerOptions(mesher="gmsh", mesh_size=6.0, edge_ratio=1.0, mesh_refine=0) if ctx.quick else FingerOptions()
-    series, basis = VtkSeries(outdir / "finger.pvd"), []
+    series = SceneSeries(outdir / "finger.pvd")
     with progress_bar("  bending the finger", "P") as bar:
         def on_state(model, state):
-            basis[:] = basis or [model.vector_basis()]
-            series.write(state.P, basis[0], model.displacement(state.y), model.law,
-                         J_bar=model.element_dilatation(state.y))
+            series.write(state.P, *finger_scene(model, state.y, state.P))
             bar.update(1)
 
         result = run(BendingStudy(d, pressures, options), on_state=on_state)
@@ -259,17 +258,23 @@ errors against its measurements:
 
 
 def write_sheet_vtk(result, outdir: Path) -> list[str]:
-    """The deformed sheet per volume (r-z section and revolved to 3D) as .vtu files."""
+    """The deformed sheet per volume: the scene series sheet.pvd (the sheet revolved in 3D,
+    one .vtm per volume, by increasing volume) and the r-z sections sheet_V<volume>_rz.vtu."""
+    from fem.io import SceneSeries
     from fem.reservoir import sheet_vtk
+    from fem.scene import sheet_block
     from meshes.convert import write_vtu
 
     solid, names = result.fem.model.build()[0], []
-    for state in result.states:
-        for suffix, (points, cells, data) in zip(("", "_3d"), sheet_vtk(solid, state)):
-            name = f"sheet_V{state.volume:.0f}{suffix}.vtu"
-            write_vtu(outdir / name, points, cells, point_data=data)
-            names.append(name)
-    return names
+    series = SceneSeries(outdir / "sheet.pvd")
+    for state in sorted({s.volume: s for s in result.states}.values(), key=lambda s: s.volume):
+        series.write(state.volume, [sheet_block(solid, state)],
+                     {"volume_mm3": state.volume, "pressure_MPa": state.pressure})
+        name = f"sheet_V{state.volume:.0f}_rz.vtu"
+        points, cells, data = sheet_vtk(solid, state)
+        write_vtu(outdir / name, points, cells, point_data=data)
+        names.append(name)
+    return ["sheet.pvd", *names]
 
 
 def progress_bar(desc: str, unit: str):

@@ -100,7 +100,7 @@ def finger_options(mesh_size_mm: float):
 
 def compute(case: WeightsCase, out=None) -> dict:
     """Run the grasp FEM for one case (no cache): the flat result; with ``out`` (a folder)
-    also the two states' fields as the VTK series ``grasp.pvd`` (finger frame, half tube)."""
+    also the two states' fields as the VTK scene series ``grasp.pvd`` (hand, object, contact forces)."""
     from fem.finger import FingerModel
     from fem.grasp import GraspModel, grasp_weights
 
@@ -108,20 +108,21 @@ def compute(case: WeightsCase, out=None) -> dict:
     model = GraspModel(finger, case.diameter_mm, mass=case.mass_kg, depth=case.depth_mm)
     r = grasp_weights(model, case.pressure_mpa, case.dP_mpa)
     if out is not None:
-        _write_vtk(out, finger, (r.state, r.state_dP))
+        _write_vtk(out, model, (r.state, r.state_dP))
     return {"diameter_mm": case.diameter_mm, "mass_kg": case.mass_kg, "depth_mm": model.depth,
             "dP_MPa": case.dP_mpa, "w": r.w.tolist(), "w_sum": float(r.w.sum()),
             **state_row(r.state, r.w, case.mass_kg, case.design),
             "mesh_size_mm": case.mesh_size_mm, "ndofs": r.ndofs, "wall_seconds": r.wall_seconds}
 
 
-def _write_vtk(out, finger, states) -> None:
-    from fem.io import VtkSeries
+def _write_vtk(out, model, states) -> None:
+    """The contact states as the scene series grasp.pvd (see :mod:`fem.scene`)."""
+    from fem.io import SceneSeries
+    from fem.scene import grasp_scene
 
-    series, basis = VtkSeries(Path(out) / "grasp.pvd"), finger.vector_basis()
+    series = SceneSeries(Path(out) / "grasp.pvd")
     for s in states:
-        series.write(s.P, basis, finger.displacement(s.y), finger.law,
-                     J_bar=finger.element_dilatation(s.y))
+        series.write(s.P, *grasp_scene(model, s))
 
 
 def weights(case: WeightsCase, *, cache: bool = True, out=None) -> dict:

@@ -4,7 +4,8 @@ Per pressure: P_MPa, theta_deg, hinge_deg, dQ_mm3, radial_stretch_max,
 max_principal_stretch, theta_reduced_deg (eq. (28) at the same P), dQ_reduced_mm3 (eq. (2)
 at the FEM's theta), max_von_mises_MPa, newton_iterations. Then, unless ``--peak-mpa 0``,
 the path goes on to 2.0 MPa and the peak stretch and stress there are reported.
-Files in ``--out DIR``: result.json, table.csv, the VTK series finger.pvd (+ .vtu).
+Files in ``--out DIR``: result.json, table.csv, the VTK series finger.pvd (one .vtm scene per
+pressure: tube, links, hinges; see ``softhand inspect``).
 """
 from __future__ import annotations
 
@@ -76,7 +77,8 @@ def _options(args):
 def run(args) -> int:
     from tqdm import tqdm
 
-    from fem.io import VtkSeries
+    from fem.io import SceneSeries
+    from fem.scene import finger_scene
     from fem.newton import NotConverged
     from studies.bending import BendingStudy, run as run_study
     from studies.output import write_csv, write_json
@@ -85,16 +87,12 @@ def run(args) -> int:
     study = BendingStudy(design_from_args(args), pressures, _options(args),
                          peak_mpa=args.peak_mpa if args.peak_mpa > pressures[-1] else 0.0)
     out = Path(args.out)
-    series = VtkSeries(out / "finger.pvd")
+    series = SceneSeries(out / "finger.pvd")
     n_steps = len(pressures) + (1 if study.peak_mpa else 0)
     bar = tqdm(total=n_steps, desc="bend", unit="P", file=sys.stderr, leave=False)
-    basis = []
 
     def on_state(model, state):
-        if not basis:
-            basis.append(model.vector_basis())
-        series.write(state.P, basis[0], model.displacement(state.y), model.law,
-                     J_bar=model.element_dilatation(state.y))
+        series.write(state.P, *finger_scene(model, state.y, state.P))
         bar.set_postfix(P=f"{state.P:.2f}", theta=f"{state.theta * 57.29578:.1f}deg")
         bar.update(0 if state.P > pressures[-1] and state.P < study.peak_mpa else 1)
 

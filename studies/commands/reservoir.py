@@ -122,7 +122,7 @@ def _write_outputs(out: Path, result, summary) -> None:
     write_json(out / "result.json", {"rows": result.rows, **summary, "profiles": profiles,
                                      "path": path})
     write_csv(out / "rows.csv", result.rows)
-    write_sheet_vtk(result, out)  # sheet_V<volume>.vtu (r–z) and sheet_V<volume>_3d.vtu
+    write_sheet_vtk(result, out)  # sheet.pvd (3D scenes) and sheet_V<volume>_rz.vtu (r–z)
 
 
 def _git_commit() -> str:
