@@ -83,8 +83,8 @@ def _flatten(data, name: str) -> pv.MultiBlock:
         if isinstance(block, pv.MultiBlock):
             for k, b in zip(*(lambda f: (f.keys(), list(f)))(_flatten(block, key))):
                 out[k] = b
-        elif block is not None and block.n_points:
-            out[key if len(data) > 1 else name] = block
+        elif block is not None and block.n_points:  # a .vtu in a .pvd: named after the file
+            out[name if re.fullmatch(r"Block-\d+", key or "Block-0") else key] = block
     return out
 
 

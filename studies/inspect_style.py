@@ -43,7 +43,7 @@ def colour_label(field: str) -> str:
     if component is not None:
         words += f" [{component}]"
     elif name in ("displacement", "cauchy_stress", "force"):
-        words = f"|{words}|"
+        words = f"{words} magnitude"
     return words if unit is None else f"{words} [{unit}]"
 
 

@@ -60,7 +60,7 @@ def fig7_fem(ctx: Context, outdir: Path):
     pressures = tuple(np.round(np.arange(0.0, 0.8 + 1e-9, step), 10))
     options = FingerOptions(mesher="gmsh", mesh_size=6.0, edge_ratio=1.0, mesh_refine=0) if ctx.quick else FingerOptions()
     series = SceneSeries(outdir / "finger.pvd")
-    with progress_bar("  bending the finger", "P") as bar:
+    with progress_bar("  bending the finger", " pressure") as bar:
         def on_state(model, state):
             series.write(state.P, *finger_scene(model, state.y, state.P))
             bar.update(1)
@@ -121,9 +121,9 @@ def reservoir_fem(ctx: Context, outdir: Path):
     from studies.reservoir import COLUMNS, ReservoirStudy, run
 
     mesh = {"n_radial": 16, "n_thick": 1} if ctx.quick else {}
-    with progress_bar("  inflating the sheet", "mm³") as bar:
+    with progress_bar("  inflating the sheet", " mm³") as bar:  # whole mm³ of oil
         result = run(ReservoirStudy(design=ctx.design, **mesh),
-                     progress=lambda v: bar.update(v - bar.n))
+                     progress=lambda v: bar.update(round(v) - bar.n))
     write_csv(outdir / "reservoir.csv", result.rows, COLUMNS)
     v = result.verdict
     verdict = [{"quantity": name, "min": v[key]["min"], "max": v[key]["max"], "at_V0": v[key]["at_V0"]}

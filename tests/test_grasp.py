@@ -147,11 +147,38 @@ def test_vtk_series_of_the_contact_states(grasp180, tmp_path):
     from studies.weights import _write_vtk
 
     model, a, b, _ = grasp180
-    _write_vtk(tmp_path, model.finger, (a, b))
+    _write_vtk(tmp_path, model, (a, b))
     assert (tmp_path / "grasp.pvd").read_text().count("<DataSet") == 2
-    mesh = meshio.read(tmp_path / "grasp_0001.vtu")
-    u = mesh.point_data["displacement"]
+    mesh = meshio.read(tmp_path / "grasp" / "grasp_0001" / "tube.vtu")
+    u = mesh.point_data["displacement_mm"]
     assert u.shape[1] == 3 and np.isfinite(u).all() and np.abs(u).max() > 1.0  # mm: the finger moved
+    assert mesh.field_data["pressure_MPa"][0] == b.P
+
+
+def test_scene_of_a_contact_state_holds_the_object_and_the_pad_forces(grasp180, tmp_path):
+    """The object's sphere (radius D/2 around the hand axis at the model's depth), the pad
+    forces (normal part along the line from the centre = N of the FEM state), the links
+    turned by the state's hinge angles."""
+    from studies.inspect import load_scene
+    from studies.weights import _write_vtk
+
+    model, a, _, _ = grasp180
+    _write_vtk(tmp_path, model, (a,))
+    scene = load_scene(tmp_path / "grasp.pvd")[0]
+    assert {"object", "contact_forces"} <= set(scene.keys())
+    centre = np.array([0.0, model.depth, 0.0])
+    radius = np.linalg.norm(np.asarray(scene["object"].points) - centre, axis=1)
+    np.testing.assert_allclose(radius, 0.5 * model.diameter, rtol=1e-12)
+    forces = scene["contact_forces"]
+    assert forces.n_points == DESIGN.n_s + 1
+    away = np.asarray(forces.points) - centre
+    normal = np.einsum("ki,ki->k", forces.point_data["force_N"], away / np.linalg.norm(away, axis=1)[:, None])
+    np.testing.assert_allclose(normal, a.N, atol=1e-9 * a.N.max())
+    touching = a.N > 0  # the touching pads lie on the sphere (gap below the contact tolerance)
+    np.testing.assert_allclose(np.linalg.norm(away[touching], axis=1), 0.5 * model.diameter,
+                               atol=model.options.gap_tol)
+    edge = np.array([scene[f"link_{k}"].points[1] - scene[f"link_{k}"].points[0] for k in range(DESIGN.n_s + 1)])
+    np.testing.assert_allclose(np.diff(np.unwrap(np.arctan2(edge[:, 1], edge[:, 0]))), a.q, atol=1e-12)
 
 
 def test_grasp_cli_takes_w_from_the_fem_or_the_paper_by_name(tmp_path, monkeypatch, capsys):

@@ -28,7 +28,7 @@ def series(tmp_path_factory):
 
 def test_png_is_not_blank_and_range_is_reported(series, tmp_path):
     png = tmp_path / "pic.png"
-    summary = inspect(series, field="von_mises", out=png)
+    summary = inspect(series, field="von_mises_MPa", out=png)
     image = imread(png)[..., :3]
     assert image.shape[0] > 100 and image.std() > 0.05  # a blank picture has std 0
     assert summary.step == 2 and summary.n_steps == 3

@@ -31,16 +31,16 @@ def test_homogeneous_fields_match_closed_forms(box):
     s = sigma - np.trace(sigma) / 3 * np.eye(3)
     # P2 reproduces the linear displacement exactly: only round-off (~1e-12 of kappa (J-1))
     for data in (point, cell):
-        assert np.allclose(data["cauchy_stress"], sigma.ravel(), rtol=0, atol=1e-9)
-        assert np.allclose(data["von_mises"], np.sqrt(1.5 * np.sum(s * s)), atol=1e-9)
+        assert np.allclose(data["cauchy_stress_MPa"], sigma.ravel(), rtol=0, atol=1e-9)
+        assert np.allclose(data["von_mises_MPa"], np.sqrt(1.5 * np.sum(s * s)), atol=1e-9)
         assert np.allclose(data["J"], np.linalg.det(F0), atol=1e-12)
         assert np.allclose(data["principal_stretches"],
                            np.sqrt(np.linalg.eigvalsh(F0.T @ F0))[::-1], atol=1e-12)
         assert np.allclose(data["fiber_stretch"], np.linalg.norm(F0 @ [1, 1, 0]) / np.sqrt(2))
-    assert point["displacement"].shape == (basis.N // 3, 3)
+    assert point["displacement_mm"].shape == (basis.N // 3, 3)
     # J_bar = J for a homogeneous state: the mean-dilatation stress is the same
     point_bar, _ = state_fields(basis, u, law, J_bar=np.full(mesh.nelements, np.linalg.det(F0)))
-    assert np.allclose(point_bar["cauchy_stress"], sigma.ravel(), atol=1e-9)
+    assert np.allclose(point_bar["cauchy_stress_MPa"], sigma.ravel(), atol=1e-9)
 
 
 def test_vtu_has_quadratic_cells_and_extra_data(box, tmp_path):
@@ -64,7 +64,7 @@ def test_series_lists_every_step(box, tmp_path):
     text = (tmp_path / "run.pvd").read_text()
     assert text.count("<DataSet") == 3 and 'file="run_0002.vtu"' in text
     last = meshio.read(tmp_path / "run_0002.vtu")
-    assert np.allclose(last.point_data["displacement"], u.reshape(-1, 3))
+    assert np.allclose(last.point_data["displacement_mm"], u.reshape(-1, 3))
 
 
 def test_solid_output_uses_the_mean_dilatation_pressure(box):
@@ -74,4 +74,4 @@ def test_solid_output_uses_the_mean_dilatation_pressure(box):
     args = solid_output(solid, u)
     assert np.allclose(args["J_bar"], np.linalg.det(F0))
     point, _ = state_fields(args["basis"], u, law, J_bar=args["J_bar"])
-    assert np.allclose(point["cauchy_stress"], cauchy(law, F0).ravel(), atol=1e-9)
+    assert np.allclose(point["cauchy_stress_MPa"], cauchy(law, F0).ravel(), atol=1e-9)

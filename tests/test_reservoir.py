@@ -152,7 +152,15 @@ def test_cli_table_json_files_and_bad_input(tmp_path, capsys):
     data = json.loads(capsys.readouterr().out)
     assert set(data["rows"][0]) >= {"V_mm3", "p_MPa", "h_mm", "W_Nmm", "p_ellipse_MPa",
                                     "h_ellipse_mm", "W_ellipse_Nmm", "lambda_r", "max_gap_mm"}
-    assert (out / "sheet_V17800.vtu").is_file() and (out / "sheet_V17800_3d.vtu").is_file()
+    assert (out / "sheet_V17800_rz.vtu").is_file()
+    from studies.inspect import load_scene
+
+    sheet = load_scene(out / "sheet.pvd")[0]["sheet"]  # the last step: the largest volume
+    height = np.asarray(sheet.points)[:, 2] + np.asarray(sheet.point_data["displacement_mm"])[:, 2]
+    wet = np.asarray(sheet.points)[:, 2] == 0.0  # the revolved wet surface's apex is h
+    h = next(r["h_mm"] for r in data["rows"] if r["V_mm3"] == 17800)
+    assert height[wet].max() == pytest.approx(h, rel=1e-9)
+    assert float(sheet.field_data["volume_mm3"][0]) == 17800
     assert (tmp_path / "r.png").stat().st_size > 0
     assert main(["reservoir", "--volume-mm3", "-5"]) == 2
     assert "--volume-mm3" in capsys.readouterr().err

@@ -190,11 +190,14 @@ def _plot(result, mode: str, theta_ref_deg: float, path: str) -> None:
     ax2.plot(other.t, other.P, ":", lw=1.2, label="P, other mode")
     ax2.set(xlabel="t [s]", ylabel="pump pressure P [MPa]", title="Fig. 10 (d) analogue")
     twin = ax2.twinx()
-    twin.plot(sim.t, sim.force, color="tab:red", lw=0.8, alpha=0.6)
+    twin.plot(sim.t, sim.force, color="tab:red", lw=0.8, alpha=0.6, label="external push (right axis)")
     twin.set_ylabel("push [N]", color="tab:red")
-    for ax in (ax1, ax2):
-        ax.grid(alpha=0.3)
-        ax.legend(fontsize=7, loc="lower right")
+    ax1.grid(alpha=0.3)
+    ax1.legend(fontsize=7, loc="lower right", ncol=2, title="bend angle of each finger and their mean",
+               title_fontsize=7)
+    ax2.grid(alpha=0.3)
+    lines = ax2.get_lines() + twin.get_lines()
+    ax2.legend(lines, [line.get_label() for line in lines], fontsize=7, loc="lower right")
     save_figure(fig, path)
 
 

@@ -65,8 +65,8 @@ def run(args) -> int:
     from fem.volume_path import NotConverged
 
     try:
-        with tqdm(desc="inflating", unit="mm^3", leave=False) as bar:
-            result = run_study(study, progress=lambda v: bar.update(v - bar.n))
+        with tqdm(desc="inflating", unit=" mm³", leave=False) as bar:  # whole mm³ of oil
+            result = run_study(study, progress=lambda v: bar.update(round(v) - bar.n))
     except NotConverged as exc:
         last = exc.last
         print(f"softhand reservoir: error: {str(exc).split(';')[0]} (Newton failed at the smallest "
