@@ -128,7 +128,7 @@ def describe(path: str | Path, step: int | None = None) -> list[dict]:
 
 
 def inspect(path: str | Path, *, field: str | None = None, step: int | None = None,
-            out: str | Path | None = None, view: str | None = None,
+            out: str | Path | None = None, view: str | None = None, hand: bool = True,
             interactive: bool = False) -> FieldSummary:
     """Render ``path`` coloured by ``field``; write ``out`` (PNG) unless only interactive."""
     scene, index, n_steps = load_scene(path, step)
@@ -142,7 +142,7 @@ def inspect(path: str | Path, *, field: str | None = None, step: int | None = No
                                                 "omit it to render off-screen")
     png = None if interactive and out is None else Path(out or _default_png(path, index, field))
     plotter = _plotter(interactive=interactive)
-    _draw(plotter, scene, field, title=title_of(path, scene, index, n_steps), view=view)
+    _draw(plotter, scene, field, title=title_of(path, scene, index, n_steps), view=view, hand=hand)
     if png is not None:
         with atomic_path(png) as tmp:
             plotter.screenshot(str(tmp))
@@ -154,7 +154,7 @@ def inspect(path: str | Path, *, field: str | None = None, step: int | None = No
 
 
 def animate(path: str | Path, out: str | Path, *, field: str | None = None,
-            view: str | None = None, fps: float = 4.0) -> FieldSummary:
+            view: str | None = None, hand: bool = True, fps: float = 4.0) -> FieldSummary:
     """Render every step of a ``.pvd`` with one camera and colour range into a GIF or MP4."""
     import imageio.v2 as imageio
 
@@ -173,7 +173,7 @@ def animate(path: str | Path, out: str | Path, *, field: str | None = None,
     for scene, index, n in scenes[::-1]:  # the last (largest) state first: it sets the camera
         plotter.clear()
         _draw(plotter, scene, field, title=title_of(path, scene, index, n), view=view, clim=clim,
-              keep_camera=bool(frames))
+              keep_camera=bool(frames), hand=hand)
         frames.append(plotter.screenshot(return_img=True))
     plotter.close()
     frames = frames[::-1]
@@ -231,12 +231,12 @@ def _draw(plotter, scene, field, *, title, view, clim=None, keep_camera=False, h
     actors = [plotter.add_mesh(mesh.rotate_y(360.0 * k / n, point=(0.0, 0.0, 0.0), inplace=False)
                                if k else mesh, show_scalar_bar=False, **style)
               for k in range(n) for mesh, style in parts]
-    plotter.add_scalar_bar(colour_label(field), mapper=actors[0].mapper, vertical=True, position_x=0.86, position_y=0.12,
+    plotter.add_scalar_bar(colour_label(field), mapper=actors[0].mapper, vertical=True, position_x=0.8, position_y=0.12,
                            width=0.05, height=0.7, color="black", fmt="%.3g", title_font_size=14,
                            label_font_size=13)
     plotter.add_text(title, font_size=10, color="black")
     if not keep_camera:
-        camera(plotter, view, sheet=body_key == "sheet")
+        camera(plotter, view, sheet=body_key == "sheet", zoom=1.3 if n > 1 else 1.0)
 
 
 def _clim(values) -> tuple[float, float]:

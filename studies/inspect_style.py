@@ -40,7 +40,9 @@ def colour_label(field: str) -> str:
     name, unit = (unit_match.group(1), UNITS[unit_match.group(2)]) if unit_match else \
         (base, "-" if base in DIMENSIONLESS else None)
     words = {"von_mises": "von Mises stress", "cauchy_stress": "Cauchy stress"}.get(name, name.replace("_", " "))
-    if component is not None:
+    if component is not None and name == "principal_stretches":
+        words = f"principal stretch {int(component) + 1}" + (" (largest)" if component == "0" else "")
+    elif component is not None:
         words += f" [{component}]"
     elif name in ("displacement", "cauchy_stress", "force"):
         words = f"{words} magnitude"
@@ -63,7 +65,7 @@ def title_of(path, scene, index: int, n_steps: int) -> str:
     return "   ".join(parts)
 
 
-def camera(plotter, view: str | None, *, sheet: bool) -> None:
+def camera(plotter, view: str | None, *, sheet: bool, zoom: float = 1.0) -> None:
     """Point the camera: finger scenes are in the hand frame (y down, bending plane z = 0),
     the sheet has z up; ``side`` (the default of a finger) looks normal to the bending plane."""
     view = view or ("iso" if sheet else "side")
@@ -84,4 +86,4 @@ def camera(plotter, view: str | None, *, sheet: bool) -> None:
     d = np.asarray(direction) / np.linalg.norm(direction)
     plotter.camera_position = [tuple(focus + distance * d), tuple(focus), up]
     plotter.reset_camera()
-    plotter.camera.zoom(1.3)
+    plotter.camera.zoom(zoom)

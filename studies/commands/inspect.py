@@ -19,6 +19,8 @@ def configure(parser) -> None:
                         help="step of a .pvd series (default: the last; negative from the end)")
     parser.add_argument("--view", default=None, help="camera: side (normal to the bending "
                         "plane; the default of a finger), iso (the default of a sheet), top, front")
+    parser.add_argument("--one-finger", action="store_true",
+                        help="draw only the modelled finger, not the hand's other fingers")
     parser.add_argument("--out", metavar="FILE.png", default=None,
                         help="picture to write (default: FILE_step<K>_<field>.png next to FILE)")
     parser.add_argument("--animate", metavar="OUT.gif|mp4", default=None,
@@ -39,10 +41,11 @@ def run(args) -> int:
             print(f"{r['block']:16s} {r['location']:5s} {r['field']:22s} {r['components']}")
         return 0
     if args.animate:
-        summary = animate(args.file, args.animate, field=args.field, view=args.view)
+        summary = animate(args.file, args.animate, field=args.field, view=args.view,
+                          hand=not args.one_finger)
     else:
         summary = inspect(args.file, field=args.field, step=args.step, out=args.out,
-                          view=args.view, interactive=args.interactive)
+                          view=args.view, hand=not args.one_finger, interactive=args.interactive)
     if args.json:
         print_json(dataclasses.asdict(summary))
         return 0
