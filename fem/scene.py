@@ -26,6 +26,7 @@ model's geometry (the model's shell is the tie of :mod:`fem.finger`).
 from __future__ import annotations
 
 import math
+import weakref
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -79,11 +80,14 @@ def finger_blocks(model, y, *, load=None) -> list[Block]:
     return blocks
 
 
+_BASES = weakref.WeakKeyDictionary()
+
+
 def _vector_basis(model):
     """The model's vector P2 basis, built once per model (it costs a quadrature setup)."""
-    if getattr(model, "_scene_basis", None) is None:
-        model._scene_basis = model.vector_basis()
-    return model._scene_basis
+    if model not in _BASES:
+        _BASES[model] = model.vector_basis()
+    return _BASES[model]
 
 
 def _mirrored(half: Block, design) -> Block:
@@ -194,8 +198,8 @@ def sheet_block(solid, state, n_phi: int = 48) -> Block:
         points.append(np.stack([np.outer(r0, cos), np.outer(r0, sin),
                                 np.full((len(r0), n_phi), z0)], axis=-1).reshape(-1, 3))
         ur = (r - r0)[:, None]
-        data["displacement_mm"].append(np.stack([ur * cos, ur * sin, (z - z0)[:, None] + 0 * cos],
-                                                axis=-1).reshape(-1, 3))
+        uz = np.broadcast_to((z - z0)[:, None], ur.shape[:1] + cos.shape[1:])
+        data["displacement_mm"].append(np.stack([ur * cos, ur * sin, uz], axis=-1).reshape(-1, 3))
         data["height_mm"].append(np.repeat(z, n_phi))
         hoop = np.where(r0 > 0, r / np.where(r0 > 0, r0, 1.0), state.lambda_hoop[0])
         data["hoop_stretch"].append(np.repeat(hoop, n_phi))

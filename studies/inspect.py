@@ -17,9 +17,7 @@ from __future__ import annotations
 
 import contextlib
 import logging
-import os
 import re
-import sys
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -28,8 +26,8 @@ import pyvista as pv
 
 from meshes.atomic import atomic_path
 from reduced.errors import InputError
-from studies.inspect_style import (VIEWS, body_name, camera, colour_label, default_field,
-                                   title_of)
+from studies.inspect_style import (VIEWS, body_name, camera, clim_of, colour_label, default_field,
+                                   default_png, has_display, step_index, title_of)
 
 SUFFIXES = (".vtu", ".vtm", ".pvd", ".vtk")
 ANIMATIONS = (".gif", ".mp4")
@@ -59,7 +57,7 @@ def load_scene(path: str | Path, step: int | None = None) -> tuple[pv.MultiBlock
         try:
             reader = pv.get_reader(str(path))
             n = len(reader.time_values) if path.suffix == ".pvd" else 1
-            index = _step_index(step, n)
+            index = step_index(step, n)
             if path.suffix == ".pvd":
                 reader.set_active_time_point(index)
             data = reader.read()
@@ -81,7 +79,8 @@ def _flatten(data, name: str) -> pv.MultiBlock:
         return out
     for key, block in zip(data.keys(), data):
         if isinstance(block, pv.MultiBlock):
-            for k, b in zip(*(lambda f: (f.keys(), list(f)))(_flatten(block, key))):
+            inner = _flatten(block, key)
+            for k, b in zip(inner.keys(), inner):
                 out[k] = b
         elif block is not None and block.n_points:  # a .vtu in a .pvd: named after the file
             out[name if re.fullmatch(r"Block-\d+", key or "Block-0") else key] = block
@@ -137,10 +136,10 @@ def inspect(path: str | Path, *, field: str | None = None, step: int | None = No
     values, location = _checked_values(body, field)
     centres = body.points if location == "point" else body.cell_centers().points
     peak = np.asarray(centres[int(np.nanargmax(values))], dtype=float)
-    if interactive and not _has_display():
+    if interactive and not has_display():
         raise InputError("--interactive", True, "needs a display (DISPLAY is not set); "
                                                 "omit it to render off-screen")
-    png = None if interactive and out is None else Path(out or _default_png(path, index, field))
+    png = None if interactive and out is None else Path(out or default_png(path, index, field))
     plotter = _plotter(interactive=interactive)
     _draw(plotter, scene, field, title=title_of(path, scene, index, n_steps), view=view, hand=hand)
     if png is not None:
@@ -217,7 +216,7 @@ def _draw(plotter, scene, field, *, title, view, clim=None, keep_camera=False, h
     shown.clear_data()
     getattr(shown, f"{location}_data")["field"] = values
     plotter.add_mesh(_surface(body), color="grey", opacity=0.12)
-    parts = [(_surface(shown), {"scalars": "field", "cmap": "viridis", "clim": clim or _clim(values)})]
+    parts = [(_surface(shown), {"scalars": "field", "cmap": "viridis", "clim": clim or clim_of(values)})]
     for name, block in zip(names, scene):
         if name.startswith("link_"):
             parts.append((block.extract_surface(algorithm="dataset_surface"), {"color": "#b0b4bb"}))
@@ -237,14 +236,6 @@ def _draw(plotter, scene, field, *, title, view, clim=None, keep_camera=False, h
     plotter.add_text(title, font_size=10, color="black")
     if not keep_camera:
         camera(plotter, view, sheet=body_key == "sheet", zoom=1.3 if n > 1 else 1.0)
-
-
-def _clim(values) -> tuple[float, float]:
-    """Colour range: min to max, but to the 95th percentile when a few peaks (e.g. at the
-    edges of the ties) would leave the rest of the body in one colour; the bar's top
-    colour then stands for 'this or more'."""
-    lo, hi, q = np.nanmin(values), np.nanmax(values), np.nanpercentile(values, 95.0)
-    return float(lo), float(q if hi - lo > 2.0 * (q - lo) > 0 else hi)
 
 
 def _draw_forces(plotter, forces) -> None:
@@ -303,25 +294,6 @@ def _quiet_logging():
 def _first_line(exc: Exception) -> str:
     return next((line.strip() for line in str(exc).splitlines() if line.strip()),
                 type(exc).__name__)
-
-
-def _step_index(step: int | None, n: int) -> int:
-    if step is None:
-        return n - 1
-    if not -n <= step < n:
-        raise InputError("--step", step, f"must be in 0..{n - 1} (or -{n}..-1 from the end)")
-    return step % n
-
-
-def _default_png(path, index: int, field: str) -> Path:
-    path = Path(path)
-    safe = re.sub(r"[^A-Za-z0-9_]+", "_", field).strip("_")
-    return path.with_name(f"{path.stem}_step{index}_{safe}.png")
-
-
-def _has_display() -> bool:
-    return sys.platform in ("win32", "darwin") or bool(os.environ.get("DISPLAY")
-                                                        or os.environ.get("WAYLAND_DISPLAY"))
 
 
 __all__ = ["FieldSummary", "VIEWS", "animate", "describe", "field_names", "field_values",

@@ -1,10 +1,13 @@
-"""What ``softhand inspect`` shows by default: the body, its field, the labels and the camera.
+"""What ``softhand inspect`` shows by default: the body, its field, the labels, the camera,
+the colour range, the default file name.
 
 Pure functions of names and numbers (no pyvista here; :mod:`studies.inspect` draws).
 """
 from __future__ import annotations
 
+import os
 import re
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -87,3 +90,29 @@ def camera(plotter, view: str | None, *, sheet: bool, zoom: float = 1.0) -> None
     plotter.camera_position = [tuple(focus + distance * d), tuple(focus), up]
     plotter.reset_camera()
     plotter.camera.zoom(zoom)
+
+def clim_of(values) -> tuple[float, float]:
+    """Colour range: min to max, but to the 95th percentile when a few peaks (e.g. at the
+    edges of the ties) would leave the rest of the body in one colour; the bar's top
+    colour then stands for 'this or more'."""
+    lo, hi, q = np.nanmin(values), np.nanmax(values), np.nanpercentile(values, 95.0)
+    return float(lo), float(q if hi - lo > 2.0 * (q - lo) > 0 else hi)
+
+
+def step_index(step: int | None, n: int) -> int:
+    if step is None:
+        return n - 1
+    if not -n <= step < n:
+        raise InputError("--step", step, f"must be in 0..{n - 1} (or -{n}..-1 from the end)")
+    return step % n
+
+
+def default_png(path, index: int, field: str) -> Path:
+    path = Path(path)
+    safe = re.sub(r"[^A-Za-z0-9_]+", "_", field).strip("_")
+    return path.with_name(f"{path.stem}_step{index}_{safe}.png")
+
+
+def has_display() -> bool:
+    return sys.platform in ("win32", "darwin") or bool(os.environ.get("DISPLAY")
+                                                        or os.environ.get("WAYLAND_DISPLAY"))

@@ -60,7 +60,7 @@ def fig7_fem(ctx: Context, outdir: Path):
     pressures = tuple(np.round(np.arange(0.0, 0.8 + 1e-9, step), 10))
     options = FingerOptions(mesher="gmsh", mesh_size=6.0, edge_ratio=1.0, mesh_refine=0) if ctx.quick else FingerOptions()
     series = SceneSeries(outdir / "finger.pvd")
-    with progress_bar("  bending the finger", " pressure") as bar:
+    with progress_bar("  bending the finger", "pressure") as bar:
         def on_state(model, state):
             series.write(state.P, *finger_scene(model, state.y, state.P))
             bar.update(1)
@@ -286,9 +286,11 @@ def progress_bar(desc: str, unit: str):
 
 SECTIONS: list[Section] = [
     Section("fig7_fem", "Fig. 7 with finger-FEM points, and the whole hand",
-            ("studies.bending:run", "studies.bending:BendingStudy", "fem.io:VtkSeries"), fig7_fem),
+            ("studies.bending:run", "studies.bending:BendingStudy", "fem.io:SceneSeries",
+             "fem.scene:finger_scene"), fig7_fem),
     Section("reservoir_fem", "Reservoir: FEM against the ellipse model",
-            ("studies.reservoir:run", "fem.reservoir:sheet_vtk", "meshes.convert:write_vtu"),
+            ("studies.reservoir:run", "fem.reservoir:sheet_vtk", "fem.scene:sheet_block",
+             "meshes.convert:write_vtu"),
             reservoir_fem),
     Section("weights_fem", "w for the 180 mm and 240 mm objects by grasp FEM",
             ("studies.weights:weights", "studies.weights:WeightsCase"), weights_fem),

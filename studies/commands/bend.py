@@ -89,7 +89,7 @@ def run(args) -> int:
     out = Path(args.out)
     series = SceneSeries(out / "finger.pvd")
     n_steps = len(pressures) + (1 if study.peak_mpa else 0)
-    bar = tqdm(total=n_steps, desc="bend", unit=" pressure", file=sys.stderr, leave=False)
+    bar = tqdm(total=n_steps, desc="bend", unit="pressure", file=sys.stderr, leave=False)
 
     def on_state(model, state):
         series.write(state.P, *finger_scene(model, state.y, state.P))
