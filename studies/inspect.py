@@ -235,7 +235,7 @@ def _draw(plotter, scene, field, *, title, view, clim=None, keep_camera=False, h
                            label_font_size=13)
     plotter.add_text(title, font_size=10, color="black")
     if not keep_camera:
-        camera(plotter, view, sheet=body_key == "sheet", zoom=1.3 if n > 1 else 1.0)
+        camera(plotter, view, sheet=body_key != "tube", zoom=1.0 if body_key == "tube" and n == 1 else 1.3)
 
 
 def _draw_forces(plotter, forces) -> None:

@@ -70,7 +70,8 @@ def title_of(path, scene, index: int, n_steps: int) -> str:
 
 def camera(plotter, view: str | None, *, sheet: bool, zoom: float = 1.0) -> None:
     """Point the camera: finger scenes are in the hand frame (y down, bending plane z = 0),
-    the sheet has z up; ``side`` (the default of a finger) looks normal to the bending plane."""
+    anything else (``sheet``) has z up; ``side`` (the default of a finger) looks normal to
+    the bending plane, ``iso`` is the default of the rest."""
     view = view or ("iso" if sheet else "side")
     if view not in VIEWS:
         raise InputError("--view", view, f"allowed: {', '.join(VIEWS)}")

@@ -123,11 +123,24 @@ def test_animation_has_one_frame_per_step(series, tmp_path):
 
 
 def test_fields_lists_blocks_and_cli_errors(series, capsys):
-    rows = describe(series)
+    rows = describe(series.parent / "finger" / "finger_0001.vtm")  # one step's scene
     assert {"block": "tube", "field": "von_mises_MPa", "location": "point", "components": 1} in rows
+    assert {"block": "link_3", "field": "pressure_MPa", "location": "field", "components": 1} in rows
     assert main(["inspect", str(series), "--fields"]) == 0
     assert "displacement_mm" in capsys.readouterr().out
     for argv, word in ((["--view", "up"], "--view"), (["--animate", "x.png"], "--animate")):
         assert main(["inspect", str(series), *argv]) == 2
         err = capsys.readouterr().err
         assert err.count("\n") == 1 and word in err
+
+
+def test_default_camera_looks_normal_to_the_bending_plane(series):
+    from studies.inspect import _draw, _plotter
+
+    plotter = _plotter(window_size=(200, 150))
+    _draw(plotter, load_scene(series)[0], "J", title="t", view=None, hand=False)
+    position, focus, up = plotter.camera_position
+    plotter.close()
+    direction = np.subtract(position, focus)
+    assert abs(direction[2]) == pytest.approx(np.linalg.norm(direction), rel=1e-12)  # along z
+    assert up[1] < 0  # the hand frame's y points down: up is -y
