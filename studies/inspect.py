@@ -16,6 +16,7 @@ preferred to cell data of the same name.
 from __future__ import annotations
 
 import contextlib
+import importlib.util
 import logging
 import re
 from dataclasses import dataclass
@@ -130,6 +131,7 @@ def inspect(path: str | Path, *, field: str | None = None, step: int | None = No
             out: str | Path | None = None, view: str | None = None, hand: bool = True,
             interactive: bool = False) -> FieldSummary:
     """Render ``path`` coloured by ``field``; write ``out`` (PNG) unless only interactive."""
+    _check_view(view)
     scene, index, n_steps = load_scene(path, step)
     body = scene[body_name(scene.keys())]
     field = field or default_field(field_names(body))
@@ -157,11 +159,15 @@ def animate(path: str | Path, out: str | Path, *, field: str | None = None,
     """Render every step of a ``.pvd`` with one camera and colour range into a GIF or MP4."""
     import imageio.v2 as imageio
 
+    _check_view(view)
     out = Path(out)
     if out.suffix not in ANIMATIONS:
         raise InputError("--animate", str(out), f"must end in {' or '.join(ANIMATIONS)}")
     if Path(path).suffix != ".pvd":
         raise InputError("file", str(path), "must be a .pvd series to animate")
+    if out.suffix == ".mp4" and importlib.util.find_spec("imageio_ffmpeg") is None:
+        raise InputError("--animate", str(out), "MP4 needs imageio-ffmpeg (pip install imageio-ffmpeg); "
+                                                "or write a .gif")
     scenes = [load_scene(path, k) for k in range(load_scene(path)[2])]
     bodies = [s[body_name(s.keys())] for s, _, _ in scenes]
     field = field or default_field(field_names(bodies[-1]))
@@ -180,13 +186,14 @@ def animate(path: str | Path, out: str | Path, *, field: str | None = None,
         if out.suffix == ".gif":
             imageio.mimsave(tmp, frames, format="GIF", duration=1000.0 / fps, loop=0)
         else:
-            try:
-                imageio.mimsave(tmp, frames, fps=fps)
-            except Exception as exc:  # no ffmpeg plugin
-                raise InputError("--animate", str(out), f"MP4 needs imageio-ffmpeg "
-                                 f"(pip install imageio-ffmpeg): {_first_line(exc)}") from None
+            imageio.mimsave(tmp, frames, fps=fps)
     return FieldSummary(str(path), len(scenes) - 1, len(scenes), field, "point", clim[0], clim[1],
                         (np.nan,) * 3, str(out))
+
+
+def _check_view(view) -> None:
+    if view is not None and view not in VIEWS:
+        raise InputError("--view", view, f"allowed: {', '.join(VIEWS)}")
 
 
 def _checked_values(body, field):
