@@ -1,0 +1,96 @@
+"""The architecture, enforced: dependencies point down, and no module imports itself in a circle.
+
+Layers, bottom up (the README's Architecture section describes them):
+
+* ``reduced`` -- the design vocabulary and the paper's model; NumPy/SciPy only;
+* ``meshes`` -- geometry as code; may use ``reduced`` (design, errors);
+* ``fem`` -- the FEM core and the hand models; may use ``meshes`` and ``reduced``;
+* ``studies`` -- studies, batch, reproduce, verification, the CLI; may use all.
+
+Every import counts, also those inside functions (a lazy import is still a dependency).
+Cycles are looked for among module-level imports, the ones that run at import time.
+"""
+from __future__ import annotations
+
+import ast
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parent.parent
+LAYERS = ("reduced", "meshes", "fem", "studies")
+#: third-party packages each layer may not import (reduced stays light: ~0.2 s start-up)
+FORBIDDEN = {"reduced": ("skfem", "gmsh", "pyvista", "meshio", "matplotlib", "dask")}
+
+
+def modules():
+    """(dotted name, path) of every module of the four packages."""
+    for layer in LAYERS:
+        for path in sorted((ROOT / layer).rglob("*.py")):
+            parts = path.relative_to(ROOT).with_suffix("").parts
+            if parts[-1] == "__init__":
+                parts = parts[:-1]
+            yield ".".join(parts), path
+
+
+def imports(name: str, path: Path, *, top_level_only: bool = False):
+    """Absolute names of the modules that ``name`` imports (relative imports resolved)."""
+    tree = ast.parse(path.read_text(), filename=str(path))
+    package = name if path.name == "__init__.py" else name.rpartition(".")[0]
+    nodes = tree.body if top_level_only else ast.walk(tree)
+    for node in nodes:
+        if isinstance(node, ast.Import):
+            yield from (alias.name for alias in node.names)
+        elif isinstance(node, ast.ImportFrom):
+            base = node.module or ""
+            if node.level:
+                anchor = package.split(".")[: len(package.split(".")) - node.level + 1]
+                base = ".".join([*anchor, base] if base else anchor)
+            yield base
+            yield from (f"{base}.{alias.name}" for alias in node.names)
+
+
+def layer_of(module: str) -> str | None:
+    top = module.split(".")[0]
+    return top if top in LAYERS else None
+
+
+ALL = dict(modules())
+
+
+@pytest.mark.parametrize("name", sorted(ALL))
+def test_dependencies_point_down(name):
+    own = layer_of(name)
+    for target in imports(name, ALL[name]):
+        other = layer_of(target)
+        if other is not None:
+            assert LAYERS.index(other) <= LAYERS.index(own), f"{name} ({own}) imports {target} ({other})"
+        assert target.split(".")[0] not in FORBIDDEN.get(own, ()), f"{name} imports {target}"
+
+
+def test_no_import_cycles():
+    graph = {name: {t for t in imports(name, path, top_level_only=True) if t in ALL and t != name}
+             for name, path in ALL.items()}
+    state: dict[str, int] = {}
+
+    def visit(node, trail):
+        state[node] = 1
+        for nxt in sorted(graph[node]):
+            if state.get(nxt) == 1:
+                raise AssertionError("import cycle: " + " -> ".join([*trail, node, nxt]))
+            if nxt not in state:
+                visit(nxt, [*trail, node])
+        state[node] = 2
+
+    for node in sorted(graph):
+        if node not in state:
+            visit(node, [])
+
+
+def test_the_checks_see_a_violation(tmp_path):
+    """The import scanner itself: a lazy, a relative and an absolute import are all seen."""
+    path = tmp_path / "mod.py"
+    path.write_text("from . import design\nimport numpy\n\ndef f():\n    from fem import solid\n")
+    found = set(imports("reduced.mod", path))
+    assert {"reduced.design", "numpy", "fem.solid"} <= found
+    assert "fem.solid" not in set(imports("reduced.mod", path, top_level_only=True))
