@@ -1,8 +1,8 @@
 """Wall time and size of the finger FEM's default P-theta curve (0-0.8 MPa in 0.1 MPa steps).
 
 Run: ``python benchmarks/bench_finger.py [--mesh-size-mm H ...]``. Prints, per mesh size,
-the unknowns, tetrahedra, Newton iterations, assembly / linear-solve / total seconds and
-theta at the last pressure. Issue 5's target: the default mesh under 5 minutes.
+the unknowns, tetrahedra, Newton iterations, tangent factorisations, assembly /
+linear-solve / total seconds and theta at the last pressure. Issue 5's target: the default mesh under 5 minutes.
 """
 from __future__ import annotations
 
@@ -17,13 +17,13 @@ def main() -> None:
     parser.add_argument("--mesh-size-mm", type=float, nargs="+", default=[],
                         help="also gmsh meshes of these sizes (default: only the default layered mesh)")
     args = parser.parse_args()
-    print("mesh     unknowns  tets  newton  assembly_s  solve_s  total_s  theta_0.8_deg")
+    print("mesh     unknowns  tets  newton  factorisations  assembly_s  solve_s  total_s  theta_0.8_deg")
     cases = [("default", FingerOptions())] + [(f"gmsh {h:g}", FingerOptions(mesher="gmsh", mesh_size=h))
                                               for h in args.mesh_size_mm]
     for name, options in cases:
         result = run(BendingStudy(options=options))
         s = result.stats
-        print(f"{name:8s} {result.ndofs:8d}  {result.nelements:4d}  {s.newton_iterations:6d}  "
+        print(f"{name:8s} {result.ndofs:8d}  {result.nelements:4d}  {s.newton_iterations:6d}  {s.factorizations:14d}  "
               f"{s.assembly_seconds:10.1f}  {s.solve_seconds:7.1f}  {s.wall_seconds:7.1f}  "
               f"{result.rows[-1]['theta_deg']:13.3f}", flush=True)
         print(f"# solver: {s.solver}; mesh and setup {result.build_seconds:.1f} s")

@@ -452,6 +452,7 @@ class SweepStats:
     newton_iterations: int
     cutbacks: int
     solver: str
+    factorizations: int = 0  #: tangents factorised (fewer than iterations with refactor="adaptive")
 
 
 def solve_pressures(model: FingerModel, pressures, *, link_load=None, y0=None, callback=None,
@@ -469,7 +470,7 @@ def solve_pressures(model: FingerModel, pressures, *, link_load=None, y0=None, c
     solver = make_solver(symmetric=True, precision="double")
     t0 = time.perf_counter()
     history = [(0.0, model.constraint.zero() if y0 is None else np.array(y0, dtype=float))]
-    states, totals = [], np.zeros(4)  # assembly s, solve s, iterations, cutbacks
+    states, totals = [], np.zeros(5)  # assembly s, solve s, iterations, cutbacks, factorisations
     scale = model.design.mu_sf * model.design.a ** 2 * model.design.l0  # [N] residual scale
     for P in (float(p) for p in pressures):
         y, its = _solve_one(model, P, history, link_load, solver, newton_options, scale, totals)
@@ -479,7 +480,7 @@ def solve_pressures(model: FingerModel, pressures, *, link_load=None, y0=None, c
         if callback is not None:
             callback(states[-1])
     stats = SweepStats(time.perf_counter() - t0, totals[0], totals[1], int(totals[2]),
-                       int(totals[3]), solver.describe())
+                       int(totals[3]), solver.describe(), int(totals[4]))
     return states, stats
 
 
@@ -494,5 +495,6 @@ def _solve_one(model, P, history, link_load, solver, options, scale, totals):
     path = solve_path(lambda y, t: model.residual_tangent(y, P1 + t * (P - P1), link_load), y1,
                       PathOptions(steps=1, newton=options), solver=solver, scale_t=lambda t: scale,
                       residual_t=lambda y, t: model.residual(y, P1 + t * (P - P1), link_load))
-    totals += (path.assembly_seconds, path.solve_seconds, path.total_iterations, path.cutbacks)
+    totals += (path.assembly_seconds, path.solve_seconds, path.total_iterations, path.cutbacks,
+               path.factorizations)
     return path.x[-1], path.total_iterations

@@ -25,7 +25,7 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 from scipy.optimize import brentq
@@ -111,6 +111,7 @@ class GraspState:
     iterations: int         #: Newton iterations
     penalty: float          #: the contact penalty at convergence [N/mm]
     y: np.ndarray = field(repr=False, default=None)
+    factorizations: int = 0  #: tangents factorised (fewer than iterations with refactor="adaptive")
 
     @property
     def theta(self) -> float:
@@ -186,7 +187,8 @@ class GraspModel:
             penetration = float(np.max(np.abs(g[(L.N > 0) | (lam > 0)]), initial=0.0))
             if penetration <= self.options.gap_tol and \
                     np.max(np.abs(new_shares - shares)) <= self.options.share_tol:
-                return self._state(P, y, L, g, update, its, penalty)
+                return replace(self._state(P, y, L, g, update, its, penalty),
+                               factorizations=solver.n_factorizations)
             if penetration > 0.25 * last:  # slow Uzawa (near-dependent contacts): stiffen
                 penalty = min(10.0 * penalty, self.options.max_penalty)
             lam, shares, last = L.N, new_shares, penetration

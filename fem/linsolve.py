@@ -1,12 +1,18 @@
 """Sparse direct solvers for Newton tangents, chosen automatically and reported.
 
-Order of preference for ``method="auto"`` (measured on the 85k-DOF benchmark tangent,
-issue 3): MKL PARDISO (``pypardiso``, the ``fast`` extra) -- symmetric indefinite
+Order of preference for ``method="auto"``: MKL PARDISO (``pypardiso``, a dependency
+wherever Intel ships MKL wheels: x86-64 Linux, Windows, macOS) -- symmetric indefinite
 mode (mtype -2, 2x2 Bunch-Kaufman pivoting, upper triangle only) when the caller
 declares the matrix symmetric, real unsymmetric mode (mtype 11) otherwise (follower
 pressure on an open surface makes the tangent unsymmetric); then UMFPACK
-(``scikit-umfpack``) if installed; then SciPy's SuperLU with a minimum-degree
-ordering on A^T + A (the default COLAMD ordering is ~10x slower on these meshes).
+(``scikit-umfpack``) if installed; then, for symmetric matrices, QDLDL (``qdldl``, the
+dependency where MKL is missing: LDL^T with an AMD ordering and no pivoting, for the
+quasi-definite tangents here; a zero pivot falls back to SuperLU); then SciPy's SuperLU
+with a minimum-degree ordering on A^T + A. On the finger FEM's 38k-unknown tangent
+(loaded 2-core machine) one factorisation took 2.9 s with PARDISO, 35 s with QDLDL,
+27 s with cholespy (SPD only), > 60 s with SuperLU (MMD on A^T + A) and > 400 s with
+SuperLU's default COLAMD; the one python-mumps wheel does not import with NumPy 2. A
+fallback is announced once (a :class:`RuntimeWarning`) with its expected slowdown.
 
 The symbolic analysis (ordering + symbolic factorisation) is done once per sparsity
 pattern and reused for every later matrix with the same pattern (PARDISO phase 11
@@ -25,12 +31,16 @@ from __future__ import annotations
 
 import os
 import time
+import warnings
 
 import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-METHODS = ("auto", "pardiso", "umfpack", "superlu")
+METHODS = ("auto", "pardiso", "umfpack", "qdldl", "superlu")
+#: factorisation time over PARDISO's on the finger FEM's tangent (module docstring)
+SLOWDOWN = {"umfpack": 3, "qdldl": 12, "superlu": 30}
+_announced = set()
 PRECISIONS = ("mixed", "double")
 REFINE_RTOL = 1e-10  #: mixed precision: relative residual the refinement must reach
 REFINE_MAX = 8  #: mixed precision: refinement steps before falling back to double
@@ -44,11 +54,12 @@ def available() -> list[str]:
         out.append("pardiso")
     except (ImportError, OSError):
         pass
-    try:
-        import scikits.umfpack  # noqa: F401
-        out.append("umfpack")
-    except ImportError:
-        pass
+    for name, module in (("umfpack", "scikits.umfpack"), ("qdldl", "qdldl")):
+        try:
+            __import__(module)
+            out.append(name)
+        except ImportError:
+            pass
     return out + ["superlu"]
 
 
@@ -60,10 +71,23 @@ def make_solver(method: str = "auto", *, symmetric: bool = False, precision: str
     if precision not in PRECISIONS:
         raise ValueError(f"precision {precision!r} not in {PRECISIONS}")
     if method == "auto":
-        method = available()[0]
+        method = next(m for m in available() if symmetric or m != "qdldl")
+        _announce(method)
+    if method == "qdldl" and not symmetric:
+        raise ValueError("linear solver 'qdldl' needs a symmetric matrix (symmetric=True)")
     if method == "pardiso":
         return PardisoSolver(symmetric, precision)
-    return {"umfpack": UmfpackSolver, "superlu": SuperLUSolver}[method](symmetric)
+    return {"umfpack": UmfpackSolver, "qdldl": QdldlSolver, "superlu": SuperLUSolver}[method](symmetric)
+
+
+def _announce(method: str) -> None:
+    """Warn once per backend that the automatic choice is not PARDISO, and by how much it is slower."""
+    if method == "pardiso" or method in _announced:
+        return
+    _announced.add(method)
+    warnings.warn(f"MKL PARDISO (pypardiso) is not available here: the FEM's sparse factorisations "
+                  f"use {method}, about {SLOWDOWN[method]}x slower (pypardiso needs MKL, which "
+                  f"Intel ships for x86-64 only)", RuntimeWarning, stacklevel=3)
 
 
 def _pardiso_handle(**kwargs):
@@ -76,16 +100,22 @@ def _pardiso_handle(**kwargs):
 
 
 class LinearSolver:
-    """Common bookkeeping: times and counts of analyses and factorisations."""
+    """Common bookkeeping: times and counts of analyses, factorisations and solves.
+
+    ``solve(K, b)`` factorises K and solves; ``factorize(K)`` then ``apply(b)`` keep the
+    factor for later right-hand sides (a modified Newton step reuses an old tangent's).
+    """
 
     name = "?"
 
     def __init__(self, symmetric: bool):
         self.symmetric = symmetric
         self.n_analyses = 0
+        self.n_factorizations = 0
         self.n_solves = 0
         self.seconds = 0.0
         self._pattern = None
+        self._K = None  #: the matrix of the current factor
 
     def _same_pattern(self, K) -> bool:
         p = self._pattern
@@ -95,23 +125,44 @@ class LinearSolver:
             self.n_analyses += 1
         return same
 
-    def solve(self, K: sp.spmatrix, b: np.ndarray) -> np.ndarray:
-        """x with K x = b (K square sparse, b of shape (n,))."""
+    @property
+    def factored_size(self) -> int | None:
+        """Order of the matrix of the current factor (None: nothing factorised yet)."""
+        return None if self._K is None else self._K.shape[0]
+
+    def factorize(self, K: sp.spmatrix) -> None:
+        """Factorise K (square sparse) for :meth:`apply`; the analysis is reused for the same pattern."""
         t0 = time.perf_counter()
-        K = K.tocsr()
+        K = K.tocsr(copy=True)  # the factor's own copy: the caller may reuse K's arrays
         if not K.has_sorted_indices:
             K.sort_indices()
-        x = self._solve(K, np.asarray(b, dtype=float))
+        self._K = K
+        self._factorize(K)
+        self.n_factorizations += 1
+        self.seconds += time.perf_counter() - t0
+
+    def apply(self, b: np.ndarray) -> np.ndarray:
+        """x with K x = b for the last factorised K."""
+        if self._K is None:
+            raise RuntimeError(f"{self.name}: apply() before factorize()")
+        t0 = time.perf_counter()
+        x = self._apply(np.asarray(b, dtype=float))
         self.n_solves += 1
         self.seconds += time.perf_counter() - t0
         if not np.all(np.isfinite(x)):
             raise np.linalg.LinAlgError(f"{self.name}: non-finite solution (singular tangent?)")
         return x
 
+    def solve(self, K: sp.spmatrix, b: np.ndarray) -> np.ndarray:
+        """x with K x = b (K square sparse, b of shape (n,)); K's factor is kept."""
+        self.factorize(K)
+        return self.apply(b)
+
     def describe(self) -> str:
         """One line for reports."""
         kind = "symmetric" if self.symmetric else "unsymmetric"
-        return f"{self.name} ({kind}), {self.n_analyses} analyses, {self.n_solves} solves, {self.seconds:.2f} s"
+        return (f"{self.name} ({kind}), {self.n_analyses} analyses, {self.n_factorizations} "
+                f"factorisations, {self.n_solves} solves, {self.seconds:.2f} s")
 
 
 class PardisoSolver(LinearSolver):
@@ -144,22 +195,30 @@ class PardisoSolver(LinearSolver):
             return f"{line}, double precision ({self.fallback})"
         return line
 
-    def _solve(self, K, b):
+    def _factorize(self, K):
         same = self._same_pattern(K)
         A = self._stored(K, same)
         if self.precision == "mixed":
-            x = self._solve_mixed(K, A, b, same)
-            if x is not None:
-                return x
-            self.precision, self._ps, same = "double", self._handle("double"), False
-            self.n_analyses += 1
-        b2 = np.asfortranarray(b.reshape(-1, 1))
+            A = sp.csr_matrix((A.data.astype(np.float32), A.indices, A.indptr), shape=A.shape, copy=False)
+        self._A = A
+        work = np.zeros((K.shape[0], 1), dtype=A.dtype, order="F")
         self._ps.set_iparm(12, 0)  # CSR, not transposed
         if not same:
             self._ps.set_phase(11)  # reordering + symbolic factorisation
-            self._ps._call_pardiso(A, b2)
-        self._ps.set_phase(23)  # numerical factorisation + solve
-        return self._ps._call_pardiso(A, b2).ravel()
+            self._ps._call_pardiso(A, work)
+        self._ps.set_phase(22)  # numerical factorisation
+        self._ps._call_pardiso(A, work)
+
+    def _apply(self, b):
+        if self.precision == "mixed":
+            x = self._refine(self._K, b)
+            if x is not None:
+                return x
+            self.precision, self._ps, self._pattern = "double", self._handle("double"), None
+            self._factorize(self._K)  # a new analysis, in double precision
+            self.n_factorizations += 1
+        self._ps.set_phase(33)  # solve with the stored factor
+        return self._ps._call_pardiso(self._A, np.asfortranarray(b.reshape(-1, 1))).ravel()
 
     def _stored(self, K, same):
         """The matrix PARDISO gets: K, or its upper triangle in symmetric mode."""
@@ -176,15 +235,10 @@ class PardisoSolver(LinearSolver):
         A.has_sorted_indices = True
         return A
 
-    def _solve_mixed(self, K, A, b, same):
+    def _refine(self, K, b):
         """Single-precision factor + double-precision refinement; None when it stalls."""
-        A32 = sp.csr_matrix((A.data.astype(np.float32), A.indices, A.indptr), shape=A.shape, copy=False)
+        A32 = self._A
         work = np.zeros((len(b), 1), dtype=np.float32, order="F")
-        if not same:
-            self._ps.set_phase(11)
-            self._ps._call_pardiso(A32, work)
-        self._ps.set_phase(22)  # numerical factorisation only
-        self._ps._call_pardiso(A32, work)
         self._ps.set_phase(33)  # solves with the stored factor
         bnorm = float(np.linalg.norm(b))
         x, r, last = np.zeros_like(b), b, bnorm
@@ -222,14 +276,52 @@ class UmfpackSolver(LinearSolver):
         self._ctx = um.UmfpackContext("di")
         self._um = um
 
-    def _solve(self, K, b):
+    def _factorize(self, K):
         Kc = K.tocsc()
         Kc.sort_indices()
         Kc.indptr, Kc.indices = Kc.indptr.astype(np.int32), Kc.indices.astype(np.int32)
         if not self._same_pattern(Kc):
             self._ctx.symbolic(Kc)
         self._ctx.numeric(Kc)
-        return self._ctx.solve(self._um.UMFPACK_A, Kc, b, autoTranspose=True)
+        self._Kc = Kc
+
+    def _apply(self, b):
+        return self._ctx.solve(self._um.UMFPACK_A, self._Kc, b, autoTranspose=True)
+
+
+class QdldlSolver(LinearSolver):
+    """QDLDL on the upper triangle (symmetric K); the symbolic analysis (AMD ordering,
+    elimination tree) once per pattern. A zero pivot (no LDL^T without pivoting in that
+    ordering) or a tiny one (a solution with a relative residual above 1e-6) falls back to
+    SuperLU for that matrix."""
+
+    name = "qdldl"
+
+    def __init__(self, symmetric):
+        super().__init__(symmetric)
+        import qdldl
+        self._qdldl, self._f, self._lu = qdldl, None, None
+
+    def _factorize(self, K):
+        U = sp.triu(K, format="csc")
+        self._lu = None
+        try:
+            if self._same_pattern(K) and self._f is not None:
+                self._f.update(U, upper=True)
+            else:
+                self._f = self._qdldl.Solver(U, upper=True)
+        except (ValueError, RuntimeError):
+            self._f, self._pattern = None, None
+            self._lu = spla.splu(K.tocsc(), permc_spec="MMD_AT_PLUS_A")
+
+    def _apply(self, b):
+        if self._lu is None:
+            x = self._f.solve(b)
+            with np.errstate(over="ignore", invalid="ignore"):  # a tiny pivot's huge x
+                if np.linalg.norm(self._K @ x - b) <= 1e-6 * np.linalg.norm(b):
+                    return x
+            self._lu = spla.splu(self._K.tocsc(), permc_spec="MMD_AT_PLUS_A")  # a tiny pivot
+        return self._lu.solve(b)
 
 
 class SuperLUSolver(LinearSolver):
@@ -237,7 +329,9 @@ class SuperLUSolver(LinearSolver):
 
     name = "superlu"
 
-    def _solve(self, K, b):
+    def _factorize(self, K):
         self._same_pattern(K)
-        lu = spla.splu(K.tocsc(), permc_spec="MMD_AT_PLUS_A")
-        return lu.solve(b)
+        self._lu = spla.splu(K.tocsc(), permc_spec="MMD_AT_PLUS_A")
+
+    def _apply(self, b):
+        return self._lu.solve(b)

@@ -53,10 +53,19 @@ class NewtonOptions:
     eta: float = 0.5  #: "slope": accept when |R(x + s dx).dx| <= eta |R(x).dx|
     max_backtracks: int = 6  #: trial steps before taking the last one
     armijo: float = 1e-4  #: "residual": sufficient-decrease constant c
+    #: "always": factorise the tangent at every iterate (Newton); "adaptive": quasi-Newton on
+    #: the solver's last factorisation (also one left by an earlier solve), see :func:`newton`
+    refactor: str = "always"
+    contraction: float = 0.1  #: "adaptive": largest ||R_new|| / ||R|| kept on an old factorisation
+    memory: int = 10  #: "adaptive": secant pairs of the BFGS update kept
 
     def __post_init__(self):
         if self.merit not in ("slope", "residual", "finite"):
             raise ValueError(f"merit {self.merit!r} not in ('slope', 'residual', 'finite')")
+        if self.refactor not in ("always", "adaptive"):
+            raise ValueError(f"refactor {self.refactor!r} not in ('always', 'adaptive')")
+        if not 0 < self.contraction < 1:
+            raise ValueError(f"contraction {self.contraction!r} not in (0, 1)")
 
 
 class NotConverged(RuntimeError):
@@ -81,6 +90,7 @@ class NewtonResult:
     steps: list  #: accepted line-search step lengths
     assembly_seconds: float = 0.0  #: time spent in fun
     solve_seconds: float = 0.0  #: time spent in the linear solver
+    factorizations: int = 0  #: tangents factorised (= iterations for refactor="always")
 
 
 def newton(fun, x0, options: NewtonOptions = NewtonOptions(), *, solver=None, scale=None,
@@ -93,45 +103,105 @@ def newton(fun, x0, options: NewtonOptions = NewtonOptions(), *, solver=None, sc
     predictor, line-searched like a Newton step); on_accept(x): called with x0 and every
     accepted iterate before fun is evaluated around it (e.g. :class:`fem.solid.MixedNewton`);
     residual(x) -> R: optional, fun's residual alone, for the line search's trial points.
+
+    ``options.refactor = "adaptive"`` (quasi-Newton): the direction is
+    :math:`-H R` with H the limited-memory BFGS update (secant pairs of the accepted steps
+    since the last factorisation, :func:`_bfgs_direction`) of the inverse of the last
+    factorised tangent, so an iteration costs a residual and a solve with the stored factor
+    instead of an assembly and a factorisation. A step that does not lower ||R|| is
+    discarded and redone with the tangent at the same iterate; one that lowers it by less
+    than ``options.contraction`` (or is cut by the line search) is kept and the tangent is
+    re-factorised at the new iterate. The convergence test is the same as Newton's.
     """
     solver = solver or make_solver()
+    adaptive = options.refactor == "adaptive"
     t0 = time.perf_counter()
     x = np.array(x0, dtype=float)
     if on_accept is not None:
         on_accept(x)
-    R, K = fun(x)
+    reuse = adaptive and _factored_size(solver) == len(x)
+    R, K = (residual(x), None) if reuse and residual is not None else fun(x)
+    K = None if reuse else K  # K: the tangent at x still to be factorised (None: keep the factor)
     t_asm = time.perf_counter() - t0
     norm = float(np.linalg.norm(R))
     tol = options.atol + options.rtol * (norm if scale is None else scale)
-    history, steps, t_solve = [norm], [], 0.0
+    history, steps, t_solve, factorizations, pairs = [norm], [], 0.0, 0, []
     for it in range(options.max_iter + 1):
         if not np.isfinite(norm):
             raise NotConverged("residual is not finite", history, x)
         if norm <= tol:
-            return NewtonResult(x, it, history, steps, t_asm, t_solve)
+            return NewtonResult(x, it, history, steps, t_asm, t_solve, factorizations)
         if it == options.max_iter:
             break
         t1 = time.perf_counter()
+        old = False  # the step uses a factorisation of another iterate's tangent
         try:
-            dx = solver.solve(K, -R) if (it > 0 or direction is None) else np.asarray(direction)
+            if it == 0 and direction is not None:
+                dx = np.asarray(direction)
+            elif K is not None:
+                dx, pairs = solver.solve(K, -R), []
+                factorizations += 1
+            else:
+                dx, old = _bfgs_direction(R, pairs, solver.apply), True
         except (RuntimeError, np.linalg.LinAlgError, ValueError) as err:
             raise NotConverged(f"linear solve failed ({err})", history, x) from err
         t_solve += time.perf_counter() - t1
         t1 = time.perf_counter()
         small = it > 0 and np.linalg.norm(dx) <= options.xtol * (1.0 + np.linalg.norm(x))
-        x, R, K, norm, s = _line_search(fun, x, dx, R, norm, options, residual)
-        t_asm += time.perf_counter() - t1
+        xt, Rt, Kt, normt, s = _line_search(fun, x, dx, R, norm, options, residual, tangent=not adaptive)
+        rate = normt / norm
+        if old and not rate < 1.0:  # the old factorisation is not good enough here: redo with K(x)
+            R, K = fun(x)
+            t_asm += time.perf_counter() - t1
+            continue
+        if adaptive:
+            _add_pair(pairs, xt - x, Rt - R, options.memory)
+        x, R, K, norm = xt, Rt, Kt, normt
         history.append(norm)
         steps.append(s)
         if on_accept is not None:
             on_accept(x)
-        if small and s == 1.0 and np.isfinite(norm):  # converged to round-off (ill-conditioned K)
-            return NewtonResult(x, it + 1, history, steps, t_asm, t_solve)
+        if adaptive:
+            if rate > options.contraction or _factored_size(solver) != len(x):
+                R, K = (R, K) if K is not None else fun(x)
+            else:
+                K = None
+        t_asm += time.perf_counter() - t1
+        if small and s == 1.0 and np.isfinite(norm) and (not old or rate <= options.contraction):
+            return NewtonResult(x, it + 1, history, steps, t_asm, t_solve, factorizations)  # round-off
     raise NotConverged(f"no convergence in {options.max_iter} iterations (tol {tol:.2e})", history, x)
 
 
-def _line_search(fun, x, dx, R0, norm0, options, residual=None):
-    """Step length on x + s dx; returns the accepted (x, R, K, ||R||, s). See the module docstring."""
+def _bfgs_direction(R, pairs, apply):
+    """-H R by the two-loop recursion: H the BFGS update of H0 = apply (the stored factor's
+    inverse) by the secant pairs (s, y, 1 / s.y), oldest first."""
+    q, alphas = np.array(R, dtype=float), []
+    for s, y, rho in reversed(pairs):
+        alphas.append(rho * (s @ q))
+        q -= alphas[-1] * y
+    r = apply(q)
+    for (s, y, rho), a in zip(pairs, reversed(alphas)):
+        r += (a - rho * (y @ r)) * s
+    return -r
+
+
+def _add_pair(pairs, s, y, memory):
+    """Keep the secant pair (s = dx, y = dR) when its curvature s.y is positive (BFGS stays
+    positive definite), at most ``memory`` of them."""
+    sy = float(s @ y)
+    if np.isfinite(sy) and sy > 1e-12 * np.linalg.norm(s) * np.linalg.norm(y):
+        pairs.append((s, y, 1.0 / sy))
+        del pairs[:-memory]
+
+
+def _factored_size(solver):
+    """Order of the solver's current factorisation (None: none, or a solver without one)."""
+    return getattr(solver, "factored_size", None)
+
+
+def _line_search(fun, x, dx, R0, norm0, options, residual=None, tangent=True):
+    """Step length on x + s dx; returns the accepted (x, R, K, ||R||, s); K is None when
+    ``tangent`` is false and only ``residual`` was evaluated. See the module docstring."""
     trial = fun if residual is None else (lambda xt: (residual(xt), None))
     g0 = float(R0 @ dx)  # slope of the energy along dx at s = 0 (< 0 for a descent direction)
     s, lo, glo, hi, ghi = 1.0, 0.0, g0, None, None
@@ -162,7 +232,7 @@ def _line_search(fun, x, dx, R0, norm0, options, residual=None):
         s_new = lo + (hi - lo) * glo / (glo - ghi) if ghi is not None else 0.5 * (lo + hi)
         s = float(np.clip(s_new, lo + 0.1 * (hi - lo), hi - 0.1 * (hi - lo)))
     # accepted, or no sufficient step in max_backtracks: the last trial (Newton may still recover)
-    if K is None:
+    if K is None and tangent:
         with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
             R, K = fun(xt)
     return xt, R, K, norm, s
@@ -190,6 +260,7 @@ class PathResult:
     histories: list  #: residual histories of the converged steps
     assembly_seconds: float = 0.0
     solve_seconds: float = 0.0
+    factorizations: int = 0  #: tangents factorised, predictors and failed attempts included
 
     @property
     def total_iterations(self) -> int:
@@ -207,12 +278,14 @@ def solve_path(fun_t, x0, options: PathOptions = PathOptions(), *, solver=None, 
     """
     solver = solver or make_solver()
     res = PathResult([0.0], [np.array(x0, dtype=float)], [], 0, [])
+    factorizations0 = getattr(solver, "n_factorizations", 0)
+    reuse = options.newton.refactor == "adaptive"
     dt = 1.0 / options.steps
     while res.t[-1] < 1.0 - 1e-12:
         t = min(1.0, res.t[-1] + dt)
         if on_accept is not None:
             on_accept(res.x[-1])
-        step = _predict(res, t, fun_t, solver, options.predictor)
+        step = _predict(res, t, fun_t, solver, options.predictor, residual_t, reuse)
         try:
             r = newton(lambda x: fun_t(x, t), res.x[-1], options.newton, solver=solver,
                        scale=None if scale_t is None else scale_t(t), direction=step, on_accept=on_accept,
@@ -232,13 +305,18 @@ def solve_path(fun_t, x0, options: PathOptions = PathOptions(), *, solver=None, 
         res.solve_seconds += r.solve_seconds
         if callback is not None:
             callback(t, r.x)
-        if r.iterations <= options.easy_iter:
-            dt *= options.grow
+        if r.iterations <= options.easy_iter or (reuse and r.factorizations <= 1):
+            dt *= options.grow  # easy: few iterations, or (quasi-Newton) at most one factorisation
+    res.factorizations = getattr(solver, "n_factorizations", 0) - factorizations0
     return res
 
 
-def _predict(res: PathResult, t: float, fun_t, solver, kind: str):
-    """Predictor step from the last converged state to t (None: none, or a singular tangent)."""
+def _predict(res: PathResult, t: float, fun_t, solver, kind: str, residual_t=None, reuse=False):
+    """Predictor step from the last converged state to t (None: none, or a singular tangent).
+
+    ``residual_t``: the residual at t0 + eps costs no tangent; with ``reuse`` (quasi-Newton)
+    and a factorisation of this size in ``solver`` the tangent predictor solves with that
+    factorisation (the last iterate's tangent) instead of factorising K(x0)."""
     if kind not in ("tangent", "secant", "none"):
         raise ValueError(f"predictor {kind!r} not in ('tangent', 'secant', 'none')")
     if kind == "none":
@@ -246,10 +324,12 @@ def _predict(res: PathResult, t: float, fun_t, solver, kind: str):
     if kind == "tangent" or len(res.t) < 2:
         t0, x0 = res.t[-1], res.x[-1]
         eps = 1e-7 * max(t - t0, 1e-3)
-        R0, K0 = fun_t(x0, t0)
-        R1 = fun_t(x0, t0 + eps)[0]
+        old = reuse and residual_t is not None and _factored_size(solver) == len(x0)
+        R0, K0 = (residual_t(x0, t0), None) if old else fun_t(x0, t0)
+        R1 = residual_t(x0, t0 + eps) if residual_t is not None else fun_t(x0, t0 + eps)[0]
         try:
-            return -solver.solve(K0, R0 + (R1 - R0) * ((t - t0) / eps))
+            rhs = R0 + (R1 - R0) * ((t - t0) / eps)
+            return -(solver.apply(rhs) if old else solver.solve(K0, rhs))
         except (RuntimeError, np.linalg.LinAlgError, ValueError):
             return None
     t1, t2 = res.t[-2], res.t[-1]

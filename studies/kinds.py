@@ -109,4 +109,5 @@ def weights(params: dict, design: HandDesign, outdir: Path) -> dict:
     keep = ("w", "w_sum", "theta_deg", "hinge_deg", "F_v_fem_N", "F_v_reduced_N", "contact_force_N")
     return {**{k: r[k] for k in keep if r.get(k) is not None},
             "mesh": {"mesh_size_mm": r["mesh_size_mm"], "dofs": r["ndofs"]},
-            "solver": {"newton_iterations": r["newton_iterations"], "wall_time_s": r["wall_seconds"]}}
+            "solver": {"newton_iterations": r["newton_iterations"], "factorizations": r["factorizations"],
+                       "wall_time_s": r["wall_seconds"]}}

@@ -28,7 +28,7 @@ from reduced.errors import InputError
 from studies.output import jsonable, write_json
 
 #: bump when the FEM or the result's fields change, to invalidate cached results
-CACHE_FORMAT = 3  # 3: the finger's windings on their own degree-5 rule, mesh graded at the ring edges
+CACHE_FORMAT = 4  # 3: the finger's windings on their own degree-5 rule, mesh graded at the ring edges; 4: factorisations
 #: the default element size of the grasp FEM [mm] (docs/grasp.md: w's mesh sensitivity)
 MESH_SIZE = 6.0
 
@@ -87,7 +87,7 @@ def state_row(state, w, mass: float, design: HandDesign) -> dict:
             "F_v_error_kgf": None if F_v_red is None else (F_v_red - state.F_v) / grasp.KGF,
             "max_penetration_mm": float(np.max(-state.gap[state.N > 0], initial=0.0)),
             "contact_updates": state.updates, "contact_penalty_N_per_mm": state.penalty,
-            "newton_iterations": state.iterations}
+            "newton_iterations": state.iterations, "factorizations": state.factorizations}
 
 
 def finger_options(mesh_size_mm: float):

@@ -1,0 +1,91 @@
+"""Factorisation reuse: quasi-Newton on an old factor, the solvers' factor/apply, the fallback."""
+import warnings
+
+import numpy as np
+import pytest
+import scipy.sparse as sp
+import skfem as fe
+
+from fem import linsolve
+from fem.assembly import Restriction
+from fem.linsolve import make_solver
+from fem.loads import FollowerPressure
+from fem.materials import NeoHookean
+from fem.newton import NewtonOptions, PathOptions, _add_pair, _bfgs_direction, solve_path
+from fem.solid import Solid
+
+
+def inflated_block():
+    """A Neo-Hookean block clamped on one face, follower pressure on the opposite one."""
+    mesh = fe.MeshTet.init_tensor(*(np.linspace(0, 1, 3),) * 3).with_defaults()
+    solid = Solid(mesh, NeoHookean(1.0, 100.0))
+    red = Restriction(solid.ndofs, solid.free_dofs(solid.dofs("left")))
+    load = FollowerPressure(solid, "right")
+
+    def fun_t(x, t):
+        u = red.expand(x)
+        R, data = solid.residual_tangent_data(u)
+        return (red.vector(R + load.residual(u, 0.4 * t)),
+                red.restrict(solid.scatter.csr(data + load.tangent_data(u, 0.4 * t))))
+    return fun_t, len(red.keep)
+
+
+def test_quasi_newton_on_old_factors_reaches_the_same_path_with_fewer_factorisations():
+    fun_t, n = inflated_block()
+    runs = {}
+    for mode in ("always", "adaptive"):
+        solver = make_solver()
+        opts = PathOptions(steps=4, newton=NewtonOptions(rtol=1e-10, refactor=mode, contraction=0.1))
+        res = solve_path(fun_t, np.zeros(n), opts, solver=solver,
+                         residual_t=lambda x, t: fun_t(x, t)[0])
+        assert res.t[-1] == 1.0 and res.factorizations == solver.n_factorizations
+        runs[mode] = res
+    full, quasi = runs["always"], runs["adaptive"]
+    R0 = np.linalg.norm(fun_t(np.zeros(n), 1.0)[0])
+    for x in (full.x[-1], quasi.x[-1]):  # both converged to the tolerance at the end of the path
+        assert np.linalg.norm(fun_t(x, 1.0)[0]) <= 1e-10 * R0 + 1e-10
+    # the same solution to the accuracy the residual tolerance implies (well-conditioned block)
+    assert np.linalg.norm(quasi.x[-1] - full.x[-1]) <= 1e-7 * np.linalg.norm(full.x[-1])
+    assert quasi.factorizations < full.factorizations
+    assert full.factorizations == full.total_iterations  # Newton: one per iteration (the predictor's too)
+
+
+def test_bfgs_direction_satisfies_the_secant_condition():
+    rng = np.random.default_rng(3)
+    n = 12
+    M = rng.standard_normal((n, n))
+    K0, K = np.eye(n) * 3.0, M @ M.T + n * np.eye(n)  # old factor, true (SPD) Hessian
+    pairs = []
+    for _ in range(3):
+        s = rng.standard_normal(n)
+        _add_pair(pairs, s, K @ s, memory=10)
+    apply = lambda r: np.linalg.solve(K0, r)
+    s, y, _ = pairs[-1]
+    assert np.allclose(-_bfgs_direction(y, pairs, apply), s, rtol=1e-10)  # H y_k = s_k
+    _add_pair(pairs, np.ones(n), -np.ones(n), memory=10)  # negative curvature: not kept
+    assert len(pairs) == 3
+    for _ in range(10):
+        _add_pair(pairs, rng.standard_normal(n), rng.standard_normal(n) + 100.0, memory=4)
+    assert len(pairs) == 4
+
+
+def test_qdldl_falls_back_to_superlu_on_a_zero_pivot():
+    pytest.importorskip("qdldl")
+    A = sp.csr_matrix(np.array([[1e-300, 1.0, 0.0], [1.0, 0.0, 2.0], [0.0, 2.0, 1.0]]))
+    solver = make_solver("qdldl", symmetric=True)
+    b = np.array([1.0, 2.0, 3.0])
+    x = solver.solve(A, b)
+    assert np.allclose(A @ x, b, rtol=1e-12) and solver._lu is not None
+
+
+def test_a_fallback_solver_is_announced_once(monkeypatch):
+    monkeypatch.setattr(linsolve, "available", lambda: ["qdldl", "superlu"])
+    monkeypatch.setattr(linsolve, "_announced", set())
+    pytest.importorskip("qdldl")
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        names = [make_solver(symmetric=True).name, make_solver(symmetric=True).name,
+                 make_solver(symmetric=False).name]
+    assert names == ["qdldl", "qdldl", "superlu"]  # qdldl needs a symmetric matrix
+    messages = [str(w.message) for w in caught if issubclass(w.category, RuntimeWarning)]
+    assert len(messages) == 2 and "qdldl, about 12x slower" in messages[0] and "superlu" in messages[1]
