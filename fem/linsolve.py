@@ -16,7 +16,7 @@ fallback is announced once (a :class:`RuntimeWarning`) with its expected slowdow
 
 The symbolic analysis (ordering + symbolic factorisation) is done once per sparsity
 pattern and reused for every later matrix with the same pattern (PARDISO phase 11
-once, then phase 23 per solve). ``solver.name`` says which backend runs.
+once, then phase 22 per factorisation, phase 33 per solve). ``solver.name`` says which backend runs.
 
 Mixed precision (PARDISO, ``precision="mixed"``, the default): the matrix is factorised
 in single precision (half the factor's memory, ~1.8x faster on the 80k-DOF benchmark

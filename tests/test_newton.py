@@ -148,7 +148,7 @@ def _path_laplacian(n, shift):
     return sp.diags([-np.ones(n - 1), main + shift, -np.ones(n - 1)], [-1, 0, 1], format="csr")
 
 
-@pytest.mark.skipif("pardiso" not in available(), reason="PARDISO (the fast extra) not installed")
+@pytest.mark.skipif("pardiso" not in available(), reason="PARDISO (pypardiso, MKL) not installed")
 def test_mixed_precision_refines_to_double_accuracy_and_falls_back_when_ill_conditioned():
     rng = np.random.default_rng(2)
     b = rng.standard_normal(3000)
