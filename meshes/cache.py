@@ -1,9 +1,12 @@
 """A cache of generated meshes, so the same mesh is never generated twice.
 
 The key is a hash of (the geometry function's module and name, its parameters, the
-element size, the element order, the gmsh version, :data:`FORMAT`). Files live in
-``$SOFTHAND_CACHE/meshes`` (default ``~/.cache/softhand/meshes``) and are written
-atomically, so concurrent workers asking for the same mesh at worst both generate it.
+element size, the element order, the gmsh version, the softhand version, :data:`FORMAT`).
+Files live in ``$SOFTHAND_CACHE/meshes`` (default ``~/.cache/softhand/meshes``) and are
+written atomically, so concurrent workers asking for the same mesh at worst both generate
+it. Each ``.msh`` has a ``.msh.sha256`` next to it; a mesh whose checksum does not match
+(truncated, edited, swapped) is generated again. A cache folder that cannot be written
+is a warning: the mesh is generated into a temporary folder instead.
 """
 from __future__ import annotations
 
@@ -11,6 +14,9 @@ import dataclasses
 import hashlib
 import json
 import os
+import sys
+import tempfile
+from functools import lru_cache
 from pathlib import Path
 
 import skfem
@@ -35,18 +41,53 @@ def mesh_key(geometry: Geometry, params, *, size: float, order: int, refine: int
         "geometry": f"{geometry.__module__}.{geometry.__qualname__}",
         "params": fields, "size": float(size), "order": int(order),
         **({"refine": int(refine)} if refine else {}),
-        "gmsh": GMSH_VERSION, "format": FORMAT,
+        "gmsh": GMSH_VERSION, "softhand": _softhand_version(), "format": FORMAT,
     }, sort_keys=True, default=repr)
     return hashlib.sha256(blob.encode()).hexdigest()[:20]
 
 
+@lru_cache(maxsize=1)
+def _softhand_version() -> str:
+    from importlib.metadata import PackageNotFoundError, version
+
+    try:
+        return version("softhand")
+    except PackageNotFoundError:
+        return "unknown"
+
+
+def _sha256(path: Path) -> str:
+    return hashlib.sha256(path.read_bytes()).hexdigest()
+
+
+def valid_entry(path: Path) -> bool:
+    """True if the cached mesh ``path`` is there and matches its recorded checksum."""
+    try:
+        return path.is_file() and Path(f"{path}.sha256").read_text().strip() == _sha256(path)
+    except (OSError, ValueError):
+        return False
+
+
 def cached_msh(geometry: Geometry, params, *, size: float, order: int = 2, refine: int = 0,
                folder: str | Path | None = None) -> Path:
-    """The ``.msh`` file of this geometry; generated with gmsh only if not cached yet."""
+    """The ``.msh`` file of this geometry; generated with gmsh only if not cached (and valid)."""
     name = f"{geometry.__name__}-{mesh_key(geometry, params, size=size, order=order, refine=refine)}.msh"
-    path = Path(folder) if folder is not None else cache_dir()
-    path = path / name
-    if not path.is_file():
+    path = (Path(folder) if folder is not None else cache_dir()) / name
+    if valid_entry(path):
+        return path
+    if path.exists():
+        print(f"softhand: warning: cached mesh {name} does not match its checksum; "
+              f"generating it again", file=sys.stderr)
+    try:
+        generate_msh(geometry, params, path, size=size, order=order, refine=refine)
+        from meshes.atomic import atomic_path
+
+        with atomic_path(f"{path}.sha256") as tmp:
+            tmp.write_text(_sha256(path) + "\n")
+    except OSError as exc:
+        print(f"softhand: warning: the mesh cache {path.parent} cannot be written "
+              f"({exc.strerror or exc}); the mesh is not cached", file=sys.stderr)
+        path = Path(tempfile.mkdtemp(prefix="softhand-mesh-")) / name
         generate_msh(geometry, params, path, size=size, order=order, refine=refine)
     return path
 

@@ -33,6 +33,9 @@ COLUMNS = {
     "F_v_N": "grasping force F_v normal to the finger, eq. (29) [N]",
     "diameter_mm": "object diameter, selects the weight vector w (optional) [mm]",
 }
+#: column -> (lowest, highest) allowed value of a measurement
+LIMITS = {"P_MPa": (-5.0, 5.0), "theta_deg": (-90.0, 180.0), "mass_kg": (0.0, 100.0),
+          "F_v_N": (-1e4, 1e4), "diameter_mm": (1.0, 1000.0)}
 BENDING_COLUMNS = ("P_MPa", "theta_deg")
 GRASP_COLUMNS = ("P_MPa", "theta_deg", "mass_kg", "F_v_N")
 
@@ -91,12 +94,11 @@ def read_measurements(path: str | Path) -> Measurements:
 
 def _read_rows(path: Path) -> tuple[list[str], list[tuple[int, list[str]]]]:
     """Header cells and (line number, cells) of the data rows; comments and blank lines skipped."""
+    from .design import read_input_file
+
+    data = read_input_file(path, "--data", "a CSV file")
     try:
-        text = path.read_text(encoding="utf-8-sig")
-    except FileNotFoundError:
-        raise InputError("--data", str(path), "no such file; give a CSV file") from None
-    except IsADirectoryError:
-        raise InputError("--data", str(path), "is a directory; give a CSV file") from None
+        text = data.decode("utf-8-sig")
     except UnicodeDecodeError:
         raise InputError("--data", str(path), "is not a UTF-8 text (CSV) file") from None
     lines = [(i, line) for i, line in enumerate(text.splitlines(), start=1)
@@ -138,4 +140,7 @@ def _number(name: str, line: int, col: str, text: str) -> float:
         raise InputError(f"{name}: line {line}, column {col}", text, "must be a whole number")
     if col in ("mass_kg", "diameter_mm") and not value > 0:
         raise InputError(f"{name}: line {line}, column {col}", text, "must be positive")
+    lo, hi = LIMITS.get(col, (-math.inf, math.inf))
+    if not lo <= value <= hi:
+        raise InputError(f"{name}: line {line}, column {col}", text, f"must be in [{lo:g}, {hi:g}]")
     return value

@@ -92,24 +92,23 @@ class HandDesign:
 
     # ------------------------------------------------------------------ validation
     def validate(self) -> None:
-        """Raise :class:`InputError` naming the first bad field."""
-        for name in ("l0", "a", "b", "d", "R", "t", "V0", "mu_sf", "mu_sr", "g"):
-            _positive(_KEY_OF[name], getattr(self, name))
-        if not 0.0 <= self.theta0 < math.pi / 2:
-            raise InputError("theta0_deg", math.degrees(self.theta0), "must be in [0, 90) degrees")
+        """Raise :class:`InputError` naming the first bad field (bounds: :data:`BOUNDS`)."""
+        for name, key in _KEY_OF.items():
+            if key in BOUNDS:
+                _in_bounds(key, _to_public(name, getattr(self, name)))
         for name in ("n", "n_s"):
             value = getattr(self, name)
-            if isinstance(value, bool) or not isinstance(value, int) or value < 1:
-                raise InputError(name, value, "must be a whole number >= 1")
+            if isinstance(value, bool) or not isinstance(value, int):
+                raise InputError(name, value, "must be a whole number")
         if len(self.hinge_s) != self.n_s:
             raise InputError("hinge_s_mm", list(self.hinge_s),
                              f"must have n_s = {self.n_s} values")
         s = (0.0, *self.hinge_s, self.l0)
         if any(s1 <= s0 for s0, s1 in zip(s, s[1:])):
             raise InputError("hinge_s_mm", list(self.hinge_s),
-                             f"must increase strictly within (0, l0 = {self.l0}) mm")
-        if not math.isfinite(self.base_offset):
-            raise InputError("base_offset_mm", self.base_offset, "must be a finite number")
+                             f"must increase strictly within (0, l0 = {self.l0:g}) mm")
+        for check in CONSISTENCY:
+            check(self)
         if self.reservoir_model not in RESERVOIR_MODELS:
             raise InputError("reservoir_model", self.reservoir_model,
                              f"must be one of {', '.join(RESERVOIR_MODELS)}")
@@ -228,10 +227,48 @@ def _material_changes(part: str, table, source: str, values: dict) -> dict:
     return {f"{part}_material": material, name: material.mu0}
 
 
-def _positive(key: str, value) -> None:
-    if not isinstance(value, (int, float)) or isinstance(value, bool) or not value > 0 \
-            or not math.isfinite(value):
-        raise InputError(key, value, "must be a positive number")
+#: public key -> (lowest, highest) allowed value, both included, in the key's unit. Every
+#: number of a design is checked against this one table (the hinge positions hinge_s_mm lie
+#: strictly inside (0, l0_mm));
+#: a new numeric design key adds one line here. The limits are physical: a rubber tube of
+#: a hand-sized soft finger, a rubber reservoir sheet, Earth-like gravity.
+BOUNDS: dict[str, tuple[float, float]] = {
+    "theta0_deg": (0.0, 89.0),        # base link inclination
+    "l0_mm": (10.0, 1000.0),          # finger tube length
+    "a_mm": (0.1, 50.0),              # tube inner radius
+    "b_mm": (0.1, 50.0),              # tube wall thickness
+    "d_mm": (0.2, 200.0),             # tube axis to hinge plate (also > a + b)
+    "R_mm": (1.0, 500.0),             # reservoir sheet radius
+    "t_mm": (0.01, 50.0),             # reservoir sheet thickness (also < R)
+    "V0_mm3": (1.0, 1.0e8),           # initial oil volume
+    "n": (1, 12),                     # fingers
+    "n_s": (1, 20),                   # hinges per finger
+    "mu_sf_MPa": (1.0e-3, 100.0),     # rubber shear modulus, finger tube
+    "mu_sr_MPa": (1.0e-3, 100.0),     # rubber shear modulus, reservoir sheet
+    "base_offset_mm": (-1000.0, 1000.0),
+    "g_N_per_kg": (0.01, 100.0),
+}
+
+
+def _in_bounds(key: str, value) -> None:
+    lo, hi = BOUNDS[key]
+    if not _is_number(value) or not math.isfinite(value) or not lo <= value <= hi:
+        raise InputError(key, value, f"must be a number in [{lo:g}, {hi:g}]")
+
+
+def _tube_fits(design: "HandDesign") -> None:
+    if not design.a + design.b < design.d:
+        raise InputError("d_mm", design.d, f"must exceed the tube's outer radius a_mm + b_mm = "
+                         f"{design.a + design.b:g} (the tube lies between its axis and the hinge plate)")
+
+
+def _sheet_thinner_than_radius(design: "HandDesign") -> None:
+    if not design.t < design.R:
+        raise InputError("t_mm", design.t, f"must be smaller than the sheet radius R_mm = {design.R:g}")
+
+
+#: checks between fields, run after the bounds; each raises InputError naming one field
+CONSISTENCY = (_tube_fits, _sheet_thinner_than_radius)
 
 
 def _to_public(name: str, value):
@@ -285,16 +322,41 @@ def design_from_dict(values: dict, base: HandDesign | None = None, *, source: st
     return dataclasses.replace(base, **changes)
 
 
+#: largest design / study / data file read [bytes]; a bigger one (or /dev/zero) is refused
+MAX_FILE_BYTES = 1_000_000
+
+
+def read_input_file(path: str | Path, field: str, what: str) -> bytes:
+    """The bytes of a small regular input file; InputError (one line) for anything else."""
+    path = Path(path)
+    try:
+        with open(path, "rb") as f:
+            if not path.is_file():
+                raise InputError(field, str(path), f"is not a regular file; give {what}")
+            data = f.read(MAX_FILE_BYTES + 1)
+    except FileNotFoundError:
+        raise InputError(field, str(path), f"no such file; give {what}") from None
+    except IsADirectoryError:
+        raise InputError(field, str(path), f"is a directory; give {what}") from None
+    except OSError as exc:
+        raise InputError(field, str(path), f"cannot be read ({exc.strerror or exc}); "
+                         f"give {what}") from None
+    if len(data) > MAX_FILE_BYTES:
+        raise InputError(field, str(path), f"is larger than {MAX_FILE_BYTES} bytes; give {what}")
+    return data
+
+
+def read_toml(path: str | Path, field: str, what: str) -> dict:
+    """A small TOML file as a dict; InputError (one line) if unreadable or not TOML."""
+    data = read_input_file(path, field, what)
+    try:
+        return tomllib.loads(data.decode("utf-8"))
+    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
+        raise InputError(field, str(path), f"is not valid TOML ({exc})") from None
+
+
 def load_design(path: str | Path | None = None) -> HandDesign:
     """Read a design TOML file (keys as in ``studies/designs/paper.toml``); None: the paper's."""
     path = Path(path) if path is not None else PAPER_DESIGN_FILE
-    try:
-        with open(path, "rb") as f:
-            values = tomllib.load(f)
-    except FileNotFoundError:
-        raise InputError("--design", str(path), "no such file; give a design TOML file") from None
-    except IsADirectoryError:
-        raise InputError("--design", str(path), "is a directory; give a design TOML file") from None
-    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
-        raise InputError("--design", str(path), f"is not valid TOML ({exc})") from None
+    values = read_toml(path, "--design", "a design TOML file")
     return design_from_dict(values, source=path.name)

@@ -1,8 +1,20 @@
 """The one error type for bad user input, shared by every layer.
 
-The CLI turns an :class:`InputError` into one line on stderr and exit code 2.
+The CLI turns an :class:`InputError` into one line on stderr and exit code 2. The line is
+bounded in length: a huge value (a 50 MB list, a long string) is cut to its start.
 """
 from __future__ import annotations
+
+#: longest field name and value text in a message [characters]
+MAX_FIELD, MAX_VALUE = 120, 120
+
+
+def short(text: str, limit: int) -> str:
+    """``text`` on one line, cut to ``limit`` characters (with '...' and the length)."""
+    text = " ".join(str(text).split())
+    if len(text) <= limit:
+        return text
+    return f"{text[:limit]}... ({len(text)} characters)"
 
 
 class InputError(ValueError):
@@ -12,4 +24,9 @@ class InputError(ValueError):
         self.field = field
         self.value = value
         self.allowed = allowed
-        super().__init__(f"{field} = {value!r}: {allowed}")
+        shown = short(repr(value), MAX_VALUE)
+        super().__init__(f"{short(field, MAX_FIELD)} = {shown}: {short(allowed, 600)}")
+
+    def renamed(self, field: str) -> "InputError":
+        """The same complaint under the name the user typed (an option, a file's key)."""
+        return InputError(field, self.value, self.allowed)

@@ -13,22 +13,52 @@ from reduced.errors import InputError
 from studies.output import jsonable
 
 
-def parse_values(text: str, field: str) -> np.ndarray:
-    """``'0:90:10'`` (start:stop:step, stop included) or ``'1,2.5,3'`` -> float array."""
+#: most values one range or list may give: reduced-model verbs, and FEM runs (one solve each)
+MAX_POINTS, MAX_FEM_POINTS = 100_000, 200
+#: longest range or list text read [characters]
+MAX_TEXT = 100_000
+_FORMS = "start:stop:step (step > 0, stop >= start) or a comma-separated list of finite numbers"
+
+
+def parse_values(text: str, field: str, max_count: int = MAX_POINTS) -> np.ndarray:
+    """``'0:90:10'`` (start:stop:step, stop included) or ``'1,2.5,3'`` -> float array.
+
+    Every value finite; at most ``max_count`` of them (InputError otherwise).
+    """
+    if len(text) > MAX_TEXT:
+        raise InputError(field, text, f"is longer than {MAX_TEXT} characters")
     try:
-        if ":" in text:
-            start, stop, step = (float(x) for x in text.split(":"))
-            if not step > 0 or stop < start:
-                raise ValueError
-            count = int(math.floor((stop - start) / step + 1e-9)) + 1
-            return start + step * np.arange(count)
-        values = np.array([float(x) for x in text.split(",") if x.strip()], dtype=float)
-        if values.size == 0 or not np.all(np.isfinite(values)):
-            raise ValueError
-        return values
+        numbers = [float(x) for x in (text.split(":") if ":" in text else text.split(","))
+                   if x.strip() or ":" in text]
     except ValueError:
-        raise InputError(field, text, "must be start:stop:step (step > 0, stop >= start) "
-                                      "or a comma-separated list of numbers") from None
+        numbers = []
+    if ":" in text:
+        if len(numbers) != 3 or not all(map(math.isfinite, numbers)) or not numbers[2] > 0 \
+                or numbers[1] < numbers[0]:
+            raise InputError(field, text, f"must be {_FORMS}")
+        start, stop, step = numbers
+        count = (stop - start) / step + 1
+        if not count <= max_count:
+            raise InputError(field, text, f"gives {_count(count)} values; at most {max_count} allowed")
+        values = start + step * np.arange(int(math.floor(count - 1 + 1e-9)) + 1)
+    else:
+        values = np.array(numbers, dtype=float)
+        if values.size > max_count:
+            raise InputError(field, text, f"gives {values.size} values; at most {max_count} allowed")
+    if values.size == 0 or not np.all(np.isfinite(values)):
+        raise InputError(field, text, f"must be {_FORMS}")
+    return values
+
+
+def _count(count: float) -> str:
+    return f"{count:.3g}" if math.isfinite(count) else "too many"
+
+
+def check_range(field: str, value: float, lo: float, hi: float, unit: str = "") -> float:
+    """``value`` if finite and in [lo, hi], else InputError naming ``field``."""
+    if not (math.isfinite(value) and lo <= value <= hi):
+        raise InputError(field, value, f"must be a number in [{lo:g}, {hi:g}]{unit and ' ' + unit}")
+    return value
 
 
 def add_design_option(parser: argparse.ArgumentParser) -> None:

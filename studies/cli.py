@@ -15,9 +15,11 @@ from __future__ import annotations
 
 import argparse
 import importlib
+import os
+import signal
 import sys
 
-from reduced.errors import InputError
+from reduced.errors import InputError, short
 
 #: verb -> module under studies.commands; the order is the order of ``--help``.
 VERBS = (
@@ -31,7 +33,7 @@ class ArgumentParser(argparse.ArgumentParser):
     """argparse, but a usage error is one line and exit code 2."""
 
     def error(self, message):
-        self.exit(2, f"{self.prog}: error: {message}\n")
+        self.exit(2, f"{self.prog}: error: {short(message, 400)}\n")
 
 
 def _version() -> str:
@@ -77,14 +79,16 @@ def main(argv: list[str] | None = None) -> int:
         return 0
     verb, rest = argv[0], argv[1:]
     if verb not in VERBS:
-        print(f"softhand: error: unknown verb {verb!r}; allowed: {', '.join(VERBS)}",
+        print(f"softhand: error: unknown verb {short(repr(verb), 80)}; allowed: {', '.join(VERBS)}",
               file=sys.stderr)
         return 2
     module = _verb_module(verb)
     parser = ArgumentParser(prog=f"softhand {verb}", description=module.HELP)
     module.configure(parser)
     args = parser.parse_args(rest)
+    previous = _sigterm_as_interrupt()
     try:
+        _check(verb, args, parser)
         return int(module.run(args) or 0)
     except InputError as exc:
         print(f"softhand {verb}: error: {exc}", file=sys.stderr)
@@ -92,6 +96,42 @@ def main(argv: list[str] | None = None) -> int:
     except KeyboardInterrupt:
         print(f"softhand {verb}: interrupted; finished results are kept", file=sys.stderr)
         return 130
+    except BrokenPipeError:  # e.g. 'softhand study status FILE | head': the reader left
+        _silence_stdout()
+        return 141
+    finally:
+        if previous is not None:
+            signal.signal(signal.SIGTERM, previous)
+
+
+def _check(verb: str, args, parser) -> None:
+    """The checks every verb gets before it runs: finite numbers, writable outputs, cache."""
+    from studies.checks import check_finite, check_outputs, warn_cache
+
+    check_finite(args, parser)
+    if not (verb == "study" and args.action == "status"):
+        check_outputs(verb, args, parser)
+    warn_cache(verb)
+
+
+def _sigterm_as_interrupt():
+    """SIGTERM raises KeyboardInterrupt, as Ctrl-C does (main thread only); the old handler."""
+    def interrupt(signum, frame):
+        raise KeyboardInterrupt
+
+    try:
+        return signal.signal(signal.SIGTERM, interrupt)
+    except ValueError:  # not the main thread
+        return None
+
+
+def _silence_stdout() -> None:
+    """Point stdout at /dev/null so that Python's exit flush cannot fail again."""
+    try:
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+    except (OSError, ValueError):
+        pass
 
 
 if __name__ == "__main__":  # pragma: no cover

@@ -17,6 +17,7 @@ from __future__ import annotations
 import hashlib
 import json
 import math
+import sys
 from dataclasses import asdict, dataclass, field, replace
 from pathlib import Path
 
@@ -28,7 +29,7 @@ from reduced.errors import InputError
 from studies.output import jsonable, write_json
 
 #: bump when the FEM or the result's fields change, to invalidate cached results
-CACHE_FORMAT = 4  # 3: the finger's windings on their own degree-5 rule, mesh graded at the ring edges; 4: factorisations
+CACHE_FORMAT = 5  # 5: entries {format, key, sha256, result}; 4: factorisations counted; 3: the finger's windings on their own degree-5 rule, mesh graded at the ring edges
 #: the default element size of the grasp FEM [mm] (docs/grasp.md: w's mesh sensitivity)
 MESH_SIZE = 6.0
 
@@ -127,23 +128,61 @@ def _write_vtk(out, model, states) -> None:
 
 def weights(case: WeightsCase, *, cache: bool = True, out=None) -> dict:
     """:func:`compute`, through the JSON cache keyed by :meth:`WeightsCase.key` (``cached`` says
-    which); ``out``: a folder for result.json and the VTK series (always computes)."""
+    which); ``out``: a folder for result.json and the VTK series (always computes).
+
+    A cache entry is used only if it is valid (:func:`read_entry`); an invalid one is
+    recomputed and replaced, with a warning. A cache that cannot be written is a warning.
+    """
     path = cache_dir() / f"{case.key()}.json"
+    if out is None and cache:
+        entry = read_entry(path, case.key())
+        if entry is not None:
+            return {**entry, "cached": True}
+    result = compute(case) if out is None else compute(case, out)
     if out is not None:
-        result = compute(case, out)
         write_json(Path(out) / "result.json", result)
-        if cache:
-            write_json(path, result)
-        return {**result, "cached": False}
-    if cache and path.is_file():
-        try:
-            return {**json.loads(path.read_text()), "cached": True}
-        except (OSError, ValueError):
-            pass  # unreadable entry: recompute and overwrite
-    result = compute(case)
     if cache:
-        write_json(path, result)
+        write_entry(path, case.key(), result)
     return {**result, "cached": False}
+
+
+#: keys and types every cached result has
+_SCHEMA = {"w": list, "w_sum": float, "theta_deg": float, "F_v_fem_N": float,
+           "diameter_mm": float, "mesh_size_mm": float, "ndofs": int}
+
+
+def _checksum(result: dict) -> str:
+    return hashlib.sha256(json.dumps(result, sort_keys=True, default=jsonable).encode()).hexdigest()
+
+
+def read_entry(path: Path, key: str) -> dict | None:
+    """The cached result at ``path`` if it is there and valid (format, key, schema, checksum)."""
+    if not path.exists():
+        return None
+    try:
+        entry = json.loads(path.read_text())
+        result = entry["result"]
+        valid = (entry["format"] == CACHE_FORMAT and entry["key"] == key
+                 and entry["sha256"] == _checksum(result)
+                 and all(isinstance(result.get(k), t if t is not float else (int, float))
+                         for k, t in _SCHEMA.items()))
+    except (OSError, ValueError, KeyError, TypeError):
+        valid = False
+    if valid:
+        return result
+    print(f"softhand: warning: invalid cache entry {path.name}; recomputing it", file=sys.stderr)
+    return None
+
+
+def write_entry(path: Path, key: str, result: dict) -> None:
+    """Cache ``result`` with its format, key and checksum; a failure to write is a warning."""
+    result = json.loads(json.dumps(result, default=jsonable))  # as it reads back
+    try:
+        write_json(path, {"format": CACHE_FORMAT, "key": key, "sha256": _checksum(result),
+                          "result": result})
+    except OSError as exc:
+        print(f"softhand: warning: the result is not cached ({path.parent}: "
+              f"{exc.strerror or exc})", file=sys.stderr)
 
 
 def interpolate(diameters, ws, diameter: float) -> np.ndarray:

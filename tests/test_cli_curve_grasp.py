@@ -76,15 +76,15 @@ def test_grasp_warns_on_weight_sum(capsys):
 
 @pytest.mark.parametrize("argv, field", [
     (["curve", "--theta-deg", "0:-10:5"], "--theta-deg"),
-    (["curve", "--theta-deg", "0:400:100"], "theta_deg"),
-    (["curve", "--pressure-mpa", "0,9"], "pressure_MPa"),
+    (["curve", "--theta-deg", "0:400:100"], "--theta-deg"),
+    (["curve", "--pressure-mpa", "0,9"], "--pressure-mpa"),
     (["curve", "--theta-deg", "a,b"], "--theta-deg"),
     (["grasp", "--pressure-mpa", "0.9", "--theta-deg", "50", "--mass-kg", "-2",
-      "--diameter-mm", "180"], "mass_kg"),
+      "--diameter-mm", "180"], "--mass-kg"),
     (["grasp", "--pressure-mpa", "0.9", "--theta-deg", "50", "--mass-kg", "2",
-      "--diameter-mm", "-5"], "diameter_mm"),
+      "--diameter-mm", "-5"], "--diameter-mm"),
     (["grasp", "--pressure-mpa", "0.9", "--theta-deg", "50", "--mass-kg", "2",
-      "--weights", "0.5,0.5"], "weights"),
+      "--weights", "0.5,0.5"], "--weights"),
     (["grasp", "--pressure-mpa", "0.9,1", "--theta-deg", "50", "--mass-kg", "2",
       "--diameter-mm", "180"], "--pressure-mpa"),
 ])

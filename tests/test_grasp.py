@@ -116,7 +116,8 @@ def test_weights_cli_caches_by_input(tmp_path, monkeypatch, capsys):
 
     def fake_compute(case):
         calls.append(case)
-        return {"diameter_mm": case.diameter_mm, "w": [0.2] * 5, "w_sum": 1.0}
+        return {"diameter_mm": case.diameter_mm, "w": [0.2] * 5, "w_sum": 1.0, "theta_deg": 40.0,
+                "F_v_fem_N": 3.0, "mesh_size_mm": case.mesh_size_mm, "ndofs": 10}
 
     monkeypatch.setenv("SOFTHAND_CACHE", str(tmp_path))
     monkeypatch.setattr(sw, "compute", fake_compute)

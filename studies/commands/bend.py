@@ -57,6 +57,35 @@ def configure(parser) -> None:
     add_json_option(parser)
 
 
+#: option -> (lowest, highest) allowed; the mesh and quadrature options of the finger FEM
+LIMITS = {"--axial-size-mm": (0.25, 20.0), "--mesh-size-mm": (0.5, 12.0),
+          "--edge-ratio": (0.05, 1.0), "--refine": (0, 3), "--tie-width-mm": (0.5, 100.0),
+          "--peak-mpa": (0.0, 5.0)}
+#: quadrature degrees of the windings' rule: tetrahedral rules with positive weights, >= 2
+FIBER_INTORDERS = (2, 5, 6, 7)
+#: pressures the finger FEM is run at [MPa]
+PRESSURE_RANGE = (0.0, 5.0)
+
+
+def _check(args) -> tuple[float, ...]:
+    """Every numeric option in its range before any FEM work; the pressures."""
+    from reduced.errors import InputError
+    from studies.args import MAX_FEM_POINTS, check_range
+
+    for option, (lo, hi) in LIMITS.items():
+        value = getattr(args, option[2:].replace("-", "_"))
+        if value is not None:
+            check_range(option, value, lo, hi)
+    if args.fiber_intorder is not None and args.fiber_intorder not in FIBER_INTORDERS:
+        raise InputError("--fiber-intorder", args.fiber_intorder,
+                         f"must be one of {', '.join(map(str, FIBER_INTORDERS))}")
+    pressures = parse_values(args.pressure_mpa, "--pressure-mpa", MAX_FEM_POINTS)
+    lo, hi = PRESSURE_RANGE
+    if pressures.min() < lo or pressures.max() > hi:
+        raise InputError("--pressure-mpa", args.pressure_mpa, f"pressures must be in [{lo:g}, {hi:g}] MPa")
+    return tuple(float(p) for p in pressures)
+
+
 def _options(args):
     from fem.finger import FingerOptions
     from reduced.errors import InputError
@@ -83,8 +112,14 @@ def run(args) -> int:
     from studies.bending import BendingStudy, run as run_study
     from studies.output import write_csv, write_json
 
-    pressures = tuple(float(p) for p in parse_values(args.pressure_mpa, "--pressure-mpa"))
-    study = BendingStudy(design_from_args(args), pressures, _options(args),
+    pressures = _check(args)
+    design = design_from_args(args)
+    if args.tie_width_mm is not None and args.tie_width_mm >= min(design.link_lengths):
+        from reduced.errors import InputError
+
+        raise InputError("--tie-width-mm", args.tie_width_mm,
+                         f"must be shorter than every link (shortest {min(design.link_lengths):g} mm)")
+    study = BendingStudy(design, pressures, _options(args),
                          peak_mpa=args.peak_mpa if args.peak_mpa > pressures[-1] else 0.0)
     out = Path(args.out)
     series = SceneSeries(out / "finger.pvd")

@@ -25,8 +25,8 @@ from reduced import grasp
 from reduced.control import Gains, default_gains, flexibility, ramp
 from reduced.errors import InputError
 from reduced.plant import HandTables, PlantParams, Push
-from studies.args import add_design_option, add_json_option, design_from_args, print_json, \
-    print_table
+from studies.args import add_design_option, add_json_option, check_range, design_from_args, \
+    print_json, print_table
 from studies.output import save_figure, write_csv, write_json
 
 HELP = "simulate angle control (eqs. 30, 31) vs pressure control under a push (Table II, Fig. 10)"
@@ -81,10 +81,11 @@ def _plant_options(parser) -> None:
 def read_disturbance(path: str | Path):
     """The push profile of a ``t_s,force_N`` CSV file as a function of t [s]; InputError on bad files."""
     path = Path(path)
+    from reduced.design import read_input_file
+
+    data = read_input_file(path, "--disturbance", "a CSV file t_s,force_N")
     try:
-        text = path.read_text(encoding="utf-8-sig")
-    except (FileNotFoundError, IsADirectoryError):
-        raise InputError("--disturbance", str(path), "no such file; give a CSV file t_s,force_N") from None
+        text = data.decode("utf-8-sig")
     except UnicodeDecodeError:
         raise InputError("--disturbance", str(path), "is not a text (CSV) file") from None
     rows = [(number, cells) for number, cells in enumerate(csv.reader(text.splitlines()), start=1)
@@ -127,6 +128,22 @@ def _check_inputs(args) -> None:
     for name, value, ok, allowed in checks:
         if not (ok and math.isfinite(value)):
             raise InputError(name, value, f"must be {allowed}")
+    for option, (lo, hi) in LIMITS.items():
+        value = getattr(args, option[2:].replace("-", "_"))
+        if value is not None:
+            check_range(option, value, lo, hi)
+    if args.diameter_mm not in grasp.PAPER_WEIGHTS:
+        raise InputError("--diameter-mm", args.diameter_mm,
+                         f"must be one of {', '.join(f'{D:g}' for D in grasp.PAPER_WEIGHTS)}")
+
+
+#: option -> (lowest, highest) allowed, beyond the checks above
+LIMITS = {"--push-N": (-1000.0, 1000.0), "--push-rise-s": (0.0, 600.0),
+          "--push-azimuth-deg": (-360.0, 360.0), "--push-elevation-deg": (-90.0, 90.0),
+          "--kp": (0.0, 100.0), "--ki": (0.0, 1000.0), "--plant-mu-scale": (0.01, 100.0),
+          "--tau-f-s": (1e-3, 100.0), "--tau-m-s": (1e-3, 100.0), "--q-max-mm3-s": (1.0, 1e7),
+          "--p-max-mpa": (0.01, 10.0), "--sample-hz": (1.0, 1000.0), "--noise-deg": (0.0, 30.0),
+          "--noise-mpa": (0.0, 1.0), "--seed": (0, 2**32 - 1), "--mass-kg": (0.0, 100.0)}
 
 
 def _setup(args):

@@ -51,12 +51,17 @@ def rows_at_pressures(P: np.ndarray, design: HandDesign) -> list[dict]:
 
 
 def run(args) -> int:
+    from reduced.errors import InputError
+
     design = design_from_args(args)
-    if args.theta_deg is not None:
-        theta_deg = parse_values(args.theta_deg, "--theta-deg")
-        rows = rows_at_angles(theta_deg, design)
-    else:
-        rows = rows_at_pressures(parse_values(args.pressure_mpa, "--pressure-mpa"), design)
+    option = "--theta-deg" if args.theta_deg is not None else "--pressure-mpa"
+    values = parse_values(args.theta_deg if args.theta_deg is not None else args.pressure_mpa, option)
+    try:
+        rows = (rows_at_angles if args.theta_deg is not None else rows_at_pressures)(values, design)
+    except InputError as exc:  # named as the option the user typed
+        if exc.field in ("theta_deg", "pressure_MPa"):
+            raise exc.renamed(option) from None
+        raise
     if args.plot:
         plot_curve(args.plot, design, rows, by_pressure=args.theta_deg is None)
     if args.json:

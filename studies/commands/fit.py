@@ -89,7 +89,12 @@ def _start_from_shore_a(design, keys, shore_a):
     from reduced.design import design_from_dict
     from reduced.materials_data import shear_modulus_from_shore_a
 
-    mu = shear_modulus_from_shore_a(shore_a)
+    from reduced.errors import InputError
+
+    try:
+        mu = shear_modulus_from_shore_a(shore_a)
+    except InputError as exc:
+        raise exc.renamed("--shore-a") from None
     start = {k: mu for k in ("mu_sf_MPa", "mu_sr_MPa") if k in keys}
     if not start:
         from reduced.errors import InputError
@@ -107,7 +112,10 @@ def _weights(args, design):
     if args.diameter_mm is not None:
         from reduced.grasp import weights_for_diameter
 
-        return weights_for_diameter(args.diameter_mm, design)
+        try:
+            return weights_for_diameter(args.diameter_mm, design)
+        except InputError as exc:
+            raise exc.renamed("--diameter-mm") from None
     if args.weights is not None:
         return parse_values(args.weights, "--weights")
     return None

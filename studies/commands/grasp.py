@@ -42,10 +42,16 @@ def configure(parser) -> None:
     add_json_option(parser)
 
 
+#: option -> (lowest, highest) allowed
+LIMITS = {"--pressure-mpa": (-5.0, 5.0), "--theta-deg": (-90.0, 180.0), "--mass-kg": (0.0, 100.0),
+          "--diameter-mm": (60.0, 500.0)}
+
+
 def _scalar(text: str, field: str) -> float:
-    values = parse_values(text, field)
-    if values.size != 1:
-        raise InputError(field, text, "must be one number")
+    values = parse_values(text, field, max_count=1)
+    lo, hi = LIMITS[field]
+    if not lo <= values[0] <= hi:
+        raise InputError(field, text, f"must be one number in [{lo:g}, {hi:g}]")
     return float(values[0])
 
 
@@ -93,9 +99,13 @@ def run(args) -> int:
     P = _scalar(args.pressure_mpa, "--pressure-mpa")
     theta_deg = _scalar(args.theta_deg, "--theta-deg")
     mass = _scalar(args.mass_kg, "--mass-kg")
-    hand.check_theta(math.radians(theta_deg))  # bad input is reported before any FEM run
-    if not mass >= 0:
-        raise InputError("mass_kg", mass, "must be a number >= 0")
+    if args.weights is not None and args.weights.strip() not in PAPER_NAMES:
+        try:
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore", grasp.WeightSumWarning)
+                grasp.check_weights(parse_values(args.weights, "--weights", max_count=1000), design)
+        except InputError as exc:
+            raise exc.renamed("--weights") from None
     w, source, notes = _weights(args, design, mass)
     result = evaluate(P, theta_deg, mass, w, design) | {"w_source": source}
     for note in notes:  # only once the inputs are known to be good

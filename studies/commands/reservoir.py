@@ -18,8 +18,8 @@ from pathlib import Path
 import numpy as np
 
 from reduced.errors import InputError
-from studies.args import add_design_option, add_json_option, design_from_args, parse_values, \
-    print_json, print_table
+from studies.args import MAX_FEM_POINTS, add_design_option, add_json_option, design_from_args, \
+    parse_values, print_json, print_table
 
 HELP = "inflate the reservoir sheet (FEM) and measure the ellipse assumption (eqs. 11-18)"
 
@@ -42,14 +42,16 @@ def _study(args):
     from studies.reservoir import ReservoirStudy
 
     design = design_from_args(args)
-    for name in ("n_radial", "n_thick"):
-        if getattr(args, name) < 1:
-            raise InputError(f"--{name.replace('_', '-')}", getattr(args, name), "must be >= 1")
+    for name, hi in (("n_radial", 400), ("n_thick", 20)):
+        if not 1 <= getattr(args, name) <= hi:
+            raise InputError(f"--{name.replace('_', '-')}", getattr(args, name),
+                             f"must be a whole number in [1, {hi}]")
     volumes = ()
     if args.volume_mm3 is not None:
-        volumes = tuple(parse_values(args.volume_mm3, "--volume-mm3"))
-        if min(volumes) <= 0:
-            raise InputError("--volume-mm3", args.volume_mm3, "volumes must be positive")
+        volumes = tuple(parse_values(args.volume_mm3, "--volume-mm3", MAX_FEM_POINTS))
+        if min(volumes) <= 0 or max(volumes) > 100 * design.V0:
+            raise InputError("--volume-mm3", args.volume_mm3,
+                             f"volumes must be in (0, {100 * design.V0:g}] mm^3 (100 V0)")
     return ReservoirStudy(design=design, volumes_mm3=volumes, n_radial=args.n_radial,
                           n_thick=args.n_thick)
 

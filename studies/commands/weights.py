@@ -12,8 +12,6 @@ from __future__ import annotations
 
 import sys
 
-import numpy as np
-
 from reduced.errors import InputError
 from studies.args import add_design_option, add_json_option, design_from_args, parse_values, \
     print_json, print_table
@@ -48,19 +46,32 @@ def configure(parser) -> None:
     add_json_option(parser)
 
 
-def _scalar(text, field: str, *, positive: bool = True) -> float:
-    values = parse_values(str(text), field)
-    if values.size != 1 or (positive and not values[0] > 0) or values[0] < 0:
-        raise InputError(field, text, "must be one positive number" if positive
-                         else "must be one number >= 0")
-    return float(values[0])
+#: option -> (lowest, highest) allowed, in the option's unit
+LIMITS = {"--diameter-mm": (60.0, 500.0), "--mass-kg": (0.0, 20.0), "--pressure-mpa": (0.01, 3.0),
+          "--dp-mpa": (0.001, 0.5), "--mesh-size-mm": (2.0, 12.0), "--depth-mm": (-1000.0, 1000.0),
+          "--check-mm": (60.0, 500.0), "--fig8": (0.01, 3.0)}
+#: most diameters of one sweep and pressures of one --fig8 (one grasp FEM each)
+MAX_DIAMETERS, MAX_FIG8 = 50, 20
+
+
+def _values(text, field: str, max_count: int = 1):
+    values = parse_values(str(text), field, max_count)
+    lo, hi = LIMITS[field]
+    if values.min() < lo or values.max() > hi:
+        raise InputError(field, text, f"must be {'numbers' if max_count > 1 else 'a number'} "
+                                      f"in [{lo:g}, {hi:g}]")
+    return values
+
+
+def _scalar(text, field: str) -> float:
+    return float(_values(text, field)[0])
 
 
 def case_from_args(args):
     from studies.weights import WeightsCase
 
     return WeightsCase(design=design_from_args(args), diameter_mm=180.0,
-                       mass_kg=_scalar(args.mass_kg, "--mass-kg", positive=False),
+                       mass_kg=_scalar(args.mass_kg, "--mass-kg"),
                        pressure_mpa=_scalar(args.pressure_mpa, "--pressure-mpa"),
                        dP_mpa=_scalar(args.dp_mpa, "--dp-mpa"),
                        mesh_size_mm=_scalar(args.mesh_size_mm, "--mesh-size-mm"),
@@ -82,11 +93,14 @@ def _run(args) -> int:
     from dataclasses import replace
 
     case = case_from_args(args)
-    diameters = parse_values(args.diameter_mm, "--diameter-mm")
-    if np.any(diameters <= 0):
-        raise InputError("--diameter-mm", args.diameter_mm, "must be positive")
+    diameters = _values(args.diameter_mm, "--diameter-mm", MAX_DIAMETERS)
+    check = None if args.check_mm is None else _scalar(args.check_mm, "--check-mm")
+    if check is not None and not diameters.min() <= check <= diameters.max():
+        raise InputError("--check-mm", args.check_mm, f"must lie within the diameters "
+                         f"[{diameters.min():g}, {diameters.max():g}] mm")
     if args.fig8 is not None:
-        return _fig8(args, replace(case, diameter_mm=float(diameters[0])))
+        pressures = _values(args.fig8, "--fig8", MAX_FIG8)
+        return _fig8(args, replace(case, diameter_mm=float(diameters[0])), pressures)
     if diameters.size == 1:
         result = _one(replace(case, diameter_mm=float(diameters[0])), args)
         print_json(result) if args.json else _print_one(result)
@@ -136,10 +150,10 @@ def _sweep(args, case, diameters) -> int:
     return 0
 
 
-def _fig8(args, case) -> int:
+def _fig8(args, case, pressures) -> int:
     from studies.weights import fig8, fig8_errors
 
-    rows = fig8(case, parse_values(args.fig8, "--fig8"))
+    rows = fig8(case, pressures)
     if args.plot:
         from studies.weights_plot import plot_fig8
 
