@@ -140,7 +140,7 @@ def _one(section: Section, ctx: Context, out: Path, only, fresh: bool) -> Outcom
         return Outcome(section, "reused", previous["provenance"]["finished_utc"],
                        previous["provenance"]["wall_time_s"], previous["numbers"])
     params = {"section": section.key, "quick": ctx.quick}
-    output = execute_case(f"{__name__}:run_section", params, ctx.design)
+    output = execute_case(run_section, params, ctx.design)
     commit(folder, {"section": section.key, "case": key,
                     **outcome_record(params, ctx.design, output)}, output.get("files", {}))
     if output["status"] != "done":

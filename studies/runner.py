@@ -8,22 +8,31 @@ Resumable and safe by construction:
   ``status`` counts the results that other sources computed, and ``run(fresh=True)``
   recomputes everything (a working tree under development changes its sources often);
 * a worker computes a case in its own temporary folder and returns the numbers and the
-  files; this process writes them into ``results/<study>/.tmp/<key>.*`` and renames
-  that folder to ``results/<study>/<key>/`` in one step. A killed run leaves finished
-  cases complete and nothing half-written (an orphaned ``.tmp`` folder is removed by
-  the next run). The same path serves the process pool and Dask, and a Dask cluster
-  needs no shared file system;
+  files; this process writes them into ``results/<study>/.<key>.<random>.tmp/`` and
+  renames that folder to ``results/<study>/<key>/`` in one step. A killed run leaves
+  finished cases complete and nothing half-written (a leftover temporary folder of a case
+  is removed by the next run that claims the case). The same path serves the process
+  pool and Dask, and a Dask cluster needs no shared file system;
+* several runs of one study may run at once: each case is claimed (:mod:`studies.claims`)
+  before it is computed, a case another run holds is left to it and taken as reused once
+  done, so every case is computed once;
+* a case file that does not parse (truncated, empty, ``null``, edited) counts as not done:
+  ``status`` reports it as corrupt and the next run recomputes it;
 * a case that raises is recorded (``<key>/failed.json``, with the error and traceback)
-  and the others go on; a rerun tries it again.
+  and the others go on; a rerun tries it again;
+* pool workers die with this process (also on SIGKILL), and SIGTERM stops a run as
+  Ctrl-C does: finished cases are kept and ``index.csv`` is written.
 
 ``results/<study>/index.csv`` lists every case of the sweep with its state and numbers.
 """
 from __future__ import annotations
 
 import hashlib
+import itertools
 import json
 import os
 import shutil
+import signal
 import sys
 import tempfile
 import time
@@ -41,6 +50,7 @@ import numpy as np
 
 from reduced.design import HandDesign
 from reduced.errors import InputError
+from studies.claims import Claims
 from studies.output import write_csv, write_json
 from studies.studyfile import Study, resolve_kind
 
@@ -67,6 +77,7 @@ class RunSummary:
     computed: int = 0
     failed: dict = field(default_factory=dict)
     not_run: int = 0  #: cases left pending (a worker died, or interrupted)
+    corrupt: int = 0  #: case files found unreadable at the start (recomputed)
 
     @property
     def ok(self) -> bool:
@@ -125,32 +136,46 @@ def study_dir(study: Study, results_root: str | Path = "results") -> Path:
 
 
 def case_state(sdir: Path, case: Case) -> str:
-    """'done', 'failed' or 'pending'."""
+    """'done', 'failed', 'pending' or 'corrupt' (a case file that does not parse)."""
     folder = sdir / case.key
-    if (folder / RESULT).is_file():
-        return "done"
-    return "failed" if (folder / FAILED).is_file() else "pending"
+    for name, state in ((RESULT, "done"), (FAILED, "failed")):
+        if (folder / name).exists():
+            return state if _record(folder / name) is not None else "corrupt"
+    return "corrupt" if folder.exists() else "pending"
 
 
 def read_case(sdir: Path, case: Case) -> dict | None:
-    """The stored result.json or failed.json of a case, or None if pending."""
+    """The stored result.json or failed.json of a case; None if pending or corrupt."""
     for name in (RESULT, FAILED):
         path = sdir / case.key / name
-        if path.is_file():
-            return json.loads(path.read_text())
+        if path.exists():
+            return _record(path)
     return None
 
 
+def _record(path: Path) -> dict | None:
+    """A case file's record if it parses and has the record's shape, else None."""
+    try:
+        record = json.loads(path.read_text())
+    except (OSError, ValueError):
+        return None
+    ok = (isinstance(record, dict) and record.get("status") == ("done" if path.name == RESULT else "failed")
+          and isinstance(record.get("numbers"), dict) and isinstance(record.get("provenance"), dict))
+    return record if ok else None
+
+
 # ---------------------------------------------------------------------- one case
-def execute_case(kind: str, params: dict, design: HandDesign) -> dict:
+def execute_case(kind, params: dict, design: HandDesign) -> dict:
     """Compute one case in a private temporary folder; return numbers, files, timing.
+
+    ``kind``: a registered kind's name, or (for callers inside softhand) the case function.
 
     Never raises for a failing kind: the error comes back as ``status = 'failed'``.
     """
     start = time.perf_counter()
     with tempfile.TemporaryDirectory(prefix="softhand-case-") as tmp:
         try:
-            out = resolve_kind(kind)(dict(params), design, Path(tmp))
+            out = (kind if callable(kind) else resolve_kind(kind))(dict(params), design, Path(tmp))
             numbers, extra = _split_output(out)
         except Exception as exc:  # a failing case is data, not a crash
             return {"status": "failed", "error": f"{type(exc).__name__}: {exc}",
@@ -198,24 +223,22 @@ def commit(final: Path, record: dict, files: dict) -> Path:
 
     The record is ``result.json`` if its status is 'done', else ``failed.json``.
     """
-    tmp = final.parent / ".tmp" / f"{final.name}.{uuid.uuid4().hex[:8]}"
+    tmp = final.parent / f".{final.name}.{uuid.uuid4().hex[:8]}.tmp"
     tmp.mkdir(parents=True)
     for rel, data in files.items():
         (tmp / rel).parent.mkdir(parents=True, exist_ok=True)
         (tmp / rel).write_bytes(data)
     write_json(tmp / (RESULT if record["status"] == "done" else FAILED), record)
     if final.exists():
-        shutil.rmtree(final)  # an earlier failure, or a result of other inputs
+        shutil.rmtree(final)  # an earlier failure, a corrupt file, or a result of other inputs
     os.rename(tmp, final)
-    _remove_if_empty(tmp.parent)
     return final
 
 
-def _remove_if_empty(folder: Path) -> None:
-    try:
-        folder.rmdir()
-    except OSError:
-        pass  # not empty: another case is being written
+def _remove_leftovers(sdir: Path, key: str) -> None:
+    """Temporary folders of case ``key`` a killed run left (only its claim holder calls this)."""
+    for tmp in sdir.glob(f".{key}.*.tmp"):
+        shutil.rmtree(tmp, ignore_errors=True)
 
 
 def _provenance(params: dict, design: HandDesign, output: dict) -> dict:
@@ -235,27 +258,58 @@ def run_study(study: Study, *, results_root: str | Path = "results", workers: in
     ``scheduler``: a Dask scheduler address, or 'local' for a LocalCluster.
     """
     sdir = study_dir(study, results_root)
-    shutil.rmtree(sdir / ".tmp", ignore_errors=True)  # leftovers of a killed run
     cases = plan(study)
-    todo = [c for c in cases if fresh or case_state(sdir, c) != "done"]
-    summary = RunSummary(total=len(cases), reused=len(cases) - len(todo), not_run=len(todo))
+    states = {c.key: case_state(sdir, c) for c in cases}
+    todo = [c for c in cases if fresh or states[c.key] != "done"]
+    summary = RunSummary(total=len(cases), reused=len(cases) - len(todo), not_run=len(todo),
+                         corrupt=sum(state == "corrupt" for state in states.values()))
+    if summary.corrupt:
+        print(f"softhand study: {summary.corrupt} case files do not parse; recomputing them",
+              file=sys.stderr)
     workers = max(1, workers or os.cpu_count() or 1)
     bar = _progress_bar(study, summary, progress)
+    claims = Claims(sdir)
     try:
-        with closing(_outcomes(study, todo, workers, scheduler)) as outcomes:
-            for case, output in outcomes:
-                commit_case(sdir, study, case, output)
-                summary.not_run -= 1
-                if output["status"] == "done":
-                    summary.computed += 1
-                else:
-                    summary.failed[case.key] = output["error"]
-                bar.update(1)
-                bar.set_postfix(running=min(workers, summary.not_run), failed=len(summary.failed))
+        while todo:
+            deferred: list[Case] = []
+            mine = _claimed(sdir, todo, claims, fresh, deferred, summary, bar)
+            with closing(_outcomes(study, mine, workers, scheduler)) as outcomes:
+                for case, output in outcomes:
+                    commit_case(sdir, study, case, output)
+                    claims.release(case.key)
+                    summary.not_run -= 1
+                    if output["status"] == "done":
+                        summary.computed += 1
+                    else:
+                        summary.failed[case.key] = output["error"]
+                    bar.update(1)
+                    bar.set_postfix(running=min(workers, summary.not_run), failed=len(summary.failed))
+            if deferred and len(deferred) == len(todo):
+                time.sleep(0.2)  # every case left is another run's: wait for it
+            todo, fresh = deferred, False
     finally:
+        claims.release_all()
         bar.close()
         write_index(study, results_root)
     return summary
+
+
+def _claimed(sdir: Path, todo: list[Case], claims: Claims, fresh: bool, deferred: list,
+             summary: RunSummary, bar):
+    """Yield the cases of ``todo`` this run claims and must compute, one at a time (claimed
+    when taken); a case another run holds goes to ``deferred``, one it finished is reused."""
+    for case in todo:
+        if not claims.try_claim(case.key):
+            deferred.append(case)
+            continue
+        if not fresh and case_state(sdir, case) == "done":  # another run has just finished it
+            claims.release(case.key)
+            summary.reused += 1
+            summary.not_run -= 1
+            bar.update(1)
+            continue
+        _remove_leftovers(sdir, case.key)
+        yield case
 
 
 def _progress_bar(study: Study, summary: RunSummary, enabled: bool):
@@ -265,12 +319,14 @@ def _progress_bar(study: Study, summary: RunSummary, enabled: bool):
                 file=sys.stderr, disable=not enabled, dynamic_ncols=True)
 
 
-def _outcomes(study: Study, todo: list[Case], workers: int, scheduler: str | None):
-    """Yield (case, output) as cases finish, on the chosen executor."""
-    if not todo:
-        return
+def _outcomes(study: Study, todo, workers: int, scheduler: str | None):
+    """Yield (case, output) as cases finish, on the chosen executor; ``todo`` is an iterator,
+    read only as workers become free (each case is claimed when read)."""
+    todo = iter(todo)
     if scheduler:
-        yield from _dask_outcomes(study, todo, workers, scheduler)
+        cases = list(todo)
+        if cases:
+            yield from _dask_outcomes(study, cases, workers, scheduler)
     elif workers == 1:
         for case in todo:
             yield case, execute_case(study.kind, case.params, case.design)
@@ -278,7 +334,7 @@ def _outcomes(study: Study, todo: list[Case], workers: int, scheduler: str | Non
         yield from _pool_outcomes(study, todo, workers)
 
 
-def _pool_outcomes(study: Study, todo: list[Case], workers: int, restarts: int = 2):
+def _pool_outcomes(study: Study, todo, workers: int, restarts: int = 2):
     """A process pool; if a worker dies, a new pool takes the cases not finished (twice at most)."""
     remaining = todo
     for attempt in range(restarts + 1):
@@ -286,28 +342,63 @@ def _pool_outcomes(study: Study, todo: list[Case], workers: int, restarts: int =
         yield from _one_pool(study, remaining, workers, lost)
         if not lost:
             return
-        remaining = lost
+        remaining = itertools.chain(lost, remaining)
         again = "; a new pool takes them" if attempt < restarts else "; rerun to finish them"
         print(f"softhand study: a worker died; {len(lost)} cases not finished{again}",
               file=sys.stderr)
+        if attempt == restarts:
+            return
 
 
-def _one_pool(study: Study, todo: list[Case], workers: int, lost: list[Case]):
-    pool = ProcessPoolExecutor(max_workers=min(workers, len(todo)))
+def _one_pool(study: Study, todo, workers: int, lost: list[Case]):
+    """At most ``workers`` cases in flight; the next one read from ``todo`` as one finishes."""
+    first = next(todo, None)
+    if first is None:
+        return
+    pool = ProcessPoolExecutor(max_workers=workers, initializer=_worker_init, initargs=(os.getpid(),))
+    futures, broken = {}, False
+
+    def submit(case):
+        futures[pool.submit(execute_case, study.kind, case.params, case.design)] = case
+
     try:
-        futures = {pool.submit(execute_case, study.kind, c.params, c.design): c for c in todo}
-        pending = set(futures)
-        while pending:
-            finished, pending = wait(pending, return_when=FIRST_COMPLETED)
+        submit(first)
+        for case in itertools.islice(todo, workers - 1):
+            submit(case)
+        while futures:
+            finished, _ = wait(futures, return_when=FIRST_COMPLETED)
             for future in finished:
+                case = futures.pop(future)
                 try:
                     output = future.result()
                 except BrokenProcessPool:
-                    lost.append(futures[future])
+                    lost.append(case)
+                    broken = True
                     continue
-                yield futures[future], output
+                yield case, output
+                if not broken:
+                    case = next(todo, None)
+                    if case is not None:
+                        submit(case)
+    except BaseException:  # Ctrl-C, SIGTERM, an error here: the workers go with us
+        for process in list((getattr(pool, "_processes", None) or {}).values()):
+            process.terminate()
+        raise
     finally:
         pool.shutdown(wait=True, cancel_futures=True)
+
+
+def _worker_init(parent: int) -> None:
+    """In each pool worker: die with the parent (Linux: PR_SET_PDEATHSIG), default SIGTERM."""
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)
+    try:
+        import ctypes
+
+        ctypes.CDLL(None, use_errno=True).prctl(1, signal.SIGKILL)  # 1 = PR_SET_PDEATHSIG
+    except (OSError, AttributeError):
+        pass  # not Linux: workers exit when they find the pool's pipe closed
+    if os.getppid() != parent:  # the parent died before the death signal was armed
+        os._exit(1)
 
 
 def _dask_outcomes(study: Study, todo: list[Case], workers: int, scheduler: str):
@@ -347,9 +438,9 @@ def _connect(Client, address: str):
 
 # ---------------------------------------------------------------------- index and status
 def status(study: Study, results_root: str | Path = "results") -> dict[str, list[Case]]:
-    """Cases grouped by state: {'done': [...], 'failed': [...], 'pending': [...]}."""
+    """Cases grouped by state: {'done', 'failed', 'pending', 'corrupt' (recomputed by a run)}."""
     sdir = study_dir(study, results_root)
-    groups = {"done": [], "failed": [], "pending": []}
+    groups = {"done": [], "failed": [], "pending": [], "corrupt": []}
     for case in plan(study):
         groups[case_state(sdir, case)].append(case)
     return groups
@@ -358,8 +449,11 @@ def status(study: Study, results_root: str | Path = "results") -> dict[str, list
 def other_sources(study: Study, done: list[Case], results_root: str | Path = "results") -> list[Case]:
     """The done cases whose result was computed by other package sources than these."""
     sdir, mine = study_dir(study, results_root), code_version()["source_sha256"]
-    return [c for c in done
-            if read_case(sdir, c)["provenance"]["code"]["source_sha256"] != mine]
+    def source(case):
+        code = ((read_case(sdir, case) or {}).get("provenance") or {}).get("code")
+        return code.get("source_sha256") if isinstance(code, dict) else None
+
+    return [c for c in done if source(c) != mine]
 
 
 def index_rows(study: Study, results_root: str | Path = "results") -> list[dict]:
@@ -368,7 +462,8 @@ def index_rows(study: Study, results_root: str | Path = "results") -> list[dict]
     rows = []
     for case in plan(study):
         record = read_case(sdir, case) or {}
-        row = {"case": case.key, "status": record.get("status", "pending"), **case.point}
+        state = record.get("status") or case_state(sdir, case)
+        row = {"case": case.key, "status": state, **case.point}
         row.update(record.get("numbers", {}))
         row["wall_time_s"] = (record.get("provenance") or {}).get("wall_time_s")
         row["error"] = record.get("error")

@@ -3,7 +3,7 @@
 A study file names a *kind* (what one case computes), a design, the sweep axes and
 optionally fixed parameters and a mesh size::
 
-    kind = "curve"                      # a name in KINDS, or "package.module:function"
+    kind = "curve"                      # a registered kind (see all_kinds())
     name = "curve_mu"                   # optional; default: the file's stem
     description = "P(theta) for three rubber moduli"
     design = "designs/paper.toml"       # a file, relative to the study file ...
@@ -22,47 +22,127 @@ optionally fixed parameters and a mesh size::
 A sweep axis is either a parameter of the kind or a public design key
 (:data:`reduced.design.PUBLIC_KEYS`). Every error is one line naming the field.
 
-Registering a kind is one line in :data:`KINDS`: ``name -> Kind("module:function",
-(accepted params...), fem=...)``. The function has the signature
+A study file is data: its kind is a *name*, looked up in the built-in :data:`KINDS` and in
+the ``softhand.kinds`` entry-point group of installed packages (:func:`all_kinds`); no
+import path written in a file is ever imported. Registering a built-in kind is one line
+in :data:`KINDS`: ``name -> Kind("module:function", {param: Num(lo, hi), ...}, fem=...)``;
+a plugin package declares ``[project.entry-points."softhand.kinds"] name =
+"package.module:KIND"`` pointing at a :class:`Kind` (or at the case function itself,
+whose parameters are then not checked). The function has the signature
 ``fn(case_params: dict, design: HandDesign, outdir: Path) -> dict`` and returns
 numbers (floats or lists of floats; optional ``"mesh"`` and ``"solver"`` dicts go
 into the provenance); it may write VTK/PNG files into ``outdir``. The module is
 imported only when a case of that kind runs.
+
+The whole file is validated before the first case runs: every case's parameters against
+their kind's ranges, every swept design, and the number of cases (at most
+:data:`MAX_CASES` unless the caller allows more).
 """
 from __future__ import annotations
 
 import importlib
 import itertools
+import math
 import re
-import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from reduced.design import PUBLIC_KEYS, HandDesign, design_from_dict, load_design
+from reduced.design import PUBLIC_KEYS, HandDesign, design_from_dict, load_design, read_toml
 from reduced.errors import InputError
 from studies.args import parse_values
 
 
 @dataclass(frozen=True)
+class Num:
+    """A numeric case parameter in [lo, hi] (``choices``: only these values)."""
+
+    lo: float = -math.inf
+    hi: float = math.inf
+    choices: tuple = ()
+
+    def check(self, where: str, value) -> None:
+        if not _is_number(value) or not math.isfinite(value):
+            raise InputError(where, value, "must be a finite number")
+        if self.choices and value not in self.choices:
+            raise InputError(where, value, f"must be one of {', '.join(f'{c:g}' for c in self.choices)}")
+        if not self.lo <= value <= self.hi:
+            raise InputError(where, value, f"must be a number in [{self.lo:g}, {self.hi:g}]")
+
+
+@dataclass(frozen=True)
+class NumList:
+    """A case parameter that is a list of finite numbers (at most ``max_len``)."""
+
+    max_len: int = 100
+
+    def check(self, where: str, value) -> None:
+        if not isinstance(value, list) or not value or len(value) > self.max_len \
+                or not all(_is_number(v) and math.isfinite(v) for v in value):
+            raise InputError(where, value, f"must be a list of 1 to {self.max_len} finite numbers")
+
+
+@dataclass(frozen=True)
 class Kind:
-    """What one case of a study computes."""
+    """What one case of a study computes, and the parameters it accepts."""
 
     target: str  #: "package.module:function", imported lazily
-    params: tuple[str, ...]  #: case parameters the function accepts
+    params: dict | None  #: parameter name -> Num / NumList; None: a plugin's, unchecked
     fem: bool = False  #: True if it takes mesh_size_mm
+    required: tuple[str, ...] = ()  #: parameters every case must have
+    exactly_one: tuple[str, ...] = ()  #: every case has exactly one of these
+    mesh: Num = Num(0.1, 50.0)  #: allowed mesh_size_mm [mm] (FEM kinds)
 
+
+_THETA, _PRESSURE, _MASS = Num(-90.0, 180.0), Num(-5.0, 5.0), Num(0.0, 100.0)
+_PAPER_D = Num(choices=(180.0, 240.0))  #: the paper's weight vectors
 
 #: kind name -> Kind. Add a kind with one line here.
 KINDS: dict[str, Kind] = {
-    "curve": Kind("studies.kinds:curve", ("theta_deg", "pressure_mpa")),
+    "curve": Kind("studies.kinds:curve", {"theta_deg": _THETA, "pressure_mpa": _PRESSURE},
+                  exactly_one=("theta_deg", "pressure_mpa")),
     "grasp": Kind("studies.kinds:grasp",
-                  ("pressure_mpa", "theta_deg", "mass_kg", "diameter_mm", "weights")),
-    "control": Kind("studies.kinds:control", ("theta_ref_deg", "mass_kg", "diameter_mm",
-                                              "push_n", "push_at_s", "t_end_s")),
-    "reservoir": Kind("studies.kinds:reservoir", ("theta_max_deg",), fem=True),
-    "weights": Kind("studies.kinds:weights", ("diameter_mm", "mass_kg", "pressure_mpa", "dP_mpa"),
-                    fem=True),
+                  {"pressure_mpa": _PRESSURE, "theta_deg": _THETA, "mass_kg": _MASS,
+                   "diameter_mm": _PAPER_D, "weights": NumList(20)},
+                  required=("pressure_mpa", "theta_deg")),
+    "control": Kind("studies.kinds:control",
+                    {"theta_ref_deg": Num(-29.9, 119.9), "mass_kg": _MASS, "diameter_mm": _PAPER_D,
+                     "push_n": Num(-1000.0, 1000.0), "push_at_s": Num(1.0, 600.0),
+                     "t_end_s": Num(2.0, 600.0)}),
+    "reservoir": Kind("studies.kinds:reservoir", {"theta_max_deg": Num(1.0, 180.0)}, fem=True,
+                      mesh=Num(0.05, 24.0)),
+    "weights": Kind("studies.kinds:weights",
+                    {"diameter_mm": Num(60.0, 500.0), "mass_kg": Num(0.0, 20.0),
+                     "pressure_mpa": Num(0.01, 3.0), "dP_mpa": Num(0.001, 0.5)}, fem=True,
+                    mesh=Num(2.0, 12.0)),
 }
+#: the entry-point group where installed packages declare more kinds
+ENTRY_POINT_GROUP = "softhand.kinds"
+#: most cases a study may have unless the caller allows more (``--max-cases``)
+MAX_CASES = 10_000
+
+
+def all_kinds() -> dict[str, Kind]:
+    """The built-in kinds and those of installed plugins (a built-in name wins)."""
+    from importlib.metadata import entry_points
+
+    kinds = {}
+    for ep in entry_points(group=ENTRY_POINT_GROUP):
+        if ep.name not in KINDS:
+            kinds[ep.name] = _plugin_kind(ep)
+    return {**kinds, **KINDS}
+
+
+def _plugin_kind(ep) -> Kind:
+    try:
+        obj = ep.load()
+    except Exception as exc:  # a broken plugin is the plugin's bad input, one line
+        raise InputError("kind", ep.name, f"plugin {ep.value} cannot be loaded ({exc})") from None
+    if isinstance(obj, Kind):
+        return obj
+    if callable(obj):
+        return Kind(ep.value, None)
+    raise InputError("kind", ep.name, f"plugin {ep.value} is neither a Kind nor a function")
+
 
 _TOP_KEYS = ("kind", "name", "description", "design", "mesh_size_mm", "sweep", "params")
 _NAME_RE = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_.-]*$")
@@ -73,7 +153,7 @@ class Study:
     """A validated study: the product of its sweep axes over a base design."""
 
     name: str  #: results go to results/<name>/
-    kind: str  #: a key of KINDS or "module:function"
+    kind: str  #: a name of :func:`all_kinds`
     design: HandDesign  #: the base design, before design axes are applied
     axes: tuple[tuple[str, tuple], ...]  #: (axis name, values) in file order
     params: dict = field(default_factory=dict)  #: fixed case parameters
@@ -97,29 +177,25 @@ class Study:
 
 
 def resolve_kind(kind: str):
-    """The case function of ``kind`` (a KINDS name or "module:function"), imported now."""
-    target = KINDS[kind].target if kind in KINDS else kind
-    module_name, _, func = target.partition(":")
+    """The case function of the registered kind ``kind``, imported now."""
+    kinds = KINDS if kind in KINDS else all_kinds()
+    if kind not in kinds:
+        raise InputError("kind", kind, f"unknown kind; allowed: {', '.join(all_kinds())}")
+    module_name, _, func = kinds[kind].target.partition(":")
     try:
         return getattr(importlib.import_module(module_name), func)
     except (ImportError, AttributeError) as exc:
         raise InputError("kind", kind, f"cannot be loaded ({exc})") from None
 
 
-def load_study(path: str | Path) -> Study:
-    """Read and validate a study TOML file."""
+def load_study(path: str | Path, *, max_cases: int = MAX_CASES) -> Study:
+    """Read and validate a study TOML file (at most ``max_cases`` cases)."""
     path = Path(path)
-    try:
-        with open(path, "rb") as f:
-            doc = tomllib.load(f)
-    except (FileNotFoundError, IsADirectoryError):
-        raise InputError("study file", str(path), "no such file; give a study TOML file") from None
-    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
-        raise InputError("study file", str(path), f"is not valid TOML ({exc})") from None
-    return study_from_dict(doc, path=path)
+    doc = read_toml(path, "study file", "a study TOML file")
+    return study_from_dict(doc, path=path, max_cases=max_cases)
 
 
-def study_from_dict(doc: dict, *, path: Path | None = None) -> Study:
+def study_from_dict(doc: dict, *, path: Path | None = None, max_cases: int = MAX_CASES) -> Study:
     """Validate a parsed study document; file paths are relative to ``path``'s folder."""
     src = path.name if path else "study"
     for key in doc:
@@ -137,22 +213,46 @@ def study_from_dict(doc: dict, *, path: Path | None = None) -> Study:
     mesh = _mesh_size(doc.get("mesh_size_mm"), kind, src)
     params = _params(doc.get("params", {}), kind, src)
     axes = _axes(doc.get("sweep"), kind, params, src)
+    count = math.prod(len(values) for _, values in axes)
+    if count > max_cases:
+        raise InputError(f"{src}: sweep", f"{count} cases", f"at most {max_cases} cases "
+                         "(the product of the axes' lengths); --max-cases N allows more")
     study = Study(name=name, kind=kind, design=design, axes=axes, params=params,
                   mesh_size_mm=mesh, description=description, path=path)
-    study.cases()  # validates every swept design now, not in a worker
+    spec = all_kinds()[kind]
+    for case_params, _ in study.cases():  # every swept design and parameter now, not in a worker
+        _check_case(case_params, spec, src)
     return study
 
 
+def _check_case(params: dict, kind: Kind, src: str) -> None:
+    """One case's parameters against its kind: ranges, required, exactly one of."""
+    if kind.params is None:
+        return
+    for key, value in params.items():
+        spec = kind.params.get(key)
+        if spec is not None:
+            spec.check(f"{src}: {key}", value)
+    missing = [k for k in kind.required if k not in params]
+    if missing:
+        raise InputError(f"{src}: {missing[0]}", None, "missing; give it in [sweep] or [params]")
+    if kind.exactly_one and sum(k in params for k in kind.exactly_one) != 1:
+        raise InputError(f"{src}: sweep", sorted(k for k in params if k in kind.exactly_one),
+                         f"give exactly one of {', '.join(kind.exactly_one)}")
+
+
 def _kind(kind, src: str) -> str:
-    if isinstance(kind, str) and (kind in KINDS or re.match(r"^[\w.]+:\w+$", kind)):
+    kinds = all_kinds()
+    if isinstance(kind, str) and kind in kinds:
         return kind
-    raise InputError(f"{src}: kind", kind,
-                     f"unknown kind; allowed: {', '.join(KINDS)} or 'package.module:function'")
+    raise InputError(f"{src}: kind", kind, f"unknown kind; allowed: {', '.join(kinds)} "
+                     f"(more from installed plugins, entry-point group {ENTRY_POINT_GROUP})")
 
 
 def _accepted(kind: str) -> tuple[str, ...] | None:
-    """The parameters ``kind`` accepts; None for a user's "module:function" kind (unchecked)."""
-    return KINDS[kind].params if kind in KINDS else None
+    """The parameters ``kind`` accepts; None for a plugin kind that does not declare them."""
+    params = all_kinds()[kind].params
+    return None if params is None else tuple(params)
 
 
 def _design(spec, base: Path, src: str) -> HandDesign:
@@ -173,10 +273,10 @@ def _design(spec, base: Path, src: str) -> HandDesign:
 def _mesh_size(value, kind: str, src: str) -> float | None:
     if value is None:
         return None
-    if kind in KINDS and not KINDS[kind].fem:
+    spec = all_kinds()[kind]
+    if spec.params is not None and not spec.fem:
         raise InputError(f"{src}: mesh_size_mm", value, f"kind {kind!r} has no mesh; remove it")
-    if isinstance(value, bool) or not isinstance(value, (int, float)) or not value > 0:
-        raise InputError(f"{src}: mesh_size_mm", value, "must be a positive number [mm]")
+    spec.mesh.check(f"{src}: mesh_size_mm", value)
     return float(value)
 
 

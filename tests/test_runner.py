@@ -26,6 +26,18 @@ def case(params, design, outdir):
 '''
 
 
+def install_kind(where: Path, module: str, code: str) -> str:
+    """A plugin kind as an installed package declares it: module ``module`` with a ``case``
+    function, and a dist-info whose ``softhand.kinds`` entry point names it; on the path
+    once ``where`` is on sys.path / PYTHONPATH. Returns the kind's name."""
+    (where / f"{module}.py").write_text(code)
+    dist = where / f"softhand_test_{module}-0.dist-info"
+    dist.mkdir()
+    (dist / "METADATA").write_text(f"Metadata-Version: 2.1\nName: softhand-test-{module}\nVersion: 0\n")
+    (dist / "entry_points.txt").write_text(f"[softhand.kinds]\n{module} = {module}:case\n")
+    return module
+
+
 def write_study(tmp_path, text, name="s.toml") -> Path:
     path = tmp_path / name
     path.write_text(text)
@@ -63,10 +75,11 @@ def _default_sigint():
 
 @pytest.mark.parametrize("sig", [signal.SIGKILL, signal.SIGINT])
 def test_killed_run_resumes_with_only_the_missing_cases(tmp_path, monkeypatch, sig):
-    (tmp_path / "slowkind.py").write_text(SLOW_KIND)
+    install_kind(tmp_path, "slowkind", SLOW_KIND)
+    monkeypatch.syspath_prepend(str(tmp_path))
     # 24 cases of 0.25 s on 2 workers: 3 s, so the signal after the 3rd lands mid-run even on
     # a loaded machine (with 12 cases a loaded CI run once finished before the signal)
-    path = write_study(tmp_path, 'kind = "slowkind:case"\n[params]\nsleep_s = 0.25\n'
+    path = write_study(tmp_path, 'kind = "slowkind"\n[params]\nsleep_s = 0.25\n'
                        f'[sweep]\nx = "1:{N_SLOW}:1"\n')
     study, root = load_study(path), tmp_path / "res"
     env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(tmp_path), str(ROOT)])}
@@ -76,48 +89,48 @@ def test_killed_run_resumes_with_only_the_missing_cases(tmp_path, monkeypatch, s
                             stderr=subprocess.PIPE, preexec_fn=_default_sigint)
     sdir = study_dir(study, root)
     deadline = time.monotonic() + 60
-    while len(list(sdir.glob(f"*/{RESULT}"))) < 3 and time.monotonic() < deadline:
+    while len(list(sdir.glob(f"[!.]*/{RESULT}"))) < 3 and time.monotonic() < deadline:
         time.sleep(0.05)
     os.killpg(proc.pid, sig)
     _, err = proc.communicate(timeout=60)
     assert proc.returncode == (-signal.SIGKILL if sig == signal.SIGKILL else 130), err.decode()[-2000:]
 
     # every case folder that exists is complete and readable
-    before = {p.parent.name: p.read_bytes() for p in sdir.glob(f"*/{RESULT}")}
-    folders = [p for p in sdir.iterdir() if p.is_dir() and p.name != ".tmp"]
+    before = {p.parent.name: p.read_bytes() for p in sdir.glob(f"[!.]*/{RESULT}")}
+    folders = [p for p in sdir.iterdir() if p.is_dir() and not p.name.startswith(".")]
     assert {p.name for p in folders} == set(before)
     assert all(json.loads(b)["status"] == "done" for b in before.values())
     assert all((sdir / k / "field.txt").stat().st_size == 100000 for k in before)
     assert 3 <= len(before) < N_SLOW
 
-    monkeypatch.syspath_prepend(str(tmp_path))
     summary = run_study(study, results_root=root, workers=1, progress=False)
     assert summary.ok and summary.reused == len(before) and summary.computed == N_SLOW - len(before)
     assert all((sdir / k / RESULT).read_bytes() == b for k, b in before.items())
-    assert not (sdir / ".tmp").exists()
+    assert not list(sdir.glob(".*.tmp"))  # the killed run's temporary folders are gone
     assert len(status(study, root)["done"]) == N_SLOW
 
 
 def test_a_failing_case_is_recorded_and_the_others_finish(tmp_path, capsys):
-    # 400 deg is outside the reduced model's range: that case raises an InputError
-    path = write_study(tmp_path, 'kind = "curve"\n[sweep]\ntheta_deg = [10, 400, 20]\n')
+    # 4.5 MPa passes the study file's check ([-5, 5] MPa) but is beyond the largest pressure
+    # of the paper's hand (3.76 MPa, at 180 deg): that case raises an InputError when it runs
+    path = write_study(tmp_path, 'kind = "curve"\n[sweep]\npressure_mpa = [0.5, 4.5, 0.8]\n')
     root = tmp_path / "res"
     args = ["study", "run", str(path), "--workers", "1", "--results", str(root), "--no-progress"]
     assert main(args) == 1
     assert "1 failed" in capsys.readouterr().out
     study = load_study(path)
     groups = status(study, root)
-    assert [c.point["theta_deg"] for c in groups["failed"]] == [400]
-    assert sorted(c.point["theta_deg"] for c in groups["done"]) == [10, 20]
+    assert [c.point["pressure_mpa"] for c in groups["failed"]] == [4.5]
+    assert sorted(c.point["pressure_mpa"] for c in groups["done"]) == [0.5, 0.8]
     failed = json.loads((study_dir(study, root) / groups["failed"][0].key / "failed.json")
                         .read_text())
-    assert "theta_deg" in failed["error"] and "Traceback" in failed["traceback"]
+    assert "pressure_MPa" in failed["error"] and "Traceback" in failed["traceback"]
     index = (study_dir(study, root) / "index.csv").read_text().splitlines()
     assert len(index) == 4 and sum(",failed," in line for line in index) == 1
     assert main(["study", "status", str(path), "--results", str(root)]) == 0
     assert "2 done, 0 pending, 1 failed" in capsys.readouterr().out
     assert main(["study", "report", str(path), "--results", str(root)]) == 0
-    assert (study_dir(study, root) / "report" / "P_MPa.png").stat().st_size > 0
+    assert (study_dir(study, root) / "report" / "theta_deg.png").stat().st_size > 0
 
 
 def test_case_key_follows_the_inputs_not_their_spelling():
@@ -141,9 +154,9 @@ def case(params, design, outdir):
 
 
 def test_a_killed_worker_loses_nothing_and_its_cases_are_rerun(tmp_path, monkeypatch):
-    (tmp_path / "dyingkind.py").write_text(DYING_KIND)
+    install_kind(tmp_path, "dyingkind", DYING_KIND)
     monkeypatch.syspath_prepend(str(tmp_path))
-    study = load_study(write_study(tmp_path, f'kind = "dyingkind:case"\n[params]\n'
+    study = load_study(write_study(tmp_path, f'kind = "dyingkind"\n[params]\n'
                                    f'marker = "{tmp_path / "died"}"\n[sweep]\nx = "1:8:1"\n'))
     summary = run_study(study, results_root=tmp_path / "res", workers=2, progress=False)
     assert (tmp_path / "died").exists()  # a worker did die

@@ -27,27 +27,35 @@ def configure(parser) -> None:
         sub.add_argument("file", metavar="FILE", help="study TOML file (see studies/*.toml)")
         sub.add_argument("--results", default="results", metavar="DIR",
                          help="results root (default: results); the study writes DIR/<name>/")
+        sub.add_argument("--max-cases", type=int, default=None, metavar="N",
+                         help="allow a study of up to N cases (default 10000)")
+
+
+#: most worker processes of one run
+MAX_WORKERS = 256
 
 
 def run(args) -> int:
-    from studies.studyfile import load_study
+    from reduced.errors import InputError
+    from studies.studyfile import MAX_CASES, load_study
 
-    study = load_study(args.file)
+    if args.max_cases is not None and not 1 <= args.max_cases <= 10**7:
+        raise InputError("--max-cases", args.max_cases, "must be a whole number in [1, 10000000]")
+    if args.action == "run" and args.workers is not None and not 1 <= args.workers <= MAX_WORKERS:
+        raise InputError("--workers", args.workers, f"must be a whole number in [1, {MAX_WORKERS}]")
+    study = load_study(args.file, max_cases=args.max_cases or MAX_CASES)
     return {"run": _run, "status": _status, "report": _report}[args.action](study, args)
 
 
 def _run(study, args) -> int:
     from studies.runner import run_study, study_dir
 
-    if args.workers is not None and args.workers < 1:
-        from reduced.errors import InputError
-
-        raise InputError("--workers", args.workers, "must be a whole number >= 1")
     s = run_study(study, results_root=args.results, workers=args.workers,
                   scheduler=args.scheduler, progress=not args.no_progress, fresh=args.fresh)
     print(f"study {study.name} ({study.kind}): {s.total} cases: "
           f"{s.total - len(s.failed) - s.not_run} done ({s.computed} computed, {s.reused} reused), "
-          f"{len(s.failed)} failed, {s.not_run} not run")
+          f"{len(s.failed)} failed, {s.not_run} not run"
+          + (f"; {s.corrupt} case files that did not parse were recomputed" if s.corrupt else ""))
     print(f"index: {study_dir(study, args.results) / 'index.csv'}")
     for key, error in list(s.failed.items())[:_SHOWN]:
         print(f"  failed {key}: {error}")
@@ -62,20 +70,22 @@ def _status(study, args) -> int:
     if args.json:
         print_json({"study": study.name, "kind": study.kind,
                     **{state: [{"case": c.key, **c.point,
-                                **({"error": read_case(sdir, c)["error"]} if state == "failed" else {})}
+                                **({"error": (read_case(sdir, c) or {}).get("error")} if state == "failed" else {})}
                                for c in cases] for state, cases in groups.items()}})
         return 0
     total = sum(map(len, groups.values()))
     print(f"study {study.name} ({study.kind}): {total} cases: "
-          + ", ".join(f"{len(groups[s])} {s}" for s in ("done", "pending", "failed")))
+          + ", ".join(f"{len(groups[s])} {s}" for s in ("done", "pending", "failed"))
+          + (f", {len(groups['corrupt'])} corrupt (case files that do not parse; "
+             f"'study run' recomputes them)" if groups["corrupt"] else ""))
     stale = other_sources(study, groups["done"], args.results)
     if stale:
         print(f"  note: {len(stale)} done cases were computed by other package sources "
               f"(an edited working tree); 'study run --fresh' recomputes them all")
-    for state in ("failed", "pending"):
+    for state in ("failed", "corrupt", "pending"):
         for case in groups[state][:_SHOWN]:
             point = " ".join(f"{k}={v}" for k, v in case.point.items())
-            error = f": {read_case(sdir, case)['error']}" if state == "failed" else ""
+            error = f": {(read_case(sdir, case) or {}).get('error')}" if state == "failed" else ""
             print(f"  {state:<7} {case.key}  {point}{error}")
         if len(groups[state]) > _SHOWN:
             print(f"  ... and {len(groups[state]) - _SHOWN} more {state}")
