@@ -10,6 +10,7 @@
 """
 from __future__ import annotations
 
+import argparse
 import math
 import os
 import sys
@@ -30,10 +31,15 @@ CACHE_VERBS = ("bend", "weights", "grasp", "study", "reproduce", "reservoir")
 
 
 def option_name(dest: str, parser) -> str:
-    """The option string the user typed for argparse destination ``dest``."""
+    """The option string the user typed for argparse destination ``dest`` (also in sub-commands)."""
     for action in parser._actions:
         if action.dest == dest and action.option_strings:
             return max(action.option_strings, key=len)
+        for sub in (getattr(action, "choices", None) or {}).values() \
+                if isinstance(action, argparse._SubParsersAction) else ():
+            name = option_name(dest, sub)
+            if name != dest:
+                return name
     return dest
 
 

@@ -259,14 +259,20 @@ def _design(spec, base: Path, src: str) -> HandDesign:
     if spec is None:
         return HandDesign()
     if isinstance(spec, str):
-        return load_design(base / spec)
+        try:
+            return load_design(base / spec)
+        except InputError as exc:
+            raise (exc.renamed(f"{src}: design") if exc.field == "--design" else exc) from None
     if not isinstance(spec, dict):
         raise InputError(f"{src}: design", spec, "must be a file name or a table of design keys")
     overrides = dict(spec)
     file = overrides.pop("file", None)
     if file is not None and not isinstance(file, str):
         raise InputError(f"{src}: design.file", file, "must be a file name")
-    start = load_design(base / file) if file else HandDesign()
+    try:
+        start = load_design(base / file) if file else HandDesign()
+    except InputError as exc:
+        raise (exc.renamed(f"{src}: design.file") if exc.field == "--design" else exc) from None
     return design_from_dict(overrides, start, source=f"{src}: design")
 
 

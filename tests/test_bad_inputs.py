@@ -1,0 +1,273 @@
+"""Every bad input of every verb and file type: exit 2, one stderr line, nothing written.
+
+Run in-process (``studies.cli.main``) in a scratch folder; each case asserts exit code 2,
+exactly one line on stderr that names an option or field, no traceback, nothing on
+stdout, and no file created or changed anywhere under the scratch folder (outputs, the
+cache, results).
+"""
+import math
+from pathlib import Path
+
+import pytest
+
+from reduced.design import BOUNDS, HandDesign
+from studies.cli import main
+
+# ---------------------------------------------------------------- input files of the cases
+GOOD_CSV = "P_MPa,theta_deg\n0.2,10\n0.4,25\n0.6,40\n0.8,55\n"
+FILES = {
+    "bad_toml.toml": "a_mm = = 3\n",
+    "binary.toml": b"\xff\xfe\x00bad",
+    "huge_hinges.toml": "hinge_s_mm = [" + ", ".join(["1.0"] * 200_000) + "]\n",
+    "good.csv": GOOD_CSV,
+    "empty.csv": "",
+    "header_only.csv": "P_MPa,theta_deg\n",
+    "unknown_col.csv": "P_MPa,theta_deg,colour\n0.2,10,1\n0.4,20,2\n",
+    "theta600.csv": "P_MPa,theta_deg\n0.2,10\n0.4,600\n0.6,700\n",
+    "nan_row.csv": "P_MPa,theta_deg\n0.2,10\n0.4,nan\n0.6,40\n",
+    "short_row.csv": "P_MPa,theta_deg\n0.2,10\n0.4\n0.6,40\n",
+    "pressure_big.csv": "P_MPa,theta_deg\n0.2,10\n40,20\n0.6,40\n",
+    "push_bad_header.csv": "time,force\n0,1\n",
+    "push_no_rows.csv": "t_s,force_N\n",
+    "push_decreasing.csv": "t_s,force_N\n0,1\n2,1\n1,1\n",
+    "push_nan.csv": "t_s,force_N\n0,1\n1,nan\n",
+    "push_text.csv": "t_s,force_N\n0,one\n",
+    "a_file": "not a folder",
+    "result.vtu": "<VTKFile>",
+}
+
+#: design key -> values outside its table bounds or of the wrong type (TOML literals)
+BAD_DESIGN_VALUES = ["-1e9", "1e9", "nan", "inf", '"ten"', "true"]
+DESIGN_KEYS = [k for k in BOUNDS if k not in ("n", "n_s")]
+
+
+def _design_files() -> dict:
+    files = {f"d_{key}_{i}.toml": f"{key} = {value}\n"
+             for key in DESIGN_KEYS for i, value in enumerate(BAD_DESIGN_VALUES)}
+    files.update({
+        "d_tube_wider.toml": "b_mm = 30.0\n",            # a + b = 34 > d = 15
+        "d_d_below_a.toml": "d_mm = 3.0\n",               # d < a
+        "d_sheet_thick.toml": "t_mm = 50.0\n",            # t > R = 24
+        "d_tiny_R.toml": "R_mm = 1e-6\n",
+        "d_tiny_mu.toml": "mu_sf_MPa = 1e-300\n",
+        "d_offset.toml": "base_offset_mm = -1e308\n",
+        "d_n_half.toml": "n = 2.5\n",
+        "d_n_zero.toml": "n = 0\n",
+        "d_n_many.toml": "n = 1000\n",
+        "d_ns_zero.toml": "n_s = 0\nhinge_s_mm = []\n",
+        "d_hinge_count.toml": "hinge_s_mm = [30.0, 60.0]\n",
+        "d_hinge_order.toml": "hinge_s_mm = [30.0, 20.0, 90.0, 120.0, 150.0]\n",
+        "d_hinge_beyond.toml": "hinge_s_mm = [30.0, 60.0, 90.0, 120.0, 190.0]\n",
+        "d_hinge_text.toml": 'hinge_s_mm = "30,60"\n',
+        "d_unknown.toml": "colour = 3\n",
+        "d_model.toml": 'reservoir_model = "balloon"\n',
+        "d_theta0.toml": "theta0_deg = 90.0\n",
+    })
+    return files
+
+
+def _study(body: str) -> str:
+    return body if body.startswith("kind") else 'kind = "curve"\n' + body
+
+
+STUDIES = {
+    "s_code.toml": 'kind = "os:getcwd"\n[sweep]\nx = [1]\n',
+    "s_module.toml": 'kind = "studies.kinds:curve"\n[sweep]\ntheta_deg = [1]\n',
+    "s_unknown_kind.toml": 'kind = "curl"\n[sweep]\ntheta_deg = [1]\n',
+    "s_no_kind.toml": '[sweep]\ntheta_deg = [1]\n',
+    "s_million.toml": _study('[sweep]\ntheta_deg = "0:99:1"\nmu_sf_MPa = "1:1.99:0.01"\n'
+                             'V0_mm3 = "17000:17990:10"\n'),
+    "s_nan.toml": _study("[sweep]\ntheta_deg = [10, nan]\n"),
+    "s_inf_range.toml": _study('[sweep]\ntheta_deg = "0:inf:1"\n'),
+    "s_strings.toml": _study('[sweep]\ntheta_deg = ["ten", "twenty"]\n'),
+    "s_range.toml": _study("[sweep]\ntheta_deg = [10, 400]\n"),
+    "s_both.toml": _study("[sweep]\ntheta_deg = [10]\npressure_mpa = [0.5]\n"),
+    "s_neither.toml": _study("[sweep]\nmu_sf_MPa = [1.0, 1.2]\n"),
+    "s_grasp_missing.toml": 'kind = "grasp"\n[sweep]\npressure_mpa = [0.8]\n',
+    "s_grasp_d.toml": 'kind = "grasp"\n[params]\ntheta_deg = 40\ndiameter_mm = 200\n'
+                      '[sweep]\npressure_mpa = [0.8]\n',
+    "s_control_long.toml": 'kind = "control"\n[params]\nt_end_s = 1e6\n[sweep]\nmass_kg = [1]\n',
+    "s_weights_mesh.toml": 'kind = "weights"\nmesh_size_mm = 1e-9\n[sweep]\ndiameter_mm = [180]\n',
+    "s_weights_d.toml": 'kind = "weights"\n[sweep]\ndiameter_mm = [1, 180]\n',
+    "s_mesh_reduced.toml": _study("mesh_size_mm = 2\n[sweep]\ntheta_deg = [1]\n"),
+    "s_unknown_param.toml": _study("[params]\ncolour = 1\n[sweep]\ntheta_deg = [1]\n"),
+    "s_unknown_top.toml": _study("colour = 1\n[sweep]\ntheta_deg = [1]\n"),
+    "s_bad_design_axis.toml": _study("[sweep]\ntheta_deg = [10]\nb_mm = [5.0, 30.0]\n"),
+    "s_design_file.toml": _study('design = "nope.toml"\n[sweep]\ntheta_deg = [1]\n'),
+    "s_design_zero.toml": _study('design = "/dev/zero"\n[sweep]\ntheta_deg = [1]\n'),
+    "s_design_key.toml": _study("[design]\nl0 = 3\n[sweep]\ntheta_deg = [1]\n"),
+    "s_name.toml": _study('name = "../../escape"\n[sweep]\ntheta_deg = [1]\n'),
+    "s_description.toml": _study("description = 3\n[sweep]\ntheta_deg = [1]\n"),
+    "s_params_number.toml": _study("params = 3\n[sweep]\ntheta_deg = [1]\n"),
+    "s_no_sweep.toml": 'kind = "curve"\n',
+    "s_empty_axis.toml": _study("[sweep]\ntheta_deg = []\n"),
+    "s_both_places.toml": _study("[params]\ntheta_deg = 1\n[sweep]\ntheta_deg = [1]\n"),
+    "s_not_toml.toml": "kind = curve\n",
+    "s_empty.toml": "",
+    "good_study.toml": _study("[sweep]\ntheta_deg = [10, 20]\n"),
+}
+
+CURVE, STUDY = ["curve", "--theta-deg", "10"], "good_study.toml"
+GRASP = ["grasp", "--pressure-mpa", "0.8", "--theta-deg", "40", "--mass-kg", "1"]
+CONTROL = ["control", "--theta-ref-deg", "50", "--mass-kg", "1"]
+FIT = ["fit", "--data", "good.csv", "--params", "V0_mm3"]
+WEIGHTS = ["weights", "--diameter-mm", "180"]
+
+
+def _cases():
+    cases = []
+    verbs = [CURVE, GRASP + ["--weights", "paper180"], CONTROL, FIT, ["bend"], WEIGHTS,
+             ["reservoir"], ["reproduce", "--quick"]]
+    for i, name in enumerate(sorted(_design_files())):  # every design file, across the verbs
+        cases.append((f"design-{name}", verbs[i % len(verbs)] + ["--design", name]))
+    for name in ("missing.toml", "/dev/zero", ".", "bad_toml.toml", "binary.toml",
+                 "huge_hinges.toml", "a_file/x.toml"):
+        cases.append((f"design-file-{name}", CURVE + ["--design", name]))
+    options = {
+        "curve": [["--theta-deg", v] for v in ("nan", "inf", "-inf", "0:inf:1", "0:90:1e-9",
+                                               "0:90:0", "90:0:10", "abc", "500", "1e400",
+                                               "0:90", "0:90:10:5", "1,2,x")]
+                 + [["--pressure-mpa", v] for v in ("10", "0:1:1e-7", "nan", "-20")]
+                 + [["--theta-deg", "10", "--plot", p] for p in ("x.txt", "x", "adir/", ".",
+                                                                 "/proc/x.png", "a_file/x.png")]
+                 + [[], ["--theta-deg", "1", "--pressure-mpa", "1"], ["--theta-deg"]],
+        "grasp": [["--pressure-mpa", "0.8", "--theta-deg", "40", "--mass-kg", "1"] + extra
+                  for extra in (["--weights", "1,2"], ["--weights", "nan,1,1,1,1"],
+                                ["--weights", ",".join(["0.1"] * 5000)], ["--weights", "paper999"],
+                                ["--weights=-inf,0,0,0,1"], ["--diameter-mm", "1"],
+                                ["--diameter-mm", "-5"], ["--diameter-mm", "1e6"],
+                                ["--diameter-mm", "nan"], ["--diameter-mm", "180,200"],
+                                ["--weights", "0,0,0,0,0", "--normalise"],
+                                ["--weights", "paper180", "--diameter-mm", "180"])]
+                 + [["--pressure-mpa", p, "--theta-deg", t, "--mass-kg", m, "--weights", "paper180"]
+                    for p, t, m in (("nan", "40", "1"), ("inf", "40", "1"), ("x", "40", "1"),
+                                    ("1,2", "40", "1"), ("0.8", "500", "1"), ("0.8", "nan", "1"),
+                                    ("0.8", "40", "-1"), ("0.8", "40", "inf"), ("0.8", "40", "1e9"),
+                                    ("50", "40", "1"))],
+        "control": [CONTROL[1:] + extra for extra in (
+            ["--kp", "nan"], ["--ki", "-1"], ["--kp", "1e9"], ["--t-end-s", "1e6"],
+            ["--t-end-s", "1"], ["--push-N", "inf"], ["--push-N", "1e9"], ["--push-at-s", "0"],
+            ["--push-at-s", "20"], ["--push-rise-s", "-1"], ["--sample-hz", "0"],
+            ["--sample-hz", "1e9"], ["--seed", "-1"], ["--tau-f-s", "0"], ["--tau-m-s", "-1"],
+            ["--q-max-mm3-s", "0"], ["--p-max-mpa", "100"], ["--diameter-mm", "200"],
+            ["--noise-deg", "-1"], ["--noise-mpa", "nan"], ["--plant-mu-scale", "0"],
+            ["--push-azimuth-deg", "inf"], ["--push-elevation-deg", "100"], ["--mode", "speed"],
+            ["--disturbance", "missing.csv"], ["--disturbance", "."], ["--disturbance", "/dev/zero"],
+            ["--disturbance", "push_bad_header.csv"], ["--disturbance", "push_no_rows.csv"],
+            ["--disturbance", "push_decreasing.csv"], ["--disturbance", "push_nan.csv"],
+            ["--disturbance", "push_text.csv"], ["--out", "a_file"], ["--out", "/proc/out"],
+            ["--plot", "x.gif"], ["--plot", "a_file/x.png"])]
+                   + [["--theta-ref-deg", "nan", "--mass-kg", "1"],
+                      ["--theta-ref-deg", "200", "--mass-kg", "1"],
+                      ["--theta-ref-deg", "50", "--mass-kg", "-1"],
+                      ["--theta-ref-deg", "fifty", "--mass-kg", "1"]],
+        "fit": [["--data", d, "--params", "V0_mm3"] for d in (
+            "missing.csv", ".", "/dev/zero", "empty.csv", "header_only.csv", "unknown_col.csv",
+            "theta600.csv", "nan_row.csv", "short_row.csv", "pressure_big.csv")]
+               + [FIT[1:3] + extra for extra in (
+                   ["--params", "colour_mm"], ["--params", ""], ["--params", "V0_mm3,V0_mm3"],
+                   ["--params", "n"], ["--params", "V0_mm3", "--bounds", "V0_mm3=3:1"],
+                   ["--params", "V0_mm3", "--bounds", "V0_mm3"],
+                   ["--params", "V0_mm3", "--bounds", "mu_sf_MPa=1:2"],
+                   ["--params", "mu_sf_MPa", "--shore-a", "500"],
+                   ["--params", "mu_sf_MPa", "--shore-a", "nan"],
+                   ["--params", "V0_mm3", "--diameter-mm", "200"],
+                   ["--params", "V0_mm3", "--model", "fem"],
+                   ["--params", "V0_mm3", "--out", "."], ["--params", "V0_mm3", "--out", "/proc/d.toml"],
+                   ["--params", "V0_mm3", "--plot", "fit.txt"])],
+        "bend": [[*extra] for extra in (
+            ["--pressure-mpa", "0:0.8:1e-7"], ["--pressure-mpa", "10"], ["--pressure-mpa", "-1"],
+            ["--pressure-mpa", "nan"], ["--pressure-mpa", "0:inf:0.1"], ["--mesh-size-mm", "inf"],
+            ["--mesh-size-mm", "0"], ["--mesh-size-mm", "100"], ["--fiber-intorder", "0"],
+            ["--fiber-intorder", "1"], ["--fiber-intorder", "3"], ["--fiber-intorder", "99"],
+            ["--refine", "9"], ["--refine", "-1"], ["--axial-size-mm", "0"],
+            ["--axial-size-mm", "1e9"], ["--edge-ratio", "2"], ["--edge-ratio", "0"],
+            ["--tie-width-mm", "50"], ["--tie-width-mm", "0"], ["--peak-mpa", "100"],
+            ["--peak-mpa", "-1"], ["--out", "a_file"], ["--out", "/proc/bend"],
+            ["--plot", "bend.txt"], ["--mesher", "layered", "--mesh-size-mm", "3"],
+            ["--mesher", "gmsh", "--axial-size-mm", "2"], ["--mesher", "tet"], ["--tie", "glue"])],
+        "weights": [[*extra] for extra in (
+            ["--diameter-mm", "1"], ["--diameter-mm", "-180"], ["--diameter-mm", "0"],
+            ["--diameter-mm", "inf"], ["--diameter-mm", "100:300:0.001"], ["--diameter-mm", "1e6"],
+            ["--diameter-mm", "abc"])]
+                   + [WEIGHTS[1:] + extra for extra in (
+                       ["--mass-kg", "-1"], ["--mass-kg", "1e6"], ["--pressure-mpa", "0"],
+                       ["--pressure-mpa", "100"], ["--dp-mpa", "0"], ["--dp-mpa", "10"],
+                       ["--mesh-size-mm", "0.01"], ["--mesh-size-mm", "1e3"], ["--mesh-size-mm", "inf"],
+                       ["--depth-mm", "nan"], ["--fig8", "0:1:1e-5"], ["--fig8", "nan"],
+                       ["--out", "a_file"], ["--plot", "w.txt"])]
+                   + [["--diameter-mm", "120:300:60", "--check-mm", "500"]],
+        "reservoir": [[*extra] for extra in (
+            ["--n-radial", "0"], ["--n-radial", "100000"], ["--n-thick", "0"], ["--n-thick", "1000"],
+            ["--volume-mm3", "-1"], ["--volume-mm3", "0:1e9:1"], ["--volume-mm3", "nan"],
+            ["--volume-mm3", "1e12"], ["--plot", "r.doc"], ["--out", "a_file"],
+            ["--write-calibration", "."], ["--n-radial", "two"])],
+        "study": [["run", s] for s in sorted(STUDIES) if s != STUDY]
+                 + [["run", f] for f in ("missing.toml", ".", "/dev/zero", "binary.toml")]
+                 + [["run", STUDY, *extra] for extra in (
+                     ["--workers", "0"], ["--workers", "100000"], ["--max-cases", "0"],
+                     ["--results", "a_file"], ["--results", "/proc/results"], ["--scheduler"])]
+                 + [["status", "s_code.toml"], ["status", "missing.toml"], ["report", "/dev/zero"],
+                    ["report", STUDY, "--results", "a_file"], ["walk", STUDY], []],
+        "inspect": [["missing.vtu"], ["good.csv"], ["/dev/zero"], ["."], ["result.vtu", "--out", "x.txt"]],
+        "verify": [["--case", "bogus"], ["--case"]],
+        "reproduce": [["--only", "bogus"], ["--only", ","], ["--out", "a_file"]],
+    }
+    for verb, variants in options.items():
+        for k, extra in enumerate(variants):
+            cases.append((f"{verb}-{k}-{' '.join(extra)[:40]}", [verb, *extra]))
+    cases += [("verb-unknown", ["bnd"]), ("verb-huge", ["x" * 100_000])]
+    return cases
+
+
+CASES = _cases()
+
+
+@pytest.fixture
+def scratch(tmp_path, monkeypatch):
+    for name, text in {**FILES, **_design_files(), **STUDIES}.items():
+        path = tmp_path / name
+        path.write_bytes(text if isinstance(text, bytes) else text.encode())
+    (tmp_path / "adir").mkdir()
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setenv("SOFTHAND_CACHE", str(tmp_path / "cache"))
+    return tmp_path
+
+
+def _snapshot(root: Path) -> dict:
+    return {p: p.stat().st_mtime_ns for p in root.rglob("*")}
+
+
+def _run(argv) -> int:
+    try:
+        return main(argv)
+    except SystemExit as exc:  # argparse's usage errors
+        return exc.code
+
+
+def test_there_are_enough_cases():
+    assert len(CASES) >= 150
+    assert {argv[0] for _, argv in CASES} >= {"curve", "grasp", "control", "fit", "bend", "weights",
+                                              "reservoir", "study", "inspect", "verify", "reproduce"}
+
+
+@pytest.mark.parametrize("argv", [argv for _, argv in CASES], ids=[name for name, _ in CASES])
+def test_bad_input_is_one_line_exit_2_and_nothing_written(argv, scratch, capsys):
+    before = _snapshot(scratch)
+    code = _run(argv)
+    out, err = capsys.readouterr()
+    assert code == 2, err
+    assert err.count("\n") == 1 and err.endswith("\n"), err
+    assert err.startswith("softhand") and "error:" in err and "Traceback" not in err
+    assert len(err) < 1500  # bounded, whatever the size of the value
+    assert out == ""
+    assert _snapshot(scratch) == before  # nothing written, not even the cache or an output folder
+
+
+def test_every_number_of_a_design_has_bounds():
+    """A new numeric design key needs a line in reduced.design.BOUNDS."""
+    numeric = [k for k, v in HandDesign().to_dict().items()
+               if isinstance(v, (int, float)) and not isinstance(v, bool)]
+    assert set(numeric) <= set(BOUNDS)
+    for key, (lo, hi) in BOUNDS.items():
+        assert math.isfinite(lo) and math.isfinite(hi) and lo < hi, key
