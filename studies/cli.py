@@ -89,7 +89,9 @@ def main(argv: list[str] | None = None) -> int:
     previous = _sigterm_as_interrupt()
     try:
         _check(verb, args, parser)
-        return int(module.run(args) or 0)
+        code = int(module.run(args) or 0)
+        sys.stdout.flush()  # a closed pipe shows here, not in Python's exit
+        return code
     except InputError as exc:
         print(f"softhand {verb}: error: {exc}", file=sys.stderr)
         return 2

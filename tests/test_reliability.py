@@ -1,0 +1,264 @@
+"""Concurrent runs of one study, corrupt case files and cache entries, signals, pipes."""
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+from meshes import cache as mesh_cache
+from studies.cli import main
+from studies.runner import RESULT, plan, study_dir
+from studies.studyfile import load_study
+from test_runner import install_kind
+
+ROOT = Path(__file__).resolve().parent.parent
+
+#: the curve kind, slowed down so that concurrent runs overlap, logging every computation
+LOGGED_CURVE = '''
+import os, time
+from studies.kinds import curve
+def case(params, design, outdir):
+    time.sleep(params["sleep_s"])
+    fd = os.open(params["log"], os.O_WRONLY | os.O_APPEND | os.O_CREAT)
+    os.write(fd, (repr(sorted(params.items())) + "\\n").encode())
+    os.close(fd)
+    return curve({"theta_deg": params["theta_deg"]}, design, outdir)
+'''
+
+
+def _env(tmp_path) -> dict:
+    return {**os.environ, "PYTHONPATH": os.pathsep.join([str(tmp_path), str(ROOT)]),
+            "SOFTHAND_CACHE": str(tmp_path / "cache")}
+
+
+def _cli(*args) -> list[str]:
+    return [sys.executable, "-m", "studies.cli", *args]
+
+
+def _logged_study(tmp_path, monkeypatch, sleep_s: float) -> Path:
+    install_kind(tmp_path, "loggedcurve", LOGGED_CURVE)
+    monkeypatch.syspath_prepend(str(tmp_path))
+    path = tmp_path / "s.toml"
+    path.write_text(f'kind = "loggedcurve"\n[params]\nsleep_s = {sleep_s}\nlog = "{tmp_path / "log"}"\n'
+                    '[sweep]\ntheta_deg = "0:90:3"\n')
+    return path
+
+
+@pytest.fixture
+def logged_study(tmp_path, monkeypatch):
+    """31 cases of 0.1 s each: long enough for concurrent runs and signals to overlap them."""
+    return _logged_study(tmp_path, monkeypatch, 0.1)
+
+
+@pytest.fixture
+def quick_study(tmp_path, monkeypatch):
+    return _logged_study(tmp_path, monkeypatch, 0.0)
+
+
+def _check_results(study, root) -> None:
+    """Every case done, with the numbers of the reduced model itself."""
+    from reduced.design import HandDesign
+    from studies.kinds import curve
+
+    sdir = study_dir(study, root)
+    for case in plan(study):
+        record = json.loads((sdir / case.key / RESULT).read_text())
+        expect = curve({"theta_deg": case.params["theta_deg"]}, HandDesign(), sdir)
+        assert record["status"] == "done"
+        assert record["numbers"] == pytest.approx({k: float(v) for k, v in expect.items()}, rel=1e-12)
+
+
+def test_four_simultaneous_runs_compute_every_case_once(logged_study, tmp_path):
+    root = tmp_path / "res"
+    runs = [subprocess.Popen(_cli("study", "run", str(logged_study), "--workers", "2",
+                                  "--results", str(root), "--no-progress"),
+                             env=_env(tmp_path), stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+            for _ in range(4)]
+    outputs = [run.communicate(timeout=300) for run in runs]
+    assert [run.returncode for run in runs] == [0] * 4, [e.decode()[-1500:] for _, e in outputs]
+    assert not any(b"Traceback" in err for _, err in outputs)
+    study = load_study(logged_study)
+    log = (tmp_path / "log").read_text().splitlines()
+    assert len(log) == len(set(log)) == len(plan(study)) == 31  # every case computed exactly once
+    computed = [int(out.decode().split(" computed")[0].rsplit("(", 1)[1]) for out, _ in outputs]
+    assert sum(computed) == 31
+    _check_results(study, root)
+    index = (study_dir(study, root) / "index.csv").read_text().splitlines()
+    assert len(index) == 32 and all(",done," in line for line in index[1:])
+
+
+DAMAGES = ("truncated", "empty", "null", "list", "no numbers", "folder only")
+
+
+def test_corrupt_case_files_are_reported_and_recomputed(quick_study, tmp_path, capsys):
+    root = tmp_path / "res"
+    argv = ["study", "run", str(quick_study), "--workers", "1", "--results", str(root), "--no-progress"]
+    assert main(argv) == 0
+    study = load_study(quick_study)
+    sdir = study_dir(study, root)
+    for damage, case in zip(DAMAGES, plan(study)[3:]):  # one case file damaged each way
+        path = sdir / case.key / RESULT
+        text = path.read_text()
+        if damage == "folder only":
+            path.unlink()
+            continue
+        path.write_text({"truncated": text[: len(text) // 2], "empty": "", "null": "null",
+                         "list": "[1, 2]", "no numbers": json.dumps({**json.loads(text),
+                                                                     "numbers": None})}[damage])
+    capsys.readouterr()
+    assert main(["study", "status", str(quick_study), "--results", str(root)]) == 0
+    out = capsys.readouterr().out
+    assert "25 done" in out and "6 corrupt" in out
+    assert main(["study", "status", str(quick_study), "--results", str(root), "--json"]) == 0
+    assert len(json.loads(capsys.readouterr().out)["corrupt"]) == 6
+    assert main(["study", "report", str(quick_study), "--results", str(root)]) == 0
+    (tmp_path / "log").unlink()
+    assert main(argv) == 0
+    out, err = capsys.readouterr()
+    assert "6 case files do not parse; recomputing them" in err
+    assert "(6 computed, 25 reused)" in out
+    assert len((tmp_path / "log").read_text().splitlines()) == 6  # only those
+    _check_results(study, root)
+
+
+def test_sigterm_stops_a_run_like_ctrl_c(logged_study, tmp_path):
+    root = tmp_path / "res"
+    proc = subprocess.Popen(_cli("study", "run", str(logged_study), "--workers", "2",
+                                 "--results", str(root), "--no-progress"),
+                            env=_env(tmp_path), stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    sdir = study_dir(load_study(logged_study), root)
+    deadline = time.monotonic() + 60
+    while len(list(sdir.glob(f"[!.]*/{RESULT}"))) < 2 and time.monotonic() < deadline:
+        time.sleep(0.05)
+    proc.send_signal(signal.SIGTERM)  # to the parent only, as a process manager does
+    _, err = proc.communicate(timeout=60)
+    assert proc.returncode == 130, err.decode()[-1500:]
+    assert b"interrupted" in err and b"Traceback" not in err
+    index = (sdir / "index.csv").read_text().splitlines()
+    done = [line for line in index[1:] if ",done," in line]
+    assert 2 <= len(done) < 31 and len(index) == 32
+
+
+def _children(pid: int) -> list[int]:
+    text = Path(f"/proc/{pid}/task/{pid}/children").read_text()
+    return [int(p) for p in text.split()]
+
+
+def _alive(pid: int) -> bool:
+    try:
+        state = Path(f"/proc/{pid}/stat").read_text().split(")")[-1].split()[0]
+    except FileNotFoundError:
+        return False
+    return state != "Z"
+
+
+@pytest.mark.skipif(not Path("/proc/self/task").exists(), reason="needs Linux /proc")
+def test_pool_workers_die_with_a_killed_parent(logged_study, tmp_path):
+    proc = subprocess.Popen(_cli("study", "run", str(logged_study), "--workers", "2",
+                                 "--results", str(tmp_path / "res"), "--no-progress"),
+                            env=_env(tmp_path), stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    deadline = time.monotonic() + 60
+    while len(_children(proc.pid)) < 2 and time.monotonic() < deadline:
+        time.sleep(0.05)
+    workers = _children(proc.pid)
+    assert len(workers) >= 2
+    proc.kill()  # SIGKILL: no handler runs in the parent
+    proc.wait(timeout=30)
+    deadline = time.monotonic() + 20
+    while any(map(_alive, workers)) and time.monotonic() < deadline:
+        time.sleep(0.1)
+    assert not any(map(_alive, workers))
+
+
+def test_a_closed_pipe_is_quiet(tmp_path):
+    path = tmp_path / "s.toml"
+    path.write_text('kind = "curve"\n[sweep]\ntheta_deg = "0:90:1"\n')
+    proc = subprocess.Popen(_cli("study", "status", str(path), "--results", str(tmp_path)),
+                            env=_env(tmp_path), stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    proc.stdout.close()  # like '| head -0': the reader is gone before the first line
+    err = proc.stderr.read()
+    proc.wait(timeout=60)
+    assert err == b"" and proc.returncode == 141
+
+
+# ---------------------------------------------------------------- caches
+def _fake_compute(calls):
+    def compute(case):
+        calls.append(case.diameter_mm)
+        return {"diameter_mm": case.diameter_mm, "w": [0.2] * 5, "w_sum": 1.0, "theta_deg": 40.0,
+                "F_v_fem_N": 3.0, "mesh_size_mm": case.mesh_size_mm, "ndofs": 10}
+    return compute
+
+
+@pytest.mark.parametrize("damage", ["truncated", "empty", "null", "{}", "edited", "other key"])
+def test_a_corrupt_weights_cache_entry_is_recomputed(tmp_path, monkeypatch, capsys, damage):
+    import studies.weights as sw
+
+    calls = []
+    monkeypatch.setenv("SOFTHAND_CACHE", str(tmp_path))
+    monkeypatch.setattr(sw, "compute", _fake_compute(calls))
+    argv = ["weights", "--diameter-mm", "200", "--json"]
+    assert main(argv) == 0 and main(argv) == 0 and len(calls) == 1
+    [entry] = (tmp_path / "weights").glob("*.json")
+    text = entry.read_text()
+    record = json.loads(text)
+    entry.write_text({"truncated": text[:40], "empty": "", "null": "null", "{}": "{}",
+                      "edited": text.replace('"theta_deg": 40.0', '"theta_deg": 41.0'),
+                      "other key": json.dumps({**record, "key": "0" * 20})}[damage])
+    capsys.readouterr()
+    assert main(argv) == 0
+    out, err = capsys.readouterr()
+    assert json.loads(out)["cached"] is False and json.loads(out)["theta_deg"] == 40.0
+    assert "invalid cache entry" in err and len(calls) == 2
+    assert main(argv) == 0 and json.loads(capsys.readouterr().out)["cached"] is True
+
+
+def test_an_unwritable_cache_is_a_warning_and_the_result_is_printed(tmp_path, monkeypatch, capsys):
+    import studies.weights as sw
+
+    (tmp_path / "a_file").write_text("")
+    monkeypatch.setenv("SOFTHAND_CACHE", str(tmp_path / "a_file" / "cache"))
+    monkeypatch.setattr(sw, "compute", _fake_compute([]))
+    assert main(["weights", "--diameter-mm", "200", "--json"]) == 0
+    out, err = capsys.readouterr()
+    assert json.loads(out)["w"] == [0.2] * 5
+    assert "cannot be written" in err and "not cached" in err and "Traceback" not in err
+
+
+def rectangle(model, params, size):
+    model.occ.addRectangle(0, 0, 0, params["width"], params["height"])
+    model.occ.synchronize()
+    model.addPhysicalGroup(2, [t for _, t in model.getEntities(2)], name="domain")
+
+
+@pytest.mark.parametrize("damage", ["truncated", "empty", "swapped", "no checksum"])
+def test_a_corrupt_cached_mesh_is_generated_again(tmp_path, monkeypatch, capsys, damage):
+    monkeypatch.setenv("SOFTHAND_CACHE", str(tmp_path))
+    params = {"width": 3.0, "height": 1.0}
+    path = mesh_cache.cached_msh(rectangle, params, size=0.5)
+    good = path.read_bytes()
+    other = mesh_cache.cached_msh(rectangle, {"width": 2.0, "height": 1.0}, size=0.5)
+    if damage == "no checksum":
+        Path(f"{path}.sha256").unlink()
+    else:
+        path.write_bytes({"truncated": good[: len(good) // 2], "empty": b"",
+                          "swapped": other.read_bytes()}[damage])
+    assert mesh_cache.cached_msh(rectangle, params, size=0.5) == path
+    assert mesh_cache.valid_entry(path)
+    assert mesh_cache.load_mesh(rectangle, params, size=0.5).p[0].max() == pytest.approx(3.0)
+    if damage != "no checksum":
+        assert "does not match its checksum" in capsys.readouterr().err
+
+
+def test_mesh_and_weights_cache_keys_carry_the_package_version(monkeypatch):
+    from studies.weights import WeightsCase
+
+    key, wkey = mesh_cache.mesh_key(rectangle, {"w": 1}, size=1.0, order=1), WeightsCase().key()
+    monkeypatch.setattr(mesh_cache, "_softhand_version", lambda: "999.0")
+    monkeypatch.setattr("studies.weights._package_version", lambda: "999.0")
+    assert mesh_cache.mesh_key(rectangle, {"w": 1}, size=1.0, order=1) != key
+    assert WeightsCase().key() != wkey
