@@ -51,7 +51,7 @@ from fem.linsolve import make_solver
 from fem.loads import CavityVolume
 from fem.hyperelastic import rubber_law
 from fem.materials import Fibers
-from fem.newton import NewtonOptions, PathOptions, solve_path
+from fem.newton import NewtonOptions, NotConverged, PathOptions, solve_path
 from fem.solid import Solid
 from meshes.finger import FingerTube, finger_tube_mesh, layered_tube_mesh
 from reduced.design import HandDesign
@@ -492,9 +492,17 @@ def _solve_one(model, P, history, link_load, solver, options, scale, totals):
     chattering tension-only fibers fail more often than it saved iterations).
     """
     P1, y1 = history[-1]
-    path = solve_path(lambda y, t: model.residual_tangent(y, P1 + t * (P - P1), link_load), y1,
-                      PathOptions(steps=1, newton=options), solver=solver, scale_t=lambda t: scale,
-                      residual_t=lambda y, t: model.residual(y, P1 + t * (P - P1), link_load))
+    try:
+        path = solve_path(lambda y, t: model.residual_tangent(y, P1 + t * (P - P1), link_load), y1,
+                          PathOptions(steps=1, newton=options), solver=solver, scale_t=lambda t: scale,
+                          residual_t=lambda y, t: model.residual(y, P1 + t * (P - P1), link_load))
+    except NotConverged as exc:  # named by the pressures, not the step's load fraction
+        t, y = exc.last_converged if exc.last_converged is not None else (0.0, y1)
+        reached = P1 + t * (P - P1)
+        error = NotConverged(f"Newton did not converge above P = {reached:.6g} MPa on the way to "
+                             f"{P:.6g} MPa", exc.history, exc.x, last_converged=(reached, y))
+        error.pressure = reached  #: the last converged pressure [MPa]
+        raise error from None
     totals += (path.assembly_seconds, path.solve_seconds, path.total_iterations, path.cutbacks,
                path.factorizations)
     return path.x[-1], path.total_iterations

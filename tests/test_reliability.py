@@ -262,3 +262,50 @@ def test_mesh_and_weights_cache_keys_carry_the_package_version(monkeypatch):
     monkeypatch.setattr("studies.weights._package_version", lambda: "999.0")
     assert mesh_cache.mesh_key(rectangle, {"w": 1}, size=1.0, order=1) != key
     assert WeightsCase().key() != wkey
+
+
+# ---------------------------------------------------------------- FEM failures
+def test_a_failed_load_step_names_the_pressures_reached(monkeypatch):
+    import numpy as np
+
+    import fem.finger as ff
+    from fem.newton import NotConverged
+
+    y = np.arange(3.0)
+
+    def failing(*args, **kwargs):  # the path solver gives up at load fraction 0.25 of the step
+        raise NotConverged("load step cut back below 1e-4 at t = 0.25", [1.0], y, (0.25, 2 * y))
+
+    monkeypatch.setattr(ff, "solve_path", failing)
+    with pytest.raises(NotConverged) as err:
+        ff._solve_one(None, 0.7, [(0.5, y)], None, None, None, 1.0, np.zeros(4))
+    assert err.value.pressure == pytest.approx(0.55)  # 0.5 + 0.25 (0.7 - 0.5)
+    assert "above P = 0.55 MPa on the way to 0.7 MPa" in str(err.value)
+    assert err.value.last_converged[0] == pytest.approx(0.55) and list(err.value.last_converged[1]) == [0, 2, 4]
+
+
+def test_bend_failure_is_one_line_with_the_pressure_and_out_never_mixes_runs(tmp_path, monkeypatch,
+                                                                              capsys):
+    import studies.bending
+    from fem.newton import NotConverged
+
+    out = tmp_path / "bend"
+    out.mkdir()
+    for name in ("result.json", "table.csv", "hand.csv", "finger.pvd", "finger_0007.vtu", "notes.txt"):
+        (out / name).write_text("an earlier run")
+    (out / "finger").mkdir()
+    (out / "finger" / "finger_0003.vtm").write_text("an earlier run")
+
+    def failing(study, on_state=None):
+        error = NotConverged("Newton did not converge above P = 0.03 MPa on the way to 0.1 MPa",
+                             [1.0], None, None)
+        error.pressure = 0.03
+        raise error
+
+    monkeypatch.setattr(studies.bending, "run", failing)
+    assert main(["bend", "--pressure-mpa", "0.1", "--out", str(out)]) == 1
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "P = 0.03 MPa" in err[0] and "Traceback" not in err[0]
+    result = json.loads((out / "result.json").read_text())
+    assert result["failed"] and "0.03 MPa" in result["error"] and result["rows"] == []
+    assert sorted(p.name for p in out.iterdir()) == ["notes.txt", "result.json"]  # the user's file stays

@@ -122,11 +122,14 @@ def run(args) -> int:
     study = BendingStudy(design, pressures, _options(args),
                          peak_mpa=args.peak_mpa if args.peak_mpa > pressures[-1] else 0.0)
     out = Path(args.out)
+    clear_outputs(out)
     series = SceneSeries(out / "finger.pvd")
     n_steps = len(pressures) + (1 if study.peak_mpa else 0)
     bar = tqdm(total=n_steps, desc="bend", unit="pressure", file=sys.stderr, leave=False)
+    converged = []
 
     def on_state(model, state):
+        converged.append((model, state))
         series.write(state.P, *finger_scene(model, state.y, state.P))
         bar.set_postfix(P=f"{state.P:.2f}", theta=f"{state.theta * 57.29578:.1f}deg")
         bar.update(0 if state.P > pressures[-1] and state.P < study.peak_mpa else 1)
@@ -134,9 +137,7 @@ def run(args) -> int:
     try:
         result = run_study(study, on_state=on_state)
     except NotConverged as exc:
-        print(f"softhand bend: error: {str(exc).split(';')[0]}; converged states are in {out}",
-              file=sys.stderr)
-        return 1
+        return _failed(exc, converged, study, series, out)
     finally:
         bar.close()
     summary = result.summary()
@@ -170,6 +171,45 @@ def run(args) -> int:
                   f"{p['max_von_mises_MPa']:.2f} MPa, hoop stretch {p['radial_stretch_max']:.4f}")
         print(f"# files in {out}")
     return 0
+
+
+#: the files and folders a bend run writes into --out; removed before a run so runs never mix
+OUTPUT_PATTERNS = ("result.json", "table.csv", "hand.csv", "finger.pvd", "finger", "finger_*.vtu")
+
+
+def clear_outputs(out: Path) -> None:
+    """Remove an earlier run's files from ``out`` (only softhand's own, nothing else)."""
+    import shutil
+
+    for pattern in OUTPUT_PATTERNS:
+        for path in out.glob(pattern):
+            shutil.rmtree(path) if path.is_dir() else path.unlink()
+
+
+def _failed(exc, converged, study, series, out: Path) -> int:
+    """Newton gave up: the last converged state (VTK + result.json) and one error line naming
+    the pressure reached; exit code 1."""
+    from fem.scene import finger_scene
+    from studies.bending import row
+    from studies.output import write_csv, write_json
+
+    rows = [row(state, study.design) for _, state in converged]
+    reached = getattr(exc, "pressure", None)
+    last_y = exc.last_converged[1] if exc.last_converged is not None else None
+    if converged and reached is not None and last_y is not None and reached > converged[-1][1].P:
+        model = converged[-1][0]  # the cut-back's last converged state, past the last requested P
+        state = model.state(last_y, reached)
+        series.write(reached, *finger_scene(model, last_y, reached))
+        rows.append(row(state, study.design))
+    message = str(exc).split(";")[0]
+    last = rows[-1]["P_MPa"] if rows else 0.0
+    write_json(out / "result.json", {"failed": True, "error": message, "last_converged_MPa": last,
+                                     "rows": rows, "design": study.design.to_dict()})
+    if rows:
+        write_csv(out / "table.csv", rows)
+    print(f"softhand bend: error: the finger FEM stopped: {message}; the last converged state "
+          f"(P = {last:.4g} MPa) is in {out}/result.json and {out}/finger.pvd", file=sys.stderr)
+    return 1
 
 
 def plot_bending(path, rows: list[dict], design, hand_result: dict | None = None) -> None:
