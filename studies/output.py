@@ -4,6 +4,8 @@ from __future__ import annotations
 import csv
 import io
 import json
+import sys
+from contextlib import contextmanager
 from pathlib import Path
 
 import numpy as np
@@ -58,3 +60,14 @@ def jsonable(value):
     if isinstance(value, Path):
         return str(value)
     raise TypeError(f"not JSON serialisable: {type(value).__name__}")
+
+
+@contextmanager
+def kept_if_unwritable(what, verb: str):
+    """Write ``what`` inside this block; if the disk refuses (full, gone, read-only) after the
+    computation, a warning instead of losing the results, which the verb still prints."""
+    try:
+        yield
+    except OSError as exc:
+        print(f"softhand {verb}: warning: {what} not written ({exc.strerror or exc}); "
+              f"the results are printed on stdout", file=sys.stderr)

@@ -140,7 +140,10 @@ def weights(case: WeightsCase, *, cache: bool = True, out=None) -> dict:
             return {**entry, "cached": True}
     result = compute(case) if out is None else compute(case, out)
     if out is not None:
-        write_json(Path(out) / "result.json", result)
+        from studies.output import kept_if_unwritable
+
+        with kept_if_unwritable(Path(out) / "result.json", "weights"):
+            write_json(Path(out) / "result.json", result)
     if cache:
         write_entry(path, case.key(), result)
     return {**result, "cached": False}

@@ -309,3 +309,17 @@ def test_bend_failure_is_one_line_with_the_pressure_and_out_never_mixes_runs(tmp
     result = json.loads((out / "result.json").read_text())
     assert result["failed"] and "0.03 MPa" in result["error"] and result["rows"] == []
     assert sorted(p.name for p in out.iterdir()) == ["notes.txt", "result.json"]  # the user's file stays
+
+
+def test_an_output_that_fails_after_the_computation_loses_nothing(tmp_path, monkeypatch, capsys):
+    """The disk refuses the picture after the curve is computed: a warning, the rows printed."""
+    import studies.output
+
+    def full_disk(path, data):
+        raise OSError(28, "No space left on device")
+
+    monkeypatch.setattr(studies.output, "write_atomic", full_disk)
+    assert main(["curve", "--theta-deg", "0:90:30", "--plot", str(tmp_path / "c.png"), "--json"]) == 0
+    out, err = capsys.readouterr()
+    assert len(json.loads(out)["rows"]) == 4
+    assert "warning" in err and "No space left on device" in err and not (tmp_path / "c.png").exists()

@@ -110,7 +110,7 @@ def run(args) -> int:
     from fem.scene import finger_scene
     from fem.newton import NotConverged
     from studies.bending import BendingStudy, run as run_study
-    from studies.output import write_csv, write_json
+    from studies.output import kept_if_unwritable, write_csv, write_json
 
     pressures = _check(args)
     design = design_from_args(args)
@@ -144,11 +144,14 @@ def run(args) -> int:
     if args.hand:
         from studies.compare import whole_hand
         summary["hand"] = whole_hand(result.rows, study.design)
-        write_csv(out / "hand.csv", summary["hand"]["rows"])
-    write_json(out / "result.json", summary)
-    write_csv(out / "table.csv", result.rows)
+    with kept_if_unwritable(f"{out}/result.json, table.csv", "bend"):
+        if args.hand:
+            write_csv(out / "hand.csv", summary["hand"]["rows"])
+        write_json(out / "result.json", summary)
+        write_csv(out / "table.csv", result.rows)
     if args.plot:
-        plot_bending(args.plot, result.rows, study.design, summary.get("hand"))
+        with kept_if_unwritable(args.plot, "bend"):
+            plot_bending(args.plot, result.rows, study.design, summary.get("hand"))
     if args.json:
         print_json(summary)
     else:

@@ -27,7 +27,7 @@ from reduced.errors import InputError
 from reduced.plant import HandTables, PlantParams, Push
 from studies.args import add_design_option, add_json_option, check_range, design_from_args, \
     print_json, print_table
-from studies.output import save_figure, write_csv, write_json
+from studies.output import kept_if_unwritable, save_figure, write_csv, write_json
 
 HELP = "simulate angle control (eqs. 30, 31) vs pressure control under a push (Table II, Fig. 10)"
 DISTURBANCE_HEADER = ("t_s", "force_N")
@@ -237,11 +237,13 @@ def run(args) -> int:
               "w": [float(x) for x in w], "design": design.to_dict()}
     if args.out:
         out = Path(args.out)
-        write_csv(out / "control_angle.csv", _series_rows(result.angle, plant.steps_per_sample))
-        write_csv(out / "control_pressure.csv", _series_rows(result.pressure, plant.steps_per_sample))
-        write_json(out / "summary.json", report)
+        with kept_if_unwritable(out, "control"):
+            write_csv(out / "control_angle.csv", _series_rows(result.angle, plant.steps_per_sample))
+            write_csv(out / "control_pressure.csv", _series_rows(result.pressure, plant.steps_per_sample))
+            write_json(out / "summary.json", report)
     if args.plot:
-        _plot(result, args.mode, args.theta_ref_deg, args.plot)
+        with kept_if_unwritable(args.plot, "control"):
+            _plot(result, args.mode, args.theta_ref_deg, args.plot)
     if result.angle_summary.P_before >= plant.P_max - 1e-3:
         print(f"softhand control: warning: angle control saturates the pump at P_max = {plant.P_max:g} MPa "
               f"before the push; theta_ref is not reached", file=sys.stderr)

@@ -63,7 +63,10 @@ def run(args) -> int:
             raise exc.renamed(option) from None
         raise
     if args.plot:
-        plot_curve(args.plot, design, rows, by_pressure=args.theta_deg is None)
+        from studies.output import kept_if_unwritable
+
+        with kept_if_unwritable(args.plot, "curve"):
+            plot_curve(args.plot, design, rows, by_pressure=args.theta_deg is None)
     if args.json:
         print_json({"rows": rows, "design": design.to_dict()})
     else:

@@ -66,13 +66,16 @@ def run(args) -> int:
         result = fit(data, keys, predictor, design, bounds=_parse_bounds(args.bounds))
     notes = [str(w.message) for w in caught] + list(result.warnings)
     if args.out:
-        from studies.output import write_atomic
+        from studies.output import kept_if_unwritable, write_atomic
 
-        write_atomic(args.out, _design_toml(result, data, args))
+        with kept_if_unwritable(args.out, "fit"):
+            write_atomic(args.out, _design_toml(result, data, args))
     if args.plot:
         from studies.fit_plot import plot_fit
+        from studies.output import kept_if_unwritable
 
-        plot_fit(result, data, predictor_for, args.plot)
+        with kept_if_unwritable(args.plot, "fit"):
+            plot_fit(result, data, predictor_for, args.plot)
     if args.json:
         print_json({**result.to_dict(), "data": args.data, "model": args.model,
                     "reservoir": not args.no_reservoir, "notes": notes})

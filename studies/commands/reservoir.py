@@ -20,6 +20,7 @@ import numpy as np
 from reduced.errors import InputError
 from studies.args import MAX_FEM_POINTS, add_design_option, add_json_option, design_from_args, \
     parse_values, print_json, print_table
+from studies.output import kept_if_unwritable
 
 HELP = "inflate the reservoir sheet (FEM) and measure the ellipse assumption (eqs. 11-18)"
 
@@ -77,9 +78,11 @@ def run(args) -> int:
         return 1
     summary = _summary(result)
     if args.out:
-        _write_outputs(Path(args.out), result, summary)
+        with kept_if_unwritable(args.out, "reservoir"):
+            _write_outputs(Path(args.out), result, summary)
     if args.plot:
-        plot_reservoir(args.plot, result)
+        with kept_if_unwritable(args.plot, "reservoir"):
+            plot_reservoir(args.plot, result)
     if args.json:
         print_json({"rows": result.rows, **summary})
     else:

@@ -15,6 +15,7 @@ import sys
 from reduced.errors import InputError
 from studies.args import add_design_option, add_json_option, design_from_args, parse_values, \
     print_json, print_table
+from studies.output import kept_if_unwritable
 
 HELP = "hinge weight vectors w for an object diameter from the grasp FEM; F_v vs eq. (25)"
 
@@ -140,7 +141,8 @@ def _sweep(args, case, diameters) -> int:
     if args.plot:
         from studies.weights_plot import plot_weights
 
-        plot_weights(args.plot, result)
+        with kept_if_unwritable(args.plot, "weights"):
+            plot_weights(args.plot, result)
     if args.json:
         print_json({"rows": result.rows, "check": result.check})
     else:
@@ -157,7 +159,8 @@ def _fig8(args, case, pressures) -> int:
     if args.plot:
         from studies.weights_plot import plot_fig8
 
-        plot_fig8(args.plot, case, rows)
+        with kept_if_unwritable(args.plot, "weights"):
+            plot_fig8(args.plot, case, rows)
     summary = fig8_errors(rows)
     if args.json:
         print_json({"rows": rows, **summary})
