@@ -203,8 +203,9 @@ def study_from_dict(doc: dict, *, path: Path | None = None, max_cases: int = MAX
             raise InputError(f"{src}: {key}", doc[key], f"unknown key; allowed: {', '.join(_TOP_KEYS)}")
     kind = _kind(doc.get("kind"), src)
     name = doc.get("name", path.stem if path else None)
-    if not isinstance(name, str) or not _NAME_RE.match(name):
-        raise InputError(f"{src}: name", name, "must be a string of letters, digits, '_', '-', '.'")
+    if not isinstance(name, str) or not _NAME_RE.match(name) or len(name) > 100:
+        raise InputError(f"{src}: name", name,
+                         "must be a string of at most 100 letters, digits, '_', '-', '.'")
     description = doc.get("description", "")
     if not isinstance(description, str):
         raise InputError(f"{src}: description", description, "must be a string")

@@ -32,6 +32,7 @@ FILES = {
     "push_decreasing.csv": "t_s,force_N\n0,1\n2,1\n1,1\n",
     "push_nan.csv": "t_s,force_N\n0,1\n1,nan\n",
     "push_text.csv": "t_s,force_N\n0,one\n",
+    "push_huge.csv": "t_s,force_N\n0,0\n1,1e300\n",
     "a_file": "not a folder",
     "result.vtu": "<VTKFile>",
 }
@@ -97,6 +98,7 @@ STUDIES = {
     "s_design_zero.toml": _study('design = "/dev/zero"\n[sweep]\ntheta_deg = [1]\n'),
     "s_design_key.toml": _study("[design]\nl0 = 3\n[sweep]\ntheta_deg = [1]\n"),
     "s_name.toml": _study('name = "../../escape"\n[sweep]\ntheta_deg = [1]\n'),
+    "s_long_name.toml": _study(f'name = "{"n" * 5000}"\n[sweep]\ntheta_deg = [1]\n'),
     "s_description.toml": _study("description = 3\n[sweep]\ntheta_deg = [1]\n"),
     "s_params_number.toml": _study("params = 3\n[sweep]\ntheta_deg = [1]\n"),
     "s_no_sweep.toml": 'kind = "curve"\n',
@@ -155,7 +157,7 @@ def _cases():
             ["--disturbance", "missing.csv"], ["--disturbance", "."], ["--disturbance", "/dev/zero"],
             ["--disturbance", "push_bad_header.csv"], ["--disturbance", "push_no_rows.csv"],
             ["--disturbance", "push_decreasing.csv"], ["--disturbance", "push_nan.csv"],
-            ["--disturbance", "push_text.csv"], ["--out", "a_file"], ["--out", "/proc/out"],
+            ["--disturbance", "push_text.csv"], ["--disturbance", "push_huge.csv"], ["--out", "a_file"], ["--out", "/proc/out"],
             ["--plot", "x.gif"], ["--plot", "a_file/x.png"])]
                    + [["--theta-ref-deg", "nan", "--mass-kg", "1"],
                       ["--theta-ref-deg", "200", "--mass-kg", "1"],
@@ -177,6 +179,7 @@ def _cases():
                    ["--params", "V0_mm3", "--plot", "fit.txt"])],
         "bend": [[*extra] for extra in (
             ["--pressure-mpa", "0:0.8:1e-7"], ["--pressure-mpa", "10"], ["--pressure-mpa", "-1"],
+            ["--pressure-mpa", "0.5,0.2"],
             ["--pressure-mpa", "nan"], ["--pressure-mpa", "0:inf:0.1"], ["--mesh-size-mm", "inf"],
             ["--mesh-size-mm", "0"], ["--mesh-size-mm", "100"], ["--fiber-intorder", "0"],
             ["--fiber-intorder", "1"], ["--fiber-intorder", "3"], ["--fiber-intorder", "99"],

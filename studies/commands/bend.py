@@ -69,6 +69,8 @@ PRESSURE_RANGE = (0.0, 5.0)
 
 def _check(args) -> tuple[float, ...]:
     """Every numeric option in its range before any FEM work; the pressures."""
+    import numpy as np
+
     from reduced.errors import InputError
     from studies.args import MAX_FEM_POINTS, check_range
 
@@ -83,6 +85,8 @@ def _check(args) -> tuple[float, ...]:
     lo, hi = PRESSURE_RANGE
     if pressures.min() < lo or pressures.max() > hi:
         raise InputError("--pressure-mpa", args.pressure_mpa, f"pressures must be in [{lo:g}, {hi:g}] MPa")
+    if np.any(np.diff(pressures) <= 0):
+        raise InputError("--pressure-mpa", args.pressure_mpa, "pressures must increase (a load path)")
     return tuple(float(p) for p in pressures)
 
 

@@ -113,6 +113,9 @@ def _row(path: Path, number: int, cells: list[str]) -> tuple[float, float]:
         raise InputError(where, ",".join(cells), "must be two numbers: t_s,force_N") from None
     if not (math.isfinite(t) and math.isfinite(force)):
         raise InputError(where, ",".join(cells), "must be finite numbers")
+    lo, hi = LIMITS["--push-N"]
+    if not (t <= 600 and lo <= force <= hi):
+        raise InputError(where, ",".join(cells), f"t_s must be at most 600 s and force_N in [{lo:g}, {hi:g}]")
     return t, force
 
 
