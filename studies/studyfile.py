@@ -25,7 +25,7 @@ A sweep axis is either a parameter of the kind or a public design key
 A study file is data: its kind is a *name*, looked up in the built-in :data:`KINDS` and in
 the ``softhand.kinds`` entry-point group of installed packages (:func:`all_kinds`); no
 import path written in a file is ever imported. Registering a built-in kind is one line
-in :data:`KINDS`: ``name -> Kind("module:function", {param: Num(lo, hi), ...}, fem=...)``;
+in :data:`studies.registry.KINDS`: ``name -> Kind("module:function", {param: Num(lo, hi), ...}, fem=...)``;
 a plugin package declares ``[project.entry-points."softhand.kinds"] name =
 "package.module:KIND"`` pointing at a :class:`Kind` (or at the case function itself,
 whose parameters are then not checked). The function has the signature
@@ -40,7 +40,6 @@ their kind's ranges, every swept design, and the number of cases (at most
 """
 from __future__ import annotations
 
-import importlib
 import itertools
 import math
 import re
@@ -50,98 +49,11 @@ from pathlib import Path
 from reduced.design import PUBLIC_KEYS, HandDesign, design_from_dict, load_design, read_toml
 from reduced.errors import InputError
 from studies.args import parse_values
+from studies.registry import ENTRY_POINT_GROUP, KINDS, MAX_CASES, Kind, Num, NumList, all_kinds, \
+    resolve_kind
 
-
-@dataclass(frozen=True)
-class Num:
-    """A numeric case parameter in [lo, hi] (``choices``: only these values)."""
-
-    lo: float = -math.inf
-    hi: float = math.inf
-    choices: tuple = ()
-
-    def check(self, where: str, value) -> None:
-        if not _is_number(value) or not math.isfinite(value):
-            raise InputError(where, value, "must be a finite number")
-        if self.choices and value not in self.choices:
-            raise InputError(where, value, f"must be one of {', '.join(f'{c:g}' for c in self.choices)}")
-        if not self.lo <= value <= self.hi:
-            raise InputError(where, value, f"must be a number in [{self.lo:g}, {self.hi:g}]")
-
-
-@dataclass(frozen=True)
-class NumList:
-    """A case parameter that is a list of finite numbers (at most ``max_len``)."""
-
-    max_len: int = 100
-
-    def check(self, where: str, value) -> None:
-        if not isinstance(value, list) or not value or len(value) > self.max_len \
-                or not all(_is_number(v) and math.isfinite(v) for v in value):
-            raise InputError(where, value, f"must be a list of 1 to {self.max_len} finite numbers")
-
-
-@dataclass(frozen=True)
-class Kind:
-    """What one case of a study computes, and the parameters it accepts."""
-
-    target: str  #: "package.module:function", imported lazily
-    params: dict | None  #: parameter name -> Num / NumList; None: a plugin's, unchecked
-    fem: bool = False  #: True if it takes mesh_size_mm
-    required: tuple[str, ...] = ()  #: parameters every case must have
-    exactly_one: tuple[str, ...] = ()  #: every case has exactly one of these
-    mesh: Num = Num(0.1, 50.0)  #: allowed mesh_size_mm [mm] (FEM kinds)
-
-
-_THETA, _PRESSURE, _MASS = Num(-90.0, 180.0), Num(-5.0, 5.0), Num(0.0, 100.0)
-_PAPER_D = Num(choices=(180.0, 240.0))  #: the paper's weight vectors
-
-#: kind name -> Kind. Add a kind with one line here.
-KINDS: dict[str, Kind] = {
-    "curve": Kind("studies.kinds:curve", {"theta_deg": _THETA, "pressure_mpa": _PRESSURE},
-                  exactly_one=("theta_deg", "pressure_mpa")),
-    "grasp": Kind("studies.kinds:grasp",
-                  {"pressure_mpa": _PRESSURE, "theta_deg": _THETA, "mass_kg": _MASS,
-                   "diameter_mm": _PAPER_D, "weights": NumList(20)},
-                  required=("pressure_mpa", "theta_deg")),
-    "control": Kind("studies.kinds:control",
-                    {"theta_ref_deg": Num(-29.9, 119.9), "mass_kg": _MASS, "diameter_mm": _PAPER_D,
-                     "push_n": Num(-1000.0, 1000.0), "push_at_s": Num(1.0, 600.0),
-                     "t_end_s": Num(2.0, 600.0)}),
-    "reservoir": Kind("studies.kinds:reservoir", {"theta_max_deg": Num(1.0, 180.0)}, fem=True,
-                      mesh=Num(0.05, 24.0)),
-    "weights": Kind("studies.kinds:weights",
-                    {"diameter_mm": Num(60.0, 500.0), "mass_kg": Num(0.0, 20.0),
-                     "pressure_mpa": Num(0.01, 3.0), "dP_mpa": Num(0.001, 0.5)}, fem=True,
-                    mesh=Num(2.0, 12.0)),
-}
-#: the entry-point group where installed packages declare more kinds
-ENTRY_POINT_GROUP = "softhand.kinds"
-#: most cases a study may have unless the caller allows more (``--max-cases``)
-MAX_CASES = 10_000
-
-
-def all_kinds() -> dict[str, Kind]:
-    """The built-in kinds and those of installed plugins (a built-in name wins)."""
-    from importlib.metadata import entry_points
-
-    kinds = {}
-    for ep in entry_points(group=ENTRY_POINT_GROUP):
-        if ep.name not in KINDS:
-            kinds[ep.name] = _plugin_kind(ep)
-    return {**kinds, **KINDS}
-
-
-def _plugin_kind(ep) -> Kind:
-    try:
-        obj = ep.load()
-    except Exception as exc:  # a broken plugin is the plugin's bad input, one line
-        raise InputError("kind", ep.name, f"plugin {ep.value} cannot be loaded ({exc})") from None
-    if isinstance(obj, Kind):
-        return obj
-    if callable(obj):
-        return Kind(ep.value, None)
-    raise InputError("kind", ep.name, f"plugin {ep.value} is neither a Kind nor a function")
+__all__ = ["KINDS", "MAX_CASES", "Kind", "Num", "NumList", "Study", "all_kinds", "load_study",
+           "resolve_kind", "study_from_dict"]
 
 
 _TOP_KEYS = ("kind", "name", "description", "design", "mesh_size_mm", "sweep", "params")
@@ -174,18 +86,6 @@ class Study:
             out.append((params, design_from_dict(design_keys, self.design, source="sweep")
                         if design_keys else self.design))
         return out
-
-
-def resolve_kind(kind: str):
-    """The case function of the registered kind ``kind``, imported now."""
-    kinds = KINDS if kind in KINDS else all_kinds()
-    if kind not in kinds:
-        raise InputError("kind", kind, f"unknown kind; allowed: {', '.join(all_kinds())}")
-    module_name, _, func = kinds[kind].target.partition(":")
-    try:
-        return getattr(importlib.import_module(module_name), func)
-    except (ImportError, AttributeError) as exc:
-        raise InputError("kind", kind, f"cannot be loaded ({exc})") from None
 
 
 def load_study(path: str | Path, *, max_cases: int = MAX_CASES) -> Study:
@@ -221,13 +121,13 @@ def study_from_dict(doc: dict, *, path: Path | None = None, max_cases: int = MAX
     study = Study(name=name, kind=kind, design=design, axes=axes, params=params,
                   mesh_size_mm=mesh, description=description, path=path)
     spec = all_kinds()[kind]
-    for case_params, _ in study.cases():  # every swept design and parameter now, not in a worker
-        _check_case(case_params, spec, src)
+    for case_params, case_design in study.cases():  # every case now, not in a worker
+        _check_case(case_params, case_design, spec, src)
     return study
 
 
-def _check_case(params: dict, kind: Kind, src: str) -> None:
-    """One case's parameters against its kind: ranges, required, exactly one of."""
+def _check_case(params: dict, design: HandDesign, kind: Kind, src: str) -> None:
+    """One case's parameters against its kind: ranges, required, exactly one of, checks."""
     if kind.params is None:
         return
     for key, value in params.items():
@@ -240,6 +140,8 @@ def _check_case(params: dict, kind: Kind, src: str) -> None:
     if kind.exactly_one and sum(k in params for k in kind.exactly_one) != 1:
         raise InputError(f"{src}: sweep", sorted(k for k in params if k in kind.exactly_one),
                          f"give exactly one of {', '.join(kind.exactly_one)}")
+    for check in kind.checks:
+        check(params, design, src)
 
 
 def _kind(kind, src: str) -> str:

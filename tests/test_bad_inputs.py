@@ -87,6 +87,10 @@ STUDIES = {
     "s_grasp_missing.toml": 'kind = "grasp"\n[sweep]\npressure_mpa = [0.8]\n',
     "s_grasp_d.toml": 'kind = "grasp"\n[params]\ntheta_deg = 40\ndiameter_mm = 200\n'
                       '[sweep]\npressure_mpa = [0.8]\n',
+    "s_grasp_weights.toml": 'kind = "grasp"\n[params]\nweights = [1, 2]\n[sweep]\n'
+                            'pressure_mpa = [0.8]\ntheta_deg = [40]\n',
+    "s_control_push.toml": 'kind = "control"\n[params]\npush_at_s = 50\n[sweep]\nmass_kg = [1]\n',
+    "s_little_oil.toml": _study("[sweep]\nV0_mm3 = [100.0]\ntheta_deg = [80]\n"),
     "s_control_long.toml": 'kind = "control"\n[params]\nt_end_s = 1e6\n[sweep]\nmass_kg = [1]\n',
     "s_weights_mesh.toml": 'kind = "weights"\nmesh_size_mm = 1e-9\n[sweep]\ndiameter_mm = [180]\n',
     "s_weights_d.toml": 'kind = "weights"\n[sweep]\ndiameter_mm = [1, 180]\n',
