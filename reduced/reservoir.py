@@ -36,14 +36,18 @@ import numpy as np
 
 from .design import HandDesign
 from .errors import InputError
+from .finger import oil_taken
 
 PressureFn = Callable[[np.ndarray, HandDesign], np.ndarray]
 _MODELS: dict[str, PressureFn] = {}
 
 
 def oil_volume(theta, design: HandDesign):
-    """Eq. (15): oil left in the reservoir at finger bend theta [rad] -> V [mm^3]."""
+    """Eq. (15): oil left in the reservoir at finger bend theta [rad] -> V [mm^3]; with
+    another finger model than the paper's, V0 - n (Q(theta) - Q(0)) of that model."""
     g = design
+    if g.finger_model != "paper":
+        return g.V0 - g.n * oil_taken(theta, g)
     return g.V0 - g.a**2 * np.pi * g.d * g.n * np.asarray(theta, float)
 
 

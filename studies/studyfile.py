@@ -62,6 +62,8 @@ KINDS: dict[str, Kind] = {
     "reservoir": Kind("studies.kinds:reservoir", ("theta_max_deg",), fem=True),
     "weights": Kind("studies.kinds:weights", ("diameter_mm", "mass_kg", "pressure_mpa", "dP_mpa"),
                     fem=True),
+    "finger_bend": Kind("studies.finger_calibration:bend_case",
+                        ("pressures_mpa", "theta_target_deg", "p_max_mpa", "p_step_mpa")),
 }
 
 _TOP_KEYS = ("kind", "name", "description", "design", "mesh_size_mm", "sweep", "params")

@@ -1,0 +1,200 @@
+"""Calibrating the reduced finger model ``"fem"``: the finger FEM over a design space.
+
+A *design space* (a TOML file, e.g. ``studies/finger_space.toml``) gives ranges of the
+dimensional design variables a, b, d, l0 and the tie width (n_s = 5 equal hinges, so 6
+equal links of l0 / 6), a Latin-hypercube sample size and seed, explicit extra designs
+(``[[design]]`` tables, e.g. corners) and the pressures::
+
+    name = "finger_fem"
+    lhs = 14                      # Latin-hypercube designs inside the box
+    seed = 1
+    pressures_mpa = [0.2, 0.5, 0.8]
+    theta_target_deg = 64.0       # then go on until this bend (if p_max_mpa allows)
+    p_max_mpa = 2.5
+    p_step_mpa = 0.5
+    [space]                        # [min, max] of each variable
+    a_mm = [3.0, 6.0]
+    b_mm = [3.0, 7.0]
+    d_mm = [10.0, 20.0]
+    l0_mm = [120.0, 200.0]
+    tie_width_mm = [5.0, 15.0]
+    [[design]]                     # optional explicit designs (all five keys)
+    a_mm = 3.0
+    ...
+
+Each design is one case of the batch runner (:mod:`studies.runner`, kind
+``finger_bend``: resumable, a local pool or Dask); :func:`bend_case` runs the free-bending
+FEM of :mod:`studies.bending` on the default (layered) mesh at the pressures, and on
+until ``theta_target_deg`` in steps of at most ``p_step_mpa`` while P <= ``p_max_mpa``.
+:func:`table_rows` turns the finished cases into the nondimensional rows of
+``reduced/data/finger_fem.csv`` (see :mod:`reduced.finger_fem`).
+"""
+from __future__ import annotations
+
+import math
+import tomllib
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from reduced.design import HandDesign
+from reduced.errors import InputError
+from studies.studyfile import Study
+
+#: the dimensional variables of a design space, in this order
+VARIABLES = ("a_mm", "b_mm", "d_mm", "l0_mm", "tie_width_mm")
+_KEYS = ("name", "lhs", "seed", "pressures_mpa", "theta_target_deg", "p_max_mpa", "p_step_mpa",
+         "space", "design", "base_design")
+
+
+@dataclass(frozen=True)
+class DesignSpace:
+    """A validated design space: the box, the sampled designs and the load path."""
+
+    name: str  #: results go to results/<name>/
+    box: dict  #: variable -> (min, max)
+    points: tuple[dict, ...]  #: the designs, each variable -> value
+    pressures_mpa: tuple[float, ...] = (0.2, 0.5, 0.8)
+    theta_target_deg: float = 64.0
+    p_max_mpa: float = 2.5
+    p_step_mpa: float = 0.5
+    base: HandDesign = HandDesign()
+
+    def designs(self) -> list[HandDesign]:
+        return [finger_design(p, self.base) for p in self.points]
+
+
+def finger_design(point: dict, base: HandDesign = HandDesign()) -> HandDesign:
+    """The design of one point (a, b, d, l0, tie width [mm]) with 5 equal hinges."""
+    l0 = float(point["l0_mm"])
+    return base.replace(a=float(point["a_mm"]), b=float(point["b_mm"]), d=float(point["d_mm"]),
+                        l0=l0, n_s=5, hinge_s=tuple(l0 * k / 6.0 for k in range(1, 6)),
+                        tie_width=float(point["tie_width_mm"]))
+
+
+def latin_hypercube(box: dict, n: int, seed: int) -> list[dict]:
+    """n points of a Latin hypercube in the box (one per stratum of each variable)."""
+    rng = np.random.default_rng(seed)
+    u = (np.array([rng.permutation(n) for _ in VARIABLES]).T + rng.uniform(size=(n, len(VARIABLES)))) / n
+    lo, hi = (np.array([box[v][i] for v in VARIABLES]) for i in (0, 1))
+    return [dict(zip(VARIABLES, np.round(lo + row * (hi - lo), 3).tolist())) for row in u]
+
+
+def load_space(path: str | Path) -> DesignSpace:
+    """Read and validate a design-space TOML file (see the module docstring)."""
+    path = Path(path)
+    try:
+        doc = tomllib.loads(path.read_text())
+    except (FileNotFoundError, IsADirectoryError):
+        raise InputError("--space", str(path), "no such file; give a design-space TOML file") from None
+    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
+        raise InputError("--space", str(path), f"is not valid TOML ({exc})") from None
+    src = path.name
+    for key in doc:
+        if key not in _KEYS:
+            raise InputError(f"{src}: {key}", doc[key], f"unknown key; allowed: {', '.join(_KEYS)}")
+    box = _box(doc.get("space"), src)
+    points = [_point(p, box, f"{src}: design[{i}]") for i, p in enumerate(doc.get("design", []))]
+    lhs = doc.get("lhs", 0)
+    if not isinstance(lhs, int) or isinstance(lhs, bool) or lhs < 0:
+        raise InputError(f"{src}: lhs", lhs, "must be a whole number >= 0")
+    points += latin_hypercube(box, lhs, int(doc.get("seed", 0))) if lhs else []
+    if not points:
+        raise InputError(f"{src}: design", [], "no designs: give lhs > 0 or [[design]] tables")
+    pressures = doc.get("pressures_mpa", [0.2, 0.5, 0.8])
+    if not isinstance(pressures, list) or not pressures or any(
+            not _number(p) or p <= 0 for p in pressures) or any(np.diff(pressures) <= 0):
+        raise InputError(f"{src}: pressures_mpa", pressures, "must be increasing numbers > 0 [MPa]")
+    numbers = {}
+    for key, default in (("theta_target_deg", 64.0), ("p_max_mpa", 2.5), ("p_step_mpa", 0.5)):
+        numbers[key] = doc.get(key, default)
+        if not _number(numbers[key]) or not numbers[key] > 0:
+            raise InputError(f"{src}: {key}", numbers[key], "must be a positive number")
+    from reduced.design import load_design
+    base = load_design(path.parent / doc["base_design"]) if "base_design" in doc else HandDesign()
+    space = DesignSpace(doc.get("name", path.stem), box, tuple(points),
+                        tuple(float(p) for p in pressures), base=base,
+                        **{k: float(v) for k, v in numbers.items()})
+    space.designs()  # validates every design now
+    return space
+
+
+def _number(value) -> bool:
+    return isinstance(value, (int, float)) and not isinstance(value, bool)
+
+
+def _box(table, src: str) -> dict:
+    if not isinstance(table, dict) or set(table) != set(VARIABLES):
+        raise InputError(f"{src}: space", table, f"must give [min, max] of {', '.join(VARIABLES)}")
+    box = {}
+    for key in VARIABLES:
+        span = table[key]
+        if not (isinstance(span, list) and len(span) == 2 and all(map(_number, span))
+                and 0 < span[0] <= span[1]):
+            raise InputError(f"{src}: space.{key}", span, "must be [min, max] with 0 < min <= max [mm]")
+        box[key] = (float(span[0]), float(span[1]))
+    return box
+
+
+def _point(table, box: dict, where: str) -> dict:
+    if not isinstance(table, dict) or set(table) != set(VARIABLES):
+        raise InputError(where, table, f"must give {', '.join(VARIABLES)}")
+    for key in VARIABLES:
+        if not _number(table[key]) or not box[key][0] <= table[key] <= box[key][1]:
+            raise InputError(f"{where}.{key}", table[key], f"must be in [{box[key][0]}, {box[key][1]}]")
+    return {key: float(table[key]) for key in VARIABLES}
+
+
+@dataclass(frozen=True)
+class SpaceStudy(Study):
+    """A design space as a study of the batch runner: one ``finger_bend`` case per design."""
+
+    points: tuple[HandDesign, ...] = ()
+
+    def cases(self) -> list[tuple[dict, HandDesign]]:
+        return [(dict(self.params), design) for design in self.points]
+
+
+def as_study(space: DesignSpace) -> SpaceStudy:
+    """The runner's study of a design space (results/<name>/, resumable)."""
+    params = {"pressures_mpa": list(space.pressures_mpa), "theta_target_deg": space.theta_target_deg,
+              "p_max_mpa": space.p_max_mpa, "p_step_mpa": space.p_step_mpa}
+    return SpaceStudy(name=space.name, kind="finger_bend", design=space.base,
+                      axes=tuple((key, ()) for key in VARIABLES), params=params,
+                      description="finger FEM over a design space", points=tuple(space.designs()))
+
+
+# ---------------------------------------------------------------------- one case
+def load_path(theta_08: float, space: dict) -> list[float]:
+    """Pressures [MPa] after the listed ones: on to theta_target (linear estimate from the
+    bend ``theta_08`` [rad] reached at the last listed pressure), in steps <= p_step_mpa."""
+    last = space["pressures_mpa"][-1]
+    target = math.radians(space["theta_target_deg"])
+    if theta_08 >= target or last >= space["p_max_mpa"]:
+        return []
+    P_end = min(space["p_max_mpa"], last * target / max(theta_08, 1e-6))
+    n = math.ceil((P_end - last) / space["p_step_mpa"] - 1e-9)
+    return [round(last + (P_end - last) * k / n, 4) for k in range(1, n + 1)]
+
+
+def bend_case(params: dict, design: HandDesign, outdir: Path) -> dict:
+    """Kind ``finger_bend``: the free-bending FEM of one design on the default mesh.
+
+    params: ``pressures_mpa`` (list), ``theta_target_deg``, ``p_max_mpa``, ``p_step_mpa``.
+    Returns P_MPa, theta_deg, dQ_mm3 (whole finger) per converged pressure.
+    """
+    from fem.finger import FingerModel, FingerOptions, solve_pressures
+
+    model = FingerModel(design, FingerOptions())
+    states, stats = solve_pressures(model, params["pressures_mpa"])
+    more = load_path(states[-1].theta, params)
+    its, wall = stats.newton_iterations, stats.wall_seconds
+    if more:  # restart at the last pressure (its state is converged: ~1 iteration) for the history
+        extra, s2 = solve_pressures(model, [states[-1].P, *more], y0=states[-1].y)
+        states, its, wall = states + extra[1:], its + s2.newton_iterations, wall + s2.wall_seconds
+    return {"P_MPa": [s.P for s in states], "theta_deg": [math.degrees(s.theta) for s in states],
+            "dQ_mm3": [s.dQ for s in states],
+            "mesh": {"mesher": model.options.mesher, "dofs": model.ndofs,
+                     "elements": model.mesh.nelements},
+            "solver": {"newton_iterations": its, "wall_time_s": wall}}
