@@ -10,7 +10,7 @@ equal links of l0 / 6), a Latin-hypercube sample size and seed, explicit extra d
     seed = 1
     pressures_mpa = [0.2, 0.5, 0.8]
     theta_target_deg = 64.0       # then go on until this bend (if p_max_mpa allows)
-    p_max_mpa = 2.5
+    p_max_mpa = 2.0
     p_step_mpa = 0.5
     [space]                        # [min, max] of each variable
     a_mm = [3.0, 6.0]
@@ -18,6 +18,8 @@ equal links of l0 / 6), a Latin-hypercube sample size and seed, explicit extra d
     d_mm = [10.0, 20.0]
     l0_mm = [120.0, 200.0]
     tie_width_mm = [5.0, 15.0]
+    # mesh_size_mm = 6.0           # optional: a uniform gmsh mesh (e.g. the CI mesh)
+    # base_design = "designs/paper.toml"   # optional: the other design values
     [[design]]                     # optional explicit designs (all five keys)
     a_mm = 3.0
     ...
@@ -26,8 +28,9 @@ Each design is one case of the batch runner (:mod:`studies.runner`, kind
 ``finger_bend``: resumable, a local pool or Dask); :func:`bend_case` runs the free-bending
 FEM of :mod:`studies.bending` on the default (layered) mesh at the pressures, and on
 until ``theta_target_deg`` in steps of at most ``p_step_mpa`` while P <= ``p_max_mpa``.
-:func:`table_rows` turns the finished cases into the nondimensional rows of
-``reduced/data/finger_fem.csv`` (see :mod:`reduced.finger_fem`).
+The finished cases become the nondimensional rows of
+``reduced/data/finger_fem.csv`` (see :mod:`reduced.finger_fem`); :mod:`studies.finger_table`
+writes it and checks a table against held-out designs.
 """
 from __future__ import annotations
 
@@ -38,14 +41,14 @@ from pathlib import Path
 
 import numpy as np
 
-from reduced.design import HandDesign
+from reduced.design import HandDesign, load_design
 from reduced.errors import InputError
 from studies.studyfile import Study
 
 #: the dimensional variables of a design space, in this order
 VARIABLES = ("a_mm", "b_mm", "d_mm", "l0_mm", "tie_width_mm")
 _KEYS = ("name", "lhs", "seed", "pressures_mpa", "theta_target_deg", "p_max_mpa", "p_step_mpa",
-         "space", "design", "base_design")
+         "space", "design", "base_design", "mesh_size_mm")
 
 
 @dataclass(frozen=True)
@@ -57,9 +60,10 @@ class DesignSpace:
     points: tuple[dict, ...]  #: the designs, each variable -> value
     pressures_mpa: tuple[float, ...] = (0.2, 0.5, 0.8)
     theta_target_deg: float = 64.0
-    p_max_mpa: float = 2.5
+    p_max_mpa: float = 2.0
     p_step_mpa: float = 0.5
     base: HandDesign = HandDesign()
+    mesh_size_mm: float | None = None  #: a uniform gmsh mesh of this size; None: the default mesh
 
     def designs(self) -> list[HandDesign]:
         return [finger_design(p, self.base) for p in self.points]
@@ -107,14 +111,17 @@ def load_space(path: str | Path) -> DesignSpace:
             not _number(p) or p <= 0 for p in pressures) or any(np.diff(pressures) <= 0):
         raise InputError(f"{src}: pressures_mpa", pressures, "must be increasing numbers > 0 [MPa]")
     numbers = {}
-    for key, default in (("theta_target_deg", 64.0), ("p_max_mpa", 2.5), ("p_step_mpa", 0.5)):
+    for key, default in (("theta_target_deg", 64.0), ("p_max_mpa", 2.0), ("p_step_mpa", 0.5)):
         numbers[key] = doc.get(key, default)
         if not _number(numbers[key]) or not numbers[key] > 0:
             raise InputError(f"{src}: {key}", numbers[key], "must be a positive number")
-    from reduced.design import load_design
+    mesh = doc.get("mesh_size_mm")
+    if mesh is not None and (not _number(mesh) or not mesh > 0):
+        raise InputError(f"{src}: mesh_size_mm", mesh, "must be a positive number [mm] (omit: the default mesh)")
     base = load_design(path.parent / doc["base_design"]) if "base_design" in doc else HandDesign()
     space = DesignSpace(doc.get("name", path.stem), box, tuple(points),
                         tuple(float(p) for p in pressures), base=base,
+                        mesh_size_mm=None if mesh is None else float(mesh),
                         **{k: float(v) for k, v in numbers.items()})
     space.designs()  # validates every design now
     return space
@@ -153,7 +160,8 @@ class SpaceStudy(Study):
     points: tuple[HandDesign, ...] = ()
 
     def cases(self) -> list[tuple[dict, HandDesign]]:
-        return [(dict(self.params), design) for design in self.points]
+        mesh = {} if self.mesh_size_mm is None else {"mesh_size_mm": self.mesh_size_mm}
+        return [({**self.params, **mesh}, design) for design in self.points]
 
 
 def as_study(space: DesignSpace) -> SpaceStudy:
@@ -162,6 +170,7 @@ def as_study(space: DesignSpace) -> SpaceStudy:
               "p_max_mpa": space.p_max_mpa, "p_step_mpa": space.p_step_mpa}
     return SpaceStudy(name=space.name, kind="finger_bend", design=space.base,
                       axes=tuple((key, ()) for key in VARIABLES), params=params,
+                      mesh_size_mm=space.mesh_size_mm,
                       description="finger FEM over a design space", points=tuple(space.designs()))
 
 
@@ -181,12 +190,15 @@ def load_path(theta_08: float, space: dict) -> list[float]:
 def bend_case(params: dict, design: HandDesign, outdir: Path) -> dict:
     """Kind ``finger_bend``: the free-bending FEM of one design on the default mesh.
 
-    params: ``pressures_mpa`` (list), ``theta_target_deg``, ``p_max_mpa``, ``p_step_mpa``.
+    params: ``pressures_mpa`` (list), ``theta_target_deg``, ``p_max_mpa``, ``p_step_mpa``;
+    ``mesh_size_mm`` (optional): a uniform gmsh mesh of that size instead of the default mesh.
     Returns P_MPa, theta_deg, dQ_mm3 (whole finger) per converged pressure.
     """
     from fem.finger import FingerModel, FingerOptions, solve_pressures
 
-    model = FingerModel(design, FingerOptions())
+    options = FingerOptions() if "mesh_size_mm" not in params else \
+        FingerOptions(mesher="gmsh", mesh_size=float(params["mesh_size_mm"]))
+    model = FingerModel(design, options)
     states, stats = solve_pressures(model, params["pressures_mpa"])
     more = load_path(states[-1].theta, params)
     its, wall = stats.newton_iterations, stats.wall_seconds
@@ -198,3 +210,15 @@ def bend_case(params: dict, design: HandDesign, outdir: Path) -> dict:
             "mesh": {"mesher": model.options.mesher, "dofs": model.ndofs,
                      "elements": model.mesh.nelements},
             "solver": {"newton_iterations": its, "wall_time_s": wall}}
+
+
+def single_design_space(path: str | Path) -> DesignSpace:
+    """The design space of one design file (its own box), for a table of that design alone."""
+    from reduced.finger_fem import groups_of
+
+    design = load_design(path)
+    groups_of(design)  # 5 equal hinges, or one error line
+    point = {"a_mm": design.a, "b_mm": design.b, "d_mm": design.d, "l0_mm": design.l0,
+             "tie_width_mm": design.tie_width}
+    return DesignSpace(f"finger_{Path(path).stem}", {k: (v, v) for k, v in point.items()}, (point,),
+                       base=design)

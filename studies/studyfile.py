@@ -63,7 +63,7 @@ KINDS: dict[str, Kind] = {
     "weights": Kind("studies.kinds:weights", ("diameter_mm", "mass_kg", "pressure_mpa", "dP_mpa"),
                     fem=True),
     "finger_bend": Kind("studies.finger_calibration:bend_case",
-                        ("pressures_mpa", "theta_target_deg", "p_max_mpa", "p_step_mpa")),
+                        ("pressures_mpa", "theta_target_deg", "p_max_mpa", "p_step_mpa"), fem=True),
 }
 
 _TOP_KEYS = ("kind", "name", "description", "design", "mesh_size_mm", "sweep", "params")

@@ -1,0 +1,271 @@
+r"""Finger model ``"fem"``: W_f(theta) and Q(theta) of one finger calibrated from the finger FEM.
+
+Dimensional analysis. The finger FEM (Neo-Hookean tube, inextensible windings, rigid links
+holding rings of the tube) has one modulus, mu_sf, and the lengths a, b, d, the link length
+L = l0 / 6 (5 equal hinges) and the tie width w. So
+
+.. math:: \frac{P}{\mu_{sf}} = \tilde p\Big(\theta; \frac{b}{a}, \frac{d}{a}, \frac{L}{a},
+          \frac{w}{L}\Big), \qquad \frac{\Delta Q}{a^3} = \tilde q(\theta; \dots).
+
+The physics already known carries most of it: the paper's eqs. (28) and (2), which give
+P and Delta Q = a^2 pi d theta for the same groups. The table ``reduced/data/finger_fem.csv``
+holds the FEM's (theta, P/mu, Delta Q/a^3) at the sampled designs; this model fits the
+slowly varying residuals
+
+.. math:: y = \ln\frac{P_{FEM}}{P_{(28)}}, \qquad z = \frac{\Delta Q_{FEM}}{a^2\pi d\,\theta}
+
+by least squares as polynomials in x = the groups' logarithms (with -ln(1 - w/L) for the
+tie, the tied share of the length) scaled to [-1, 1] over the table's range, times 1, theta,
+... (degrees from the table's ``# fit:`` line). So P(theta) = P_(28)(theta) e^{y} and
+Delta Q = a^2 pi d theta z. Beyond the table's largest angle theta_max (and below -theta_max)
+y and z are held at their end values.
+
+Energy consistency. Per design, P(theta) and Delta Q(theta) are sampled at 0.5 deg and
+interpolated by cubic splines; dW_f/dtheta is defined as P dQ/dtheta (a piecewise quintic)
+and W_f as its exact antiderivative (W_f(0) = 0), so P dQ/dtheta = dW_f/dtheta holds to
+rounding and (27), (28), (25) follow from the virtual-work balance unchanged.
+
+Its space. Designs whose groups leave the table's range, or that do not have 5 equal hinges,
+raise one InputError naming the group and its range; ``softhand calibrate finger --design``
+makes a table for such a design. Units: mm, MPa, N mm, rad.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from functools import lru_cache
+from itertools import combinations_with_replacement
+from pathlib import Path
+
+import numpy as np
+from scipy.interpolate import CubicSpline, PPoly
+
+from . import finger
+from .design import HandDesign
+from .errors import InputError
+
+__all__ = ["TABLE_FILE", "GROUPS", "Table", "read_table", "groups_of", "curves", "FEM"]
+
+TABLE_FILE = Path(__file__).resolve().parent / "data" / "finger_fem.csv"
+#: the nondimensional groups, in table column order
+GROUPS = ("b_a", "d_a", "link_a", "tie_link")
+LABELS = {"b_a": "b/a", "d_a": "d/a", "link_a": "link/a", "tie_link": "tie/link"}
+COLUMNS = ("design", *GROUPS, "theta", "p_tilde", "q_tilde")
+N_LINKS = 6
+_KNOTS = np.linspace(-0.5 * math.pi, math.pi, 541)  # 0.5 deg over the hand's THETA_RANGE
+
+
+@dataclass(frozen=True)
+class Table:
+    """A calibration table: FEM rows, the calibrated ranges and the fit's degrees."""
+
+    source: str  #: file name, for messages
+    rows: dict  #: column -> array
+    ranges: dict  #: group -> (min, max)
+    design_degree: int  #: total degree of the polynomial in the groups
+    theta_degree: int  #: degree in theta
+    header: tuple[str, ...] = ()  #: the provenance comment lines
+
+
+def _bad(path, allowed: str):
+    return InputError("finger_table", str(path), allowed)
+
+
+def read_table(path: str | Path = TABLE_FILE) -> Table:
+    """Read a finger calibration CSV; InputError naming the file on any problem."""
+    path = Path(path)
+    try:
+        text = path.read_text()
+    except (FileNotFoundError, IsADirectoryError):
+        raise _bad(path, "no such file; give a CSV written by softhand calibrate finger") from None
+    except UnicodeDecodeError:
+        raise _bad(path, "is not a text (CSV) file") from None
+    comments = [line for line in text.splitlines() if line.startswith("#")]
+    lines = [line for line in text.splitlines() if line.strip() and not line.startswith("#")]
+    if not lines or tuple(c.strip() for c in lines[0].split(",")) != COLUMNS:
+        raise _bad(path, f"needs the header {','.join(COLUMNS)}")
+    try:
+        values = np.array([[float(x) for x in line.split(",")] for line in lines[1:]], ndmin=2)
+    except ValueError:
+        raise _bad(path, "has a cell that is not a number") from None
+    if values.shape[0] == 0 or values.shape[1] != len(COLUMNS) or not np.all(np.isfinite(values)):
+        raise _bad(path, f"needs rows of {len(COLUMNS)} finite numbers")
+    rows = {c: values[:, i] for i, c in enumerate(COLUMNS)}
+    if np.any(rows["theta"] <= 0) or np.any(rows["p_tilde"] <= 0) or np.any(rows["q_tilde"] <= 0):
+        raise _bad(path, "theta, p_tilde and q_tilde must be positive (the P = 0 state is implied)")
+    ranges, degrees = _header(comments, path)
+    for g in GROUPS:
+        lo, hi = ranges[g]
+        if np.any(rows[g] < lo * (1 - 1e-9)) or np.any(rows[g] > hi * (1 + 1e-9)):
+            raise _bad(path, f"has {LABELS[g]} outside its '# range:' [{lo:g}, {hi:g}]")
+    return Table(path.name, rows, ranges, *degrees, header=tuple(comments))
+
+
+def _header(comments: list[str], path) -> tuple[dict, tuple[int, int]]:
+    """The '# range: g=lo:hi, ...' and '# fit: design_degree=D, theta_degree=T' lines."""
+    spec = {}
+    for line in comments:
+        body = line.lstrip("#").strip()
+        for tag in ("range:", "fit:"):
+            if body.startswith(tag):
+                for item in body[len(tag):].split(","):
+                    key, _, value = item.strip().partition("=")
+                    spec[key.strip()] = value.strip()
+    try:
+        ranges = {g: tuple(float(v) for v in spec[g].split(":")) for g in GROUPS}
+        degrees = (int(spec["design_degree"]), int(spec["theta_degree"]))
+    except (KeyError, ValueError):
+        raise _bad(path, "needs the lines '# range: b_a=lo:hi, d_a=..., link_a=..., tie_link=...' "
+                         "and '# fit: design_degree=D, theta_degree=T'") from None
+    if any(len(r) != 2 or not 0 < r[0] <= r[1] for r in ranges.values()) or min(degrees) < 0:
+        raise _bad(path, "has a range lo:hi with not 0 < lo <= hi, or a negative degree")
+    return ranges, degrees
+
+
+# ---------------------------------------------------------------------- groups and the fit
+def groups_of(design: HandDesign) -> dict:
+    """The design's groups b/a, d/a, link/a, tie/link (5 equal hinges required)."""
+    links = np.asarray(design.link_lengths)
+    if design.n_s != N_LINKS - 1 or np.ptp(links) > 1e-6 * design.l0:
+        raise InputError("hinge_s_mm", list(design.hinge_s),
+                         'finger_model "fem" is calibrated for n_s = 5 equal hinges '
+                         f"(l0/6 apart: {[round(design.l0 * k / 6, 3) for k in range(1, 6)]})")
+    L = design.l0 / N_LINKS
+    return {"b_a": design.b / design.a, "d_a": design.d / design.a, "link_a": L / design.a,
+            "tie_link": design.tie_width / L}
+
+
+def _x(groups: dict, table: Table) -> np.ndarray:
+    """Scaled log-groups in [-1, 1] over the table's ranges, only those the table varies; (..., k)."""
+    cols = []
+    for g in GROUPS:
+        lo, hi = table.ranges[g]
+        if hi > lo * (1 + 1e-9):
+            f = (lambda v: -np.log1p(-v)) if g == "tie_link" else np.log
+            cols.append(2 * (f(np.asarray(groups[g], float)) - f(lo)) / (f(hi) - f(lo)) - 1)
+    return np.stack(cols, axis=-1) if cols else np.zeros(np.shape(groups[GROUPS[0]]) + (0,))
+
+
+def _features(x: np.ndarray, theta, table: Table) -> np.ndarray:
+    """Monomials of x (total degree <= design_degree) times theta^k (k <= theta_degree); (..., m)."""
+    k = x.shape[-1]
+    monos = [np.ones(x.shape[:-1])]
+    for degree in range(1, table.design_degree + 1):
+        for combo in combinations_with_replacement(range(k), degree):
+            monos.append(np.prod(x[..., list(combo)], axis=-1))
+    theta = np.asarray(theta, float)
+    return np.stack([m * theta**j for j in range(table.theta_degree + 1) for m in monos], axis=-1)
+
+
+def _paper(groups: dict) -> HandDesign:
+    """The nondimensional (a = 1, mu = 1) paper-model finger with these groups."""
+    L = groups["link_a"]
+    return HandDesign(a=1.0, b=groups["b_a"], d=groups["d_a"], l0=N_LINKS * L, mu_sf=1.0,
+                      hinge_s=tuple(L * k for k in range(1, N_LINKS)),
+                      tie_width=groups["tie_link"] * L)
+
+
+@lru_cache(maxsize=8)
+def _fit(path: str) -> tuple[Table, np.ndarray, np.ndarray, float]:
+    """(table, beta_y, beta_z, theta_max): least-squares coefficients of y and z."""
+    table = read_table(path)
+    r = table.rows
+    ids = np.unique(r["design"])
+    y = np.empty(r["theta"].size)
+    for i in ids:  # eq. (28) per design, all its angles at once
+        at = r["design"] == i
+        g = {k: float(r[k][at][0]) for k in GROUPS}
+        y[at] = np.log(r["p_tilde"][at] / (finger.zeta_f(r["theta"][at], _paper(g)) / (math.pi * g["d_a"])))
+    z = r["q_tilde"] / (math.pi * r["d_a"] * r["theta"])
+    A = _features(_x(r, table), r["theta"], table)
+    if np.linalg.matrix_rank(A) < A.shape[1]:
+        raise _bad(path, f"has too few designs ({ids.size}) for the fit's degrees "
+                         f"({table.design_degree}, {table.theta_degree}); lower them in '# fit:'")
+    beta_y = np.linalg.lstsq(A, y, rcond=None)[0]
+    beta_z = np.linalg.lstsq(A, z, rcond=None)[0]
+    return table, beta_y, beta_z, float(r["theta"].max())
+
+
+def check_space(design: HandDesign, table: Table) -> dict:
+    """The design's groups; InputError naming the first group outside the table's range."""
+    groups = groups_of(design)
+    for g in GROUPS:
+        lo, hi = table.ranges[g]
+        if not lo * (1 - 1e-9) <= groups[g] <= hi * (1 + 1e-9):
+            raise InputError(LABELS[g], round(groups[g], 6),
+                             f'outside the range [{lo:.4g}, {hi:.4g}] of finger_model "fem" '
+                             f"({table.source}); calibrate this design with softhand calibrate "
+                             "finger --design FILE --out FILE.csv")
+    return groups
+
+
+def residuals(theta, design: HandDesign) -> tuple[np.ndarray, np.ndarray]:
+    """(y, z) of the fit at theta [rad] for this design: P = P_(28) e^y, Delta Q = a^2 pi d theta z."""
+    table, beta_y, beta_z, theta_max = _fit(_table_path(design))
+    groups = check_space(design, table)
+    t = np.clip(np.asarray(theta, float), -theta_max, theta_max)
+    F = _features(np.broadcast_to(_x(groups, table), t.shape + (len(_x(groups, table)),)), t, table)
+    return F @ beta_y, F @ beta_z
+
+
+def _table_path(design: HandDesign) -> str:
+    return design.finger_table or str(TABLE_FILE)
+
+
+# ---------------------------------------------------------------------- one design's curves
+@dataclass(frozen=True)
+class Curves:
+    """One design's calibrated finger: splines of P, Delta Q, and W_f = int P dQ."""
+
+    P: CubicSpline  #: pressure of the free finger [MPa]
+    dQ: CubicSpline  #: Delta Q = Q - Q(0) of one finger [mm^3]
+    dQdt: PPoly  #: d Delta Q / d theta [mm^3/rad]
+    W: PPoly  #: W_f [N mm], W(0) = 0
+    Wdt: PPoly  #: dW_f/dtheta = P dQ/dtheta [N mm/rad]
+    Q0: float  #: Q(0) = a^2 pi l0 [mm^3]
+
+
+@lru_cache(maxsize=64)
+def curves(design: HandDesign) -> Curves:
+    """The calibrated curves of ``design`` (cached per design)."""
+    y, z = residuals(_KNOTS, design)
+    paper = design.replace(finger_model="paper")
+    P = CubicSpline(_KNOTS, design.mu_sf * finger.zeta_f(_KNOTS, paper)
+                    / (design.a**2 * math.pi * design.d) * np.exp(y))
+    dQ = CubicSpline(_KNOTS, design.a**2 * math.pi * design.d * _KNOTS * z)
+    dQdt = dQ.derivative()
+    Wdt = PPoly(_product(P.c, dQdt.c), _KNOTS, extrapolate=True)
+    W = Wdt.antiderivative()
+    W.c[-1] -= W(0.0)  # W_f(0) = 0: shift the constant of every piece
+    return Curves(P, dQ, dQdt, W, Wdt, design.a**2 * math.pi * design.l0)
+
+
+def _product(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """PPoly coefficients (highest power first, per interval) of the product of two PPolys."""
+    out = np.zeros((a.shape[0] + b.shape[0] - 1, a.shape[1]))
+    for i in range(a.shape[0]):
+        for j in range(b.shape[0]):
+            out[i + j] += a[i] * b[j]
+    return out
+
+
+def _energy(theta, design):
+    return curves(design).W(theta)
+
+
+def _energy_rate(theta, design):
+    return curves(design).Wdt(theta)
+
+
+def _volume(theta, design):
+    c = curves(design)
+    return c.Q0 + c.dQ(theta)
+
+
+def _volume_rate(theta, design):
+    return curves(design).dQdt(theta)
+
+
+FEM = finger.FingerFunctions(energy=_energy, energy_rate=_energy_rate, volume=_volume,
+                             volume_rate=_volume_rate)
+finger.register_model("fem", FEM)
