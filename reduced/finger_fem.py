@@ -21,9 +21,10 @@ Delta Q = a^2 pi d theta z. Beyond the table's largest angle theta_max (and belo
 y and z are held at their end values.
 
 Energy consistency. Per design, P(theta) and Delta Q(theta) are sampled at 0.5 deg and
-interpolated by cubic splines; dW_f/dtheta is defined as P dQ/dtheta (a piecewise quintic)
-and W_f as its exact antiderivative (W_f(0) = 0), so P dQ/dtheta = dW_f/dtheta holds to
-rounding and (27), (28), (25) follow from the virtual-work balance unchanged.
+interpolated by cubic Hermite polynomials; dW_f/dtheta is defined as P dQ/dtheta (a quintic
+per piece) and W_f as its exact integral (3-point Gauss per piece, W_f(0) = 0), so
+P dQ/dtheta = dW_f/dtheta holds to rounding and (27), (28), (25) follow from the
+virtual-work balance unchanged.
 
 Its space. Designs whose groups leave the table's range, or that do not have 5 equal hinges,
 raise one InputError naming the group and its range; ``softhand calibrate finger --design``
@@ -38,7 +39,6 @@ from itertools import combinations_with_replacement
 from pathlib import Path
 
 import numpy as np
-from scipy.interpolate import CubicSpline, PPoly
 
 from . import finger
 from .design import HandDesign
@@ -213,48 +213,86 @@ def _table_path(design: HandDesign) -> str:
 
 
 # ---------------------------------------------------------------------- one design's curves
-@dataclass(frozen=True)
-class Curves:
-    """One design's calibrated finger: splines of P, Delta Q, and W_f = int P dQ."""
+class Hermite:
+    """Cubic Hermite interpolant on the uniform knots :data:`_KNOTS` of values f and slopes m
+    (the end pieces continue as polynomials); NumPy only, so ``softhand curve`` starts fast."""
 
-    P: CubicSpline  #: pressure of the free finger [MPa]
-    dQ: CubicSpline  #: Delta Q = Q - Q(0) of one finger [mm^3]
-    dQdt: PPoly  #: d Delta Q / d theta [mm^3/rad]
-    W: PPoly  #: W_f [N mm], W(0) = 0
-    Wdt: PPoly  #: dW_f/dtheta = P dQ/dtheta [N mm/rad]
+    def __init__(self, f: np.ndarray, m: np.ndarray):
+        self.f, self.m = f, m
+        self.x0, self.h = float(_KNOTS[0]), float(_KNOTS[1] - _KNOTS[0])
+
+    def _locate(self, t):
+        t = np.asarray(t, float)
+        i = np.clip(np.floor((t - self.x0) / self.h).astype(int), 0, self.f.size - 2)
+        return i, (t - self.x0) / self.h - i
+
+    def __call__(self, t):
+        i, s = self._locate(t)
+        h00, h10, h01, h11 = 2 * s**3 - 3 * s**2 + 1, s**3 - 2 * s**2 + s, 3 * s**2 - 2 * s**3, s**3 - s**2
+        return h00 * self.f[i] + self.h * (h10 * self.m[i] + h11 * self.m[i + 1]) + h01 * self.f[i + 1]
+
+    def derivative(self, t):
+        i, s = self._locate(t)
+        d00, d10, d11 = 6 * s**2 - 6 * s, 3 * s**2 - 4 * s + 1, 3 * s**2 - 2 * s
+        return d00 * (self.f[i] - self.f[i + 1]) / self.h + d10 * self.m[i] + d11 * self.m[i + 1]
+
+
+#: 3-point Gauss-Legendre rule on [0, 1]: exact for the quintic P dQ/dtheta of one piece
+_GAUSS_X = 0.5 + 0.5 * np.sqrt(0.6) * np.array([-1.0, 0.0, 1.0])
+_GAUSS_W = np.array([5.0, 8.0, 5.0]) / 18.0
+
+
+@dataclass(frozen=True, eq=False)
+class Curves:
+    """One design's calibrated finger: Hermite cubics of P and Delta Q; W_f = int P dQ exactly."""
+
+    P: Hermite  #: pressure of the free finger [MPa]
+    dQ: Hermite  #: Delta Q = Q - Q(0) of one finger [mm^3]
+    W_knots: np.ndarray  #: W_f at the knots [N mm], W_f(0) = 0
     Q0: float  #: Q(0) = a^2 pi l0 [mm^3]
+
+    def energy_rate(self, t):
+        """dW_f/dtheta = P dQ/dtheta [N mm/rad] (a quintic per piece)."""
+        return self.P(t) * self.dQ.derivative(t)
+
+    def energy(self, t):
+        """W_f [N mm]: the knot value plus the 3-point Gauss integral from the piece's start."""
+        t = np.asarray(t, float)
+        i, _ = self.P._locate(t)
+        start = _KNOTS[i]
+        span = t - start
+        tau = start[..., None] + span[..., None] * _GAUSS_X
+        return self.W_knots[i] + span * (self.energy_rate(tau) @ _GAUSS_W)
+
+
+def _with_slopes(fn) -> Hermite:
+    """Hermite interpolant of fn at the knots, slopes by central differences (h = 1e-6 rad)."""
+    h = 1e-6
+    return Hermite(fn(_KNOTS), (fn(_KNOTS + h) - fn(_KNOTS - h)) / (2 * h))
 
 
 @lru_cache(maxsize=64)
 def curves(design: HandDesign) -> Curves:
     """The calibrated curves of ``design`` (cached per design)."""
-    y, z = residuals(_KNOTS, design)
     paper = design.replace(finger_model="paper")
-    P = CubicSpline(_KNOTS, design.mu_sf * finger.zeta_f(_KNOTS, paper)
-                    / (design.a**2 * math.pi * design.d) * np.exp(y))
-    dQ = CubicSpline(_KNOTS, design.a**2 * math.pi * design.d * _KNOTS * z)
-    dQdt = dQ.derivative()
-    Wdt = PPoly(_product(P.c, dQdt.c), _KNOTS, extrapolate=True)
-    W = Wdt.antiderivative()
-    W.c[-1] -= W(0.0)  # W_f(0) = 0: shift the constant of every piece
-    return Curves(P, dQ, dQdt, W, Wdt, design.a**2 * math.pi * design.l0)
-
-
-def _product(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """PPoly coefficients (highest power first, per interval) of the product of two PPolys."""
-    out = np.zeros((a.shape[0] + b.shape[0] - 1, a.shape[1]))
-    for i in range(a.shape[0]):
-        for j in range(b.shape[0]):
-            out[i + j] += a[i] * b[j]
-    return out
+    scale = design.mu_sf / (design.a**2 * math.pi * design.d)
+    P = _with_slopes(lambda t: scale * finger.zeta_f(t, paper) * np.exp(residuals(t, design)[0]))
+    dQ = _with_slopes(lambda t: design.a**2 * math.pi * design.d * t * residuals(t, design)[1])
+    pieces = np.empty(_KNOTS.size)
+    pieces[0] = 0.0
+    tau = _KNOTS[:-1, None] + (_KNOTS[1] - _KNOTS[0]) * _GAUSS_X
+    pieces[1:] = (_KNOTS[1] - _KNOTS[0]) * (P(tau) * dQ.derivative(tau)) @ _GAUSS_W
+    W = np.cumsum(pieces)
+    W -= W[np.argmin(np.abs(_KNOTS))]  # theta = 0 is a knot
+    return Curves(P, dQ, W, design.a**2 * math.pi * design.l0)
 
 
 def _energy(theta, design):
-    return curves(design).W(theta)
+    return curves(design).energy(theta)
 
 
 def _energy_rate(theta, design):
-    return curves(design).Wdt(theta)
+    return curves(design).energy_rate(theta)
 
 
 def _volume(theta, design):
@@ -263,7 +301,7 @@ def _volume(theta, design):
 
 
 def _volume_rate(theta, design):
-    return curves(design).dQdt(theta)
+    return curves(design).dQ.derivative(theta)
 
 
 FEM = finger.FingerFunctions(energy=_energy, energy_rate=_energy_rate, volume=_volume,
