@@ -44,7 +44,6 @@ is looked up in the module ``reduced.finger_<name>``, which must register it whe
 """
 from __future__ import annotations
 
-import importlib
 import math
 from dataclasses import dataclass
 from functools import lru_cache
@@ -54,6 +53,7 @@ import numpy as np
 
 from .design import HandDesign
 from .errors import InputError
+from .registry import lookup
 
 #: Gauss-Legendre orders across the wall (r) and around the tube (phi, half turn); the
 #: relative quadrature error is below 1e-11 for -pi/2 <= theta <= pi (tests/test_reduced_finger.py).
@@ -191,14 +191,7 @@ def register_model(name: str, functions: FingerFunctions) -> None:
 
 def model(name: str) -> FingerFunctions:
     """The registered finger model ``name`` (imports reduced.finger_<name> on first use)."""
-    if name not in _MODELS:
-        try:
-            importlib.import_module(f"{__package__}.finger_{name}")
-        except ModuleNotFoundError:
-            pass
-    if name not in _MODELS:
-        raise InputError("finger_model", name, f"no such model; available: {', '.join(_MODELS)}")
-    return _MODELS[name]
+    return lookup(_MODELS, name, module=f"{__package__}.finger_{name}", field="finger_model")
 
 
 def energy(theta, design: HandDesign):

@@ -29,13 +29,13 @@ Units: mm, mm^3, MPa, N*mm, rad.
 """
 from __future__ import annotations
 
-import importlib
 from typing import Callable
 
 import numpy as np
 
 from .design import HandDesign
 from .errors import InputError
+from .registry import lookup
 from .finger import oil_taken
 
 PressureFn = Callable[[np.ndarray, HandDesign], np.ndarray]
@@ -118,14 +118,7 @@ def register_model(name: str, pressure_fn: PressureFn) -> None:
 
 def model(name: str) -> PressureFn:
     """The registered pressure function of reservoir model ``name`` (imports reduced.reservoir_<name>)."""
-    if name not in _MODELS:
-        try:
-            importlib.import_module(f"{__package__}.reservoir_{name}")
-        except ModuleNotFoundError:
-            pass
-    if name not in _MODELS:
-        raise InputError("reservoir_model", name, f"no such model; available: {', '.join(_MODELS)}")
-    return _MODELS[name]
+    return lookup(_MODELS, name, module=f"{__package__}.reservoir_{name}", field="reservoir_model")
 
 
 def pressure(V, design: HandDesign):

@@ -58,7 +58,10 @@ def run(args) -> int:
     results = _run(space, args)
     if results is None:
         return 1
-    command = "softhand calibrate finger " + " ".join(shlex.quote(a) for a in sys.argv[3:])
+    given = ("--space", args.space), ("--design", args.design), ("--out", args.out), \
+        ("--workers", args.workers if args.workers != 1 else None), ("--scheduler", args.scheduler)
+    command = "softhand calibrate finger " + " ".join(f"{k} {shlex.quote(str(v))}" for k, v in given
+                                                      if v is not None)
     path = write_table(args.out, space, results, command)
     print(f"table: {path} ({len(results)} designs)")
     if args.design:
