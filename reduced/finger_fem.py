@@ -51,6 +51,8 @@ TABLE_FILE = Path(__file__).resolve().parent / "data" / "finger_fem.csv"
 GROUPS = ("b_a", "d_a", "link_a", "tie_link")
 LABELS = {"b_a": "b/a", "d_a": "d/a", "link_a": "link/a", "tie_link": "tie/link"}
 COLUMNS = ("design", *GROUPS, "theta", "p_tilde", "q_tilde")
+#: the physics a table's residual is taken against (see :func:`prior_pressure`)
+PRIORS = ("paper", "rings")
 N_LINKS = 6
 _KNOTS = np.linspace(-0.5 * math.pi, math.pi, 541)  # 0.5 deg over the hand's THETA_RANGE
 
@@ -64,6 +66,7 @@ class Table:
     ranges: dict  #: group -> (min, max)
     design_degree: int  #: total degree of the polynomial in the groups
     theta_degree: int  #: degree in theta
+    prior: str = "paper"  #: the physics the residual is taken against, one of PRIORS
     header: tuple[str, ...] = ()  #: the provenance comment lines
 
 
@@ -93,16 +96,16 @@ def read_table(path: str | Path = TABLE_FILE) -> Table:
     rows = {c: values[:, i] for i, c in enumerate(COLUMNS)}
     if np.any(rows["theta"] <= 0) or np.any(rows["p_tilde"] <= 0) or np.any(rows["q_tilde"] <= 0):
         raise _bad(path, "theta, p_tilde and q_tilde must be positive (the P = 0 state is implied)")
-    ranges, degrees = _header(comments, path)
+    ranges, degrees, prior = _header(comments, path)
     for g in GROUPS:
         lo, hi = ranges[g]
         if np.any(rows[g] < lo * (1 - 1e-9)) or np.any(rows[g] > hi * (1 + 1e-9)):
             raise _bad(path, f"has {LABELS[g]} outside its '# range:' [{lo:g}, {hi:g}]")
-    return Table(path.name, rows, ranges, *degrees, header=tuple(comments))
+    return Table(path.name, rows, ranges, *degrees, prior=prior, header=tuple(comments))
 
 
-def _header(comments: list[str], path) -> tuple[dict, tuple[int, int]]:
-    """The '# range: g=lo:hi, ...' and '# fit: design_degree=D, theta_degree=T' lines."""
+def _header(comments: list[str], path) -> tuple[dict, tuple[int, int], str]:
+    """The '# range: g=lo:hi, ...' and '# fit: design_degree=D, theta_degree=T[, prior=P]' lines."""
     spec = {}
     for line in comments:
         body = line.lstrip("#").strip()
@@ -119,7 +122,12 @@ def _header(comments: list[str], path) -> tuple[dict, tuple[int, int]]:
                          "and '# fit: design_degree=D, theta_degree=T'") from None
     if any(len(r) != 2 or not 0 < r[0] <= r[1] for r in ranges.values()) or min(degrees) < 0:
         raise _bad(path, "has a range lo:hi with not 0 < lo <= hi, or a negative degree")
-    return ranges, degrees
+    prior = spec.get("prior", "paper")
+    if prior not in PRIORS:
+        raise _bad(path, f"has prior={prior}; allowed: {', '.join(PRIORS)}")
+    if ranges["tie_link"][1] >= 1.0:
+        raise _bad(path, "has tie/link >= 1: a ring cannot be wider than its link")
+    return ranges, degrees, prior
 
 
 # ---------------------------------------------------------------------- groups and the fit
@@ -157,12 +165,15 @@ def _features(x: np.ndarray, theta, table: Table) -> np.ndarray:
     return np.stack([m * theta**j for j in range(table.theta_degree + 1) for m in monos], axis=-1)
 
 
-def _paper(groups: dict) -> HandDesign:
-    """The nondimensional (a = 1, mu = 1) paper-model finger with these groups."""
+def prior_pressure(theta, groups: dict, prior: str):
+    """P / mu_sf [-] of the physics the fit corrects: eq. (28) ("paper"), or eq. (28) with the
+    tube stretching over its untied length l0 - 6 w only ("rings": the tied rings cannot
+    stretch, the kinematic bound of the finger FEM)."""
     L = groups["link_a"]
-    return HandDesign(a=1.0, b=groups["b_a"], d=groups["d_a"], l0=N_LINKS * L, mu_sf=1.0,
-                      hinge_s=tuple(L * k for k in range(1, N_LINKS)),
-                      tie_width=groups["tie_link"] * L)
+    l0 = N_LINKS * L * ((1.0 - groups["tie_link"]) if prior == "rings" else 1.0)
+    free = HandDesign(a=1.0, b=groups["b_a"], d=groups["d_a"], l0=l0, mu_sf=1.0,
+                      hinge_s=tuple(l0 * k / N_LINKS for k in range(1, N_LINKS)))
+    return finger.zeta_f(theta, free) / (math.pi * groups["d_a"])
 
 
 @lru_cache(maxsize=8)
@@ -175,7 +186,7 @@ def _fit(path: str) -> tuple[Table, np.ndarray, np.ndarray, float]:
     for i in ids:  # eq. (28) per design, all its angles at once
         at = r["design"] == i
         g = {k: float(r[k][at][0]) for k in GROUPS}
-        y[at] = np.log(r["p_tilde"][at] / (finger.zeta_f(r["theta"][at], _paper(g)) / (math.pi * g["d_a"])))
+        y[at] = np.log(r["p_tilde"][at] / prior_pressure(r["theta"][at], g, table.prior))
     z = r["q_tilde"] / (math.pi * r["d_a"] * r["theta"])
     A = _features(_x(r, table), r["theta"], table)
     if np.linalg.matrix_rank(A) < A.shape[1]:
@@ -274,9 +285,10 @@ def _with_slopes(fn) -> Hermite:
 @lru_cache(maxsize=64)
 def curves(design: HandDesign) -> Curves:
     """The calibrated curves of ``design`` (cached per design)."""
-    paper = design.replace(finger_model="paper")
-    scale = design.mu_sf / (design.a**2 * math.pi * design.d)
-    P = _with_slopes(lambda t: scale * finger.zeta_f(t, paper) * np.exp(residuals(t, design)[0]))
+    table = _fit(_table_path(design))[0]
+    groups = check_space(design, table)
+    P = _with_slopes(lambda t: design.mu_sf * prior_pressure(t, groups, table.prior)
+                     * np.exp(residuals(t, design)[0]))
     dQ = _with_slopes(lambda t: design.a**2 * math.pi * design.d * t * residuals(t, design)[1])
     pieces = np.empty(_KNOTS.size)
     pieces[0] = 0.0

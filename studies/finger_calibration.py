@@ -19,8 +19,10 @@ equal links of l0 / 6), a Latin-hypercube sample size and seed, explicit extra d
     l0_mm = [120.0, 200.0]
     tie_width_mm = [5.0, 15.0]
     # mesh_size_mm = 6.0           # optional: a uniform gmsh mesh (e.g. the CI mesh)
+    # axial_size_mm = 5.0          # optional: the layered mesh with longer slices
     # base_design = "designs/paper.toml"   # optional: the other design values
-    [[design]]                     # optional explicit designs (all five keys)
+    [[design]]                     # optional explicit designs (all five keys; may also set
+                                   # its own p_max_mpa, p_step_mpa)
     a_mm = 3.0
     ...
 
@@ -47,8 +49,10 @@ from studies.studyfile import Study
 
 #: the dimensional variables of a design space, in this order
 VARIABLES = ("a_mm", "b_mm", "d_mm", "l0_mm", "tie_width_mm")
+#: load-path parameters a [[design]] table may set for itself
+_PATH_KEYS = ("p_max_mpa", "p_step_mpa")
 _KEYS = ("name", "lhs", "seed", "pressures_mpa", "theta_target_deg", "p_max_mpa", "p_step_mpa",
-         "space", "design", "base_design", "mesh_size_mm")
+         "space", "design", "base_design", "mesh_size_mm", "axial_size_mm", "mesh_pair", "prior")
 
 
 @dataclass(frozen=True)
@@ -64,6 +68,11 @@ class DesignSpace:
     p_step_mpa: float = 0.5
     base: HandDesign = HandDesign()
     mesh_size_mm: float | None = None  #: a uniform gmsh mesh of this size; None: the default mesh
+    axial_size_mm: float | None = None  #: the layered mesh's largest slice [mm]; None: its default
+    #: (point, pressures): one design run on this mesh and on the default one, to correct the
+    #: table for the mesh (see studies.finger_table.mesh_correction); None: no correction
+    mesh_pair: tuple | None = None
+    prior: str = "paper"  #: the physics the table's residual is taken against (reduced.finger_fem.PRIORS)
 
     def designs(self) -> list[HandDesign]:
         return [finger_design(p, self.base) for p in self.points]
@@ -115,13 +124,34 @@ def load_space(path: str | Path) -> DesignSpace:
         numbers[key] = doc.get(key, default)
         if not _number(numbers[key]) or not numbers[key] > 0:
             raise InputError(f"{src}: {key}", numbers[key], "must be a positive number")
-    mesh = doc.get("mesh_size_mm")
-    if mesh is not None and (not _number(mesh) or not mesh > 0):
-        raise InputError(f"{src}: mesh_size_mm", mesh, "must be a positive number [mm] (omit: the default mesh)")
+    mesh, axial = doc.get("mesh_size_mm"), doc.get("axial_size_mm")
+    for key, value in (("mesh_size_mm", mesh), ("axial_size_mm", axial)):
+        if value is not None and (not _number(value) or not value > 0):
+            raise InputError(f"{src}: {key}", value, "must be a positive number [mm] (omit: the default mesh)")
+    if mesh is not None and axial is not None:
+        raise InputError(f"{src}: axial_size_mm", axial, "applies to the layered mesh; remove mesh_size_mm")
     base = load_design(path.parent / doc["base_design"]) if "base_design" in doc else HandDesign()
+    pair = doc.get("mesh_pair")
+    if pair is not None:
+        if not isinstance(pair, dict) or "pressures_mpa" not in pair:
+            raise InputError(f"{src}: mesh_pair", pair, f"must give {', '.join(VARIABLES)} and pressures_mpa")
+        pair = dict(pair)
+        pressures_pair = pair.pop("pressures_mpa")
+        if not isinstance(pressures_pair, list) or len(pressures_pair) < 2 or any(
+                not _number(p) or p <= 0 for p in pressures_pair) or any(np.diff(pressures_pair) <= 0):
+            raise InputError(f"{src}: mesh_pair.pressures_mpa", pressures_pair,
+                             "must be 2 or more increasing numbers > 0 [MPa]")
+        pair = (_point(pair, {k: (0.0, math.inf) for k in VARIABLES}, f"{src}: mesh_pair"),
+                tuple(float(p) for p in pressures_pair))
+    from reduced.finger_fem import PRIORS
+    prior = doc.get("prior", "paper")
+    if prior not in PRIORS:
+        raise InputError(f"{src}: prior", prior, f"must be one of {', '.join(PRIORS)}")
     space = DesignSpace(doc.get("name", path.stem), box, tuple(points),
                         tuple(float(p) for p in pressures), base=base,
                         mesh_size_mm=None if mesh is None else float(mesh),
+                        axial_size_mm=None if axial is None else float(axial), mesh_pair=pair,
+                        prior=prior,
                         **{k: float(v) for k, v in numbers.items()})
     space.designs()  # validates every design now
     return space
@@ -145,33 +175,64 @@ def _box(table, src: str) -> dict:
 
 
 def _point(table, box: dict, where: str) -> dict:
-    if not isinstance(table, dict) or set(table) != set(VARIABLES):
-        raise InputError(where, table, f"must give {', '.join(VARIABLES)}")
+    if not isinstance(table, dict) or not set(VARIABLES) <= set(table) <= set(VARIABLES + _PATH_KEYS):
+        raise InputError(where, table, f"must give {', '.join(VARIABLES)} (and optionally "
+                                       f"{', '.join(_PATH_KEYS)})")
     for key in VARIABLES:
         if not _number(table[key]) or not box[key][0] <= table[key] <= box[key][1]:
             raise InputError(f"{where}.{key}", table[key], f"must be in [{box[key][0]}, {box[key][1]}]")
-    return {key: float(table[key]) for key in VARIABLES}
+    for key in set(table) & set(_PATH_KEYS):
+        if not _number(table[key]) or not table[key] > 0:
+            raise InputError(f"{where}.{key}", table[key], "must be a positive number [MPa]")
+    return {key: float(value) for key, value in table.items()}
 
 
 @dataclass(frozen=True)
 class SpaceStudy(Study):
     """A design space as a study of the batch runner: one ``finger_bend`` case per design."""
 
-    points: tuple[HandDesign, ...] = ()
+    case_list: tuple[tuple[dict, HandDesign], ...] = ()  #: (params, design) of every case
 
     def cases(self) -> list[tuple[dict, HandDesign]]:
-        mesh = {} if self.mesh_size_mm is None else {"mesh_size_mm": self.mesh_size_mm}
-        return [({**self.params, **mesh}, design) for design in self.points]
+        return list(self.case_list)
 
 
 def as_study(space: DesignSpace) -> SpaceStudy:
     """The runner's study of a design space (results/<name>/, resumable)."""
+    return SpaceStudy(name=space.name, kind="finger_bend", design=space.base,
+                      axes=tuple((key, ()) for key in VARIABLES), params=space_params(space),
+                      description="finger FEM over a design space",
+                      case_list=tuple(design_cases(space) + mesh_pair_cases(space)))
+
+
+def space_params(space: DesignSpace) -> dict:
+    """The case parameters every design of the space shares (load path and mesh)."""
     params = {"pressures_mpa": list(space.pressures_mpa), "theta_target_deg": space.theta_target_deg,
               "p_max_mpa": space.p_max_mpa, "p_step_mpa": space.p_step_mpa}
-    return SpaceStudy(name=space.name, kind="finger_bend", design=space.base,
-                      axes=tuple((key, ()) for key in VARIABLES), params=params,
-                      mesh_size_mm=space.mesh_size_mm,
-                      description="finger FEM over a design space", points=tuple(space.designs()))
+    if space.mesh_size_mm is not None:
+        params["mesh_size_mm"] = space.mesh_size_mm
+    if space.axial_size_mm is not None:
+        params["axial_size_mm"] = space.axial_size_mm
+    return params
+
+
+def design_cases(space: DesignSpace) -> list[tuple[dict, HandDesign]]:
+    """(params, design) of each design, with its own load-path keys."""
+    shared = space_params(space)
+    return [({**shared, **{k: p[k] for k in _PATH_KEYS if k in p}}, d)
+            for p, d in zip(space.points, space.designs())]
+
+
+def mesh_pair_cases(space: DesignSpace) -> list[tuple[dict, HandDesign]]:
+    """The [mesh_pair] design on the space's mesh and on the default mesh (none if absent)."""
+    if space.mesh_pair is None:
+        return []
+    point, pressures = space.mesh_pair
+    design = finger_design(point, space.base)
+    path = {"pressures_mpa": list(pressures), "theta_target_deg": space.theta_target_deg,
+            "p_max_mpa": pressures[-1], "p_step_mpa": space.p_step_mpa}
+    coarse = {k: v for k, v in space_params(space).items() if k in ("mesh_size_mm", "axial_size_mm")}
+    return [({**path, **coarse}, design), (path, design)]
 
 
 # ---------------------------------------------------------------------- one case
@@ -191,13 +252,16 @@ def bend_case(params: dict, design: HandDesign, outdir: Path) -> dict:
     """Kind ``finger_bend``: the free-bending FEM of one design on the default mesh.
 
     params: ``pressures_mpa`` (list), ``theta_target_deg``, ``p_max_mpa``, ``p_step_mpa``;
-    ``mesh_size_mm`` (optional): a uniform gmsh mesh of that size instead of the default mesh.
+    ``mesh_size_mm`` (optional): a uniform gmsh mesh of that size instead of the default mesh;
+    ``axial_size_mm`` (optional): the default (layered) mesh with slices of at most that length.
     Returns P_MPa, theta_deg, dQ_mm3 (whole finger) per converged pressure.
     """
     from fem.finger import FingerModel, FingerOptions, solve_pressures
 
     options = FingerOptions() if "mesh_size_mm" not in params else \
         FingerOptions(mesher="gmsh", mesh_size=float(params["mesh_size_mm"]))
+    if "axial_size_mm" in params:  # the layered mesh with longer slices
+        options = FingerOptions(axial_size=float(params["axial_size_mm"]))
     model = FingerModel(design, options)
     states, stats = solve_pressures(model, params["pressures_mpa"])
     more = load_path(states[-1].theta, params)

@@ -52,13 +52,14 @@ def fit_degrees(n_designs: int, n_varying: int) -> tuple[int, int]:
     return (1, 1) if n_varying and n_designs >= n_varying + 1 else (0, 1)
 
 
-def table_csv(rows: list[dict], ranges: dict, provenance: list[str], degrees: tuple[int, int]) -> str:
+def table_csv(rows: list[dict], ranges: dict, provenance: list[str], degrees: tuple[int, int],
+              prior: str = "paper") -> str:
     """The calibration CSV of :mod:`reduced.finger_fem`: provenance, range and fit lines, rows."""
     lines = [f"# {line}" for line in provenance]
     lines.append("# groups: b_a = b/a, d_a = d/a, link_a = (l0/6)/a, tie_link = tie width/(l0/6); "
                  "theta [rad]; p_tilde = P/mu_sf; q_tilde = dQ/a^3 (one finger)")
     lines.append("# range: " + ", ".join(f"{g}={ranges[g][0]:.10g}:{ranges[g][1]:.10g}" for g in GROUPS))
-    lines.append(f"# fit: design_degree={degrees[0]}, theta_degree={degrees[1]}")
+    lines.append(f"# fit: design_degree={degrees[0]}, theta_degree={degrees[1]}, prior={prior}")
     lines.append(",".join(COLUMNS))
     for r in rows:
         lines.append(",".join(str(int(r[c])) if c == "design" else f"{r[c]:.10g}" for c in COLUMNS))
@@ -71,25 +72,49 @@ def provenance_lines(command: str, results: list[tuple[HandDesign, dict]], recor
     from studies.runner import code_version
 
     code = code_version()
-    mesh = {(r.get("mesh") or {}).get("mesher") for r in records}
+    mesh = {f"{(r.get('mesh') or {}).get('mesher')}"
+            + (f" (slices {r['inputs']['axial_size_mm']} mm)" if "axial_size_mm" in r["inputs"] else "")
+            for r in records}
     dofs = sorted((r.get("mesh") or {}).get("dofs", 0) for r in records)
     wall = sum((r.get("solver") or {}).get("wall_time_s", 0.0) for r in records)
     return [f"FEM calibration of reduced/finger_fem.py, written {datetime.now(timezone.utc):%Y-%m-%d %H:%M} "
             f"UTC at commit {_git_commit()} (softhand {code['softhand']}, sources {code['source_sha256']}) by",
             command,
-            f"model: finger FEM (fem/finger.py), default FingerOptions, mesher {','.join(sorted(map(str, mesh)))}, "
+            f"model: finger FEM (fem/finger.py), FingerOptions, mesher {', '.join(sorted(mesh))}, "
             f"{dofs[0]}..{dofs[-1]} unknowns; {len(results)} designs, {wall / 60:.1f} min of solver wall time"]
 
 
+def mesh_correction(coarse: dict, fine: dict) -> tuple[float, float]:
+    """(ln P_fine/P_coarse, dQ_fine/dQ_coarse) at equal bend, averaged over the pair's points:
+    the same design on the space's mesh (``coarse`` numbers) and on the default mesh."""
+    th_c, P_c, dQ_c = (np.array(coarse[k], float) for k in ("theta_deg", "P_MPa", "dQ_mm3"))
+    th_f, P_f, dQ_f = (np.array(fine[k], float) for k in ("theta_deg", "P_MPa", "dQ_mm3"))
+    inside = th_c <= th_f.max()
+    at = th_c[inside]
+    P_fine = PchipInterpolator(np.r_[0.0, th_f], np.r_[0.0, P_f])(at)
+    dQ_fine = PchipInterpolator(np.r_[0.0, th_f], np.r_[0.0, dQ_f])(at)
+    return float(np.mean(np.log(P_fine / P_c[inside]))), float(np.mean(dQ_fine / dQ_c[inside]))
+
+
 def write_table(path, space: DesignSpace, results: list[tuple[HandDesign, dict]], command: str) -> Path:
-    """Write the calibration CSV of ``results`` [(design, case record)] over ``space``'s box."""
-    pairs = [(design, record["numbers"]) for design, record in results]
+    """Write the calibration CSV of ``results`` [(design, case record)], in the order of
+    ``as_study(space).cases()`` (the designs, then the mesh pair if any), over ``space``'s box."""
+    n = len(space.points)
+    pairs = [(design, record["numbers"]) for design, record in results[:n]]
     rows = table_rows(pairs)
+    records = [record["provenance"] for _, record in results]
+    notes = provenance_lines(command, pairs, records)
+    if space.mesh_pair is not None:  # scale the coarse mesh's points to the default mesh
+        dy, rq = mesh_correction(results[n][1]["numbers"], results[n + 1][1]["numbers"])
+        for row in rows:
+            row["p_tilde"] *= math.exp(dy)
+            row["q_tilde"] *= rq
+        notes.append(f"mesh correction to the default mesh (the mesh_pair design on both meshes, at "
+                     f"equal bend): P x {math.exp(dy):.5f}, dQ x {rq:.5f}, applied to every row")
     ranges = space_ranges(space.box)
     varying = sum(ranges[g][1] > ranges[g][0] * (1 + 1e-9) for g in GROUPS)
     degrees = fit_degrees(len(pairs), varying)
-    records = [record["provenance"] for _, record in results]
-    text = table_csv(rows, ranges, provenance_lines(command, pairs, records), degrees)
+    text = table_csv(rows, ranges, notes, degrees, prior=space.prior)
     return write_atomic(path, text)
 
 
