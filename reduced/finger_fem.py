@@ -8,15 +8,17 @@ L = l0 / 6 (5 equal hinges) and the tie width w. So
           \frac{w}{L}\Big), \qquad \frac{\Delta Q}{a^3} = \tilde q(\theta; \dots).
 
 The physics already known carries most of it: the paper's eqs. (28) and (2), which give
-P and Delta Q = a^2 pi d theta for the same groups. The table ``reduced/data/finger_fem.csv``
+P and Delta Q = a^2 pi d theta for the same groups (the table's ``prior``: ``"paper"``, or
+``"rings"``: eq. (28) with the tube stretching only over its untied length l0 - 6 w, the
+finger FEM's kinematic bound, see :func:`prior_pressure`). The table ``reduced/data/finger_fem.csv``
 holds the FEM's (theta, P/mu, Delta Q/a^3) at the sampled designs; this model fits the
 slowly varying residuals
 
-.. math:: y = \ln\frac{P_{FEM}}{P_{(28)}}, \qquad z = \frac{\Delta Q_{FEM}}{a^2\pi d\,\theta}
+.. math:: y = \ln\frac{P_{FEM}}{P_{prior}}, \qquad z = \frac{\Delta Q_{FEM}}{a^2\pi d\,\theta}
 
 by least squares as polynomials in x = the groups' logarithms (with -ln(1 - w/L) for the
 tie, the tied share of the length) scaled to [-1, 1] over the table's range, times 1, theta,
-... (degrees from the table's ``# fit:`` line). So P(theta) = P_(28)(theta) e^{y} and
+... (degrees from the table's ``# fit:`` line). So P(theta) = P_prior(theta) e^{y} and
 Delta Q = a^2 pi d theta z. Beyond the table's largest angle theta_max (and below -theta_max)
 y and z are held at their end values.
 

@@ -40,6 +40,9 @@ def configure(parser) -> None:
     finger.add_argument("--results", default="results", metavar="DIR",
                         help="results root of the FEM cases (default: results)")
     finger.add_argument("--no-progress", action="store_true", help="no progress bar")
+    finger.add_argument("--finished", action="store_true",
+                        help="run no FEM: use the designs already finished in --results (the "
+                             "others are listed as pending)")
     add_json_option(finger)
 
 
@@ -58,12 +61,13 @@ def run(args) -> int:
     results = _run(space, args)
     if results is None:
         return 1
+    space, results = _finished_only(space, results)
     given = ("--space", args.space), ("--design", args.design), ("--out", args.out), \
         ("--workers", args.workers if args.workers != 1 else None), ("--scheduler", args.scheduler)
     command = "softhand calibrate finger " + " ".join(f"{k} {shlex.quote(str(v))}" for k, v in given
                                                       if v is not None)
     path = write_table(args.out, space, results, command)
-    print(f"table: {path} ({len(results)} designs)")
+    print(f"table: {path} ({len(space.points)} designs)")
     if args.design:
         toml = write_design_with_table(space.designs()[0], path)
         print(f"design using it: {toml}")
@@ -71,11 +75,19 @@ def run(args) -> int:
 
 
 def _run(space, args):
-    """Run the space's FEM cases (resumable); [(design, record)] or None if some failed."""
+    """Run the space's FEM cases (resumable); [(design, record)] or None if some failed.
+    With --finished: only the cases already done, without running any."""
     from studies.finger_calibration import as_study
-    from studies.runner import plan, read_case, run_study, study_dir
+    from studies.runner import case_state, plan, read_case, run_study, study_dir
 
     study = as_study(space)
+    sdir = study_dir(study, args.results)
+    if args.finished:
+        cases = plan(study)
+        done = [case_state(sdir, c) == "done" for c in cases]
+        print(f"FEM: {sum(done)} of {len(cases)} cases finished in {sdir}; "
+              f"{len(cases) - sum(done)} pending, not run (--finished)", file=sys.stderr)
+        return [(c.design, read_case(sdir, c) if ok else None) for c, ok in zip(cases, done)]
     s = run_study(study, results_root=args.results, workers=args.workers,
                   scheduler=args.scheduler, progress=not args.no_progress)
     print(f"FEM: {s.total} designs: {s.computed} computed, {s.reused} reused, "
@@ -85,8 +97,22 @@ def _run(space, args):
         print(f"  failed {key}: {error}", file=sys.stderr)
     if not s.ok:
         return None
-    sdir = study_dir(study, args.results)
     return [(case.design, read_case(sdir, case)) for case in plan(study)]
+
+
+def _finished_only(space, results):
+    """The space reduced to its designs with a result (all of them unless --finished)."""
+    import dataclasses
+
+    from reduced.errors import InputError
+
+    n = len(space.points)
+    keep = [i for i in range(n) if results[i][1] is not None]
+    if not keep or any(record is None for _, record in results[n:]):
+        raise InputError("--finished", "results", "need one finished design and the finished "
+                                                  "mesh_pair cases; run without --finished")
+    return (dataclasses.replace(space, points=tuple(space.points[i] for i in keep)),
+            [results[i] for i in keep] + results[n:])
 
 
 def _check(space, args) -> int:
@@ -95,6 +121,7 @@ def _check(space, args) -> int:
     results = _run(space, args)
     if results is None:
         return 1
+    results = [r for r in results if r[1] is not None]
     rows, worst = heldout_rows(results, args.table)
     if args.json:
         print_json({"rows": rows, "worst": worst})
