@@ -175,7 +175,17 @@ def prior_pressure(theta, groups: dict, prior: str):
     l0 = N_LINKS * L * ((1.0 - groups["tie_link"]) if prior == "rings" else 1.0)
     free = HandDesign(a=1.0, b=groups["b_a"], d=groups["d_a"], l0=l0, mu_sf=1.0,
                       hinge_s=tuple(l0 * k / N_LINKS for k in range(1, N_LINKS)))
-    return finger.zeta_f(theta, free) / (math.pi * groups["d_a"])
+    # bent backwards beyond the angle where the outermost fibre halves its length, P continues
+    # linearly (C1): the short untied length of "rings" would otherwise compress it to nothing
+    lo = -0.5 * l0 / (groups["d_a"] + 1.0 + groups["b_a"])
+    theta = np.asarray(theta, float)
+    t = np.maximum(theta, lo)
+    P = finger.zeta_f(t, free) / (math.pi * groups["d_a"])
+    if np.any(theta < lo):
+        h = 1e-6
+        slope = (finger.zeta_f(lo + h, free) - finger.zeta_f(lo - h, free)) / (2 * h * math.pi * groups["d_a"])
+        P = np.where(theta < lo, P + slope * (theta - lo), P)
+    return P
 
 
 @lru_cache(maxsize=8)
