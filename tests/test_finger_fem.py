@@ -124,3 +124,20 @@ def test_missing_table_and_too_few_designs(tmp_path):
     d = designs[0].replace(finger_model="fem", finger_table=str(path))
     with pytest.raises(InputError, match="too few designs"):
         hand.pressure(0.5, d)
+
+
+def test_a_design_file_names_its_own_table_relative_to_itself(tmp_path):
+    """write_design_with_table: FILE.toml next to FILE.csv, finger_model "fem", the table found
+    relative to the design file; the CLI's error for a design outside it is one line, exit 2."""
+    from studies.cli import main
+    from studies.finger_table import write_design_with_table
+    from reduced.design import load_design
+
+    path, designs, _ = _synthetic_table(tmp_path)
+    toml = write_design_with_table(designs[1], path)
+    d = load_design(toml)
+    assert d.finger_model == "fem" and d.finger_table == str(path.resolve()) and d.tie_width == 10.0
+    assert hand.bend_angle(0.5, d, reservoir=False) > 0
+    wide = tmp_path / "wide.toml"
+    wide.write_text(toml.read_text().replace("b_mm = 5.0", "b_mm = 6.0"))
+    assert main(["curve", "--design", str(wide), "--pressure-mpa", "0.5"]) == 2
