@@ -1,4 +1,5 @@
-"""Speed of the reduced model: P(theta), theta(P), F_v for 1e5 values; `softhand curve` wall time.
+"""Speed of the reduced model: P(theta), theta(P), F_v for 1e5 values; `softhand curve` wall time;
+the same P(theta), theta(P) with the FEM-calibrated finger model (finger_model = "fem").
 
 Run: python benchmarks/bench_reduced.py   (prints the best of a few repeats, in seconds)
 """
@@ -8,7 +9,9 @@ import math
 import os
 import subprocess
 import sys
+import tempfile
 import time
+from pathlib import Path
 
 import numpy as np
 
@@ -48,12 +51,25 @@ def main() -> None:
         ("F_v, eqs. (25), (29), 1e5 states",
          lambda: grasp.grasp_forces(P_grasp, theta, mass, w, design).F_v),
     ]
+    fem = design.replace(finger_model="fem")
+    P_fem = hand.pressure(theta, fem)
+    rows += [
+        ("P(theta), finger_model fem, 1e5 angles", lambda: hand.pressure(theta, fem)),
+        ("theta(P), finger_model fem, 1e5 pressures", lambda: hand.bend_angle(P_fem, fem)),
+    ]
     print(f"{'':<45} {'wall [s]':>9} {'cpu [s]':>9}   (load average {os.getloadavg()[0]:.1f})")
     for label, fn in rows:
         print(f"{label:<45} {'%9.4f %9.4f' % best_of(fn)}")
     command = [sys.executable, "-m", "studies.cli", "curve", "--theta-deg", "0:90:10"]
     wall, _ = best_of(lambda: subprocess.run(command, check=True, capture_output=True), repeats=3)
     print(f"{'softhand curve --theta-deg 0:90:10, start-up incl.':<45} {wall:9.4f}")
+    with tempfile.TemporaryDirectory() as tmp:
+        path = Path(tmp) / "fem.toml"
+        path.write_text(fem.to_toml())
+        wall, _ = best_of(lambda: subprocess.run(command[:-2] + ["--pressure-mpa", "0.2,0.5,0.8",
+                                                                "--design", str(path)],
+                                                 check=True, capture_output=True), repeats=3)
+    print(f"{'softhand curve, finger_model fem, start-up incl.':<45} {wall:9.4f}")
 
 
 if __name__ == "__main__":

@@ -126,7 +126,7 @@ class FingerOptions:
     edge_reach: float = 3.0    #: gmsh: distance over which the size grows back to mesh_size [mm]
     mesh_refine: int = 0       #: split every element / halve every spacing this many times (nested meshes)
     tie: str = "ring"          #: which outer surface the links hold: "ring" or "full"
-    tie_width: float = 10.0    #: width of each link's tied ring, centred on the link [mm]
+    tie_width: float | None = None  #: width of each link's tied ring [mm]; None: the design's tie_width_mm
     hinge_gap: float = 4.0     #: untied tube length around each hinge, tie = "full" [mm]
     cap: float | None = None   #: end-cap thickness at the tip [mm]; None: the wall b
     kappa_ratio: float = 1000.0  #: bulk over shear modulus of the rubber
@@ -151,17 +151,23 @@ class FingerOptions:
         if self.mesh_refine not in range(0, 4):
             raise InputError("mesh_refine", self.mesh_refine, "must be 0, 1, 2 or 3")
         for name in ("layer_first", "axial_size", "mesh_size", "edge_reach", "tie_width", "hinge_gap", "kappa_ratio", "fiber_ratio"):
-            if not getattr(self, name) > 0:
+            if getattr(self, name) is not None and not getattr(self, name) > 0:
                 raise InputError(name, getattr(self, name), "must be a positive number")
+
+
+def ring_width(design: HandDesign, options: FingerOptions) -> float:
+    """Width of each link's tied ring [mm]: the options' if given, else the design's tie_width."""
+    return design.tie_width if options.tie_width is None else options.tie_width
 
 
 def tie_bands(design: HandDesign, options: FingerOptions) -> tuple[tuple[float, float], ...]:
     """(x_start, x_end) of the tube band each link holds [mm] (see :class:`FingerOptions`)."""
     s = np.array((0.0, *design.hinge_s, design.l0))
     if options.tie == "ring":
-        mid, half = 0.5 * (s[:-1] + s[1:]), 0.5 * options.tie_width
-        if options.tie_width >= np.diff(s).min():
-            raise InputError("tie_width", options.tie_width, "must be shorter than every link")
+        width = ring_width(design, options)
+        mid, half = 0.5 * (s[:-1] + s[1:]), 0.5 * width
+        if width >= np.diff(s).min():
+            raise InputError("tie_width_mm", width, "must be shorter than every link")
         return tuple((float(m - half), float(m + half)) for m in mid)
     gap = 0.5 * options.hinge_gap
     if options.hinge_gap >= np.diff(s).min():

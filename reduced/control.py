@@ -157,10 +157,9 @@ def _integrate(controller, tables: HandTables, plant: PlantParams, theta, F_x, F
     every = plant.steps_per_sample
     alpha = 1.0 - math.exp(-dt / plant.tau_m)
     ktau = tables.k_bar * plant.tau_f
-    q_max, area = plant.q_max, tables.area
-    P_shift = q_max * ktau / (d.n * area)  # p_f - mean p^s at the flow limit
+    q_max = plant.q_max
     theta = np.array(theta, float)
-    V = float(tables.volume(theta.sum()))
+    V = float(tables.volume(theta))
     Pm, P_cmd, limit = 0.0, 0.0, 0
     rec_theta, rec = np.empty((N, d.n)), np.empty((N, 4))
     lo, hi = tables.theta[0], tables.theta[-1]
@@ -175,10 +174,12 @@ def _integrate(controller, tables: HandTables, plant: PlantParams, theta, F_x, F
         p_r = float(np.interp(V, tables.V, tables.p_r))
         ps = tables.static_pressure(theta, F_x[k], F_y[k])
         drive = Pm + p_r - ps
-        q = area * drive.sum() / ktau
+        rate = tables.volume_rate(theta)  # dQ/dtheta per finger: a scalar for the paper's model
+        q = (rate * drive.sum() if np.ndim(rate) == 0 else rate @ drive) / ktau
         limit = 1 if q > q_max else (-1 if q < -q_max else 0)
-        if limit:
-            p_f = ps.mean() + limit * P_shift
+        if limit:  # the line pressure p_f that passes exactly +-q_max
+            p_f = (ps.mean() + limit * q_max * ktau / (d.n * rate) if np.ndim(rate) == 0
+                   else (rate @ ps + limit * q_max * ktau) / rate.sum())
             Pm, drive, q = p_f - p_r, p_f - ps, limit * q_max
         rec_theta[k] = theta
         rec[k] = Pm, P_cmd, V, limit

@@ -50,6 +50,8 @@ from .errors import InputError
 
 #: Reservoir models the reduced layer knows; extended when a new one is added.
 RESERVOIR_MODELS = ("ellipse", "fem")
+#: Finger models the reduced layer knows: the paper's eqs. (2), (5), (10), or FEM-calibrated.
+FINGER_MODELS = ("paper", "fem")
 
 PAPER_DESIGN_FILE = Path(__file__).resolve().parent.parent / "studies" / "designs" / "paper.toml"
 
@@ -85,6 +87,12 @@ class HandDesign:
     finger_material: rubber.Rubber | None = None
     #: reservoir sheet's strain energy (its shape; scaled to mu_sr); None: Neo-Hookean
     reservoir_material: rubber.Rubber | None = None
+    finger_model: str = "paper"  #: reduced finger model (W_f, Q), one of FINGER_MODELS
+    #: width of the ring by which each link holds the tube, centred on the link [mm];
+    #: not in the paper. The finger FEM ties these rings; finger_model "fem" is calibrated on it
+    tie_width: float = 10.0
+    #: calibration table of finger_model "fem" (a CSV file); "" = the one in the package
+    finger_table: str = ""
 
     def __post_init__(self):
         object.__setattr__(self, "hinge_s", tuple(float(s) for s in self.hinge_s))
@@ -116,10 +124,19 @@ class HandDesign:
             raise InputError("reservoir_model", "fem", "the FEM-calibrated reservoir table holds a "
                              f"Neo-Hookean sheet, not {self.reservoir_material.model}; use "
                              "reservoir_model = \"ellipse\" with this [reservoir.material]")
+        if self.finger_model not in FINGER_MODELS:
+            raise InputError("finger_model", self.finger_model,
+                             f"must be one of {', '.join(FINGER_MODELS)}")
+        if self.finger_model == "fem" and not self.finger_is_neo_hookean:
+            raise InputError("finger_model", "fem", "the FEM-calibrated finger table holds a "
+                             f"Neo-Hookean tube, not {self.finger_material.model}; use "
+                             "finger_model = \"paper\" with this [finger.material]")
 
     def check_volume(self, theta_max: float) -> None:
         """Raise if V0 cannot supply the oil the fingers take at bend ``theta_max`` [rad] (eq. (15))."""
-        needed = self.n * math.pi * self.a**2 * self.d * theta_max
+        from .finger import oil_taken  # the finger model's Q(theta) - Q(0); finger imports design
+
+        needed = self.n * float(oil_taken(theta_max, self))
         if needed >= self.V0:
             raise InputError("V0_mm3", self.V0,
                              f"must exceed the {needed:.0f} mm^3 the fingers take at "
@@ -191,6 +208,7 @@ _KEY_OF = {
     "R": "R_mm", "t": "t_mm", "V0": "V0_mm3", "n": "n", "n_s": "n_s",
     "mu_sf": "mu_sf_MPa", "mu_sr": "mu_sr_MPa", "hinge_s": "hinge_s_mm",
     "base_offset": "base_offset_mm", "g": "g_N_per_kg", "reservoir_model": "reservoir_model",
+    "finger_model": "finger_model", "tie_width": "tie_width_mm", "finger_table": "finger_table",
 }
 _FIELD_OF = {key: name for name, key in _KEY_OF.items()}
 PUBLIC_KEYS = tuple(_KEY_OF.values())
@@ -247,6 +265,7 @@ BOUNDS: dict[str, tuple[float, float]] = {
     "mu_sr_MPa": (1.0e-3, 100.0),     # rubber shear modulus, reservoir sheet
     "base_offset_mm": (-1000.0, 1000.0),
     "g_N_per_kg": (0.01, 100.0),
+    "tie_width_mm": (0.1, 1000.0),    # the links' tied rings (also shorter than every link)
 }
 
 
@@ -268,7 +287,14 @@ def _sheet_thinner_than_radius(design: "HandDesign") -> None:
 
 
 #: checks between fields, run after the bounds; each raises InputError naming one field
-CONSISTENCY = (_tube_fits, _sheet_thinner_than_radius)
+def _ties_fit_links(design: "HandDesign") -> None:
+    shortest = min(design.link_lengths)
+    if design.tie_width >= shortest:
+        raise InputError("tie_width_mm", design.tie_width,
+                         f"must be shorter than every link (shortest {shortest:g} mm)")
+
+
+CONSISTENCY = (_tube_fits, _sheet_thinner_than_radius, _ties_fit_links)
 
 
 def _to_public(name: str, value):
@@ -359,4 +385,7 @@ def load_design(path: str | Path | None = None) -> HandDesign:
     """Read a design TOML file (keys as in ``studies/designs/paper.toml``); None: the paper's."""
     path = Path(path) if path is not None else PAPER_DESIGN_FILE
     values = read_toml(path, "--design", "a design TOML file")
+    table = values.get("finger_table")
+    if isinstance(table, str) and table and not Path(table).is_absolute():
+        values["finger_table"] = str((path.parent / table).resolve())  # relative to the file
     return design_from_dict(values, source=path.name)

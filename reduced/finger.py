@@ -32,15 +32,28 @@ written without cancellation at small theta:
           \lambda^2 + \lambda^{-2} - 2 = \Big(\frac{x (2 + x)}{1 + x}\Big)^2.
 
 Everything is vectorised over theta (any shape). Units: mm, MPa, N*mm, rad.
+
+Finger models. What the hand (eqs. (25), (27), (28)) needs of a finger is its strain
+energy W_f(theta) and its oil volume Q(theta), both of one finger, with their derivatives:
+the pressure that holds a free finger at theta is P = (dW_f/dtheta) / (dQ/dtheta).
+:func:`energy`, :func:`energy_rate`, :func:`volume`, :func:`volume_rate` and
+:func:`oil_taken` dispatch on ``design.finger_model`` through a small registry mirroring the
+reservoir's: ``"paper"`` (this module: eqs. (2), (5), (10)) is built in; another model
+registers a :class:`FingerFunctions` with :func:`register_model`. A name not registered yet
+is looked up in the module ``reduced.finger_<name>``, which must register it when imported.
 """
 from __future__ import annotations
 
+import math
+from dataclasses import dataclass
 from functools import lru_cache
+from typing import Callable
 
 import numpy as np
 
 from .design import HandDesign
 from .errors import InputError
+from .registry import lookup
 
 #: Gauss-Legendre orders across the wall (r) and around the tube (phi, half turn); the
 #: relative quadrature error is below 1e-11 for -pi/2 <= theta <= pi (tests/test_reduced_finger.py).
@@ -152,3 +165,68 @@ def finger_force(theta, design: HandDesign, orders: tuple[int, int] = ORDERS):
     _check_stretch(theta, design)
     rubber = design.finger_rubber
     return _integrate(lambda x: rubber.nominal_stress("pure-shear", 1.0 + x), theta, design, orders, 1)
+
+
+# ---------------------------------------------------------------------- finger models
+Fn = Callable[[np.ndarray, HandDesign], np.ndarray]
+
+
+@dataclass(frozen=True)
+class FingerFunctions:
+    """One finger model: functions ``(theta [rad], design) -> array`` of theta's shape."""
+
+    energy: Fn  #: strain energy W_f of one finger [N mm]
+    energy_rate: Fn  #: dW_f/dtheta [N mm / rad]
+    volume: Fn  #: oil volume Q inside one finger [mm^3]
+    volume_rate: Fn  #: dQ/dtheta of one finger [mm^3 / rad]
+
+
+_MODELS: dict[str, FingerFunctions] = {}
+
+
+def register_model(name: str, functions: FingerFunctions) -> None:
+    """Make ``functions`` the finger model called ``name``."""
+    _MODELS[name] = functions
+
+
+def model(name: str) -> FingerFunctions:
+    """The registered finger model ``name`` (imports reduced.finger_<name> on first use)."""
+    return lookup(_MODELS, name, module=f"{__package__}.finger_{name}", field="finger_model")
+
+
+def energy(theta, design: HandDesign):
+    """Strain energy W_f(theta) of one finger [N mm] of the model ``design.finger_model``."""
+    return model(design.finger_model).energy(np.asarray(theta, float), design)
+
+
+def energy_rate(theta, design: HandDesign):
+    """dW_f/dtheta of one finger [N mm/rad]; the paper's model: mu_sf zeta_f (9)."""
+    return model(design.finger_model).energy_rate(np.asarray(theta, float), design)
+
+
+def volume(theta, design: HandDesign):
+    """Oil volume Q(theta) inside one finger [mm^3]; the paper's model: eq. (2) / n."""
+    return model(design.finger_model).volume(np.asarray(theta, float), design)
+
+
+def volume_rate(theta, design: HandDesign):
+    """dQ/dtheta of one finger [mm^3/rad]; the paper's model: a^2 pi d (eq. (4))."""
+    return model(design.finger_model).volume_rate(np.asarray(theta, float), design)
+
+
+def oil_taken(theta, design: HandDesign):
+    """Q(theta) - Q(0) of one finger [mm^3]: the oil it has drawn from the reservoir at theta."""
+    m = model(design.finger_model)
+    if m is PAPER:  # eq. (2): a^2 pi d theta, without the cancellation of Q(theta) - Q(0)
+        return design.a**2 * math.pi * design.d * np.asarray(theta, float)
+    theta = np.asarray(theta, float)
+    return m.volume(theta, design) - m.volume(np.zeros(()), design)
+
+
+PAPER = FingerFunctions(
+    energy=strain_energy,
+    energy_rate=finger_force,
+    volume=lambda theta, design: Q(theta, design) / design.n,
+    volume_rate=lambda theta, design: np.full(np.shape(theta), design.a**2 * math.pi * design.d),
+)
+register_model("paper", PAPER)

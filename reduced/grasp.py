@@ -30,7 +30,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from . import hand
+from . import finger, hand
 from .design import HandDesign
 from .errors import InputError
 
@@ -115,9 +115,11 @@ def _pad_axis(theta, design: HandDesign):
     return np.cos(alpha), np.sin(alpha)
 
 
-def _pump_area(design: HandDesign) -> float:
-    """n a^2 pi d [mm^3/rad]: oil per radian of bend, all fingers (eq. (4))."""
-    return design.n * design.a**2 * math.pi * design.d
+def _pump_area(design: HandDesign, theta):
+    """n dQ/dtheta [mm^3/rad]: oil per radian of bend, all fingers; eq. (4): n a^2 pi d."""
+    if design.finger_model == "paper":
+        return design.n * design.a**2 * math.pi * design.d
+    return design.n * finger.volume_rate(theta, design)
 
 
 def grasp_forces(P, theta, mass, w, design: HandDesign, *, reservoir: bool = True) -> GraspForces:
@@ -132,7 +134,7 @@ def grasp_forces(P, theta, mass, w, design: HandDesign, *, reservoir: bool = Tru
         raise InputError("weights", np.asarray(w).tolist(),
                          "make J_x w = 0: the tip does not move sideways, F_x is undetermined")
     mg = mass * design.g
-    F_x = (_pump_area(design) * (hand.pressure(theta, design, reservoir) - np.asarray(P, float))
+    F_x = (_pump_area(design, theta) * (hand.pressure(theta, design, reservoir) - np.asarray(P, float))
            - mg * J_yw) / (design.n * J_xw)
     F_y = mg / design.n * np.ones_like(F_x)
     cos_a, sin_a = _pad_axis(theta, design)
@@ -148,7 +150,7 @@ def pressure_to_hold(mass, theta, w, design: HandDesign, *, F_v=0.0, reservoir: 
     cos_a, sin_a = _pad_axis(theta, design)
     F_x = (np.asarray(F_v, float) - mg / design.n * sin_a) / cos_a
     J_xw, J_yw = projected_jacobian(theta, w, design)
-    return hand.pressure(theta, design, reservoir) - (design.n * F_x * J_xw + mg * J_yw) / _pump_area(design)
+    return hand.pressure(theta, design, reservoir) - (design.n * F_x * J_xw + mg * J_yw) / _pump_area(design, theta)
 
 
 def angle_at(P, mass: float, w, design: HandDesign, *, F_v: float = 0.0, reservoir: bool = True):

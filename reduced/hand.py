@@ -7,7 +7,9 @@ Eq. (25) with F_x = F_y = 0 gives, for n fingers sharing one pump and one reserv
 
 since mu_sr zeta_r / (n a^2 pi d) = -p_r(V(theta)) (dV/dtheta = -n a^2 pi d); the second form
 works for every reservoir model of :mod:`reduced.reservoir`. Without reservoir (28) the last
-term is absent. P is the pump's differential pressure: with the reservoir P(0) < 0, i.e. at
+term is absent. For any finger model of :mod:`reduced.finger` (W_f, Q of one finger) the
+same balance P n dQ/dtheta = d(n W_f + W_r)/dtheta reads P = (dW_f/dtheta)/(dQ/dtheta) -
+p_r(V0 - n (Q(theta) - Q(0))); the paper's model gives (27), (28) as printed. P is the pump's differential pressure: with the reservoir P(0) < 0, i.e. at
 zero pump pressure the charged sheet already bends the fingers a little (reported, not clipped).
 
 The inverse theta(P) is found on the monotone branch of P(theta) through theta = 0 inside
@@ -44,8 +46,11 @@ def check_theta(theta) -> np.ndarray:
 
 def finger_pressure(theta, design: HandDesign):
     """Eq. (28): P = mu_sf zeta_f / (a^2 pi d) [MPa], the hand without reservoir, theta [rad];
-    for another rubber mu_sf zeta_f is dW_f/dtheta (:func:`reduced.finger.finger_force`)."""
-    return finger.finger_force(theta, design) / (design.a**2 * math.pi * design.d)
+    for another rubber mu_sf zeta_f is dW_f/dtheta (:func:`reduced.finger.finger_force`); for any
+    finger model P = (dW_f/dtheta) / (dQ/dtheta)."""
+    if design.finger_model == "paper":  # as printed, bit for bit
+        return finger.finger_force(theta, design) / (design.a**2 * math.pi * design.d)
+    return finger.energy_rate(theta, design) / finger.volume_rate(theta, design)
 
 
 def pressure(theta, design: HandDesign, reservoir: bool = True):
@@ -67,9 +72,19 @@ def bend_angle(P, design: HandDesign, reservoir: bool = True):
     """Inverse of :func:`pressure`: free bend theta [rad] at pump pressure P [MPa], vectorised."""
     lo, hi = THETA_RANGE
     if reservoir:  # the fingers cannot take more oil than the reservoir holds
-        hi = min(hi, 0.999 * design.V0 / (design.n * design.a**2 * math.pi * design.d))
+        hi = min(hi, volume_limit(design))
     return invert_monotone(lambda th: pressure(th, design, reservoir), P, (lo, hi),
                            field="pressure_MPa", unit="MPa")
+
+
+def volume_limit(design: HandDesign) -> float:
+    """The bend [rad] at which the n fingers have taken 99.9 % of the reservoir's oil V0."""
+    if design.finger_model == "paper":
+        return 0.999 * design.V0 / (design.n * design.a**2 * math.pi * design.d)
+    theta = np.linspace(0.0, THETA_RANGE[1], 4097)
+    taken = design.n * finger.oil_taken(theta, design)  # increasing: dQ/dtheta > 0
+    return float(np.interp(0.999 * design.V0, taken, theta)) if taken[-1] > 0.999 * design.V0 \
+        else THETA_RANGE[1]
 
 
 def invert_monotone(fn, y, bracket: tuple[float, float], *, field: str, unit: str = "",

@@ -49,6 +49,9 @@ non-negatively, onto the outward directions of the two fingers that bracket its 
 other fingers feel no horizontal force (frictionless contact, no adhesion). So a
 horizontal push bends the fingers unequally.
 
+Another finger model (``design.finger_model``, :mod:`reduced.finger`) replaces a^2 pi d by
+that finger's dQ/dtheta at theta_j and a^2 pi d theta_j by its Q(theta_j) - Q(0) throughout.
+
 Sensors. Angles and pressure are sampled every ``1 / sample_hz`` s (zero-order hold to
 the controller), with optional Gaussian noise.
 
@@ -64,7 +67,7 @@ from functools import cached_property
 
 import numpy as np
 
-from . import hand, reservoir
+from . import finger, hand, reservoir
 from .design import HandDesign
 from .errors import InputError
 from .grasp import PAPER_WEIGHTS, projected_jacobian
@@ -142,8 +145,12 @@ class HandTables:
         self.theta = np.linspace(*TABLE_RANGE, TABLE_SIZE)
         self.p28 = hand.finger_pressure(self.theta, design)
         self.jxw, self.jyw = projected_jacobian(self.theta, self.w, design)
-        self.area = design.a**2 * math.pi * design.d  #: a^2 pi d [mm^2]: dQ/dtheta of one finger
-        span = self.area * design.n * np.array(TABLE_RANGE)
+        self.area = design.a**2 * math.pi * design.d  #: a^2 pi d [mm^2]: dQ/dtheta of one finger (2)
+        #: dQ/dtheta and Q - Q(0) of one finger on the table (the finger model's; eq. (2) for "paper")
+        self.rate, self.taken = (finger.volume_rate(self.theta, design), finger.oil_taken(self.theta, design))
+        self.uniform = design.finger_model == "paper"  #: dQ/dtheta = a^2 pi d for every angle
+        span = self.area * design.n * np.array(TABLE_RANGE) if self.uniform else \
+            design.n * finger.oil_taken(np.array(TABLE_RANGE), design)
         self.V = np.linspace(design.V0 - span[1], design.V0 - span[0], TABLE_SIZE)
         if self.V[0] <= 0:  # the fingers can take all the oil: keep the table where V > 0
             self.V = np.linspace(1e-3 * design.V0, self.V[-1], TABLE_SIZE)
@@ -156,15 +163,22 @@ class HandTables:
         p = np.interp(theta, self.theta, self.p28)
         jx = np.interp(theta, self.theta, self.jxw)
         jy = np.interp(theta, self.theta, self.jyw)
-        return p - (F_x * jx + F_y * jy) / self.area
+        return p - (F_x * jx + F_y * jy) / self.volume_rate(theta)
 
     def reservoir_pressure(self, V):
         """p_r(V) [MPa] from the table."""
         return np.interp(V, self.V, self.p_r)
 
-    def volume(self, theta_sum):
-        """Eq. (15) with unequal fingers: V = V0 - a^2 pi d sum_j theta_j [mm^3]."""
-        return self.design.V0 - self.area * theta_sum
+    def volume_rate(self, theta):
+        """dQ/dtheta of each finger at its angle [mm^3/rad]; the scalar a^2 pi d for the paper's model."""
+        return self.area if self.uniform else np.interp(theta, self.theta, self.rate)
+
+    def volume(self, theta):
+        """Eq. (15) with unequal fingers (n,) [rad]: V = V0 - a^2 pi d sum_j theta_j [mm^3];
+        V0 - sum_j (Q(theta_j) - Q(0)) for another finger model."""
+        if self.uniform:
+            return self.design.V0 - self.area * np.sum(theta)
+        return self.design.V0 - np.sum(np.interp(theta, self.theta, self.taken))
 
     @cached_property
     def slopes(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
@@ -192,14 +206,14 @@ def equilibrium(P, F_x, F_y, tables: HandTables, theta0=None, *, tol=1e-10, max_
     theta = np.full(d.n, 0.5) if theta0 is None else np.array(theta0, float)
     dp28, djx, djy, dpr = tables.slopes
     for _ in range(max_iter):
-        V = tables.volume(theta.sum())
+        V = tables.volume(theta)
         r = P + tables.reservoir_pressure(V) - tables.static_pressure(theta, F_x, F_y)
         if np.max(np.abs(r)) < tol:
             return theta
         ks = (np.interp(theta, tables.theta, dp28)
               - (F_x * np.interp(theta, tables.theta, djx)
-                 + F_y * np.interp(theta, tables.theta, djy)) / tables.area)
-        J = -np.diag(ks) - np.interp(V, tables.V, dpr) * tables.area
+                 + F_y * np.interp(theta, tables.theta, djy)) / tables.volume_rate(theta))
+        J = -np.diag(ks) - np.interp(V, tables.V, dpr) * tables.volume_rate(theta)
         theta = theta - np.linalg.solve(J, r)
         tables.check(theta)
     raise InputError("equilibrium", float(P), f"no static state found (residual {np.max(np.abs(r)):.2e} MPa)")

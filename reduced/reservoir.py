@@ -29,21 +29,25 @@ Units: mm, mm^3, MPa, N*mm, rad.
 """
 from __future__ import annotations
 
-import importlib
 from typing import Callable
 
 import numpy as np
 
 from .design import HandDesign
 from .errors import InputError
+from .registry import lookup
+from .finger import oil_taken
 
 PressureFn = Callable[[np.ndarray, HandDesign], np.ndarray]
 _MODELS: dict[str, PressureFn] = {}
 
 
 def oil_volume(theta, design: HandDesign):
-    """Eq. (15): oil left in the reservoir at finger bend theta [rad] -> V [mm^3]."""
+    """Eq. (15): oil left in the reservoir at finger bend theta [rad] -> V [mm^3]; with
+    another finger model than the paper's, V0 - n (Q(theta) - Q(0)) of that model."""
     g = design
+    if g.finger_model != "paper":
+        return g.V0 - g.n * oil_taken(theta, g)
     return g.V0 - g.a**2 * np.pi * g.d * g.n * np.asarray(theta, float)
 
 
@@ -114,14 +118,7 @@ def register_model(name: str, pressure_fn: PressureFn) -> None:
 
 def model(name: str) -> PressureFn:
     """The registered pressure function of reservoir model ``name`` (imports reduced.reservoir_<name>)."""
-    if name not in _MODELS:
-        try:
-            importlib.import_module(f"{__package__}.reservoir_{name}")
-        except ModuleNotFoundError:
-            pass
-    if name not in _MODELS:
-        raise InputError("reservoir_model", name, f"no such model; available: {', '.join(_MODELS)}")
-    return _MODELS[name]
+    return lookup(_MODELS, name, module=f"{__package__}.reservoir_{name}", field="reservoir_model")
 
 
 def pressure(V, design: HandDesign):

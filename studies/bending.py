@@ -19,7 +19,7 @@ from dataclasses import asdict, dataclass, field
 
 import numpy as np
 
-from fem.finger import FingerModel, FingerOptions, FingerState, SweepStats, solve_pressures
+from fem.finger import FingerModel, FingerOptions, FingerState, SweepStats, ring_width, solve_pressures
 from fem.newton import NotConverged
 from reduced import finger as reduced_finger
 from reduced import hand
@@ -58,7 +58,8 @@ class BendingResult:
         """Numbers and provenance for result.json."""
         return {"rows": self.rows, "peak": self.peak, "ndofs": self.ndofs,
                 "nelements": self.nelements, "build_seconds": self.build_seconds,
-                "stats": asdict(self.stats), "options": asdict(self.model.options),
+                "stats": asdict(self.stats), "options": {**asdict(self.model.options),  # the ring width in effect
+                                  "tie_width": ring_width(self.model.design, self.model.options)},
                 "design": self.model.design.to_dict(), "design_hash": self.model.design.hash()}
 
 

@@ -94,6 +94,11 @@ KINDS: dict[str, Kind] = {
                     {"diameter_mm": Num(60.0, 500.0), "mass_kg": Num(0.0, 20.0),
                      "pressure_mpa": Num(0.01, 3.0), "dP_mpa": Num(0.001, 0.5)}, fem=True,
                     mesh=Num(2.0, 12.0)),
+    "finger_bend": Kind("studies.finger_calibration:bend_case",
+                        {"pressures_mpa": NumList(200), "theta_target_deg": Num(1.0, 180.0),
+                         "p_max_mpa": Num(0.01, 5.0), "p_step_mpa": Num(0.001, 1.0),
+                         "axial_size_mm": Num(0.2, 20.0)},
+                        fem=True, mesh=Num(2.0, 12.0), required=("pressures_mpa",)),
 }
 #: the entry-point group where installed packages declare more kinds
 ENTRY_POINT_GROUP = "softhand.kinds"

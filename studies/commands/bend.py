@@ -42,7 +42,8 @@ def configure(parser) -> None:
                         help="outer surface held by the links: a ring in each link's middle "
                              "(default) or the whole link but a gap at the hinges")
     parser.add_argument("--tie-width-mm", type=float, default=None,
-                        help="width of each ring for --tie ring [mm] (default 10)")
+                        help="width of each ring for --tie ring [mm]; overrides the design's "
+                             "tie_width_mm (default 10)")
     parser.add_argument("--peak-mpa", type=float, default=2.0,
                         help="go on to this pressure and report peak stretch and stress "
                              "(default 2.0; 0: skip)")
@@ -101,7 +102,7 @@ def _options(args):
                          "apply to --mesher gmsh only")
     if mesher == "gmsh" and args.axial_size_mm is not None:
         raise InputError("--axial-size-mm", args.axial_size_mm, "applies to --mesher layered only")
-    given = {"mesher": mesher, "mesh_size": args.mesh_size_mm, "tie_width": args.tie_width_mm,
+    given = {"mesher": mesher, "mesh_size": args.mesh_size_mm,
              "axial_size": args.axial_size_mm, "edge_ratio": args.edge_ratio,
              "fiber_intorder": args.fiber_intorder, "mesh_refine": args.refine}
     return FingerOptions(tie=args.tie, **{k: v for k, v in given.items() if v is not None})
@@ -123,6 +124,8 @@ def run(args) -> int:
 
         raise InputError("--tie-width-mm", args.tie_width_mm,
                          f"must be shorter than every link (shortest {min(design.link_lengths):g} mm)")
+    if args.tie_width_mm is not None:
+        design = design.replace(tie_width=args.tie_width_mm)
     study = BendingStudy(design, pressures, _options(args),
                          peak_mpa=args.peak_mpa if args.peak_mpa > pressures[-1] else 0.0)
     out = Path(args.out)

@@ -1,0 +1,344 @@
+r"""Finger model ``"fem"``: W_f(theta) and Q(theta) of one finger calibrated from the finger FEM.
+
+Dimensional analysis. The finger FEM (Neo-Hookean tube, inextensible windings, rigid links
+holding rings of the tube) has one modulus, mu_sf, and the lengths a, b, d, the link length
+L = l0 / 6 (5 equal hinges) and the tie width w. So
+
+.. math:: \frac{P}{\mu_{sf}} = \tilde p\Big(\theta; \frac{b}{a}, \frac{d}{a}, \frac{L}{a},
+          \frac{w}{L}\Big), \qquad \frac{\Delta Q}{a^3} = \tilde q(\theta; \dots).
+
+The physics already known carries most of it: the paper's eqs. (28) and (2), which give
+P and Delta Q = a^2 pi d theta for the same groups (the table's ``prior``: ``"paper"``, or
+``"rings"``: eq. (28) with the tube stretching only over its untied length l0 - 6 w, the
+finger FEM's kinematic bound, see :func:`prior_pressure`). The table ``reduced/data/finger_fem.csv``
+holds the FEM's (theta, P/mu, Delta Q/a^3) at the sampled designs; this model fits the
+slowly varying residuals
+
+.. math:: y = \ln\frac{P_{FEM}}{P_{prior}}, \qquad z = \frac{\Delta Q_{FEM}}{a^2\pi d\,\theta}
+
+by least squares as polynomials in x = the groups' logarithms (with -ln(1 - w/L) for the
+tie, the tied share of the length) scaled to [-1, 1] over the table's range, times 1, theta,
+... (degrees from the table's ``# fit:`` line). So P(theta) = P_prior(theta) e^{y} and
+Delta Q = a^2 pi d theta z. Beyond the table's largest angle theta_max (and below -theta_max)
+y and z are held at their end values.
+
+Energy consistency. Per design, P(theta) and Delta Q(theta) are sampled at 0.5 deg and
+interpolated by cubic Hermite polynomials; dW_f/dtheta is defined as P dQ/dtheta (a quintic
+per piece) and W_f as its exact integral (3-point Gauss per piece, W_f(0) = 0), so
+P dQ/dtheta = dW_f/dtheta holds to rounding and (27), (28), (25) follow from the
+virtual-work balance unchanged.
+
+Its space. Designs whose groups leave the table's range, or that do not have 5 equal hinges,
+raise one InputError naming the group and its range; ``softhand calibrate finger --design``
+makes a table for such a design. Units: mm, MPa, N mm, rad.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from functools import lru_cache
+from itertools import combinations_with_replacement
+from pathlib import Path
+from typing import NamedTuple
+
+import numpy as np
+
+from . import finger
+from .design import HandDesign
+from .errors import InputError
+
+__all__ = ["TABLE_FILE", "GROUPS", "Table", "read_table", "groups_of", "curves", "FEM"]
+
+TABLE_FILE = Path(__file__).resolve().parent / "data" / "finger_fem.csv"
+#: the nondimensional groups, in table column order
+GROUPS = ("b_a", "d_a", "link_a", "tie_link")
+LABELS = {"b_a": "b/a", "d_a": "d/a", "link_a": "link/a", "tie_link": "tie/link"}
+COLUMNS = ("design", *GROUPS, "theta", "p_tilde", "q_tilde")
+#: the physics a table's residual is taken against (see :func:`prior_pressure`)
+PRIORS = ("paper", "rings")
+N_LINKS = 6
+_KNOTS = np.linspace(-0.5 * math.pi, math.pi, 541)  # 0.5 deg over the hand's THETA_RANGE
+
+
+@dataclass(frozen=True)
+class Table:
+    """A calibration table: FEM rows, the calibrated ranges and the fit's degrees."""
+
+    source: str  #: file name, for messages
+    rows: dict  #: column -> array
+    ranges: dict  #: group -> (min, max)
+    design_degree: int  #: total degree of the polynomial in the groups
+    theta_degree: int  #: degree in theta
+    prior: str = "paper"  #: the physics the residual is taken against, one of PRIORS
+    header: tuple[str, ...] = ()  #: the provenance comment lines
+
+
+def _bad(path, allowed: str):
+    return InputError("finger_table", str(path), allowed)
+
+
+def read_table(path: str | Path = TABLE_FILE) -> Table:
+    """Read a finger calibration CSV; InputError naming the file on any problem."""
+    path = Path(path)
+    try:
+        text = path.read_text()
+    except (FileNotFoundError, IsADirectoryError):
+        raise _bad(path, "no such file; give a CSV written by softhand calibrate finger") from None
+    except UnicodeDecodeError:
+        raise _bad(path, "is not a text (CSV) file") from None
+    comments = [line for line in text.splitlines() if line.startswith("#")]
+    lines = [line for line in text.splitlines() if line.strip() and not line.startswith("#")]
+    if not lines or tuple(c.strip() for c in lines[0].split(",")) != COLUMNS:
+        raise _bad(path, f"needs the header {','.join(COLUMNS)}")
+    try:
+        values = np.array([[float(x) for x in line.split(",")] for line in lines[1:]], ndmin=2)
+    except ValueError:
+        raise _bad(path, "has a cell that is not a number") from None
+    if values.shape[0] == 0 or values.shape[1] != len(COLUMNS) or not np.all(np.isfinite(values)):
+        raise _bad(path, f"needs rows of {len(COLUMNS)} finite numbers")
+    rows = {c: values[:, i] for i, c in enumerate(COLUMNS)}
+    if np.any(rows["theta"] <= 0) or np.any(rows["p_tilde"] <= 0) or np.any(rows["q_tilde"] <= 0):
+        raise _bad(path, "theta, p_tilde and q_tilde must be positive (the P = 0 state is implied)")
+    ranges, degrees, prior = _header(comments, path)
+    for g in GROUPS:
+        lo, hi = ranges[g]
+        if np.any(rows[g] < lo * (1 - 1e-9)) or np.any(rows[g] > hi * (1 + 1e-9)):
+            raise _bad(path, f"has {LABELS[g]} outside its '# range:' [{lo:g}, {hi:g}]")
+    return Table(path.name, rows, ranges, *degrees, prior=prior, header=tuple(comments))
+
+
+def _header(comments: list[str], path) -> tuple[dict, tuple[int, int], str]:
+    """The '# range: g=lo:hi, ...' and '# fit: design_degree=D, theta_degree=T[, prior=P]' lines."""
+    spec = {}
+    for line in comments:
+        body = line.lstrip("#").strip()
+        for tag in ("range:", "fit:"):
+            if body.startswith(tag):
+                for item in body[len(tag):].split(","):
+                    key, _, value = item.strip().partition("=")
+                    spec[key.strip()] = value.strip()
+    try:
+        ranges = {g: tuple(float(v) for v in spec[g].split(":")) for g in GROUPS}
+        degrees = (int(spec["design_degree"]), int(spec["theta_degree"]))
+    except (KeyError, ValueError):
+        raise _bad(path, "needs the lines '# range: b_a=lo:hi, d_a=..., link_a=..., tie_link=...' "
+                         "and '# fit: design_degree=D, theta_degree=T'") from None
+    if any(len(r) != 2 or not 0 < r[0] <= r[1] for r in ranges.values()) or min(degrees) < 0:
+        raise _bad(path, "has a range lo:hi with not 0 < lo <= hi, or a negative degree")
+    prior = spec.get("prior", "paper")
+    if prior not in PRIORS:
+        raise _bad(path, f"has prior={prior}; allowed: {', '.join(PRIORS)}")
+    if ranges["tie_link"][1] >= 1.0:
+        raise _bad(path, "has tie/link >= 1: a ring cannot be wider than its link")
+    return ranges, degrees, prior
+
+
+# ---------------------------------------------------------------------- groups and the fit
+def groups_of(design: HandDesign) -> dict:
+    """The design's groups b/a, d/a, link/a, tie/link (5 equal hinges required)."""
+    links = np.asarray(design.link_lengths)
+    if design.n_s != N_LINKS - 1 or np.ptp(links) > 1e-6 * design.l0:
+        raise InputError("hinge_s_mm", list(design.hinge_s),
+                         'finger_model "fem" is calibrated for n_s = 5 equal hinges '
+                         f"(l0/6 apart: {[round(design.l0 * k / 6, 3) for k in range(1, 6)]})")
+    L = design.l0 / N_LINKS
+    return {"b_a": design.b / design.a, "d_a": design.d / design.a, "link_a": L / design.a,
+            "tie_link": design.tie_width / L}
+
+
+def _x(groups: dict, table: Table) -> np.ndarray:
+    """Scaled log-groups in [-1, 1] over the table's ranges, only those the table varies; (..., k)."""
+    cols = []
+    for g in GROUPS:
+        lo, hi = table.ranges[g]
+        if hi > lo * (1 + 1e-9):
+            f = (lambda v: -np.log1p(-v)) if g == "tie_link" else np.log
+            cols.append(2 * (f(np.asarray(groups[g], float)) - f(lo)) / (f(hi) - f(lo)) - 1)
+    return np.stack(cols, axis=-1) if cols else np.zeros(np.shape(groups[GROUPS[0]]) + (0,))
+
+
+def _features(x: np.ndarray, theta, table: Table) -> np.ndarray:
+    """Monomials of x (total degree <= design_degree) times theta^k (k <= theta_degree); (..., m)."""
+    k = x.shape[-1]
+    monos = [np.ones(x.shape[:-1])]
+    for degree in range(1, table.design_degree + 1):
+        for combo in combinations_with_replacement(range(k), degree):
+            monos.append(np.prod(x[..., list(combo)], axis=-1))
+    theta = np.asarray(theta, float)
+    return np.stack([m * theta**j for j in range(table.theta_degree + 1) for m in monos], axis=-1)
+
+
+class _Tube(NamedTuple):
+    """The lengths of a tube [mm] that eq. (10) integrates over (a design's a, b, d, l0)."""
+
+    a: float
+    b: float
+    d: float
+    l0: float
+
+
+def prior_pressure(theta, groups: dict, prior: str):
+    """P / mu_sf [-] of the physics the fit corrects: eq. (28) ("paper"), or eq. (28) with the
+    tube stretching over its untied length l0 - 6 w only ("rings": the tied rings cannot
+    stretch, the kinematic bound of the finger FEM)."""
+    L = groups["link_a"]
+    l0 = N_LINKS * L * ((1.0 - groups["tie_link"]) if prior == "rings" else 1.0)
+    # eq. (10) needs only the tube's lengths; any point of the groups' box, not only a design
+    free = _Tube(a=1.0, b=groups["b_a"], d=groups["d_a"], l0=l0)
+
+    # bent backwards beyond the angle where the outermost fibre halves its length, P continues
+    # linearly (C1): the short untied length of "rings" would otherwise compress it to nothing
+    lo = -0.5 * l0 / (groups["d_a"] + 1.0 + groups["b_a"])
+    theta = np.asarray(theta, float)
+    t = np.maximum(theta, lo)
+    P = finger.zeta_f(t, free) / (math.pi * groups["d_a"])
+    if np.any(theta < lo):
+        h = 1e-6
+        slope = (finger.zeta_f(lo + h, free) - finger.zeta_f(lo - h, free)) / (2 * h * math.pi * groups["d_a"])
+        P = np.where(theta < lo, P + slope * (theta - lo), P)
+    return P
+
+
+@lru_cache(maxsize=8)
+def _fit(path: str) -> tuple[Table, np.ndarray, np.ndarray, float]:
+    """(table, beta_y, beta_z, theta_max): least-squares coefficients of y and z."""
+    table = read_table(path)
+    r = table.rows
+    ids = np.unique(r["design"])
+    y = np.empty(r["theta"].size)
+    for i in ids:  # eq. (28) per design, all its angles at once
+        at = r["design"] == i
+        g = {k: float(r[k][at][0]) for k in GROUPS}
+        y[at] = np.log(r["p_tilde"][at] / prior_pressure(r["theta"][at], g, table.prior))
+    z = r["q_tilde"] / (math.pi * r["d_a"] * r["theta"])
+    A = _features(_x(r, table), r["theta"], table)
+    if np.linalg.matrix_rank(A) < A.shape[1]:
+        raise _bad(path, f"has too few designs ({ids.size}) for the fit's degrees "
+                         f"({table.design_degree}, {table.theta_degree}); lower them in '# fit:'")
+    beta_y = np.linalg.lstsq(A, y, rcond=None)[0]
+    beta_z = np.linalg.lstsq(A, z, rcond=None)[0]
+    return table, beta_y, beta_z, float(r["theta"].max())
+
+
+def check_space(design: HandDesign, table: Table) -> dict:
+    """The design's groups; InputError naming the first group outside the table's range."""
+    groups = groups_of(design)
+    for g in GROUPS:
+        lo, hi = table.ranges[g]
+        if not lo * (1 - 1e-9) <= groups[g] <= hi * (1 + 1e-9):
+            raise InputError(LABELS[g], round(groups[g], 6),
+                             f'outside the range [{lo:.4g}, {hi:.4g}] of finger_model "fem" '
+                             f"({table.source}); calibrate this design with softhand calibrate "
+                             "finger --design FILE --out FILE.csv")
+    return groups
+
+
+def residuals(theta, design: HandDesign) -> tuple[np.ndarray, np.ndarray]:
+    """(y, z) of the fit at theta [rad] for this design: P = P_(28) e^y, Delta Q = a^2 pi d theta z."""
+    table, beta_y, beta_z, theta_max = _fit(_table_path(design))
+    groups = check_space(design, table)
+    t = np.clip(np.asarray(theta, float), -theta_max, theta_max)
+    F = _features(np.broadcast_to(_x(groups, table), t.shape + (len(_x(groups, table)),)), t, table)
+    return F @ beta_y, F @ beta_z
+
+
+def _table_path(design: HandDesign) -> str:
+    return design.finger_table or str(TABLE_FILE)
+
+
+# ---------------------------------------------------------------------- one design's curves
+class Hermite:
+    """Cubic Hermite interpolant on the uniform knots :data:`_KNOTS` of values f and slopes m
+    (the end pieces continue as polynomials); NumPy only, so ``softhand curve`` starts fast."""
+
+    def __init__(self, f: np.ndarray, m: np.ndarray):
+        self.f, self.m = f, m
+        self.x0, self.h = float(_KNOTS[0]), float(_KNOTS[1] - _KNOTS[0])
+
+    def _locate(self, t):
+        t = np.asarray(t, float)
+        i = np.clip(np.floor((t - self.x0) / self.h).astype(int), 0, self.f.size - 2)
+        return i, (t - self.x0) / self.h - i
+
+    def __call__(self, t):
+        i, s = self._locate(t)
+        h00, h10, h01, h11 = 2 * s**3 - 3 * s**2 + 1, s**3 - 2 * s**2 + s, 3 * s**2 - 2 * s**3, s**3 - s**2
+        return h00 * self.f[i] + self.h * (h10 * self.m[i] + h11 * self.m[i + 1]) + h01 * self.f[i + 1]
+
+    def derivative(self, t):
+        i, s = self._locate(t)
+        d00, d10, d11 = 6 * s**2 - 6 * s, 3 * s**2 - 4 * s + 1, 3 * s**2 - 2 * s
+        return d00 * (self.f[i] - self.f[i + 1]) / self.h + d10 * self.m[i] + d11 * self.m[i + 1]
+
+
+#: 3-point Gauss-Legendre rule on [0, 1]: exact for the quintic P dQ/dtheta of one piece
+_GAUSS_X = 0.5 + 0.5 * np.sqrt(0.6) * np.array([-1.0, 0.0, 1.0])
+_GAUSS_W = np.array([5.0, 8.0, 5.0]) / 18.0
+
+
+@dataclass(frozen=True, eq=False)
+class Curves:
+    """One design's calibrated finger: Hermite cubics of P and Delta Q; W_f = int P dQ exactly."""
+
+    P: Hermite  #: pressure of the free finger [MPa]
+    dQ: Hermite  #: Delta Q = Q - Q(0) of one finger [mm^3]
+    W_knots: np.ndarray  #: W_f at the knots [N mm], W_f(0) = 0
+    Q0: float  #: Q(0) = a^2 pi l0 [mm^3]
+
+    def energy_rate(self, t):
+        """dW_f/dtheta = P dQ/dtheta [N mm/rad] (a quintic per piece)."""
+        return self.P(t) * self.dQ.derivative(t)
+
+    def energy(self, t):
+        """W_f [N mm]: the knot value plus the 3-point Gauss integral from the piece's start."""
+        t = np.asarray(t, float)
+        i, _ = self.P._locate(t)
+        start = _KNOTS[i]
+        span = t - start
+        tau = start[..., None] + span[..., None] * _GAUSS_X
+        return self.W_knots[i] + span * (self.energy_rate(tau) @ _GAUSS_W)
+
+
+def _with_slopes(fn) -> Hermite:
+    """Hermite interpolant of fn at the knots, slopes by central differences (h = 1e-6 rad)."""
+    h = 1e-6
+    return Hermite(fn(_KNOTS), (fn(_KNOTS + h) - fn(_KNOTS - h)) / (2 * h))
+
+
+@lru_cache(maxsize=64)
+def curves(design: HandDesign) -> Curves:
+    """The calibrated curves of ``design`` (cached per design)."""
+    table = _fit(_table_path(design))[0]
+    groups = check_space(design, table)
+    P = _with_slopes(lambda t: design.mu_sf * prior_pressure(t, groups, table.prior)
+                     * np.exp(residuals(t, design)[0]))
+    dQ = _with_slopes(lambda t: design.a**2 * math.pi * design.d * t * residuals(t, design)[1])
+    pieces = np.empty(_KNOTS.size)
+    pieces[0] = 0.0
+    tau = _KNOTS[:-1, None] + (_KNOTS[1] - _KNOTS[0]) * _GAUSS_X
+    pieces[1:] = (_KNOTS[1] - _KNOTS[0]) * (P(tau) * dQ.derivative(tau)) @ _GAUSS_W
+    W = np.cumsum(pieces)
+    W -= W[np.argmin(np.abs(_KNOTS))]  # theta = 0 is a knot
+    return Curves(P, dQ, W, design.a**2 * math.pi * design.l0)
+
+
+def _energy(theta, design):
+    return curves(design).energy(theta)
+
+
+def _energy_rate(theta, design):
+    return curves(design).energy_rate(theta)
+
+
+def _volume(theta, design):
+    c = curves(design)
+    return c.Q0 + c.dQ(theta)
+
+
+def _volume_rate(theta, design):
+    return curves(design).dQ.derivative(theta)
+
+
+FEM = finger.FingerFunctions(energy=_energy, energy_rate=_energy_rate, volume=_volume,
+                             volume_rate=_volume_rate)
+finger.register_model("fem", FEM)

@@ -1,0 +1,147 @@
+"""The FEM-calibrated finger model ("fem"): energy identity, the fit, the table loader, its space."""
+import math
+
+import numpy as np
+import pytest
+from scipy.integrate import quad
+
+from reduced import finger, finger_fem, hand, reservoir
+from reduced.design import HandDesign
+from reduced.errors import InputError
+from studies.finger_calibration import finger_design
+from studies.finger_table import table_csv
+
+BOX = {"a_mm": (3.0, 6.0), "b_mm": (3.0, 7.0), "d_mm": (10.0, 20.0), "l0_mm": (120.0, 200.0),
+       "tie_width_mm": (5.0, 15.0)}
+#: a known residual the fit's model class holds exactly: y = ln(P / P_28), z = dQ / (a^2 pi d theta)
+Y = (0.25, 0.05, 0.1)   # y = Y0 + Y1 x_tie + Y2 theta
+Z = (1.7, -0.03, 0.08)  # z = Z0 + Z1 x_tie + Z2 theta
+
+
+def _synthetic_table(tmp_path, ties=(5.0, 10.0, 15.0)):
+    """A table whose 'FEM' points follow Y, Z exactly, over the tie width only."""
+    designs = [finger_design({"a_mm": 4.0, "b_mm": 5.0, "d_mm": 15.0, "l0_mm": 180.0,
+                              "tie_width_mm": t}) for t in ties]
+    groups = [finger_fem.groups_of(d) for d in designs]
+    lo, hi = (-math.log1p(-g) for g in (groups[0]["tie_link"], groups[-1]["tie_link"]))
+    rows = []
+    for i, (d, g) in enumerate(zip(designs, groups)):
+        x = 2 * (-math.log1p(-g["tie_link"]) - lo) / (hi - lo) - 1
+        for theta in (0.2, 0.6, 1.0):
+            P28 = float(hand.finger_pressure(theta, d))
+            rows.append({"design": i, **g, "theta": theta,
+                         "p_tilde": P28 * math.exp(Y[0] + Y[1] * x + Y[2] * theta) / d.mu_sf,
+                         "q_tilde": math.pi * d.d * theta * (Z[0] + Z[1] * x + Z[2] * theta) * d.a**2 / d.a**3})
+    ranges = {k: (v, v) for k, v in groups[0].items()}
+    ranges["tie_link"] = (groups[0]["tie_link"], groups[-1]["tie_link"])
+    path = tmp_path / "synthetic.csv"
+    path.write_text(table_csv(rows, ranges, ["synthetic test table"], (1, 1)))
+    return path, designs, (lo, hi)
+
+
+def test_fit_recovers_a_residual_of_its_model_class(tmp_path):
+    """P = P_28 e^y and dQ = a^2 pi d theta z between and beyond the rows: rtol 1e-6 bounds the
+    cubic splines' interpolation error (0.5 deg knots); theta is capped at the table's 1.0 rad."""
+    path, designs, (lo, hi) = _synthetic_table(tmp_path)
+    d = designs[0].replace(tie_width=8.0, finger_model="fem", finger_table=str(path))
+    x = 2 * (-math.log1p(-finger_fem.groups_of(d)["tie_link"]) - lo) / (hi - lo) - 1
+    theta = np.array([0.05, 0.4, 0.9, 1.3])
+    t = np.minimum(theta, 1.0)
+    expected_P = hand.finger_pressure(theta, d.replace(finger_model="paper")) * np.exp(Y[0] + Y[1] * x + Y[2] * t)
+    np.testing.assert_allclose(hand.finger_pressure(theta, d), expected_P, rtol=1e-6)
+    inside = theta[:3]
+    expected_dQ = d.a**2 * math.pi * d.d * inside * (Z[0] + Z[1] * x + Z[2] * inside)
+    np.testing.assert_allclose(finger.oil_taken(inside, d), expected_dQ, rtol=1e-6)
+
+
+def test_energy_is_the_integral_of_P_dQ(tmp_path):
+    """W_f(theta) = int_0^theta P dQ (adaptive quadrature, independent of the spline algebra),
+    dW_f/dtheta = P dQ/dtheta (central differences, h = 1e-5: error ~h^2 W''' ~ 1e-9 relative)
+    and the whole hand's P dQ_n = d(n W_f + W_r)."""
+    path, designs, _ = _synthetic_table(tmp_path)
+    d = designs[1].replace(finger_model="fem", finger_table=str(path))
+    for theta in (0.3, 1.2, 2.0):
+        W = quad(lambda t: hand.finger_pressure(t, d) * finger.volume_rate(t, d), 0.0, theta,
+                 limit=200, epsabs=0, epsrel=1e-11)[0]
+        assert float(finger.energy(theta, d)) == pytest.approx(W, rel=1e-9)
+    theta, h = np.linspace(-0.5, 2.5, 13), 1e-5
+    dW = (finger.energy(theta + h, d) - finger.energy(theta - h, d)) / (2 * h)
+    np.testing.assert_allclose(dW, hand.finger_pressure(theta, d) * finger.volume_rate(theta, d),
+                               rtol=1e-8, atol=1e-8 * np.abs(dW).max())
+    # the hand with reservoir: P n dQ/dtheta = n dW_f/dtheta + dW_r/dtheta, W_r(V0 - n dQ)
+    th = np.array([0.3, 0.8])
+    W_r = lambda t: reservoir.strain_energy(reservoir.oil_volume(t, d), d)  # noqa: E731
+    dWr = (W_r(th + h) - W_r(th - h)) / (2 * h)
+    lhs = hand.pressure(th, d) * d.n * finger.volume_rate(th, d)
+    np.testing.assert_allclose(lhs, d.n * finger.energy_rate(th, d) + dWr, rtol=1e-6)
+
+
+def test_the_paper_model_is_unchanged():
+    """finger_model = "paper" gives eqs. (28), (2) as before, through the registry."""
+    d = HandDesign()
+    theta = np.linspace(0.0, 1.5, 7)
+    np.testing.assert_array_equal(hand.finger_pressure(theta, d),
+                                  d.mu_sf * finger.zeta_f(theta, d) / (d.a**2 * math.pi * d.d))
+    np.testing.assert_array_equal(finger.oil_taken(theta, d), d.a**2 * math.pi * d.d * theta)
+    np.testing.assert_array_equal(reservoir.oil_volume(theta, d), d.V0 - d.n * d.a**2 * math.pi * d.d * theta)
+
+
+def test_package_table_covers_its_space_and_names_the_group_outside():
+    """Every corner of the box that is a design (the tube fits between its axis and the hinge
+    plate, a + b < d) loads; a tube wall of b = 8 mm (b/a = 8/3) is outside: one error
+    naming b/a and its range."""
+    for corner in np.array(np.meshgrid(*BOX.values())).reshape(5, -1).T:
+        point = dict(zip(BOX, corner))
+        if point["a_mm"] + point["b_mm"] >= point["d_mm"]:
+            continue  # not a finger: refused by the design's own check
+        d = finger_design(point).replace(finger_model="fem")
+        assert np.isfinite(hand.bend_angle(0.5, d, reservoir=False))
+    bad = finger_design({"a_mm": 3.0, "b_mm": 8.0, "d_mm": 15.0, "l0_mm": 150.0,
+                         "tie_width_mm": 10.0}).replace(finger_model="fem")
+    with pytest.raises(InputError, match=r"b/a = 2\.66.*outside the range \[0\.5, 2\.333\]"):
+        hand.pressure(0.5, bad)
+    with pytest.raises(InputError, match="5 equal hinges"):
+        hand.pressure(0.5, HandDesign(finger_model="fem", hinge_s=(30, 60, 90, 120, 160)))
+
+
+@pytest.mark.parametrize("edit, message", [
+    (lambda t: t.replace("design,b_a", "design,b"), "needs the header"),
+    (lambda t: t.replace("# range:", "# ranges:"), "needs the lines '# range"),
+    (lambda t: t.replace("# fit: design_degree=1", "# fit: design_degree=x"), "needs the lines"),
+    (lambda t: t.rstrip("\n") + "\n9,1,2,3,0.1,0.5,0.2,oops\n", "not a number"),
+    (lambda t: t.rstrip("\n") + "\n9,1,2,3,0.1,-0.5,0.2,3\n", "must be positive"),
+    (lambda t: t.rstrip("\n") + "\n9,1.25,3.75,7.5,0.9,0.5,0.2,3\n", "tie/link outside"),
+])
+def test_loader_errors_name_the_file(tmp_path, edit, message):
+    path, designs, _ = _synthetic_table(tmp_path)
+    path.write_text(edit(path.read_text()))
+    with pytest.raises(InputError, match=message) as info:
+        finger_fem.read_table(path)
+    assert info.value.field == "finger_table"
+
+
+def test_missing_table_and_too_few_designs(tmp_path):
+    with pytest.raises(InputError, match="no such file"):
+        finger_fem.read_table(tmp_path / "none.csv")
+    path, designs, _ = _synthetic_table(tmp_path, ties=(5.0, 15.0))
+    path.write_text(path.read_text().replace("design_degree=1", "design_degree=2"))
+    d = designs[0].replace(finger_model="fem", finger_table=str(path))
+    with pytest.raises(InputError, match="too few designs"):
+        hand.pressure(0.5, d)
+
+
+def test_a_design_file_names_its_own_table_relative_to_itself(tmp_path):
+    """write_design_with_table: FILE.toml next to FILE.csv, finger_model "fem", the table found
+    relative to the design file; the CLI's error for a design outside it is one line, exit 2."""
+    from studies.cli import main
+    from studies.finger_table import write_design_with_table
+    from reduced.design import load_design
+
+    path, designs, _ = _synthetic_table(tmp_path)
+    toml = write_design_with_table(designs[1], path)
+    d = load_design(toml)
+    assert d.finger_model == "fem" and d.finger_table == str(path.resolve()) and d.tie_width == 10.0
+    assert hand.bend_angle(0.5, d, reservoir=False) > 0
+    wide = tmp_path / "wide.toml"
+    wide.write_text(toml.read_text().replace("b_mm = 5.0", "b_mm = 6.0"))
+    assert main(["curve", "--design", str(wide), "--pressure-mpa", "0.5"]) == 2
