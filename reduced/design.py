@@ -288,13 +288,17 @@ def design_from_dict(values: dict, base: HandDesign | None = None, *, source: st
 def load_design(path: str | Path | None = None) -> HandDesign:
     """Read a design TOML file (keys as in ``studies/designs/paper.toml``); None: the paper's."""
     path = Path(path) if path is not None else PAPER_DESIGN_FILE
+    return design_from_dict(read_toml(path, "--design", "design"), source=path.name)
+
+
+def read_toml(path: Path, field: str, what: str) -> dict:
+    """The tables of a TOML file; InputError (naming ``field``) if it is missing or not TOML."""
     try:
         with open(path, "rb") as f:
-            values = tomllib.load(f)
+            return tomllib.load(f)
     except FileNotFoundError:
-        raise InputError("--design", str(path), "no such file; give a design TOML file") from None
+        raise InputError(field, str(path), f"no such file; give a {what} TOML file") from None
     except IsADirectoryError:
-        raise InputError("--design", str(path), "is a directory; give a design TOML file") from None
+        raise InputError(field, str(path), f"is a directory; give a {what} TOML file") from None
     except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
-        raise InputError("--design", str(path), f"is not valid TOML ({exc})") from None
-    return design_from_dict(values, source=path.name)
+        raise InputError(field, str(path), f"is not valid TOML ({exc})") from None

@@ -23,7 +23,7 @@ from reduced.errors import InputError
 VERBS = (
     "curve", "grasp", "control", "fit",
     "verify", "reservoir", "bend", "weights",
-    "study", "inspect", "reproduce", "material",
+    "design", "study", "inspect", "reproduce", "material",
 )
 
 
