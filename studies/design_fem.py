@@ -2,12 +2,13 @@ r"""The FEM proof of a design: free bend with the reservoir, and the grasp at th
 
 Three FEM models check the reduced model's answer (:class:`studies.design_opt.Evaluation`):
 
-1. **Free bend** (finger FEM, :mod:`fem.finger`): cavity pressures in steps of a quarter of
+1. **Free bend** (finger FEM, :mod:`fem.finger`): cavity pressures of 1, 1.25, 1.5, ... times
    eq. (28)'s pressure at the grasp angle theta_g until the finger bends past theta_g; the
    cavity pressure p_finger, the cavity volume change dQ and the peak principal stretch at
    theta_g are interpolated (monotone cubic in theta).
-2. **Reservoir** (sheet FEM, :mod:`fem.reservoir`): p_r at the oil left,
-   V = V0 - n dQ, so that the hand's pump pressure at contact is
+2. **Reservoir** (sheet FEM, :mod:`fem.reservoir`, one path from flat to V0): p_r at the oil
+   left, V = V0 - n dQ (at the grasp: interpolated on the path), so that the hand's pump
+   pressure at contact is
    P_contact = p_finger(theta_g) - p_r(V) -- as :func:`studies.compare.whole_hand`.
 3. **Grasp** (:mod:`fem.grasp`, the finger closing on the rigid object with its weight share):
    first at the cavity pressure that the *predicted* pump pressure gives with the FEM
@@ -22,7 +23,7 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 from scipy.interpolate import PchipInterpolator
@@ -37,9 +38,11 @@ class ProofOptions:
     mesh_size_mm: float = 6.0   #: finger element size (gmsh, graded as the grasp FEM) [mm]
     dP_mpa: float = 0.05        #: first secant step of the grasp's cavity pressure [MPa]
     rtol: float = 0.01          #: the verified grasp's F_v within this of the requirement
-    max_secant: int = 4         #: secant steps at most
+    max_secant: int = 2         #: secant steps at most
+    max_step_mpa: float = 0.2   #: largest cavity-pressure step of the continuation from contact [MPa]
+    edge_ratio: float = 0.5     #: finger mesh grading at the ring edges (1: uniform)
     sheet: dict = field(default_factory=dict)  #: sheet FEM mesh keywords (fem.reservoir.SheetModel)
-    bend_steps: int = 12        #: free-bend pressure steps at most (quarters of eq. (28)'s)
+    bend_factors: tuple = (1.0, 1.25, 1.5, 1.75, 2.0, 2.5, 3.0, 4.0)  #: free bend: x eq. (28)'s pressure
 
 
 class _Past(Exception):
@@ -61,7 +64,7 @@ def free_bend(finger, theta_g: float, options: ProofOptions) -> dict:
 
     t0 = time.perf_counter()
     try:
-        solve_pressures(finger, 0.25 * P28 * np.arange(1, options.bend_steps + 1), callback=keep)
+        solve_pressures(finger, P28 * np.asarray(options.bend_factors), callback=keep)
     except _Past:
         pass
     if not states or states[-1].theta <= theta_g:
@@ -76,21 +79,33 @@ def free_bend(finger, theta_g: float, options: ProofOptions) -> dict:
             "seconds": time.perf_counter() - t0}
 
 
-def grasp_secant(model, P_start: float, F_req: float, options: ProofOptions) -> dict:
-    """Grasp states from P_start [MPa] (cavity); secant on F_v_fem(P) = F_req [N]."""
+def grasp_secant(model, ladder, F_req: float, options: ProofOptions, say=None) -> dict:
+    """Grasp states up the cavity pressures ``ladder`` [MPa] (each from the last; the last is
+    the start), then a secant on F_v_fem(P) = F_req [N]."""
     from fem.grasp import weight_vector
 
     t0 = time.perf_counter()
-    first = model.solve(P_start)
-    second = model.solve(P_start + options.dP_mpa, start=first)
+
+    def solve(P, start=None):
+        state = model.solve(P, start=start)
+        if say is not None:
+            say(f"  grasp state: cavity {state.P:.4g} MPa, theta {math.degrees(state.theta):.2f} deg, "
+                f"F_v {state.F_v:.4g} N ({time.perf_counter() - t0:.0f} s)")
+        return state
+
+    P_start, first, known = ladder[-1], None, []
+    for P in ladder:  # continuation through contact: the Uzawa loop fails on big jumps
+        first = solve(P, start=first)
+        known.append(first)
+    second = solve(P_start + options.dP_mpa, start=first)
     pair, steps = [first, second], 0
     while abs(pair[-1].F_v - F_req) > options.rtol * F_req and steps < options.max_secant:
         a, b = pair[-2], pair[-1]
         if b.F_v == a.F_v:
             break
         P = max(b.P + (F_req - b.F_v) * (b.P - a.P) / (b.F_v - a.F_v), 0.5 * b.P)
-        below = [s for s in pair if s.P <= P]  # continue from the nearest state below P
-        pair.append(model.solve(P, start=max(below, key=lambda s: s.P) if below else None))
+        below = [s for s in known + pair if s.P <= P]  # continue from the nearest state below P
+        pair.append(solve(P, start=max(below, key=lambda s: s.P) if below else None))
         steps += 1
     best = min(pair, key=lambda s: abs(s.F_v - F_req))
     near = min((s for s in pair if s is not best), key=lambda s: abs(s.P - best.P))
@@ -110,24 +125,28 @@ def prove(ev: Evaluation, task: Task, options: ProofOptions = ProofOptions(), *,
     say = progress or (lambda text: None)
     design = ev.design
     t0 = time.perf_counter()
-    finger = FingerModel(design, finger_options(options.mesh_size_mm))
+    finger = FingerModel(design, replace(finger_options(options.mesh_size_mm), edge_ratio=options.edge_ratio))
     say(f"free bend FEM to the grasp angle {math.degrees(ev.theta_grasp):.2f} deg "
         f"({finger.ndofs} unknowns)")
     bend = free_bend(finger, ev.theta_grasp, options)
     say("reservoir sheet FEM at the oil left at contact")
     V_contact = design.V0 - design.n * bend["dQ_mm3"]
     sheet_model = SheetModel.from_design(design, **options.sheet)
-    p_contact = inflate(sheet_model, [V_contact]).states[0].pressure
+    sheet = inflate(sheet_model, [V_contact, design.V0])
+    p_contact = sheet.states[0].pressure
     model = GraspModel(finger, task.diameter, mass=task.mass)
     P_cav = ev.P_grasp + p_contact  # the predicted pump pressure with the FEM reservoir
     P_start = max(P_cav, bend["P_finger_MPa"] + 0.5 * options.dP_mpa)
     say(f"grasp FEM from the cavity pressure {P_start:.4g} MPa (object depth {model.depth:.1f} mm)")
-    g = grasp_secant(model, P_start, ev.F_v, options)
+    P_touch = bend["P_finger_MPa"] + 0.5 * options.dP_mpa  # just past the FEM's contact
+    steps = max(1, math.ceil((P_start - P_touch) / options.max_step_mpa - 1e-9))
+    g = grasp_secant(model, np.linspace(P_touch, P_start, steps + 1) if P_start > P_touch else [P_start],
+                     ev.F_v, options, say)
     best = g["best"]
     fs = finger.state(best.y, best.P)
     V_grasp = design.V0 - design.n * fs.dQ
-    sheet = inflate(sheet_model, [V_grasp, V_contact, design.V0])
-    p_grasp = sheet.states[0].pressure
+    # the sheet's path from flat to V0 passes V_grasp (steps <= R^2 t / 2): interpolated
+    p_grasp = float(np.interp(V_grasp, sheet.path_volume, sheet.path_pressure))
     if out is not None:
         _write_vtk(out, finger, (best,))
     first = g["first"]
@@ -145,7 +164,7 @@ def prove(ev: Evaluation, task: Task, options: ProofOptions = ProofOptions(), *,
         "contact_force_N": best.N.tolist(),
         "cavity_pressure_MPa": best.P,
         "reservoir_pressure_MPa": p_grasp,
-        "reservoir_offset_MPa": sheet.states[2].pressure,
+        "reservoir_offset_MPa": sheet.states[1].pressure,
         "reservoir_pressure_maximum": sheet.pressure_max,
         "depth_mm": model.depth,
         "free_bend": bend,

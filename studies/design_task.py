@@ -20,8 +20,9 @@ A task is a TOML file (``studies/designs/tasks/paper_task.toml`` is the paper's)
     [design]                  # optional: any other design key over the base design
     [free]                    # design variables and their bounds
     a_mm = [3.0, 6.0]
-    [fem]                     # optional: the FEM proof's meshes
+    [fem]                     # optional: the FEM proof's finger mesh (gmsh)
     mesh_size_mm = 6.0
+    edge_ratio = 0.5          # element size at the ring edges / mesh_size (1: uniform)
 
 ``base_design`` is looked up as given, then next to the task file, then in the package.
 Every mistake is one :class:`InputError` naming the key.
@@ -44,7 +45,7 @@ _SECTIONS = {
     "pump": {"max_pressure_MPa"},
     "limits": {"max_principal_stretch", "min_wall_mm"},
     "material": {"mu_sf_MPa", "mu_sr_MPa"},
-    "fem": {"mesh_size_mm", "dP_MPa"},
+    "fem": {"mesh_size_mm", "edge_ratio", "dP_MPa"},
 }
 _TOP = {"base_design", "object", "grasp", "pump", "limits", "material", "design", "free", "fem"}
 
@@ -65,6 +66,7 @@ class Task:
     max_stretch: float = 1.5               #: peak principal stretch of the tube
     min_wall: float = 1.0                  #: least tube wall and sheet thickness [mm]
     mesh_size: float = 6.0                 #: FEM proof: finger element size [mm]
+    edge_ratio: float = 0.5                #: FEM proof: element size at the ring edges / mesh_size
     dP: float = 0.05                       #: FEM proof: pressure step of the secant [MPa]
     name: str = "task"
     source: dict = field(default_factory=dict, compare=False, repr=False)  #: the file's tables
@@ -118,6 +120,7 @@ def task_from_dict(data: dict, *, folder: Path = Path("."), name: str = "task") 
         max_stretch=_number(limits, "limits", "max_principal_stretch", default=1.5, above=1.0),
         min_wall=_number(limits, "limits", "min_wall_mm", default=1.0),
         mesh_size=_number(fem, "fem", "mesh_size_mm", default=6.0),
+        edge_ratio=_number(fem, "fem", "edge_ratio", default=0.5),
         dP=_number(fem, "fem", "dP_MPa", default=0.05))
 
 

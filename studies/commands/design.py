@@ -76,7 +76,8 @@ def _prove(ev, task, args, out, say) -> dict:
 
     h = args.mesh_size_mm if args.mesh_size_mm is not None else task.mesh_size
     try:
-        return prove(ev, task, ProofOptions(mesh_size_mm=h, dP_mpa=task.dP), out=out, progress=say)
+        options = ProofOptions(mesh_size_mm=h, dP_mpa=task.dP, edge_ratio=task.edge_ratio)
+        return prove(ev, task, options, out=out, progress=say)
     except (NotConverged, RuntimeError) as exc:
         say(f"the FEM proof failed: {str(exc)[:300]}")
         return {"error": str(exc)[:300]}
