@@ -131,6 +131,10 @@ def prove(ev: Evaluation, task: Task, options: ProofOptions = ProofOptions(), *,
     bend = free_bend(finger, ev.theta_grasp, options)
     say("reservoir sheet FEM at the oil left at contact")
     V_contact = design.V0 - design.n * bend["dQ_mm3"]
+    if not V_contact > 0:
+        raise RuntimeError(f"the FEM fingers take {design.n * bend['dQ_mm3']:.0f} mm^3 of oil to reach "
+                           f"the grasp angle, more than V0 = {design.V0:.0f} mm^3 (eq. (2) says "
+                           f"{design.n * design.a**2 * math.pi * design.d * ev.theta_grasp:.0f})")
     sheet_model = SheetModel.from_design(design, **options.sheet)
     sheet = inflate(sheet_model, [V_contact, design.V0])
     p_contact = sheet.states[0].pressure
@@ -140,7 +144,8 @@ def prove(ev: Evaluation, task: Task, options: ProofOptions = ProofOptions(), *,
     say(f"grasp FEM from the cavity pressure {P_start:.4g} MPa (object depth {model.depth:.1f} mm)")
     P_touch = bend["P_finger_MPa"] + 0.5 * options.dP_mpa  # just past the FEM's contact
     steps = max(1, math.ceil((P_start - P_touch) / options.max_step_mpa - 1e-9))
-    g = grasp_secant(model, np.linspace(P_touch, P_start, steps + 1) if P_start > P_touch else [P_start],
+    near = P_start - P_touch < 0.5 * options.dP_mpa  # no continuation needed
+    g = grasp_secant(model, [P_start] if near else np.linspace(P_touch, P_start, steps + 1),
                      ev.F_v, options, say)
     best = g["best"]
     fs = finger.state(best.y, best.P)
