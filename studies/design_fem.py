@@ -2,8 +2,9 @@ r"""The FEM proof of a design: free bend with the reservoir, and the grasp at th
 
 Three FEM models check the reduced model's answer (:class:`studies.design_opt.Evaluation`):
 
-1. **Free bend** (finger FEM, :mod:`fem.finger`): cavity pressures of 1, 1.25, 1.5, ... times
-   eq. (28)'s pressure at the grasp angle theta_g until the finger bends past theta_g; the
+1. **Free bend** (finger FEM, :mod:`fem.finger`): cavity pressures in steps of at most
+   ``max_step_mpa`` up to eq. (28)'s pressure at the grasp angle theta_g, then 1.25, 1.5, ...
+   times it, until the finger bends past theta_g; the
    cavity pressure p_finger, the cavity volume change dQ and the peak principal stretch at
    theta_g are interpolated (monotone cubic in theta).
 2. **Reservoir** (sheet FEM, :mod:`fem.reservoir`, one path from flat to V0): p_r at the oil
@@ -64,7 +65,9 @@ def free_bend(finger, theta_g: float, options: ProofOptions) -> dict:
 
     t0 = time.perf_counter()
     try:
-        solve_pressures(finger, P28 * np.asarray(options.bend_factors), callback=keep)
+        targets = P28 * np.asarray(options.bend_factors)
+        ramp = np.arange(options.max_step_mpa, targets[0], options.max_step_mpa)  # no big first step
+        solve_pressures(finger, np.concatenate([ramp, targets]), callback=keep)
     except _Past:
         pass
     if not states or states[-1].theta <= theta_g:

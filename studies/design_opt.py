@@ -83,8 +83,14 @@ class Evaluation:
     P_contact: float           #: free hand's pump pressure at theta_g (27) [MPa]
     F_v: float                 #: required normal force per finger [N]
     F_v_at_limit: float        #: F_v at the pump limit [N]
-    stretch: float             #: peak principal stretch, eq. (8)
+    stretch: float             #: the tube's peak principal stretch, eq. (8)
+    sheet_stretch: float       #: the reservoir sheet's stretch at V0, eq. (16)
     constraints: tuple[Constraint, ...]
+
+    @property
+    def rubber_stretch(self) -> float:
+        """The larger of the tube's and the sheet's stretch (the Pareto front's axis)."""
+        return max(self.stretch, self.sheet_stretch)
 
     @property
     def feasible(self) -> bool:
@@ -95,7 +101,7 @@ class Evaluation:
                 "theta_grasp_deg": math.degrees(self.theta_grasp), "F_v_N": self.F_v,
                 "F_v_at_pump_limit_N": self.F_v_at_limit, "margin_N": self.F_v_at_limit - self.F_v,
                 "w": self.w.tolist(), "touching_link": self.link, "depth_mm": self.depth,
-                "max_principal_stretch": self.stretch}
+                "max_principal_stretch": self.stretch, "sheet_stretch": self.sheet_stretch}
 
 
 def design_at(task: Task, x) -> HandDesign:
@@ -158,6 +164,7 @@ def evaluate(design: HandDesign, task: Task, *, exact: bool = True) -> Evaluatio
     if not math.isfinite(theta_open):
         P_open = -math.inf
     stretch = peak_stretch(theta, design)
+    sheet = float(reservoir.stretch(design.V0, design))
     cons = [
         Constraint("tube_fits_links (a + b < d) [mm]", design.a + design.b, design.d, "<="),
         Constraint("tube_wall b [mm]", design.b, task.min_wall, ">="),
@@ -165,15 +172,14 @@ def evaluate(design: HandDesign, task: Task, *, exact: bool = True) -> Evaluatio
         Constraint("reservoir_oil at the grasp [mm^3]", oil, design.V0, "<="),
         Constraint("reservoir_below_limit_point V0 [mm^3]", design.V0, limit_point_volume(design), "<="),
         Constraint("max_principal_stretch", stretch, task.max_stretch, "<="),
-        Constraint("sheet_stretch at V0, eq. (16)", float(reservoir.stretch(design.V0, design)),
-                   task.max_stretch, "<="),
+        Constraint("sheet_stretch at V0, eq. (16)", sheet, task.max_stretch, "<="),
         Constraint("pump_pressure at the grasp [MPa]", P_grasp, task.max_pressure, "<="),
         Constraint("F_v at the pump limit [N]", F_lim, F_req, ">="),
         Constraint("opening: P(theta_open), the free hand's pump pressure where the tips "
                    f"span {task.opening_mm:g} mm [MPa]", P_open, 0.0, ">=", task.max_pressure),
         *calibrated_range(design),
     ]
-    return Evaluation(design, depth, theta, link, w, P_grasp, P_contact, F_req, F_lim, stretch,
+    return Evaluation(design, depth, theta, link, w, P_grasp, P_contact, F_req, F_lim, stretch, sheet,
                       tuple(cons))
 
 

@@ -1,6 +1,8 @@
 """Pump pressure against peak stretch: the Pareto front of a design task, its knee and plot.
 
-A softer, thinner, longer-armed finger needs less pressure but stretches its rubber more.
+The stretch is the rubber's: the larger of the tube's (eq. (8)) and the reservoir sheet's
+(eq. (16)). A fuller sheet or a longer lever arm needs less pump pressure but stretches the
+rubber more.
 The front is traced by the epsilon-constraint method: the least stretch any feasible design
 reaches (differential evolution on the stretch), then the task's objective with the stretch
 limit lowered step by step from the optimum's stretch to that least one, each step an SLSQP
@@ -23,19 +25,19 @@ from studies.design_task import Task
 def least_stretch(task: Task, options: design_opt.OptimiserOptions) -> tuple[np.ndarray, float]:
     """The feasible design (free values) with the least peak stretch, and that stretch."""
     problem = design_opt.Problem(task)
-    res = differential_evolution(lambda x: problem.evaluation(x).stretch, problem.bounds,
+    res = differential_evolution(lambda x: problem.evaluation(x).rubber_stretch, problem.bounds,
                                  constraints=NonlinearConstraint(problem.slacks, 0.0, np.inf),
                                  seed=options.seed, popsize=max(5, options.popsize // 2),
                                  maxiter=options.maxiter, tol=1e-6, polish=False, init="sobol",
                                  updating="immediate", workers=1)
-    return np.asarray(res.x), float(problem.evaluation(res.x).stretch)
+    return np.asarray(res.x), float(problem.evaluation(res.x).rubber_stretch)
 
 
 def front(task: Task, optimum: design_opt.Optimum, options: design_opt.OptimiserOptions,
           points: int = 8) -> list[dict]:
     """Points (stretch, objective, free values), from the optimum to the least stretch."""
     _, lam_min = least_stretch(task, options)
-    lam_opt = optimum.evaluation.stretch
+    lam_opt = optimum.evaluation.rubber_stretch
     rows = [_row(task, optimum.x, optimum.evaluation)]
     x = optimum.x
     for eps in np.linspace(lam_opt, lam_min, points)[1:]:
@@ -51,7 +53,7 @@ def front(task: Task, optimum: design_opt.Optimum, options: design_opt.Optimiser
 
 
 def _row(task: Task, x, ev: design_opt.Evaluation) -> dict:
-    return {"stretch_limit": task.max_stretch, "max_principal_stretch": ev.stretch,
+    return {"stretch_limit": task.max_stretch, "max_principal_stretch": ev.rubber_stretch,
             "P_grasp_MPa": ev.P_grasp, "margin_N": ev.F_v_at_limit - ev.F_v,
             "objective": design_opt.objective(ev, task),
             "free": {k: float(v) for (k, _, _), v in zip(task.free, x)}}
@@ -89,8 +91,8 @@ def plot(rows: list[dict], path, *, task: Task, base: design_opt.Evaluation | No
     k = knee(rows)
     ax.plot(lam[k], obj[k], "D", ms=9, mfc="none", label="knee")
     if base is not None and math.isfinite(design_opt.objective(base, task)):
-        ax.plot(base.stretch, design_opt.objective(base, task), "x", ms=9, label="base design")
-    ax.set_xlabel("peak principal stretch, eq. (8)")
+        ax.plot(base.rubber_stretch, design_opt.objective(base, task), "x", ms=9, label="base design")
+    ax.set_xlabel("peak stretch of the rubber: tube eq. (8), sheet eq. (16)")
     ax.set_ylabel(label)
     ax.set_title(f"{task.name}: {task.diameter:g} mm, {task.mass:g} kg")
     ax.grid(alpha=0.3)

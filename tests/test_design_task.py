@@ -1,11 +1,9 @@
 """softhand design on the reduced model: task files, the evaluation against eqs. (8), (25), (29)
 called directly, the optimiser against a brute-force grid, determinism, infeasible tasks, CLI."""
+import contextlib
+import io
 import json
 import math
-import subprocess
-import sys
-from dataclasses import replace
-
 import numpy as np
 import pytest
 
@@ -120,9 +118,19 @@ def test_l0_scales_the_hinges():
     assert kinematics.tip_position(np.zeros(5), design).shape == (2,)
 
 
-def _cli(*argv, cwd=None):
-    return subprocess.run([sys.executable, "-m", "studies.cli", *argv], capture_output=True,
-                          text=True, cwd=cwd)
+class _Run:
+    def __init__(self, returncode, stdout, stderr):
+        self.returncode, self.stdout, self.stderr = returncode, stdout, stderr
+
+
+def _cli(*argv):
+    """``softhand ARGV`` in-process (the CLI's own error handling included)."""
+    from studies.cli import main
+
+    out, err = io.StringIO(), io.StringIO()
+    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+        code = main(list(argv))
+    return _Run(code, out.getvalue(), err.getvalue())
 
 
 CI_TASK_TOML = """
