@@ -53,6 +53,7 @@ class _Past(Exception):
 def free_bend(finger, theta_g: float, options: ProofOptions) -> dict:
     """The free finger FEM up to theta_g [rad]: cavity pressure, dQ, stretch at theta_g."""
     from fem.finger import solve_pressures
+    from fem.newton import NotConverged
 
     design = finger.design
     P28 = float(hand.pressure(theta_g, design, reservoir=False))
@@ -70,6 +71,12 @@ def free_bend(finger, theta_g: float, options: ProofOptions) -> dict:
         solve_pressures(finger, np.concatenate([ramp, targets]), callback=keep)
     except _Past:
         pass
+    except NotConverged as exc:
+        last = states[-1] if states else None
+        reached = f"{math.degrees(last.theta):.1f} deg at {last.P:.3g} MPa" if last else "nothing"
+        raise RuntimeError(f"free-bend FEM: Newton failed on the way to the grasp angle "
+                           f"{math.degrees(theta_g):.1f} deg (converged: {reached}): "
+                           f"{str(exc).split(';')[0]}") from None
     if not states or states[-1].theta <= theta_g:
         raise RuntimeError(f"free-bend FEM: {math.degrees(states[-1].theta) if states else 0:.2f} deg "
                            f"at {states[-1].P if states else 0:.3g} MPa, below the grasp angle")
@@ -143,9 +150,9 @@ def prove(ev: Evaluation, task: Task, options: ProofOptions = ProofOptions(), *,
     p_contact = sheet.states[0].pressure
     model = GraspModel(finger, task.diameter, mass=task.mass)
     P_cav = ev.P_grasp + p_contact  # the predicted pump pressure with the FEM reservoir
-    P_start = max(P_cav, bend["P_finger_MPa"] + 0.5 * options.dP_mpa)
-    say(f"grasp FEM from the cavity pressure {P_start:.4g} MPa (object depth {model.depth:.1f} mm)")
     P_touch = bend["P_finger_MPa"] + 0.5 * options.dP_mpa  # just past the FEM's contact
+    P_start = max(P_cav, P_touch)
+    say(f"grasp FEM from the cavity pressure {P_start:.4g} MPa (object depth {model.depth:.1f} mm)")
     steps = max(1, math.ceil((P_start - P_touch) / options.max_step_mpa - 1e-9))
     near = P_start - P_touch < 0.5 * options.dP_mpa  # no continuation needed
     g = grasp_secant(model, [P_start] if near else np.linspace(P_touch, P_start, steps + 1),

@@ -36,7 +36,7 @@ from functools import lru_cache
 import numpy as np
 from scipy.optimize import NonlinearConstraint, differential_evolution, minimize
 
-from reduced import contact, grasp, hand, kinematics, reservoir
+from reduced import contact, grasp, reservoir
 from reduced.design import HandDesign, design_from_dict
 from reduced.errors import InputError
 from studies.design_task import Task
@@ -190,7 +190,7 @@ def calibrated_range(design: HandDesign) -> list[Constraint]:
         return []
     from reduced import finger_fem
 
-    table = finger_fem.read_table(design.finger_table or finger_fem.TABLE_FILE)
+    table = _finger_table(design.finger_table or str(finger_fem.TABLE_FILE))
     groups = finger_fem.groups_of(design)
     out = []
     for g in finger_fem.GROUPS:
@@ -198,6 +198,13 @@ def calibrated_range(design: HandDesign) -> list[Constraint]:
         label = f"calibrated range of {finger_fem.LABELS[g]}"
         out += [Constraint(label, groups[g], lo, ">="), Constraint(label, groups[g], hi, "<=")]
     return out
+
+
+@lru_cache(maxsize=4)
+def _finger_table(path: str):
+    from reduced import finger_fem
+
+    return finger_fem.read_table(path)
 
 
 def objective(ev: Evaluation, task: Task) -> float:

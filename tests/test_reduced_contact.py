@@ -1,6 +1,5 @@
 """reduced.contact: pad gaps and placement against the grasp FEM's own geometry (fem.contact,
 another frame and code), gap gradients against finite differences, contact angle, rolling w."""
-import math
 
 import numpy as np
 import pytest
