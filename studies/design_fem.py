@@ -163,7 +163,7 @@ def prove(ev: Evaluation, task: Task, options: ProofOptions = ProofOptions(), *,
     # the sheet's path from flat to V0 passes V_grasp (steps <= R^2 t / 2): interpolated
     p_grasp = float(np.interp(V_grasp, sheet.path_volume, sheet.path_pressure))
     if out is not None:
-        _write_vtk(out, finger, (best,))
+        _write_vtk(out, model, (best,))
     first = g["first"]
     return {
         "P_grasp_MPa": best.P - p_grasp,
