@@ -73,12 +73,17 @@ def axial_stretch(theta, r, phi, design: HandDesign):
     return (g.l0 + (g.d + (g.a + r) * np.sin(phi)) * theta) / g.l0
 
 
+@lru_cache(maxsize=8)
+def _gauss(order: int):
+    """Gauss-Legendre nodes and weights on [-1, 1] (numpy's leggauss costs ~1 ms a call)."""
+    return np.polynomial.legendre.leggauss(order)
+
+
 @lru_cache(maxsize=32)
 def _nodes(a: float, b: float, d: float, l0: float, orders: tuple[int, int]):
     """Quadrature nodes c_q = d(lambda_f)/d(theta) and weights of l0 * rho dr dphi over the tube."""
-    n_r, n_phi = orders
-    xr, wr = np.polynomial.legendre.leggauss(n_r)
-    xp, wp = np.polynomial.legendre.leggauss(n_phi)
+    xr, wr = _gauss(orders[0])
+    xp, wp = _gauss(orders[1])
     rho = a + 0.5 * b * (xr + 1.0)                  # [a, a + b]
     phi = 0.5 * np.pi * xp                          # [-pi/2, pi/2]
     c = (d + np.outer(rho, np.sin(phi))) / l0       # (n_r, n_phi)

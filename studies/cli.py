@@ -25,7 +25,7 @@ from reduced.errors import InputError, short
 VERBS = (
     "curve", "grasp", "control", "fit",
     "verify", "reservoir", "bend", "weights",
-    "study", "calibrate", "inspect", "reproduce", "material",
+    "design", "study", "calibrate", "inspect", "reproduce", "material",
 )
 
 

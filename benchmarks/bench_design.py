@@ -1,0 +1,57 @@
+"""The design optimiser on the reduced model: differential evolution (several settings) against
+SLSQP alone from the base design and from random starts. Prints the objective, whether the
+result is feasible, evaluations and wall time for each.
+
+    PYTHONPATH=. python benchmarks/bench_design.py [TASK.toml ...]
+"""
+from __future__ import annotations
+
+import sys
+import time
+
+import numpy as np
+from scipy.optimize import minimize
+
+from studies import design_opt
+from studies.design_task import load_task
+
+TASKS = ["studies/designs/tasks/paper_task.toml", "studies/designs/tasks/small_object.toml",
+         "studies/designs/tasks/large_object.toml", "studies/designs/tasks/low_pressure.toml"]
+
+
+def slsqp(task, x0):
+    """SLSQP alone (finite-difference gradients) from x0, variables scaled to [0, 1]."""
+    t0 = time.perf_counter()
+    problem = design_opt.Problem(task)
+    lo, hi = np.array(problem.bounds).T
+    to_x = lambda z: lo + z * (hi - lo)  # noqa: E731
+    res = minimize(lambda z: problem.f(to_x(z)), (np.asarray(x0) - lo) / (hi - lo), method="SLSQP",
+                   bounds=[(0.0, 1.0)] * len(lo), options={"ftol": 1e-12, "maxiter": 200},
+                   constraints=[{"type": "ineq", "fun": lambda z: problem.slacks(to_x(z))}])
+    x = np.clip(to_x(res.x), lo, hi)
+    ev = problem.evaluation(x)
+    return design_opt.objective(ev, task), ev.feasible, problem.evaluations, time.perf_counter() - t0
+
+
+def main(paths) -> None:
+    for path in paths:
+        task = load_task(path)
+        print(f"== {path} (objective: {task.objective}; free: {', '.join(k for k, _, _ in task.free)})")
+        for popsize, tol in ((15, 1e-8), (10, 1e-6), (8, 1e-4)):
+            opts = design_opt.OptimiserOptions(popsize=popsize, tol=tol)
+            opt = design_opt.optimise(task, opts)
+            print(f"DE popsize {popsize:2d} tol {tol:.0e} + polish: objective "
+                  f"{design_opt.objective(opt.evaluation, task):.6g}, feasible {opt.evaluation.feasible}, "
+                  f"{opt.evaluations} evaluations, {opt.generations} generations, {opt.seconds:.1f} s")
+        base = [task.base.to_dict()[k] for k, _, _ in task.free]
+        starts = [np.clip(base, *np.array([(lo, hi) for _, lo, hi in task.free]).T)]
+        rng = np.random.default_rng(0)
+        starts += [rng.uniform(*np.array([(lo, hi) for _, lo, hi in task.free]).T) for _ in range(4)]
+        for i, x0 in enumerate(starts):
+            f, ok, n, s = slsqp(task, x0)
+            print(f"SLSQP from {'the base design' if i == 0 else f'random start {i}'}: objective {f:.6g}, "
+                  f"feasible {ok}, {n} evaluations, {s:.1f} s")
+
+
+if __name__ == "__main__":
+    main(sys.argv[1:] or TASKS[:1])

@@ -1,0 +1,196 @@
+"""softhand design on the reduced model: task files, the evaluation against eqs. (8), (25), (29)
+called directly, the optimiser against a brute-force grid, determinism, infeasible tasks, CLI."""
+import contextlib
+import io
+import json
+import math
+import numpy as np
+import pytest
+
+from reduced import finger, grasp, hand, kinematics
+from reduced.design import load_design
+from reduced.errors import InputError
+from studies import design_opt
+from studies.design_task import load_task, task_from_dict
+
+#: a CI-sized task: two free keys, so that a grid search can check the optimum
+CI_TASK = {
+    "object": {"diameter_mm": 180.0, "mass_kg": 2.0},
+    "grasp": {"force_factor": 2.0},
+    "pump": {"max_pressure_MPa": 2.0},
+    "limits": {"max_principal_stretch": 1.4},
+    "free": {"d_mm": [10.0, 20.0], "V0_mm3": [12000.0, 30000.0]},
+}
+FAST = design_opt.OptimiserOptions(seed=3)
+
+
+def _write(tmp_path, text, name="task.toml"):
+    path = tmp_path / name
+    path.write_text(text)
+    return path
+
+
+def test_task_file_reads_the_paper_task():
+    task = load_task("studies/designs/tasks/paper_task.toml")
+    assert (task.diameter, task.mass, task.max_pressure) == (180.0, 2.0, 2.0)
+    assert [k for k, _, _ in task.free] == ["a_mm", "b_mm", "d_mm", "V0_mm3"]
+    assert task.required_F_v() == pytest.approx(2.0 * 2.0 * 9.80665 / 4)  # force_factor m g / n
+
+
+@pytest.mark.parametrize("change, field", [
+    ({"object": {"mass_kg": 2.0}}, "object.diameter_mm"),
+    ({"object": {"diameter_mm": -1.0, "mass_kg": 2.0}}, "object.diameter_mm"),
+    ({"free": {"a_mm": [6.0, 3.0]}}, "free.a_mm"),
+    ({"free": {"n": [1, 4]}}, "free.n"),
+    ({"free": {}}, "free"),
+    ({"grasp": {"force_factor": 2.0, "margin_N": 1.0}}, "grasp.margin_N"),
+    ({"grasp": {"objective": "cheapest"}}, "grasp.objective"),
+    ({"pump": {"max_pressure_MPa": "high"}}, "pump.max_pressure_MPa"),
+    ({"limits": {"max_principal_stretch": 0.9}}, "limits.max_principal_stretch"),
+    ({"colour": "red"}, "colour"),
+    ({"base_design": "nowhere.toml"}, "base_design"),
+    ({"design": {"b_mm": -5.0}}, "b_mm"),
+])
+def test_bad_task_files_name_the_field(change, field):
+    with pytest.raises(InputError) as info:
+        task_from_dict({**CI_TASK, **change})
+    assert info.value.field == field
+
+
+def test_evaluation_against_the_reduced_model_called_directly():
+    task = task_from_dict(CI_TASK)
+    ev = design_opt.evaluate(task.base, task)
+    # the pump pressure found makes eq. (25) -> (29) press with exactly the required F_v
+    forces = grasp.grasp_forces(ev.P_grasp, ev.theta_grasp, task.mass, ev.w, task.base)
+    assert float(forces.F_v) == pytest.approx(task.required_F_v(), rel=1e-12)
+    forces = grasp.grasp_forces(task.max_pressure, ev.theta_grasp, task.mass, ev.w, task.base)
+    assert ev.F_v_at_limit == pytest.approx(float(forces.F_v), rel=1e-12)
+    assert ev.P_contact == pytest.approx(float(hand.pressure(ev.theta_grasp, task.base)), rel=1e-12)
+    # eq. (8)'s largest stretch over a grid of the tube's cross-section
+    r, phi = np.meshgrid(np.linspace(0, task.base.b, 21), np.linspace(-math.pi, math.pi, 721))
+    lam = finger.axial_stretch(ev.theta_grasp, r, phi, task.base)
+    assert ev.stretch == pytest.approx(lam.max(), rel=1e-9)
+    assert ev.feasible
+
+
+def test_optimum_beats_a_grid_search_and_is_deterministic():
+    task = task_from_dict(CI_TASK)
+    opt = design_opt.optimise(task, FAST)
+    assert opt.evaluation.feasible
+    again = design_opt.optimise(task, FAST)
+    np.testing.assert_array_equal(opt.x, again.x)                        # same seed, same answer
+    d, V0 = np.meshgrid(np.linspace(10, 20, 41), np.linspace(12000, 30000, 41))
+    best = math.inf
+    for x in zip(d.ravel(), V0.ravel()):
+        ev = design_opt.evaluate(design_opt.design_at(task, x), task)
+        if ev.feasible:
+            best = min(best, ev.P_grasp)
+    # the grid's spacing (0.25 mm, 450 mm^3) bounds how far the grid's best can be above
+    assert opt.evaluation.P_grasp <= best + 1e-9
+    assert opt.evaluation.P_grasp > best - 0.02
+    base = design_opt.evaluate(task.base, task)
+    assert opt.evaluation.P_grasp < base.P_grasp
+
+
+def test_active_constraint_is_the_stretch_of_the_sheet():
+    """With d and V0 free and nothing else in the way, the pressure falls with V0 (a fuller
+    sheet pushes harder) until the sheet's stretch (16) reaches the limit."""
+    task = task_from_dict(CI_TASK)
+    ev = design_opt.optimise(task, FAST).evaluation
+    names = [c.name for c in design_opt.binding(ev)]
+    assert any(n.startswith("sheet_stretch") for n in names)
+    assert ev.design.d == pytest.approx(20.0)  # the longest lever arm (bound)
+
+
+def test_infeasible_task_names_the_binding_constraint():
+    task = task_from_dict({**CI_TASK, "pump": {"max_pressure_MPa": 0.05}})
+    opt = design_opt.optimise(task, FAST)
+    assert not opt.evaluation.feasible
+    text = design_opt.infeasible_report(task, opt)
+    assert "pump_pressure" in text or "F_v at the pump limit" in text
+    assert "d_mm = " in text and "\n" not in text
+
+
+def test_l0_scales_the_hinges():
+    task = task_from_dict({**CI_TASK, "free": {"l0_mm": [150.0, 210.0]}})
+    design = design_opt.design_at(task, [210.0])
+    np.testing.assert_allclose(design.link_lengths, [35.0] * 6)
+    assert kinematics.tip_position(np.zeros(5), design).shape == (2,)
+
+
+class _Run:
+    def __init__(self, returncode, stdout, stderr):
+        self.returncode, self.stdout, self.stderr = returncode, stdout, stderr
+
+
+def _cli(*argv):
+    """``softhand ARGV`` in-process (the CLI's own error handling included)."""
+    from studies.cli import main
+
+    out, err = io.StringIO(), io.StringIO()
+    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+        code = main(list(argv))
+    return _Run(code, out.getvalue(), err.getvalue())
+
+
+CI_TASK_TOML = """
+[object]
+diameter_mm = 180.0
+mass_kg = 2.0
+[grasp]
+force_factor = 2.0
+[pump]
+max_pressure_MPa = 2.0
+[limits]
+max_principal_stretch = 1.4
+[free]
+d_mm = [10.0, 20.0]
+V0_mm3 = [12000.0, 30000.0]
+"""
+
+
+def test_cli_json_no_fem_writes_a_design_every_verb_reads(tmp_path):
+    task = _write(tmp_path, CI_TASK_TOML)
+    out = tmp_path / "out"
+    proc = _cli("design", "--task", str(task), "--no-fem", "--json", "--out", str(out), "--seed", "3")
+    assert proc.returncode == 0, proc.stderr
+    result = json.loads(proc.stdout)
+    for key in ("design", "predicted", "fem", "constraints", "design_file"):
+        assert key in result
+    assert set(result["predicted"]) >= {"P_grasp_MPa", "theta_grasp_deg", "F_v_N", "max_principal_stretch"}
+    assert all({"name", "value", "limit", "satisfied"} <= set(c) for c in result["constraints"])
+    assert result["fem"] is None
+    design = load_design(result["design_file"])
+    assert design.to_dict() == result["design"]
+    assert json.loads((out / "result.json").read_text())["design"] == result["design"]
+    curve = _cli("curve", "--design", result["design_file"], "--theta-deg", "10", "--json")
+    assert curve.returncode == 0, curve.stderr
+
+
+def test_cli_pareto_plot(tmp_path):
+    task = _write(tmp_path, CI_TASK_TOML)
+    plot = tmp_path / "front.png"
+    proc = _cli("design", "--task", str(task), "--no-fem", "--pareto", "--plot", str(plot),
+                "--out", str(tmp_path / "out"), "--json")
+    assert proc.returncode == 0, proc.stderr
+    rows = json.loads(proc.stdout)["pareto"]["rows"]
+    assert plot.stat().st_size > 1000
+    lam = [r["max_principal_stretch"] for r in rows]
+    P = [r["P_grasp_MPa"] for r in rows]
+    assert np.all(np.diff(lam) < 0) and np.all(np.diff(P) >= -1e-9)  # less stretch costs pressure
+
+
+def test_cli_bad_task_is_one_line_exit_2(tmp_path):
+    task = _write(tmp_path, CI_TASK_TOML.replace("[10.0, 20.0]", "[20.0, 10.0]"))
+    proc = _cli("design", "--task", str(task), "--no-fem")
+    assert proc.returncode == 2
+    assert proc.stderr.count("\n") == 1 and proc.stderr.startswith("softhand design: error: free.d_mm")
+    proc = _cli("design", "--task", str(_write(tmp_path, "[object\n", "broken.toml")), "--no-fem")
+    assert proc.returncode == 2 and "not valid TOML" in proc.stderr
+
+
+def test_cli_infeasible_task_is_one_paragraph_exit_1(tmp_path):
+    task = _write(tmp_path, CI_TASK_TOML.replace("max_pressure_MPa = 2.0", "max_pressure_MPa = 0.05"))
+    proc = _cli("design", "--task", str(task), "--no-fem", "--out", str(tmp_path / "out"))
+    assert proc.returncode == 1, proc.stderr
+    assert "The task cannot be met" in proc.stdout
