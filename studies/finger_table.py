@@ -26,7 +26,10 @@ def space_ranges(box: dict) -> dict:
     each variable, so the extremes are at the box's corners)."""
     corners = [dict(zip(VARIABLES, c)) for c in np.array(np.meshgrid(*[box[v] for v in VARIABLES]))
                .reshape(len(VARIABLES), -1).T]
-    values = [groups_of(finger_design(c)) for c in corners]
+    # the groups of each corner, which need not be a finger (a + b >= d at some corners)
+    values = [{"b_a": c["b_mm"] / c["a_mm"], "d_a": c["d_mm"] / c["a_mm"],
+               "link_a": c["l0_mm"] / 6.0 / c["a_mm"], "tie_link": c["tie_width_mm"] / (c["l0_mm"] / 6.0)}
+              for c in corners]
     return {g: (min(v[g] for v in values), max(v[g] for v in values)) for g in GROUPS}
 
 
