@@ -33,7 +33,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from fem import kinematics as kin
-from fem.materials import Law, Volumetric
+from fem.materials import Law, SplitLaw, Volumetric
 from reduced import rubber as rubber_models
 
 #: relative gap of two principal stretches below which the coincident limit is used
@@ -180,7 +180,7 @@ def _pair_coefficients(lam, Phi1, Phi2):
 
 
 @dataclass(frozen=True)
-class RubberLaw(Law):
+class RubberLaw(SplitLaw):
     """W(J^{-1/3} lambda_i) + kappa/2 (J - 1)^2: any :mod:`reduced.rubber` model, split for the
     mean-dilatation solids (``kappa`` default 1000 mu0, as :class:`fem.materials.NeoHookean`)."""
 
@@ -194,17 +194,6 @@ class RubberLaw(Law):
     def split(self):
         return IsochoricRubber(self.material), Volumetric(self.kappa)
 
-    def energy(self, F):
-        dev, vol = self.split()
-        return dev.energy(F) + vol.energy(F)
-
-    def stress(self, F):
-        dev, vol = self.split()
-        return dev.stress(F) + vol.stress(F)
-
-    def tangent(self, F):
-        dev, vol = self.split()
-        return dev.tangent(F) + vol.tangent(F)
 
 
 def rubber_law(material: rubber_models.Rubber, kappa: float):

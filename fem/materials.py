@@ -115,8 +115,25 @@ class NeoHookeanIsochoric(Law):
         return self.mu * J ** (-2.0 / 3.0) * A
 
 
+class SplitLaw(Law):
+    """A law defined by its :meth:`split` (isochoric part, volumetric part): energy, stress and
+    tangent are the sums of the parts'."""
+
+    def energy(self, F):
+        dev, vol = self.split()
+        return dev.energy(F) + vol.energy(F)
+
+    def stress(self, F):
+        dev, vol = self.split()
+        return dev.stress(F) + vol.stress(F)
+
+    def tangent(self, F):
+        dev, vol = self.split()
+        return dev.tangent(F) + vol.tangent(F)
+
+
 @dataclass(frozen=True)
-class NeoHookean(Law):
+class NeoHookean(SplitLaw):
     r"""Nearly incompressible Neo-Hookean rubber: mu/2 (J^{-2/3} I1 - 3) + kappa/2 (J - 1)^2.
 
     The default kappa = 1000 mu (Poisson's ratio 0.4995) follows DESIGN.md.
@@ -132,17 +149,6 @@ class NeoHookean(Law):
     def split(self):
         return NeoHookeanIsochoric(self.mu), Volumetric(self.kappa)
 
-    def energy(self, F):
-        dev, vol = self.split()
-        return dev.energy(F) + vol.energy(F)
-
-    def stress(self, F):
-        dev, vol = self.split()
-        return dev.stress(F) + vol.stress(F)
-
-    def tangent(self, F):
-        dev, vol = self.split()
-        return dev.tangent(F) + vol.tangent(F)
 
 
 @dataclass(frozen=True)
