@@ -15,10 +15,10 @@ import time
 import timeit
 import warnings
 
-from reduced import grasp
-from reduced.control import AngleController, default_gains, flexibility, ramp, simulate
-from reduced.design import HandDesign
-from reduced.plant import HandTables, PlantParams
+from softhand.reduced import grasp
+from softhand.reduced.control import AngleController, default_gains, flexibility, ramp, simulate
+from softhand.reduced.design import HandDesign
+from softhand.reduced.plant import HandTables, PlantParams
 
 
 def best(fn, repeat: int) -> tuple[float, float]:

@@ -12,8 +12,8 @@ import time
 import numpy as np
 from scipy.optimize import minimize
 
-from studies import design_opt
-from studies.design_task import load_task
+from softhand.studies.design import optimise as design_opt
+from softhand.studies.design.task import load_task
 
 TASKS = ["studies/designs/tasks/paper_task.toml", "studies/designs/tasks/small_object.toml",
          "studies/designs/tasks/large_object.toml", "studies/designs/tasks/low_pressure.toml"]

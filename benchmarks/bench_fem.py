@@ -22,13 +22,13 @@ import time
 
 import numpy as np
 
-from fem.assembly import Restriction
-from fem.linsolve import make_solver
-from fem.loads import dead_load
-from fem.materials import CompressibleNeoHookean
-from fem.newton import NewtonOptions, PathOptions, solve_path
-from fem.solid import Solid
-from meshes.tube import Tube, tube_mesh
+from softhand.fem.assembly import Restriction
+from softhand.fem.linsolve import make_solver
+from softhand.fem.loads import dead_load
+from softhand.fem.materials import CompressibleNeoHookean
+from softhand.fem.newton import NewtonOptions, PathOptions, solve_path
+from softhand.fem.solid import Solid
+from softhand.meshes.tube import Tube, tube_mesh
 
 #: gmsh element size [mm] giving about 20k / 80k / 200k P2 DOFs on this tube
 SIZES = {"small": 2.6, "medium": 1.6, "large": 1.15}

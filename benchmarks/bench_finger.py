@@ -8,8 +8,8 @@ from __future__ import annotations
 
 import argparse
 
-from fem.finger import FingerOptions
-from studies.bending import BendingStudy, run
+from softhand.fem.hand.finger import FingerOptions
+from softhand.studies.bending import BendingStudy, run
 
 
 def main() -> None:

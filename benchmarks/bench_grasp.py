@@ -12,10 +12,10 @@ from __future__ import annotations
 import argparse
 import time
 
-from fem.finger import FingerModel
-from fem.grasp import GraspModel, grasp_weights
-from reduced.design import HandDesign
-from studies.weights import finger_options
+from softhand.fem.hand.finger import FingerModel
+from softhand.fem.hand.grasp import GraspModel, grasp_weights
+from softhand.reduced.design import HandDesign
+from softhand.studies.weights import finger_options
 
 
 def timed(fn):

@@ -15,8 +15,8 @@ from pathlib import Path
 
 import numpy as np
 
-from reduced import grasp, hand
-from reduced.design import HandDesign
+from softhand.reduced import grasp, hand
+from softhand.reduced.design import HandDesign
 
 N = 100_000
 
@@ -60,11 +60,11 @@ def main() -> None:
     print(f"{'':<45} {'wall [s]':>9} {'cpu [s]':>9}   (load average {os.getloadavg()[0]:.1f})")
     for label, fn in rows:
         print(f"{label:<45} {'%9.4f %9.4f' % best_of(fn)}")
-    command = [sys.executable, "-m", "studies.cli", "curve", "--theta-deg", "0:90:10"]
+    command = [sys.executable, "-m", "softhand.studies.cli.main", "curve", "--theta-deg", "0:90:10"]
     wall, _ = best_of(lambda: subprocess.run(command, check=True, capture_output=True), repeats=3)
     print(f"{'softhand curve --theta-deg 0:90:10, start-up incl.':<45} {wall:9.4f}")
     with tempfile.TemporaryDirectory() as tmp:
-        path = Path(tmp) / "fem.toml"
+        path = Path(tmp) / "softhand.fem.toml"
         path.write_text(fem.to_toml())
         wall, _ = best_of(lambda: subprocess.run(command[:-2] + ["--pressure-mpa", "0.2,0.5,0.8",
                                                                 "--design", str(path)],

@@ -12,9 +12,9 @@ import time
 import numpy as np
 import scipy.sparse as sp
 
-from fem.linsolve import make_solver
-from fem.reservoir import SheetModel, inflate
-from reduced.design import HandDesign
+from softhand.fem.linsolve import make_solver
+from softhand.fem.hand.reservoir import SheetModel, inflate
+from softhand.reduced.design import HandDesign
 
 MESHES = ((20, 1), (40, 2), (80, 2), (40, 4), (80, 4))
 

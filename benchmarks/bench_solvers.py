@@ -22,9 +22,9 @@ import scipy.sparse as sp
 
 def tangent(path: Path) -> None:
     """Write the benchmark tangent K and right-hand side b to ``path`` (npz)."""
-    from fem.finger import FingerModel, FingerOptions
-    from fem.linsolve import make_solver
-    from reduced.design import HandDesign
+    from softhand.fem.hand.finger import FingerModel, FingerOptions
+    from softhand.fem.linsolve import make_solver
+    from softhand.reduced.design import HandDesign
 
     model = FingerModel(HandDesign(), FingerOptions())
     y = model.constraint.zero()
@@ -49,7 +49,7 @@ def factorise(path: str, method: str) -> None:
         x = np.zeros_like(b)
         chol.solve(b.copy(), x)
     else:
-        from fem.linsolve import make_solver
+        from softhand.fem.linsolve import make_solver
         x = make_solver(method, symmetric=True, precision="double").solve(K, b)
     seconds = time.perf_counter() - t0
     print(f"{method:9s} {seconds:8.2f} s   relative residual {np.linalg.norm(K @ x - b) / np.linalg.norm(b):.1e}")
@@ -62,7 +62,7 @@ def main() -> None:
     args = parser.parse_args()
     if args.child:
         return factorise(*args.child)
-    from fem.linsolve import available
+    from softhand.fem.linsolve import available
 
     methods = available() + (["cholespy"] if _importable("cholespy") else [])
     with tempfile.TemporaryDirectory() as tmp:

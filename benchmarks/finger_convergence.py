@@ -29,11 +29,11 @@ import time
 from dataclasses import replace
 from pathlib import Path
 
-from fem.finger import FingerModel, FingerOptions, solve_pressures
-from reduced.design import HandDesign
-from reduced.errors import InputError
-from studies.convergence import richardson
-from studies.output import write_json
+from softhand.fem.hand.finger import FingerModel, FingerOptions, solve_pressures
+from softhand.reduced.design import HandDesign
+from softhand.reduced.errors import InputError
+from softhand.studies.verification.convergence import richardson
+from softhand.studies.io.files import write_json
 
 #: the gmsh family's coarsest member: the CI mesh
 BASE = FingerOptions(mesher="gmsh", mesh_size=6.0, edge_ratio=1.0, mesh_refine=0)

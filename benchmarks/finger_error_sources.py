@@ -27,7 +27,7 @@ import argparse
 from dataclasses import replace
 from pathlib import Path
 
-from fem.finger import WindingFibers
+from softhand.fem.hand.finger import WindingFibers
 from finger_convergence import BASE, theta_case
 
 

@@ -17,9 +17,9 @@ from pathlib import Path
 
 import numpy as np
 
-from reduced import hand, reservoir, rubber
-from reduced.design import load_design
-from reduced.material_fit import fit_material, read_test_data
+from softhand.reduced import hand, reservoir, rubber
+from softhand.reduced.design import load_design
+from softhand.reduced.material_fit import fit_material, read_test_data
 
 MU0 = 1.15
 PRESSURES = (0.5, 1.0, 1.5, 2.0)
@@ -65,7 +65,7 @@ def main() -> None:
     for name, d in cases.items():
         ell = reservoir.ellipse_pressure(V, d)
         if args.fem:
-            from fem.reservoir import SheetModel, inflate
+            from softhand.fem.hand.reservoir import SheetModel, inflate
 
             fem[name] = inflate(SheetModel.from_design(d), V)
         cells = [f"{e:.4f}" + (f" / {s.pressure:.4f}" if args.fem else "")
@@ -77,8 +77,8 @@ def main() -> None:
 
 def finger_fem_table(cases) -> None:
     """theta(P) of one finger without reservoir: FEM (CI mesh) and eq. (28), per material."""
-    from fem.finger import FingerOptions
-    from studies.bending import BendingStudy, run
+    from softhand.fem.hand.finger import FingerOptions
+    from softhand.studies.bending import BendingStudy, run
 
     print("\n| material | " + " | ".join(f"theta({p:g} MPa) [deg] FEM / eq. (28)" for p in PRESSURES)
           + " | largest principal stretch at 2.0 MPa (FEM) |")
@@ -96,7 +96,7 @@ def plot(path, cases, fem) -> None:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from studies.output import save_figure
+    from softhand.studies.io.files import save_figure
 
     fig, ax = plt.subplots(1, 2, figsize=(11, 4.2))
     P = np.linspace(0.0, 2.0, 81)

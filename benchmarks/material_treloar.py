@@ -10,8 +10,8 @@ from __future__ import annotations
 import time
 from pathlib import Path
 
-from reduced import rubber
-from reduced.material_fit import FIT_MODELS, drucker_check, fit_material, read_test_data
+from softhand.reduced import rubber
+from softhand.reduced.material_fit import FIT_MODELS, drucker_check, fit_material, read_test_data
 
 DATA = Path(__file__).resolve().parent.parent / "studies" / "data" / "treloar1944.csv"
 KGF_CM2 = 0.0980665  #: MPa

@@ -8,8 +8,8 @@ import math
 
 from scipy.optimize import brentq
 
-from reduced import hand, reservoir
-from reduced.design import load_design
+from softhand.reduced import hand, reservoir
+from softhand.reduced.design import load_design
 
 design = load_design()
 target = 0.08  # [MPa]

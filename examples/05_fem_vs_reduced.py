@@ -7,9 +7,9 @@ balance: the stored energy equals the work the oil did on the way, W = int P dQ.
 """
 import numpy as np
 
-from fem.finger import FingerOptions
-from reduced.design import load_design
-from studies.bending import BendingStudy, run
+from softhand.fem.hand.finger import FingerOptions
+from softhand.reduced.design import load_design
+from softhand.studies.bending import BendingStudy, run
 
 design = load_design()
 ci_mesh = FingerOptions(mesher="gmsh", mesh_size=6.0)          # ~10k unknowns

@@ -42,7 +42,7 @@ import numpy as np
 import scipy.sparse as sp
 from skfem import Basis, ElementQuad2, ElementVector
 
-from fem import kinematics as kin
+from softhand.fem import kinematics as kin
 
 __all__ = ["AxisymSolid", "RevolvedVolume", "scatter_pattern"]
 

@@ -41,7 +41,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from fem.constraints import OMEGA, PlanarChain, rotation
+from softhand.fem.constraints import OMEGA, PlanarChain, rotation
 
 
 @dataclass(frozen=True)

@@ -32,9 +32,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from fem import kinematics as kin
-from fem.materials import Law, SplitLaw, Volumetric
-from reduced import rubber as rubber_models
+from softhand.fem import kinematics as kin
+from softhand.fem.materials import Law, SplitLaw, Volumetric
+from softhand.reduced import rubber as rubber_models
 
 #: relative gap of two principal stretches below which the coincident limit is used
 COINCIDENT = 1e-6
@@ -198,7 +198,7 @@ class RubberLaw(SplitLaw):
 
 def rubber_law(material: rubber_models.Rubber, kappa: float):
     """The FEM law of a rubber: the closed-form :class:`fem.materials.NeoHookean` for NH."""
-    from fem.materials import NeoHookean
+    from softhand.fem.materials import NeoHookean
 
     if isinstance(material, rubber_models.NeoHookean):
         return NeoHookean(material.mu, kappa)

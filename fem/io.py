@@ -30,9 +30,9 @@ from xml.sax.saxutils import quoteattr
 import numpy as np
 from skfem import Basis, ElementTetP1
 
-from fem import kinematics as kin
-from meshes.atomic import atomic_path
-from meshes.convert import write_vtu
+from softhand.fem import kinematics as kin
+from softhand.meshes.atomic import atomic_path
+from softhand.meshes.convert import write_vtu
 
 #: scikit-fem scalar element -> VTK cell type (scikit-fem's local node order is VTK's)
 CELL_TYPES = {

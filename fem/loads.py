@@ -36,9 +36,9 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sp
 
-from fem import kinematics as kin
-from fem.kinematics import EPS
-from fem.mapping import facet_basis
+from softhand.fem import kinematics as kin
+from softhand.fem.kinematics import EPS
+from softhand.fem.mapping import facet_basis
 
 
 class _Facets:

@@ -34,7 +34,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from fem import kinematics as kin
+from softhand.fem import kinematics as kin
 
 
 class Law:

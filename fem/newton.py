@@ -37,7 +37,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from fem.linsolve import make_solver
+from softhand.fem.linsolve import make_solver
 
 
 @dataclass(frozen=True)

@@ -51,8 +51,8 @@ import numpy as np
 import scipy.sparse as sp
 from skfem import Basis, ElementTetP2
 
-from fem import kinematics as kin
-from fem.assembly import ElementScatter, Restriction
+from softhand.fem import kinematics as kin
+from softhand.fem.assembly import ElementScatter, Restriction
 
 FORMULATIONS = ("mean_dilatation", "displacement")
 
@@ -288,7 +288,7 @@ class MixedNewton:
         newton(fun, x0, on_accept=mixed.accept)   # or solve_path(..., on_accept=mixed.accept)
 
     For prescribed values that grow with the load factor t, pass an ``expand`` that applies
-    the current t (see ``studies/verify_solid.py``).
+    the current t (see ``studies/verification/solid.py``).
     """
 
     def __init__(self, solid: Solid, expand):

@@ -30,7 +30,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import scipy.sparse as sp
 
-from fem.linsolve import make_solver
+from softhand.fem.linsolve import make_solver
 
 __all__ = ["PathOptions", "PathState", "NotConverged", "follow_volume"]
 

@@ -21,8 +21,8 @@ from pathlib import Path
 
 import skfem
 
-from meshes.convert import read_mesh
-from meshes.gmsh_io import GMSH_VERSION, Geometry, generate_msh
+from softhand.meshes.convert import read_mesh
+from softhand.meshes.gmsh_io import GMSH_VERSION, Geometry, generate_msh
 
 #: bump when the way meshes are generated changes, to invalidate old cache entries
 FORMAT = 2  # 2: element size no longer capped by gmsh's default point sizes
@@ -80,7 +80,7 @@ def cached_msh(geometry: Geometry, params, *, size: float, order: int = 2, refin
               f"generating it again", file=sys.stderr)
     try:
         generate_msh(geometry, params, path, size=size, order=order, refine=refine)
-        from meshes.atomic import atomic_path
+        from softhand.meshes.atomic import atomic_path
 
         with atomic_path(f"{path}.sha256") as tmp:
             tmp.write_text(_sha256(path) + "\n")

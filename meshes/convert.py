@@ -20,8 +20,8 @@ import meshio
 import numpy as np
 import skfem
 
-from meshes.atomic import atomic_path
-from reduced.errors import InputError
+from softhand.meshes.atomic import atomic_path
+from softhand.reduced.errors import InputError
 
 #: meshio cell type -> (scikit-fem mesh class, meshio facet types that bound it)
 _VOLUME_TYPES = {

@@ -28,7 +28,7 @@ from dataclasses import dataclass
 import numpy as np
 import skfem
 
-from meshes.cache import load_mesh
+from softhand.meshes.cache import load_mesh
 
 
 @dataclass(frozen=True)

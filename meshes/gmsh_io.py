@@ -16,7 +16,7 @@ from typing import Any, Callable
 
 import gmsh
 
-from meshes.atomic import atomic_path
+from softhand.meshes.atomic import atomic_path
 
 Geometry = Callable[[Any, Any, float], None]
 

@@ -16,8 +16,8 @@ from dataclasses import dataclass
 
 import skfem
 
-from meshes.cache import load_mesh
-from meshes.gmsh_io import name_groups
+from softhand.meshes.cache import load_mesh
+from softhand.meshes.gmsh_io import name_groups
 
 SECTORS = ("full", "half", "quarter")
 

@@ -1,6 +1,6 @@
 r"""Reservoir model ``"fem"``: the sheet's p(V) calibrated from the axisymmetric FEM.
 
-The FEM (``fem/reservoir.py``: clamped Neo-Hookean sheet, Q2/P1disc, volume control) gives
+The FEM (``fem/hand/reservoir.py``: clamped Neo-Hookean sheet, Q2/P1disc, volume control) gives
 the strain energy W(V) and the pressure p = dW/dV of the sheet. By dimensional analysis a
 Neo-Hookean sheet of radius R, thickness t and modulus μ has
 

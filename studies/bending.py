@@ -19,12 +19,12 @@ from dataclasses import asdict, dataclass, field
 
 import numpy as np
 
-from fem.finger import FingerModel, FingerOptions, FingerState, SweepStats, ring_width, solve_pressures
-from fem.newton import NotConverged
-from reduced import finger as reduced_finger
-from reduced import hand
-from reduced.design import HandDesign
-from reduced.errors import InputError
+from softhand.fem.hand.finger import FingerModel, FingerOptions, FingerState, SweepStats, ring_width, solve_pressures
+from softhand.fem.newton import NotConverged
+from softhand.reduced import finger as reduced_finger
+from softhand.reduced import hand
+from softhand.reduced.design import HandDesign
+from softhand.reduced.errors import InputError
 
 
 @dataclass(frozen=True)

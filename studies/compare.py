@@ -17,10 +17,10 @@ import math
 
 import numpy as np
 
-from fem.reservoir import SheetModel, inflate
-from reduced import hand
-from reduced import reservoir as ellipse
-from reduced.design import HandDesign
+from softhand.fem.hand.reservoir import SheetModel, inflate
+from softhand.reduced import hand
+from softhand.reduced import reservoir as ellipse
+from softhand.reduced.design import HandDesign
 
 
 def whole_hand(rows: list[dict], design: HandDesign, **sheet_mesh) -> dict:

@@ -18,9 +18,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from fem.reservoir import ReservoirResult, SheetModel, inflate
-from reduced import reservoir as ellipse
-from reduced.design import HandDesign
+from softhand.fem.hand.reservoir import ReservoirResult, SheetModel, inflate
+from softhand.reduced import reservoir as ellipse
+from softhand.reduced.design import HandDesign
 
 __all__ = ["ReservoirStudy", "ReservoirStudyResult", "run", "stroke_volume", "COLUMNS"]
 

@@ -23,10 +23,10 @@ from pathlib import Path
 
 import numpy as np
 
-from reduced import grasp
-from reduced.design import HandDesign
-from reduced.errors import InputError
-from studies.output import jsonable, write_json
+from softhand.reduced import grasp
+from softhand.reduced.design import HandDesign
+from softhand.reduced.errors import InputError
+from softhand.studies.io.files import jsonable, write_json
 
 #: bump when the FEM or the result's fields change, to invalidate cached results
 CACHE_FORMAT = 5  # 5: entries {format, key, sha256, result}; 4: factorisations counted; 3: the finger's windings on their own degree-5 rule, mesh graded at the ring edges
@@ -65,7 +65,7 @@ def _package_version() -> str:
 
 def cache_dir():
     """``$SOFTHAND_CACHE/weights`` (default ``~/.cache/softhand/weights``), next to the meshes."""
-    from meshes.cache import cache_dir as mesh_cache_dir
+    from softhand.meshes.cache import cache_dir as mesh_cache_dir
 
     return mesh_cache_dir().parent / "weights"
 
@@ -94,7 +94,7 @@ def state_row(state, w, mass: float, design: HandDesign) -> dict:
 def finger_options(mesh_size_mm: float):
     """The grasp FEM's finger mesh: graded (element size mesh_size_mm, half that at the ring
     edges), not refined; pinned here so that it does not follow the free-bending default."""
-    from fem.finger import FingerOptions
+    from softhand.fem.hand.finger import FingerOptions
 
     return FingerOptions(mesher="gmsh", mesh_size=mesh_size_mm, edge_ratio=0.5, edge_reach=3.0, mesh_refine=0)
 
@@ -102,8 +102,8 @@ def finger_options(mesh_size_mm: float):
 def compute(case: WeightsCase, out=None) -> dict:
     """Run the grasp FEM for one case (no cache): the flat result; with ``out`` (a folder)
     also the two states' fields as the VTK scene series ``grasp.pvd`` (hand, object, contact forces)."""
-    from fem.finger import FingerModel
-    from fem.grasp import GraspModel, grasp_weights
+    from softhand.fem.hand.finger import FingerModel
+    from softhand.fem.hand.grasp import GraspModel, grasp_weights
 
     finger = FingerModel(case.design, finger_options(case.mesh_size_mm))
     model = GraspModel(finger, case.diameter_mm, mass=case.mass_kg, depth=case.depth_mm)
@@ -118,8 +118,8 @@ def compute(case: WeightsCase, out=None) -> dict:
 
 def _write_vtk(out, model, states) -> None:
     """The contact states as the scene series grasp.pvd (see :mod:`fem.scene`)."""
-    from fem.io import SceneSeries
-    from fem.scene import grasp_scene
+    from softhand.fem.io import SceneSeries
+    from softhand.fem.hand.scene import grasp_scene
 
     series = SceneSeries(Path(out) / "grasp.pvd")
     for s in states:
@@ -140,7 +140,7 @@ def weights(case: WeightsCase, *, cache: bool = True, out=None) -> dict:
             return {**entry, "cached": True}
     result = compute(case) if out is None else compute(case, out)
     if out is not None:
-        from studies.output import kept_if_unwritable
+        from softhand.studies.io.files import kept_if_unwritable
 
         with kept_if_unwritable(Path(out) / "result.json", "weights"):
             write_json(Path(out) / "result.json", result)
@@ -232,8 +232,8 @@ def run(study: WeightsStudy, *, cache: bool = True, progress=None) -> WeightsRes
 def fig8(case: WeightsCase, pressures_mpa, depth_offsets_mm=(0.0, 10.0, 20.0)) -> list[dict]:
     """The Fig. 8 analogue for one object: at each depth (default depth + offset) the
     pressures in turn; each point a FEM contact state with its own w (P, P + dP)."""
-    from fem.finger import FingerModel
-    from fem.grasp import GraspModel, weight_vector
+    from softhand.fem.hand.finger import FingerModel
+    from softhand.fem.hand.grasp import GraspModel, weight_vector
 
     finger = FingerModel(case.design, finger_options(case.mesh_size_mm))
     base = GraspModel(finger, case.diameter_mm, mass=case.mass_kg).depth

@@ -3,11 +3,11 @@ thick-sphere balloon past its pressure maximum against the incompressible closed
 import numpy as np
 import pytest
 
-from fem.axisym import AxisymSolid, RevolvedVolume
-from fem.balloon import ThickSphere, closed_form_pressure, inflate_sphere
-from fem.materials import NeoHookean
-from meshes.reservoir import sheet_mesh
-from meshes.shell import shell_mesh
+from softhand.fem.axisym import AxisymSolid, RevolvedVolume
+from softhand.fem.hand.balloon import ThickSphere, closed_form_pressure, inflate_sphere
+from softhand.fem.materials import NeoHookean
+from softhand.meshes.reservoir import sheet_mesh
+from softhand.meshes.shell import shell_mesh
 
 #: inner stretches on both sides of the pressure maximum (λ_a = 1.426 for B/A = 1.1)
 LAMBDA = np.array([1.2, 1.426, 1.8, 2.5])

@@ -10,8 +10,8 @@ from pathlib import Path
 
 import pytest
 
-from reduced.design import BOUNDS, HandDesign
-from studies.cli import main
+from softhand.reduced.design import BOUNDS, HandDesign
+from softhand.studies.cli.main import main
 
 # ---------------------------------------------------------------- input files of the cases
 GOOD_CSV = "P_MPa,theta_deg\n0.2,10\n0.4,25\n0.6,40\n0.8,55\n"
@@ -73,7 +73,7 @@ def _study(body: str) -> str:
 
 STUDIES = {
     "s_code.toml": 'kind = "os:getcwd"\n[sweep]\nx = [1]\n',
-    "s_module.toml": 'kind = "studies.kinds:curve"\n[sweep]\ntheta_deg = [1]\n',
+    "s_module.toml": 'kind = "softhand.studies.batch.kinds:curve"\n[sweep]\ntheta_deg = [1]\n',
     "s_unknown_kind.toml": 'kind = "curl"\n[sweep]\ntheta_deg = [1]\n',
     "s_no_kind.toml": '[sweep]\ntheta_deg = [1]\n',
     "s_million.toml": _study('[sweep]\ntheta_deg = "0:99:1"\nmu_sf_MPa = "1:1.99:0.01"\n'

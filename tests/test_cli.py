@@ -2,11 +2,11 @@
 import subprocess
 import sys
 
-from studies.cli import main
+from softhand.studies.cli.main import main
 
 
 def run(*argv):
-    return subprocess.run([sys.executable, "-m", "studies.cli", *argv],
+    return subprocess.run([sys.executable, "-m", "softhand.studies.cli.main", *argv],
                           capture_output=True, text=True)
 
 

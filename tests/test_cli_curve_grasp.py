@@ -5,9 +5,9 @@ import math
 import numpy as np
 import pytest
 
-from reduced import grasp, hand
-from reduced.design import HandDesign
-from studies.cli import main
+from softhand.reduced import grasp, hand
+from softhand.reduced.design import HandDesign
+from softhand.studies.cli.main import main
 
 D = HandDesign()
 
@@ -32,7 +32,7 @@ def test_curve_by_angle(capsys):
 
 
 def test_curve_with_the_fem_reservoir_model_has_no_ellipse_columns(capsys, tmp_path):
-    design = tmp_path / "fem.toml"
+    design = tmp_path / "softhand.fem.toml"
     design.write_text('reservoir_model = "fem"\n')
     rows = run_json(capsys, "curve", "--theta-deg", "0,30", "--design", str(design))["rows"]
     assert set(rows[0]) == {"theta_deg", "P_MPa", "P_no_reservoir_MPa", "V_mm3", "p_reservoir_MPa"}

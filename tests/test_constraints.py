@@ -4,7 +4,7 @@ import pytest
 import scipy.sparse as sp
 from scipy.optimize import brentq
 
-from fem.constraints import ChainConstraint, PlanarChain
+from softhand.fem.constraints import ChainConstraint, PlanarChain
 
 HINGES = np.c_[[30.0, 60.0, 90.0, 120.0, 150.0], np.full(5, 15.0)]
 CHAIN = PlanarChain(HINGES)

@@ -8,8 +8,8 @@ import math
 import numpy as np
 import pytest
 
-from fem.constraints import PlanarChain
-from fem.contact import Circle, Pads, contact_load, gaps, normal_forces
+from softhand.fem.constraints import PlanarChain
+from softhand.fem.contact import Circle, Pads, contact_load, gaps, normal_forces
 
 D_PLATE = 15.0
 ENDS = (0.0, 30.0, 60.0, 90.0, 120.0, 150.0, 180.0)

@@ -11,14 +11,14 @@ import warnings
 import numpy as np
 import pytest
 
-from reduced import finger, grasp, hand
-from reduced.control import (AngleController, Gains, PressureController, default_gains,
+from softhand.reduced import finger, grasp, hand
+from softhand.reduced.control import (AngleController, Gains, PressureController, default_gains,
                              flexibility, initial_state, push_interval, ramp, simulate,
                              summarize)
-from reduced.design import HandDesign
-from reduced.errors import InputError
-from reduced.plant import HandTables, PlantParams, Push, equilibrium
-from studies.cli import main
+from softhand.reduced.design import HandDesign
+from softhand.reduced.errors import InputError
+from softhand.reduced.plant import HandTables, PlantParams, Push, equilibrium
+from softhand.studies.cli.main import main
 
 W180 = grasp.PAPER_WEIGHTS[180.0]
 THETA_REF = math.radians(50.0)

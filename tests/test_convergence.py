@@ -1,8 +1,8 @@
 """Richardson extrapolation against sequences with a known limit and order."""
 import pytest
 
-from reduced.errors import InputError
-from studies.convergence import richardson
+from softhand.reduced.errors import InputError
+from softhand.studies.verification.convergence import richardson
 
 
 @pytest.mark.parametrize("limit, C, p, ratio", [(20.9, -3.0, 1.7, 2.0), (1.0, 0.5, 3.0, 1.5)])

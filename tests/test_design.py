@@ -3,8 +3,8 @@ import math
 
 import pytest
 
-from reduced.design import PUBLIC_KEYS, HandDesign, design_from_dict, load_design
-from reduced.errors import InputError
+from softhand.reduced.design import PUBLIC_KEYS, HandDesign, design_from_dict, load_design
+from softhand.reduced.errors import InputError
 
 
 def test_paper_file_is_table_one():

@@ -4,10 +4,10 @@ import math
 
 import pytest
 
-from reduced import hand
-from studies import design_opt
-from studies.design_fem import ProofOptions, prove
-from studies.design_task import task_from_dict
+from softhand.reduced import hand
+from softhand.studies.design import optimise as design_opt
+from softhand.studies.design.proof import ProofOptions, prove
+from softhand.studies.design.task import task_from_dict
 
 TASK = task_from_dict({
     "object": {"diameter_mm": 180.0, "mass_kg": 2.0},

@@ -7,11 +7,11 @@ import math
 import numpy as np
 import pytest
 
-from reduced import finger, grasp, hand, kinematics
-from reduced.design import load_design
-from reduced.errors import InputError
-from studies import design_opt
-from studies.design_task import load_task, task_from_dict
+from softhand.reduced import finger, grasp, hand, kinematics
+from softhand.reduced.design import load_design
+from softhand.reduced.errors import InputError
+from softhand.studies.design import optimise as design_opt
+from softhand.studies.design.task import load_task, task_from_dict
 
 #: a CI-sized task: two free keys, so that a grid search can check the optimum
 CI_TASK = {
@@ -125,7 +125,7 @@ class _Run:
 
 def _cli(*argv):
     """``softhand ARGV`` in-process (the CLI's own error handling included)."""
-    from studies.cli import main
+    from softhand.studies.cli.main import main
 
     out, err = io.StringIO(), io.StringIO()
     with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):

@@ -6,13 +6,13 @@ import pytest
 import scipy.sparse as sp
 import skfem as fe
 
-from fem import linsolve
-from fem.assembly import Restriction
-from fem.linsolve import make_solver
-from fem.loads import FollowerPressure
-from fem.materials import NeoHookean
-from fem.newton import NewtonOptions, PathOptions, _add_pair, _bfgs_direction, solve_path
-from fem.solid import Solid
+from softhand.fem import linsolve
+from softhand.fem.assembly import Restriction
+from softhand.fem.linsolve import make_solver
+from softhand.fem.loads import FollowerPressure
+from softhand.fem.materials import NeoHookean
+from softhand.fem.newton import NewtonOptions, PathOptions, _add_pair, _bfgs_direction, solve_path
+from softhand.fem.solid import Solid
 
 
 def inflated_block():

@@ -5,11 +5,11 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from fem.constraints import ChainConstraint
-from fem.finger import FingerModel, FingerOptions, ring_width, solve_pressures, to_hand_frame
-from fem.newton import NewtonOptions
-from reduced import hand, kinematics
-from reduced.design import HandDesign
+from softhand.fem.constraints import ChainConstraint
+from softhand.fem.hand.finger import FingerModel, FingerOptions, ring_width, solve_pressures, to_hand_frame
+from softhand.fem.newton import NewtonOptions
+from softhand.reduced import hand, kinematics
+from softhand.reduced.design import HandDesign
 
 DESIGN = HandDesign()
 CI = FingerOptions(mesher="gmsh", mesh_size=6.0, edge_ratio=1.0, mesh_refine=0)  # uniform, 9.7k unknowns; theta ~3 % low (docs)
@@ -46,7 +46,7 @@ def test_windings_kernel_equals_the_general_solid_kernel(model):
     """The windings' dedicated residual/tangent (two batched products) against fem.solid's
     general anisotropic kernel for the same law and rule, at a random displacement that
     makes part of the fibers taut: equal to rounding."""
-    from fem.solid import Solid
+    from softhand.fem.solid import Solid
     w = model.windings
     general = Solid(model.mesh, w.law, intorder=CI.fiber_intorder, formulation="displacement")
     u = 0.05 * np.random.default_rng(0).standard_normal(model.solid.ndofs)
@@ -167,7 +167,7 @@ def test_hand_frame_matches_the_reduced_kinematics(model):
                                   ["--mesher", "layered", "--mesh-size-mm", "4"],
                                   ["--mesh-size-mm", "6", "--axial-size-mm", "2"]])
 def test_bend_rejects_bad_input_in_one_line(argv, capsys, tmp_path):
-    from studies.cli import main
+    from softhand.studies.cli.main import main
     assert main(["bend", *argv, "--out", str(tmp_path)]) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "error" in err

@@ -3,9 +3,9 @@ import json
 
 import pytest
 
-from reduced import hand
-from studies.cli import main
-from studies.finger_calibration import load_space
+from softhand.reduced import hand
+from softhand.studies.cli.main import main
+from softhand.studies.calibration.finger import load_space
 
 SPACE = """
 name = "{name}"

@@ -5,11 +5,11 @@ import numpy as np
 import pytest
 from scipy.integrate import quad
 
-from reduced import finger, finger_fem, hand, reservoir
-from reduced.design import HandDesign
-from reduced.errors import InputError
-from studies.finger_calibration import finger_design
-from studies.finger_table import table_csv
+from softhand.reduced import finger, finger_fem, hand, reservoir
+from softhand.reduced.design import HandDesign
+from softhand.reduced.errors import InputError
+from softhand.studies.calibration.finger import finger_design
+from softhand.studies.calibration.finger_table import table_csv
 
 BOX = {"a_mm": (3.0, 6.0), "b_mm": (3.0, 7.0), "d_mm": (10.0, 20.0), "l0_mm": (120.0, 200.0),
        "tie_width_mm": (5.0, 15.0)}
@@ -133,9 +133,9 @@ def test_missing_table_and_too_few_designs(tmp_path):
 def test_a_design_file_names_its_own_table_relative_to_itself(tmp_path):
     """write_design_with_table: FILE.toml next to FILE.csv, finger_model "fem", the table found
     relative to the design file; the CLI's error for a design outside it is one line, exit 2."""
-    from studies.cli import main
-    from studies.finger_table import write_design_with_table
-    from reduced.design import load_design
+    from softhand.studies.cli.main import main
+    from softhand.studies.calibration.finger_table import write_design_with_table
+    from softhand.reduced.design import load_design
 
     path, designs, _ = _synthetic_table(tmp_path)
     toml = write_design_with_table(designs[1], path)

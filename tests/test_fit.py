@@ -9,11 +9,11 @@ import math
 import numpy as np
 import pytest
 
-from reduced.csvdata import Measurements, read_measurements
-from reduced.design import HandDesign
-from reduced.errors import InputError
-from reduced.fit import FitOptions, check_params, diagnose, fit
-from reduced.materials_data import shear_modulus_from_shore_a, young_modulus_gent
+from softhand.reduced.csvdata import Measurements, read_measurements
+from softhand.reduced.design import HandDesign
+from softhand.reduced.errors import InputError
+from softhand.reduced.fit import FitOptions, check_params, diagnose, fit
+from softhand.reduced.materials_data import shear_modulus_from_shore_a, young_modulus_gent
 
 
 # ---------------------------------------------------------------- a model linear in p
@@ -135,9 +135,9 @@ def test_gent_relation_limits_and_paper_value():
 
 
 # ---------------------------------------------------------------- the reduced model
-from reduced import hand  # noqa: E402
-from reduced.fit import make_predictor  # noqa: E402
-from reduced.design import design_from_dict  # noqa: E402
+from softhand.reduced import hand  # noqa: E402
+from softhand.reduced.fit import make_predictor  # noqa: E402
+from softhand.reduced.design import design_from_dict  # noqa: E402
 
 TRUTH = {"V0_mm3": 15000.0, "mu_sf_MPa": 1.30}
 P_PAPER = np.repeat(np.round(np.arange(0.0, 0.85, 0.1), 2), 4)  # 0..0.8 MPa, four fingers
@@ -216,8 +216,8 @@ def test_v0_without_reservoir_is_flagged():
 import json  # noqa: E402
 from pathlib import Path  # noqa: E402
 
-from reduced.design import load_design  # noqa: E402
-from studies.cli import main  # noqa: E402
+from softhand.reduced.design import load_design  # noqa: E402
+from softhand.studies.cli.main import main  # noqa: E402
 
 EXAMPLES = Path(__file__).resolve().parent.parent / "studies" / "data"
 

@@ -54,7 +54,7 @@ CASES = {
 
 def run_json(argv: list[str]) -> dict:
     """Run ``softhand ARGV --json`` in-process; the parsed stdout."""
-    from studies.cli import main
+    from softhand.studies.cli.main import main
 
     out = io.StringIO()
     with contextlib.redirect_stdout(out), contextlib.redirect_stderr(io.StringIO()):

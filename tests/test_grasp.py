@@ -5,14 +5,14 @@ import math
 import numpy as np
 import pytest
 
-from fem.contact import gaps
-from fem.finger import FingerModel, FingerOptions
-from fem.grasp import GraspModel, GraspOptions, default_depth, pads_of, weight_vector
-from fem.linsolve import make_solver
-from fem.newton import NewtonOptions, newton
-from reduced.design import HandDesign
-from studies.cli import main
-from studies.weights import interpolate
+from softhand.fem.contact import gaps
+from softhand.fem.hand.finger import FingerModel, FingerOptions
+from softhand.fem.hand.grasp import GraspModel, GraspOptions, default_depth, pads_of, weight_vector
+from softhand.fem.linsolve import make_solver
+from softhand.fem.newton import NewtonOptions, newton
+from softhand.reduced.design import HandDesign
+from softhand.studies.cli.main import main
+from softhand.studies.weights import interpolate
 
 DESIGN = HandDesign()
 CI_MESH = 10.0   # mm; the coarsest mesh the finger FEM builds (docs/grasp.md: w on it vs finer)
@@ -27,7 +27,7 @@ def grasp180():
 
 
 def test_default_depth_against_the_open_finger_geometry():
-    from fem.constraints import PlanarChain
+    from softhand.fem.constraints import PlanarChain
 
     opts = GraspOptions()
     pads = pads_of(PlanarChain(np.c_[DESIGN.hinge_s, np.full(DESIGN.n_s, DESIGN.d)]), DESIGN, opts)
@@ -110,7 +110,7 @@ def test_interpolated_w_sums_to_one_and_hits_the_table():
 
 
 def test_weights_cli_caches_by_input(tmp_path, monkeypatch, capsys):
-    import studies.weights as sw
+    import softhand.studies.weights as sw
 
     calls = []
 
@@ -145,7 +145,7 @@ def test_weights_bad_input_is_one_line_exit_2(argv, field, capsys):
 def test_vtk_series_of_the_contact_states(grasp180, tmp_path):
     import meshio
 
-    from studies.weights import _write_vtk
+    from softhand.studies.weights import _write_vtk
 
     model, a, b, _ = grasp180
     _write_vtk(tmp_path, model, (a, b))
@@ -160,8 +160,8 @@ def test_scene_of_a_contact_state_holds_the_object_and_the_pad_forces(grasp180, 
     """The object's sphere (radius D/2 around the hand axis at the model's depth), the pad
     forces (normal part along the line from the centre = N of the FEM state), the links
     turned by the state's hinge angles."""
-    from studies.inspect import load_scene
-    from studies.weights import _write_vtk
+    from softhand.studies.io.render import load_scene
+    from softhand.studies.weights import _write_vtk
 
     model, a, _, _ = grasp180
     _write_vtk(tmp_path, model, (a,))
@@ -183,7 +183,7 @@ def test_scene_of_a_contact_state_holds_the_object_and_the_pad_forces(grasp180, 
 
 
 def test_grasp_cli_takes_w_from_the_fem_or_the_paper_by_name(tmp_path, monkeypatch, capsys):
-    import studies.weights as sw
+    import softhand.studies.weights as sw
 
     w_fem = [-0.1, 0.1, 0.3, 0.3, 0.4]
     monkeypatch.setenv("SOFTHAND_CACHE", str(tmp_path))

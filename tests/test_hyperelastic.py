@@ -4,10 +4,10 @@ import numpy as np
 import pytest
 from scipy.optimize import brentq
 
-from fem import kinematics as kin
-from fem.hyperelastic import IsochoricRubber, RubberLaw, rubber_law
-from fem.materials import NeoHookean, NeoHookeanIsochoric, Sum, Volumetric
-from reduced import rubber
+from softhand.fem import kinematics as kin
+from softhand.fem.hyperelastic import IsochoricRubber, RubberLaw, rubber_law
+from softhand.fem.materials import NeoHookean, NeoHookeanIsochoric, Sum, Volumetric
+from softhand.reduced import rubber
 from test_materials import F_BATCH, fd_derivative
 
 MODELS = {
@@ -80,7 +80,7 @@ def _mode_stress(law, mode, lam):
 
 def test_thick_sphere_pressure_for_any_model():
     """The quadrature form reproduces the Neo-Hookean closed form and the thin-wall limit."""
-    from fem.balloon import closed_form_pressure, closed_form_pressure_general
+    from softhand.fem.hand.balloon import closed_form_pressure, closed_form_pressure_general
 
     lam = np.array([1.2, 1.5, 2.5])
     np.testing.assert_allclose(closed_form_pressure_general(lam, 10.0, 11.0, rubber.NeoHookean(1.15)),
@@ -91,8 +91,8 @@ def test_thick_sphere_pressure_for_any_model():
 
 
 def test_reservoir_sheet_takes_the_designs_material():
-    from fem.reservoir import SheetModel
-    from reduced.design import HandDesign
+    from softhand.fem.hand.reservoir import SheetModel
+    from softhand.reduced.design import HandDesign
 
     mr = rubber.MooneyRivlin(0.46, 0.115)
     model = SheetModel.from_design(HandDesign().replace(reservoir_material=mr, mu_sr=mr.mu0), n_radial=4,

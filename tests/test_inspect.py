@@ -4,10 +4,10 @@ import pytest
 import skfem
 from matplotlib.image import imread
 
-from fem.io import VtkSeries
-from fem.materials import NeoHookean
-from studies.cli import main
-from studies.inspect import inspect
+from softhand.fem.io import VtkSeries
+from softhand.fem.materials import NeoHookean
+from softhand.studies.cli.main import main
+from softhand.studies.io.render import inspect
 
 
 @pytest.fixture(scope="module")

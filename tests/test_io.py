@@ -4,9 +4,9 @@ import numpy as np
 import pytest
 import skfem
 
-from fem.io import VtkSeries, solid_output, state_fields, write_state
-from fem.materials import Fibers, NeoHookean
-from fem.solid import Solid
+from softhand.fem.io import VtkSeries, solid_output, state_fields, write_state
+from softhand.fem.materials import Fibers, NeoHookean
+from softhand.fem.solid import Solid
 
 F0 = np.array([[1.2, 0.1, 0.0], [0.0, 0.9, 0.05], [0.0, 0.0, 0.95]])
 

@@ -2,10 +2,10 @@
 
 Layers, bottom up (the README's Architecture section describes them):
 
-* ``reduced`` -- the design vocabulary and the paper's model; NumPy/SciPy only;
-* ``meshes`` -- geometry as code; may use ``reduced`` (design, errors);
-* ``fem`` -- the FEM core and the hand models; may use ``meshes`` and ``reduced``;
-* ``studies`` -- studies, batch, reproduce, verification, the CLI; may use all.
+* ``softhand.reduced`` -- the design vocabulary and the paper's model; NumPy/SciPy only;
+* ``softhand.meshes`` -- geometry as code; may use ``reduced`` (design, errors);
+* ``softhand.fem`` -- the FEM core and the hand models; may use ``meshes`` and ``reduced``;
+* ``softhand.studies`` -- studies, batch, reproduce, verification, the CLI; may use all.
 
 Every import counts, also those inside functions (a lazy import is still a dependency).
 Cycles are looked for among module-level imports, the ones that run at import time.
@@ -24,13 +24,13 @@ FORBIDDEN = {"reduced": ("skfem", "gmsh", "pyvista", "meshio", "matplotlib", "da
 
 
 def modules():
-    """(dotted name, path) of every module of the four packages."""
+    """(dotted name under softhand, path) of every module of the four packages."""
     for layer in LAYERS:
         for path in sorted((ROOT / layer).rglob("*.py")):
             parts = path.relative_to(ROOT).with_suffix("").parts
             if parts[-1] == "__init__":
                 parts = parts[:-1]
-            yield ".".join(parts), path
+            yield ".".join(("softhand", *parts)), path
 
 
 def imports(name: str, path: Path, *, top_level_only: bool = False):
@@ -51,8 +51,8 @@ def imports(name: str, path: Path, *, top_level_only: bool = False):
 
 
 def layer_of(module: str) -> str | None:
-    top = module.split(".")[0]
-    return top if top in LAYERS else None
+    parts = module.split(".")
+    return parts[1] if parts[0] == "softhand" and len(parts) > 1 and parts[1] in LAYERS else None
 
 
 ALL = dict(modules())
@@ -62,6 +62,7 @@ ALL = dict(modules())
 def test_dependencies_point_down(name):
     own = layer_of(name)
     for target in imports(name, ALL[name]):
+        assert not target.split(".")[0] in LAYERS, f"{name} imports {target}: use softhand.{target}"
         other = layer_of(target)
         if other is not None:
             assert LAYERS.index(other) <= LAYERS.index(own), f"{name} ({own}) imports {target} ({other})"
@@ -90,7 +91,7 @@ def test_no_import_cycles():
 def test_the_checks_see_a_violation(tmp_path):
     """The import scanner itself: a lazy, a relative and an absolute import are all seen."""
     path = tmp_path / "mod.py"
-    path.write_text("from . import design\nimport numpy\n\ndef f():\n    from fem import solid\n")
-    found = set(imports("reduced.mod", path))
-    assert {"reduced.design", "numpy", "fem.solid"} <= found
-    assert "fem.solid" not in set(imports("reduced.mod", path, top_level_only=True))
+    path.write_text("from . import design\nimport numpy\n\ndef f():\n    from softhand.fem import solid\n")
+    found = set(imports("softhand.reduced.mod", path))
+    assert {"softhand.reduced.design", "numpy", "softhand.fem.solid"} <= found
+    assert set(imports("softhand.reduced.mod", path, top_level_only=True)) >= {"softhand.reduced.design"}

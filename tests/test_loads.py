@@ -5,12 +5,12 @@ import numpy as np
 import pytest
 import skfem as fe
 
-from fem.assembly import Restriction
-from fem.linsolve import make_solver
-from fem.loads import CavityVolume, FollowerPressure, dead_load, volume_control
-from fem.materials import NeoHookean
-from fem.newton import newton
-from fem.solid import Solid
+from softhand.fem.assembly import Restriction
+from softhand.fem.linsolve import make_solver
+from softhand.fem.loads import CavityVolume, FollowerPressure, dead_load, volume_control
+from softhand.fem.materials import NeoHookean
+from softhand.fem.newton import newton
+from softhand.fem.solid import Solid
 
 RNG = np.random.default_rng(7)
 

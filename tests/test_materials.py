@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 from scipy.optimize import brentq
 
-from fem.materials import CompressibleNeoHookean, Fibers, NeoHookean, Volumetric
+from softhand.fem.materials import CompressibleNeoHookean, Fibers, NeoHookean, Volumetric
 
 RNG = np.random.default_rng(0)
 #: a batch (4, 2) of deformation gradients with J in about [0.7, 1.4]

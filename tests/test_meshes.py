@@ -3,10 +3,10 @@ import numpy as np
 import pytest
 import skfem
 
-from meshes import cache, gmsh_io
-from meshes.convert import read_mesh
-from meshes.tube import Tube, tube_mesh
-from reduced.errors import InputError
+from softhand.meshes import cache, gmsh_io
+from softhand.meshes.convert import read_mesh
+from softhand.meshes.tube import Tube, tube_mesh
+from softhand.reduced.errors import InputError
 
 
 @pytest.fixture(autouse=True)
@@ -102,7 +102,7 @@ def test_cache_generates_each_mesh_once(monkeypatch):
 
 
 def tube_geometry_fn():
-    from meshes.tube import tube_geometry
+    from softhand.meshes.tube import tube_geometry
     return tube_geometry
 
 
@@ -129,14 +129,14 @@ def test_a_file_that_is_not_a_mesh_is_one_line_input_error(tmp_path, content):
 
 # -- the layered finger mesh (meshes.finger.layered_tube_mesh) --------------------------------
 def layered(refine=0, **kw):
-    from meshes.finger import FingerTube, layered_tube_mesh
+    from softhand.meshes.finger import FingerTube, layered_tube_mesh
     tube = FingerTube(4.0, 5.0, 180.0, 5.0, ((10.0, 20.0), (40.0, 50.0), (70.0, 80.0)))
     opts = dict(n_phi=4, layer_first=0.2, layer_ratio=2.0, axial_size=5.0, refine=refine) | kw
     return tube, layered_tube_mesh(tube, **opts)
 
 
 def facet_measure(mesh, name):
-    from fem.mapping import facet_basis
+    from softhand.fem.mapping import facet_basis
     return float(facet_basis(mesh, skfem.ElementTetP2(), facets=mesh.boundaries[name], intorder=4).dx.sum())
 
 
@@ -174,7 +174,7 @@ def test_layered_refinement_is_nested_with_eight_times_the_wall_elements():
 
 
 def test_layered_wall_layers_grow_geometrically_and_fill_the_wall():
-    from meshes.finger import layered_radii
+    from softhand.meshes.finger import layered_radii
     r = layered_radii(4.0, 5.0, 0.2, 2.0)
     t = np.diff(r)
     assert r[0] == 4.0 and r[-1] == pytest.approx(9.0) and np.allclose(t[1:] / t[:-1], 2.0)
@@ -183,7 +183,7 @@ def test_layered_wall_layers_grow_geometrically_and_fill_the_wall():
 def test_robust_facet_map_equals_scikit_fem_where_both_work():
     """On a curved mesh scikit-fem can map, the better-started inverse gives the same facet
     quadrature (points, weights, normals); on the thin layered elements it also converges."""
-    from fem.mapping import facet_basis
+    from softhand.fem.mapping import facet_basis
     mesh = skfem.MeshTet2.init_ball()
     ours = facet_basis(mesh, skfem.ElementTetP2(), intorder=4)
     theirs = skfem.FacetBasis(mesh, skfem.ElementTetP2(), intorder=4)

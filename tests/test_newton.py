@@ -5,12 +5,12 @@ import pytest
 import scipy.sparse as sp
 import skfem as fe
 
-from fem.assembly import Restriction
-from fem.linsolve import available, make_solver
-from fem.loads import FollowerPressure
-from fem.materials import NeoHookean
-from fem.newton import NewtonOptions, NotConverged, PathOptions, newton, solve_path
-from fem.solid import Solid
+from softhand.fem.assembly import Restriction
+from softhand.fem.linsolve import available, make_solver
+from softhand.fem.loads import FollowerPressure
+from softhand.fem.materials import NeoHookean
+from softhand.fem.newton import NewtonOptions, NotConverged, PathOptions, newton, solve_path
+from softhand.fem.solid import Solid
 
 
 def scalar_system(f, df):

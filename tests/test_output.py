@@ -6,7 +6,7 @@ import stat
 import numpy as np
 import pytest
 
-from studies.output import write_atomic, write_csv, write_json
+from softhand.studies.io.files import write_atomic, write_csv, write_json
 
 
 def test_write_json_round_trip_with_numpy(tmp_path):

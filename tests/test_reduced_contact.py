@@ -1,15 +1,15 @@
-"""reduced.contact: pad gaps and placement against the grasp FEM's own geometry (fem.contact,
+"""softhand.reduced.contact: pad gaps and placement against the grasp FEM's own geometry (fem.contact,
 another frame and code), gap gradients against finite differences, contact angle, rolling w."""
 
 import numpy as np
 import pytest
 
-from fem.constraints import PlanarChain
-from fem.contact import Circle, gaps
-from fem.grasp import GraspOptions, default_depth, pads_of, to_finger_frame
-from reduced import contact, kinematics
-from reduced.design import HandDesign
-from reduced.errors import InputError
+from softhand.fem.constraints import PlanarChain
+from softhand.fem.contact import Circle, gaps
+from softhand.fem.hand.grasp import GraspOptions, default_depth, pads_of, to_finger_frame
+from softhand.reduced import contact, kinematics
+from softhand.reduced.design import HandDesign
+from softhand.reduced.errors import InputError
 
 DESIGN = HandDesign()
 

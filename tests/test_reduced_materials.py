@@ -8,10 +8,10 @@ import numpy as np
 import pytest
 from scipy import integrate
 
-from reduced import finger, hand, reservoir, rubber
-from reduced.design import HandDesign, design_from_dict, load_design
-from reduced.errors import InputError
-from studies.cli import main
+from softhand.reduced import finger, hand, reservoir, rubber
+from softhand.reduced.design import HandDesign, design_from_dict, load_design
+from softhand.reduced.errors import InputError
+from softhand.studies.cli.main import main
 
 MR = rubber.MooneyRivlin(0.5, 0.075)
 YEOH = rubber.Yeoh(0.575, -0.02, 0.004)

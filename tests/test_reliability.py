@@ -9,10 +9,10 @@ from pathlib import Path
 
 import pytest
 
-from meshes import cache as mesh_cache
-from studies.cli import main
-from studies.runner import RESULT, plan, study_dir
-from studies.studyfile import load_study
+from softhand.meshes import cache as mesh_cache
+from softhand.studies.cli.main import main
+from softhand.studies.batch.runner import RESULT, plan, study_dir
+from softhand.studies.batch.studyfile import load_study
 from test_runner import install_kind
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -20,7 +20,7 @@ ROOT = Path(__file__).resolve().parent.parent
 #: the curve kind, slowed down so that concurrent runs overlap, logging every computation
 LOGGED_CURVE = '''
 import os, time
-from studies.kinds import curve
+from softhand.studies.batch.kinds import curve
 def case(params, design, outdir):
     time.sleep(params["sleep_s"])
     fd = os.open(params["log"], os.O_WRONLY | os.O_APPEND | os.O_CREAT)
@@ -36,7 +36,7 @@ def _env(tmp_path) -> dict:
 
 
 def _cli(*args) -> list[str]:
-    return [sys.executable, "-m", "studies.cli", *args]
+    return [sys.executable, "-m", "softhand.studies.cli.main", *args]
 
 
 def _logged_study(tmp_path, monkeypatch, sleep_s: float) -> Path:
@@ -61,8 +61,8 @@ def quick_study(tmp_path, monkeypatch):
 
 def _check_results(study, root) -> None:
     """Every case done, with the numbers of the reduced model itself."""
-    from reduced.design import HandDesign
-    from studies.kinds import curve
+    from softhand.reduced.design import HandDesign
+    from softhand.studies.batch.kinds import curve
 
     sdir = study_dir(study, root)
     for case in plan(study):
@@ -196,7 +196,7 @@ def _fake_compute(calls):
 
 @pytest.mark.parametrize("damage", ["truncated", "empty", "null", "{}", "edited", "other key"])
 def test_a_corrupt_weights_cache_entry_is_recomputed(tmp_path, monkeypatch, capsys, damage):
-    import studies.weights as sw
+    import softhand.studies.weights as sw
 
     calls = []
     monkeypatch.setenv("SOFTHAND_CACHE", str(tmp_path))
@@ -218,7 +218,7 @@ def test_a_corrupt_weights_cache_entry_is_recomputed(tmp_path, monkeypatch, caps
 
 
 def test_an_unwritable_cache_is_a_warning_and_the_result_is_printed(tmp_path, monkeypatch, capsys):
-    import studies.weights as sw
+    import softhand.studies.weights as sw
 
     (tmp_path / "a_file").write_text("")
     monkeypatch.setenv("SOFTHAND_CACHE", str(tmp_path / "a_file" / "cache"))
@@ -255,11 +255,11 @@ def test_a_corrupt_cached_mesh_is_generated_again(tmp_path, monkeypatch, capsys,
 
 
 def test_mesh_and_weights_cache_keys_carry_the_package_version(monkeypatch):
-    from studies.weights import WeightsCase
+    from softhand.studies.weights import WeightsCase
 
     key, wkey = mesh_cache.mesh_key(rectangle, {"w": 1}, size=1.0, order=1), WeightsCase().key()
     monkeypatch.setattr(mesh_cache, "_softhand_version", lambda: "999.0")
-    monkeypatch.setattr("studies.weights._package_version", lambda: "999.0")
+    monkeypatch.setattr("softhand.studies.weights._package_version", lambda: "999.0")
     assert mesh_cache.mesh_key(rectangle, {"w": 1}, size=1.0, order=1) != key
     assert WeightsCase().key() != wkey
 
@@ -268,8 +268,8 @@ def test_mesh_and_weights_cache_keys_carry_the_package_version(monkeypatch):
 def test_a_failed_load_step_names_the_pressures_reached(monkeypatch):
     import numpy as np
 
-    import fem.finger as ff
-    from fem.newton import NotConverged
+    import softhand.fem.hand.finger as ff
+    from softhand.fem.newton import NotConverged
 
     y = np.arange(3.0)
 
@@ -286,8 +286,8 @@ def test_a_failed_load_step_names_the_pressures_reached(monkeypatch):
 
 def test_bend_failure_is_one_line_with_the_pressure_and_out_never_mixes_runs(tmp_path, monkeypatch,
                                                                               capsys):
-    import studies.bending
-    from fem.newton import NotConverged
+    from softhand.studies import bending
+    from softhand.fem.newton import NotConverged
 
     out = tmp_path / "bend"
     out.mkdir()
@@ -302,7 +302,7 @@ def test_bend_failure_is_one_line_with_the_pressure_and_out_never_mixes_runs(tmp
         error.pressure = 0.03
         raise error
 
-    monkeypatch.setattr(studies.bending, "run", failing)
+    monkeypatch.setattr(bending, "run", failing)
     assert main(["bend", "--pressure-mpa", "0.1", "--out", str(out)]) == 1
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "P = 0.03 MPa" in err[0] and "Traceback" not in err[0]
@@ -313,12 +313,12 @@ def test_bend_failure_is_one_line_with_the_pressure_and_out_never_mixes_runs(tmp
 
 def test_an_output_that_fails_after_the_computation_loses_nothing(tmp_path, monkeypatch, capsys):
     """The disk refuses the picture after the curve is computed: a warning, the rows printed."""
-    import studies.output
+    from softhand.studies.io import files
 
     def full_disk(path, data):
         raise OSError(28, "No space left on device")
 
-    monkeypatch.setattr(studies.output, "write_atomic", full_disk)
+    monkeypatch.setattr(files, "write_atomic", full_disk)
     assert main(["curve", "--theta-deg", "0:90:30", "--plot", str(tmp_path / "c.png"), "--json"]) == 0
     out, err = capsys.readouterr()
     assert len(json.loads(out)["rows"]) == 4

@@ -6,13 +6,13 @@ import math
 import numpy as np
 import pytest
 
-from fem.reservoir import SheetModel, inflate
-from fem.volume_path import PathOptions, PathState, follow_volume
-from reduced import hand, reservoir
-from reduced import reservoir_fem
-from reduced.design import HandDesign
-from studies.cli import main
-from studies.reservoir import ReservoirStudy, run, stroke_volume
+from softhand.fem.hand.reservoir import SheetModel, inflate
+from softhand.fem.volume_path import PathOptions, PathState, follow_volume
+from softhand.reduced import hand, reservoir
+from softhand.reduced import reservoir_fem
+from softhand.reduced.design import HandDesign
+from softhand.studies.cli.main import main
+from softhand.studies.reservoir import ReservoirStudy, run, stroke_volume
 
 DESIGN = HandDesign()
 COARSE = dict(n_radial=24, n_thick=2)
@@ -153,7 +153,7 @@ def test_cli_table_json_files_and_bad_input(tmp_path, capsys):
     assert set(data["rows"][0]) >= {"V_mm3", "p_MPa", "h_mm", "W_Nmm", "p_ellipse_MPa",
                                     "h_ellipse_mm", "W_ellipse_Nmm", "lambda_r", "max_gap_mm"}
     assert (out / "sheet_V17800_rz.vtu").is_file()
-    from studies.inspect import load_scene
+    from softhand.studies.io.render import load_scene
 
     sheet = load_scene(out / "sheet.pvd")[0]["sheet"]  # the last step: the largest volume
     height = np.asarray(sheet.points)[:, 2] + np.asarray(sheet.point_data["displacement_mm"])[:, 2]
@@ -183,12 +183,12 @@ def test_oil_leaving_retraces_the_inflation_path(study):
 
 
 def test_cli_reports_newton_failure_in_one_line(monkeypatch, capsys):
-    from fem.volume_path import NotConverged
+    from softhand.fem.volume_path import NotConverged
 
     def fail(*args, **kwargs):
         raise NotConverged("no equilibrium at V = 123 mm^3", [1.0, 0.5], PathState(100.0, 0.01, 1.0, None))
 
-    monkeypatch.setattr("studies.reservoir.inflate", fail)
+    monkeypatch.setattr("softhand.studies.reservoir.inflate", fail)
     assert main(["reservoir", "--volume-mm3", "17800"]) == 1
     err = capsys.readouterr().err.strip().splitlines()[-1]
     assert "V = 123 mm^3" in err and "last converged state V = 100 mm^3" in err

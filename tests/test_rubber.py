@@ -2,8 +2,8 @@
 import numpy as np
 import pytest
 
-from reduced import rubber
-from reduced.errors import InputError
+from softhand.reduced import rubber
+from softhand.reduced.errors import InputError
 
 MODELS = [
     rubber.NeoHookean(0.6),

@@ -9,10 +9,10 @@ from pathlib import Path
 
 import pytest
 
-from reduced.design import HandDesign
-from studies.cli import main
-from studies.runner import RESULT, case_key, plan, run_study, status, study_dir
-from studies.studyfile import load_study
+from softhand.reduced.design import HandDesign
+from softhand.studies.cli.main import main
+from softhand.studies.batch.runner import RESULT, case_key, plan, run_study, status, study_dir
+from softhand.studies.batch.studyfile import load_study
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -83,7 +83,7 @@ def test_killed_run_resumes_with_only_the_missing_cases(tmp_path, monkeypatch, s
                        f'[sweep]\nx = "1:{N_SLOW}:1"\n')
     study, root = load_study(path), tmp_path / "res"
     env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(tmp_path), str(ROOT)])}
-    proc = subprocess.Popen([sys.executable, "-m", "studies.cli", "study", "run", str(path),
+    proc = subprocess.Popen([sys.executable, "-m", "softhand.studies.cli.main", "study", "run", str(path),
                              "--workers", "2", "--results", str(root), "--no-progress"],
                             env=env, start_new_session=True, stdout=subprocess.PIPE,
                             stderr=subprocess.PIPE, preexec_fn=_default_sigint)

@@ -7,12 +7,12 @@ import numpy as np
 import pytest
 from matplotlib.image import imread
 
-from fem.finger import FingerModel, FingerOptions
-from fem.io import SceneSeries
-from fem.scene import finger_scene, link_boxes, to_hand
-from reduced.design import HandDesign
-from studies.cli import main
-from studies.inspect import animate, describe, inspect, load_scene
+from softhand.fem.hand.finger import FingerModel, FingerOptions
+from softhand.fem.io import SceneSeries
+from softhand.fem.hand.scene import finger_scene, link_boxes, to_hand
+from softhand.reduced.design import HandDesign
+from softhand.studies.cli.main import main
+from softhand.studies.io.render import animate, describe, inspect, load_scene
 
 DESIGN = HandDesign()
 Q = np.array([0.1, 0.25, 0.15, 0.05, 0.3])  # rad, distinct per hinge so a mix-up shows
@@ -139,7 +139,7 @@ def test_fields_lists_blocks_and_cli_errors(series, capsys):
 
 
 def test_default_camera_looks_normal_to_the_bending_plane(series):
-    from studies.inspect import _draw, _plotter
+    from softhand.studies.io.render import _draw, _plotter
 
     plotter = _plotter(window_size=(200, 150))
     _draw(plotter, load_scene(series)[0], "J", title="t", view=None, hand=False)

@@ -8,13 +8,13 @@ from scipy.integrate import quad
 from scipy.optimize import brentq
 from skfem.models.elasticity import linear_elasticity
 
-from fem import kinematics as kin
-from fem.assembly import Restriction
-from fem.linsolve import make_solver
-from fem.loads import FollowerPressure
-from fem.materials import CompressibleNeoHookean, Fibers, NeoHookean
-from fem.newton import NewtonOptions, PathOptions, solve_path
-from fem.solid import MixedNewton, Solid
+from softhand.fem import kinematics as kin
+from softhand.fem.assembly import Restriction
+from softhand.fem.linsolve import make_solver
+from softhand.fem.loads import FollowerPressure
+from softhand.fem.materials import CompressibleNeoHookean, Fibers, NeoHookean
+from softhand.fem.newton import NewtonOptions, PathOptions, solve_path
+from softhand.fem.solid import MixedNewton, Solid
 
 RNG = np.random.default_rng(3)
 
@@ -200,7 +200,7 @@ def stretch_box(lam: float, kappa: float, values_known: bool):
     """The unit-cross-section box of length 2 stretched to lam by a prescribed end displacement
     (one mixed-Newton solve from rest); symmetry planes x = 0, y = 0, z = 0 (with_defaults names
     left/bottom/front for x, y, z = 0 and back for z = 2). -> (solid, u, Newton iterations)."""
-    from fem.newton import newton
+    from softhand.fem.newton import newton
 
     mesh = box(n=(1, 1, 2))
     solid = Solid(mesh, NeoHookean(MU, kappa))
@@ -226,7 +226,7 @@ def test_mixed_newton_with_prescribed_displacements_converges_quadratically():
     """An anchor taken at the full state (prescribed values included) keeps Newton quadratic
     (one step to stretch 1.5 at kappa = 1000 mu, from rest); one that misses them, as ``expand`` with
     zeros for the fixed dofs did, does not converge at all."""
-    from fem.newton import NotConverged
+    from softhand.fem.newton import NotConverged
 
     _, _, history = stretch_box(1.5, 1000.0 * MU, values_known=True)
     h = np.array(history) / history[0]
@@ -240,7 +240,7 @@ def test_reaction_force_and_moment_are_the_uniaxial_closed_form():
     """The support's resultant on the stretched end is P11 A0 (homogeneous uniaxial tension,
     exact in P2), and its moment about the origin is c x F with c the end face's deformed
     centre (a uniform traction has no moment about its centroid)."""
-    from studies.closed_forms import uniaxial_lateral_stretch, uniaxial_nominal_stress
+    from softhand.studies.verification.closed_forms import uniaxial_lateral_stretch, uniaxial_nominal_stress
 
     lam, kappa = 1.5, 1000.0 * MU
     solid, u, _ = stretch_box(lam, kappa, values_known=True)

@@ -3,9 +3,9 @@ import math
 
 import pytest
 
-from reduced.design import HandDesign
-from studies.cli import main
-from studies.studyfile import KINDS, load_study, resolve_kind
+from softhand.reduced.design import HandDesign
+from softhand.studies.cli.main import main
+from softhand.studies.batch.studyfile import KINDS, load_study, resolve_kind
 
 GOOD = """
 kind = "curve"

@@ -1,15 +1,15 @@
 """The verification suite (softhand verify): every registered case passes on CI-sized meshes.
 
-Each case compares the FEM with a closed form (studies/closed_forms.py); its docstring
+Each case compares the FEM with a closed form (studies/verification/closed_forms.py); its docstring
 says what bounds its tolerance. The CLI test checks the table/JSON contract and exit codes.
 """
 import json
 
 import pytest
 
-from studies import closed_forms as cf
-from studies.cli import main
-from studies.verify import REGISTRY, Check, run_case
+from softhand.studies.verification import closed_forms as cf
+from softhand.studies.cli.main import main
+from softhand.studies.verification.registry import REGISTRY, Check, run_case
 
 
 @pytest.mark.slow
@@ -51,7 +51,7 @@ def test_cli_json_and_unknown_case(capsys):
 
 
 def test_cli_exit_1_on_a_failed_check(monkeypatch, capsys):
-    import studies.verify as verify
+    import softhand.studies.verification.registry as verify
 
     monkeypatch.setitem(verify.REGISTRY, "broken", f"{__name__}:failing_case")
     assert main(["verify", "--case", "broken"]) == 1

@@ -22,10 +22,10 @@ from pathlib import Path
 
 import numpy as np
 
-from reduced.design import design_from_dict, load_design
-from reduced.grasp import PAPER_WEIGHTS, angle_at
-from reduced.hand import bend_angle
-from studies.output import write_atomic
+from softhand.reduced.design import design_from_dict, load_design
+from softhand.reduced.grasp import PAPER_WEIGHTS, angle_at
+from softhand.reduced.hand import bend_angle
+from softhand.studies.io.files import write_atomic
 
 HERE = Path(__file__).resolve().parent
 TRUTH = {"V0_mm3": 15000.0, "mu_sf_MPa": 1.30}  #: the synthetic hand's parameters

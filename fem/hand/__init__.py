@@ -1,0 +1,1 @@
+"""softhand.fem.hand."""

@@ -1,0 +1,113 @@
+"""Case functions of the batch runner's kinds that have no module of their own.
+
+Each has the kind signature ``fn(case_params: dict, design, outdir) -> dict of numbers``
+(see :mod:`studies.studyfile`) and calls the owning library; imports stay inside the
+functions so a worker only imports what its kind needs.
+"""
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+from softhand.reduced.design import HandDesign
+from softhand.reduced.errors import InputError
+
+
+def curve(params: dict, design: HandDesign, outdir: Path) -> dict:
+    """One point of the free-finger curve: eq. (27) with and (28) without reservoir.
+
+    ``theta_deg`` -> P_MPa, P_no_reservoir_MPa, V_mm3, p_reservoir_MPa (+ h_mm, lambda_r: ellipse model);
+    ``pressure_mpa`` -> theta_deg, theta_no_reservoir_deg (the inverse).
+    """
+    from softhand.reduced import hand, reservoir
+
+    if ("theta_deg" in params) == ("pressure_mpa" in params):
+        raise InputError("curve", sorted(params), "give exactly one of theta_deg, pressure_mpa")
+    if "theta_deg" in params:
+        theta = math.radians(params["theta_deg"])
+        V = reservoir.oil_volume(theta, design)
+        return {"P_MPa": hand.pressure(theta, design, reservoir=True),
+                "P_no_reservoir_MPa": hand.pressure(theta, design, reservoir=False),
+                "V_mm3": V, **{k: float(v) for k, v in reservoir.state(V, design).items()}}
+    P = params["pressure_mpa"]
+    return {"theta_deg": math.degrees(hand.bend_angle(P, design, reservoir=True)),
+            "theta_no_reservoir_deg": math.degrees(hand.bend_angle(P, design, reservoir=False))}
+
+
+def grasp(params: dict, design: HandDesign, outdir: Path) -> dict:
+    """Eqs. (24), (25), (29) at one state: F_x, F_y, F_v for (P, theta, m) and w.
+
+    ``weights`` (n_s numbers) or ``diameter_mm`` (the paper's presets, 180 or 240).
+    """
+    from softhand.reduced.grasp import KGF, check_weights, grasp_forces, weights_for_diameter
+
+    if "weights" in params:
+        w = check_weights(params["weights"], design)
+    else:
+        w = weights_for_diameter(params.get("diameter_mm", 180.0), design)
+    F = grasp_forces(params["pressure_mpa"], math.radians(params["theta_deg"]),
+                     params.get("mass_kg", 0.0), w, design)
+    return {"F_x_N": F.F_x, "F_y_N": F.F_y, "F_v_N": F.F_v, "F_v_kgf": F.F_v / KGF, "w": w}
+
+
+def control(params: dict, design: HandDesign, outdir: Path) -> dict:
+    """The flexibility experiment (Table II) at one setting: angle control, push, pressure control."""
+    from softhand.reduced.control import flexibility, ramp
+    from softhand.reduced.grasp import PAPER_WEIGHTS
+
+    push_n, push_at = params.get("push_n", 5.0), params.get("push_at_s", 5.0)
+    result = flexibility(design, math.radians(params.get("theta_ref_deg", 50.0)),
+                         params.get("mass_kg", 2.0),
+                         PAPER_WEIGHTS[params.get("diameter_mm", 180.0)],
+                         ramp(push_n, push_at),
+                         t_end=params.get("t_end_s", 10.0))
+    s = result.angle_summary
+    out = {"settling_time_s": s.settling_time, "P_before_MPa": s.P_before,
+           "P_during_MPa": s.P_during, "theta_during_deg": math.degrees(s.theta_during)}
+    out |= {f"F_v_{r['state']}_kgf": r["F_v_estimated_kgf"] for r in result.rows}
+    return out
+
+
+def reservoir(params: dict, design: HandDesign, outdir: Path) -> dict:
+    """The reservoir sheet by FEM against the ellipse model over the fingers' stroke.
+
+    ``mesh_size_mm`` sets the elements along the radius and through the thickness;
+    ``theta_max_deg`` the largest finger bend of the operating range (default 90).
+    """
+    from softhand.studies.reservoir import ReservoirStudy, run
+
+    mesh = {}
+    if "mesh_size_mm" in params:
+        h = params["mesh_size_mm"]
+        mesh = {"n_radial": max(4, math.ceil(design.R / h)), "n_thick": max(1, math.ceil(design.t / h))}
+    result = run(ReservoirStudy(design=design, theta_max=math.radians(params.get("theta_max_deg", 90.0)),
+                                **mesh))
+    v, at_v0 = result.verdict, result.rows[1]
+    out = {f"{key}_rel_error_max": max(abs(v[key]["min"]), abs(v[key]["max"]))
+           for key in ("apex_height", "mean_stretch", "strain_energy", "pressure")}
+    out |= {"p_V0_MPa": at_v0["p_MPa"], "p_ellipse_V0_MPa": at_v0["p_ellipse_MPa"],
+            "stroke_dp_fem_MPa": v["stroke_dp_fem_MPa"],
+            "stroke_dp_ellipse_MPa": v["stroke_dp_ellipse_MPa"], "max_gap_mm": v["max_gap_mm"]}
+    from softhand.studies.reproduce.fem_sections import write_sheet_vtk
+
+    write_sheet_vtk(result, outdir)
+    fem = result.fem
+    return {**out, "mesh": {**(mesh or {"n_radial": result.study.n_radial,
+                                        "n_thick": result.study.n_thick}), "dofs": fem.ndofs},
+            "solver": {"newton_iterations": fem.newton_iterations, "wall_time_s": fem.wall_time}}
+
+
+def weights(params: dict, design: HandDesign, outdir: Path) -> dict:
+    """One grasp by FEM (:func:`studies.weights.weights`): w, theta, F_v by FEM and eq. (25)."""
+    from softhand.studies.weights import WeightsCase, weights as grasp_weights
+
+    names = {"diameter_mm": "diameter_mm", "mass_kg": "mass_kg", "pressure_mpa": "pressure_mpa",
+             "dP_mpa": "dP_mpa", "mesh_size_mm": "mesh_size_mm"}
+    case = WeightsCase(design=design, **{names[k]: float(v) for k, v in params.items()})
+    r = grasp_weights(case, out=outdir)
+    (outdir / "result.json").unlink(missing_ok=True)  # the runner writes its own result.json
+    keep = ("w", "w_sum", "theta_deg", "hinge_deg", "F_v_fem_N", "F_v_reduced_N", "contact_force_N")
+    return {**{k: r[k] for k in keep if r.get(k) is not None},
+            "mesh": {"mesh_size_mm": r["mesh_size_mm"], "dofs": r["ndofs"]},
+            "solver": {"newton_iterations": r["newton_iterations"], "factorizations": r["factorizations"],
+                       "wall_time_s": r["wall_seconds"]}}

@@ -1,0 +1,145 @@
+"""The registry of study kinds: what one case computes and the parameters it accepts.
+
+The built-in kinds are :data:`KINDS`; installed packages add more through the
+``softhand.kinds`` entry-point group (:func:`all_kinds`). A study file names a kind; no
+import path written in a file is ever imported (see :mod:`studies.batch.studyfile`).
+"""
+from __future__ import annotations
+
+import importlib
+import math
+from dataclasses import dataclass
+
+from softhand.reduced.design import HandDesign
+from softhand.reduced.errors import InputError
+
+
+@dataclass(frozen=True)
+class Num:
+    """A numeric case parameter in [lo, hi] (``choices``: only these values)."""
+
+    lo: float = -math.inf
+    hi: float = math.inf
+    choices: tuple = ()
+
+    def check(self, where: str, value) -> None:
+        if not _is_number(value) or not math.isfinite(value):
+            raise InputError(where, value, "must be a finite number")
+        if self.choices and value not in self.choices:
+            raise InputError(where, value, f"must be one of {', '.join(f'{c:g}' for c in self.choices)}")
+        if not self.lo <= value <= self.hi:
+            raise InputError(where, value, f"must be a number in [{self.lo:g}, {self.hi:g}]")
+
+
+@dataclass(frozen=True)
+class NumList:
+    """A case parameter that is a list of finite numbers (at most ``max_len``)."""
+
+    max_len: int = 100
+
+    def check(self, where: str, value) -> None:
+        if not isinstance(value, list) or not value or len(value) > self.max_len \
+                or not all(_is_number(v) and math.isfinite(v) for v in value):
+            raise InputError(where, value, f"must be a list of 1 to {self.max_len} finite numbers")
+
+
+def _one_weight_per_hinge(params: dict, design: HandDesign, src: str) -> None:
+    if "weights" in params and len(params["weights"]) != design.n_s:
+        raise InputError(f"{src}: weights", params["weights"], f"must be n_s = {design.n_s} numbers")
+
+
+def _push_before_end(params: dict, design: HandDesign, src: str) -> None:
+    push, end = params.get("push_at_s", 5.0), params.get("t_end_s", 10.0)
+    if not push < end:
+        raise InputError(f"{src}: push_at_s", push, f"must be before t_end_s = {end:g}")
+
+
+def _enough_oil(params: dict, design: HandDesign, src: str) -> None:
+    if "theta_deg" in params and params["theta_deg"] > 0:
+        design.check_volume(math.radians(params["theta_deg"]))
+
+
+@dataclass(frozen=True)
+class Kind:
+    """What one case of a study computes, and the parameters it accepts."""
+
+    target: str  #: "package.module:function", imported lazily
+    params: dict | None  #: parameter name -> Num / NumList; None: a plugin's, unchecked
+    fem: bool = False  #: True if it takes mesh_size_mm
+    required: tuple[str, ...] = ()  #: parameters every case must have
+    exactly_one: tuple[str, ...] = ()  #: every case has exactly one of these
+    mesh: Num = Num(0.1, 50.0)  #: allowed mesh_size_mm [mm] (FEM kinds)
+    #: checks of a whole case, fn(params, design, src) raising InputError (cheap: no model runs)
+    checks: tuple = ()
+
+
+_THETA, _PRESSURE, _MASS = Num(-90.0, 180.0), Num(-5.0, 5.0), Num(0.0, 100.0)
+_PAPER_D = Num(choices=(180.0, 240.0))  #: the paper's weight vectors
+
+#: kind name -> Kind. Add a kind with one line here.
+KINDS: dict[str, Kind] = {
+    "curve": Kind("softhand.studies.batch.kinds:curve", {"theta_deg": _THETA, "pressure_mpa": _PRESSURE},
+                  exactly_one=("theta_deg", "pressure_mpa"), checks=(_enough_oil,)),
+    "grasp": Kind("softhand.studies.batch.kinds:grasp",
+                  {"pressure_mpa": _PRESSURE, "theta_deg": _THETA, "mass_kg": _MASS,
+                   "diameter_mm": _PAPER_D, "weights": NumList(20)},
+                  required=("pressure_mpa", "theta_deg"), checks=(_one_weight_per_hinge,)),
+    "control": Kind("softhand.studies.batch.kinds:control",
+                    {"theta_ref_deg": Num(-29.9, 119.9), "mass_kg": _MASS, "diameter_mm": _PAPER_D,
+                     "push_n": Num(-1000.0, 1000.0), "push_at_s": Num(1.0, 600.0),
+                     "t_end_s": Num(2.0, 600.0)}, checks=(_push_before_end,)),
+    "reservoir": Kind("softhand.studies.batch.kinds:reservoir", {"theta_max_deg": Num(1.0, 180.0)}, fem=True,
+                      mesh=Num(0.05, 24.0)),
+    "weights": Kind("softhand.studies.batch.kinds:weights",
+                    {"diameter_mm": Num(60.0, 500.0), "mass_kg": Num(0.0, 20.0),
+                     "pressure_mpa": Num(0.01, 3.0), "dP_mpa": Num(0.001, 0.5)}, fem=True,
+                    mesh=Num(2.0, 12.0)),
+    "finger_bend": Kind("softhand.studies.calibration.finger:bend_case",
+                        {"pressures_mpa": NumList(200), "theta_target_deg": Num(1.0, 180.0),
+                         "p_max_mpa": Num(0.01, 5.0), "p_step_mpa": Num(0.001, 1.0),
+                         "axial_size_mm": Num(0.2, 20.0)},
+                        fem=True, mesh=Num(2.0, 12.0), required=("pressures_mpa",)),
+}
+#: the entry-point group where installed packages declare more kinds
+ENTRY_POINT_GROUP = "softhand.kinds"
+#: most cases a study may have unless the caller allows more (``--max-cases``)
+MAX_CASES = 10_000
+
+
+def all_kinds() -> dict[str, Kind]:
+    """The built-in kinds and those of installed plugins (a built-in name wins)."""
+    from importlib.metadata import entry_points
+
+    kinds = {}
+    for ep in entry_points(group=ENTRY_POINT_GROUP):
+        if ep.name not in KINDS:
+            kinds[ep.name] = _plugin_kind(ep)
+    return {**kinds, **KINDS}
+
+
+def _plugin_kind(ep) -> Kind:
+    try:
+        obj = ep.load()
+    except Exception as exc:  # a broken plugin is the plugin's bad input, one line
+        raise InputError("kind", ep.name, f"plugin {ep.value} cannot be loaded ({exc})") from None
+    if isinstance(obj, Kind):
+        return obj
+    if callable(obj):
+        return Kind(ep.value, None)
+    raise InputError("kind", ep.name, f"plugin {ep.value} is neither a Kind nor a function")
+
+
+def resolve_kind(kind: str):
+    """The case function of the registered kind ``kind``, imported now."""
+    kinds = KINDS if kind in KINDS else all_kinds()
+    if kind not in kinds:
+        raise InputError("kind", kind, f"unknown kind; allowed: {', '.join(all_kinds())}")
+    module_name, _, func = kinds[kind].target.partition(":")
+    try:
+        return getattr(importlib.import_module(module_name), func)
+    except (ImportError, AttributeError) as exc:
+        raise InputError("kind", kind, f"cannot be loaded ({exc})") from None
+
+
+def _is_number(value) -> bool:
+    return isinstance(value, (int, float)) and not isinstance(value, bool)

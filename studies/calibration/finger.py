@@ -1,0 +1,288 @@
+"""Calibrating the reduced finger model ``"fem"``: the finger FEM over a design space.
+
+A *design space* (a TOML file, e.g. ``studies/finger_space.toml``) gives ranges of the
+dimensional design variables a, b, d, l0 and the tie width (n_s = 5 equal hinges, so 6
+equal links of l0 / 6), a Latin-hypercube sample size and seed, explicit extra designs
+(``[[design]]`` tables, e.g. corners) and the pressures::
+
+    name = "finger_fem"
+    lhs = 14                      # Latin-hypercube designs inside the box
+    seed = 1
+    pressures_mpa = [0.2, 0.5, 0.8]
+    theta_target_deg = 64.0       # then go on until this bend (if p_max_mpa allows)
+    p_max_mpa = 2.0
+    p_step_mpa = 0.5
+    [space]                        # [min, max] of each variable
+    a_mm = [3.0, 6.0]
+    b_mm = [3.0, 7.0]
+    d_mm = [10.0, 20.0]
+    l0_mm = [120.0, 200.0]
+    tie_width_mm = [5.0, 15.0]
+    # mesh_size_mm = 6.0           # optional: a uniform gmsh mesh (e.g. the CI mesh)
+    # axial_size_mm = 5.0          # optional: the layered mesh with longer slices
+    # base_design = "designs/paper.toml"   # optional: the other design values
+    [[design]]                     # optional explicit designs (all five keys; may also set
+                                   # its own p_max_mpa, p_step_mpa)
+    a_mm = 3.0
+    ...
+
+Each design is one case of the batch runner (:mod:`studies.runner`, kind
+``finger_bend``: resumable, a local pool or Dask); :func:`bend_case` runs the free-bending
+FEM of :mod:`studies.bending` on the default (layered) mesh at the pressures, and on
+until ``theta_target_deg`` in steps of at most ``p_step_mpa`` while P <= ``p_max_mpa``.
+The finished cases become the nondimensional rows of
+``reduced/data/finger_fem.csv`` (see :mod:`reduced.finger_fem`); :mod:`studies.finger_table`
+writes it and checks a table against held-out designs.
+"""
+from __future__ import annotations
+
+import math
+import tomllib
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from softhand.reduced.design import HandDesign, load_design
+from softhand.reduced.errors import InputError
+from softhand.studies.batch.studyfile import Study
+
+#: the dimensional variables of a design space, in this order
+VARIABLES = ("a_mm", "b_mm", "d_mm", "l0_mm", "tie_width_mm")
+#: load-path parameters a [[design]] table may set for itself
+_PATH_KEYS = ("p_max_mpa", "p_step_mpa")
+_KEYS = ("name", "lhs", "seed", "pressures_mpa", "theta_target_deg", "p_max_mpa", "p_step_mpa",
+         "space", "design", "base_design", "mesh_size_mm", "axial_size_mm", "mesh_pair", "prior")
+
+
+@dataclass(frozen=True)
+class DesignSpace:
+    """A validated design space: the box, the sampled designs and the load path."""
+
+    name: str  #: results go to results/<name>/
+    box: dict  #: variable -> (min, max)
+    points: tuple[dict, ...]  #: the designs, each variable -> value
+    pressures_mpa: tuple[float, ...] = (0.2, 0.5, 0.8)
+    theta_target_deg: float = 64.0
+    p_max_mpa: float = 2.0
+    p_step_mpa: float = 0.5
+    base: HandDesign = HandDesign()
+    mesh_size_mm: float | None = None  #: a uniform gmsh mesh of this size; None: the default mesh
+    axial_size_mm: float | None = None  #: the layered mesh's largest slice [mm]; None: its default
+    #: (point, pressures): one design run on this mesh and on the default one, to correct the
+    #: table for the mesh (see studies.finger_table.mesh_correction); None: no correction
+    mesh_pair: tuple | None = None
+    prior: str = "paper"  #: the physics the table's residual is taken against (reduced.finger_fem.PRIORS)
+
+    def designs(self) -> list[HandDesign]:
+        return [finger_design(p, self.base) for p in self.points]
+
+
+def finger_design(point: dict, base: HandDesign = HandDesign()) -> HandDesign:
+    """The design of one point (a, b, d, l0, tie width [mm]) with 5 equal hinges."""
+    l0 = float(point["l0_mm"])
+    return base.replace(a=float(point["a_mm"]), b=float(point["b_mm"]), d=float(point["d_mm"]),
+                        l0=l0, n_s=5, hinge_s=tuple(l0 * k / 6.0 for k in range(1, 6)),
+                        tie_width=float(point["tie_width_mm"]))
+
+
+def latin_hypercube(box: dict, n: int, seed: int) -> list[dict]:
+    """n points of a Latin hypercube in the box (one per stratum of each variable)."""
+    rng = np.random.default_rng(seed)
+    u = (np.array([rng.permutation(n) for _ in VARIABLES]).T + rng.uniform(size=(n, len(VARIABLES)))) / n
+    lo, hi = (np.array([box[v][i] for v in VARIABLES]) for i in (0, 1))
+    return [dict(zip(VARIABLES, np.round(lo + row * (hi - lo), 3).tolist())) for row in u]
+
+
+def load_space(path: str | Path) -> DesignSpace:
+    """Read and validate a design-space TOML file (see the module docstring)."""
+    path = Path(path)
+    try:
+        doc = tomllib.loads(path.read_text())
+    except (FileNotFoundError, IsADirectoryError):
+        raise InputError("--space", str(path), "no such file; give a design-space TOML file") from None
+    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
+        raise InputError("--space", str(path), f"is not valid TOML ({exc})") from None
+    src = path.name
+    for key in doc:
+        if key not in _KEYS:
+            raise InputError(f"{src}: {key}", doc[key], f"unknown key; allowed: {', '.join(_KEYS)}")
+    box = _box(doc.get("space"), src)
+    points = [_point(p, box, f"{src}: design[{i}]") for i, p in enumerate(doc.get("design", []))]
+    lhs = doc.get("lhs", 0)
+    if not isinstance(lhs, int) or isinstance(lhs, bool) or lhs < 0:
+        raise InputError(f"{src}: lhs", lhs, "must be a whole number >= 0")
+    points += latin_hypercube(box, lhs, int(doc.get("seed", 0))) if lhs else []
+    if not points:
+        raise InputError(f"{src}: design", [], "no designs: give lhs > 0 or [[design]] tables")
+    pressures = doc.get("pressures_mpa", [0.2, 0.5, 0.8])
+    if not isinstance(pressures, list) or not pressures or any(
+            not _number(p) or p <= 0 for p in pressures) or any(np.diff(pressures) <= 0):
+        raise InputError(f"{src}: pressures_mpa", pressures, "must be increasing numbers > 0 [MPa]")
+    numbers = {}
+    for key, default in (("theta_target_deg", 64.0), ("p_max_mpa", 2.0), ("p_step_mpa", 0.5)):
+        numbers[key] = doc.get(key, default)
+        if not _number(numbers[key]) or not numbers[key] > 0:
+            raise InputError(f"{src}: {key}", numbers[key], "must be a positive number")
+    mesh, axial = doc.get("mesh_size_mm"), doc.get("axial_size_mm")
+    for key, value in (("mesh_size_mm", mesh), ("axial_size_mm", axial)):
+        if value is not None and (not _number(value) or not value > 0):
+            raise InputError(f"{src}: {key}", value, "must be a positive number [mm] (omit: the default mesh)")
+    if mesh is not None and axial is not None:
+        raise InputError(f"{src}: axial_size_mm", axial, "applies to the layered mesh; remove mesh_size_mm")
+    base = load_design(path.parent / doc["base_design"]) if "base_design" in doc else HandDesign()
+    pair = doc.get("mesh_pair")
+    if pair is not None:
+        if not isinstance(pair, dict) or "pressures_mpa" not in pair:
+            raise InputError(f"{src}: mesh_pair", pair, f"must give {', '.join(VARIABLES)} and pressures_mpa")
+        pair = dict(pair)
+        pressures_pair = pair.pop("pressures_mpa")
+        if not isinstance(pressures_pair, list) or len(pressures_pair) < 2 or any(
+                not _number(p) or p <= 0 for p in pressures_pair) or any(np.diff(pressures_pair) <= 0):
+            raise InputError(f"{src}: mesh_pair.pressures_mpa", pressures_pair,
+                             "must be 2 or more increasing numbers > 0 [MPa]")
+        pair = (_point(pair, {k: (0.0, math.inf) for k in VARIABLES}, f"{src}: mesh_pair"),
+                tuple(float(p) for p in pressures_pair))
+    from softhand.reduced.finger_fem import PRIORS
+    prior = doc.get("prior", "paper")
+    if prior not in PRIORS:
+        raise InputError(f"{src}: prior", prior, f"must be one of {', '.join(PRIORS)}")
+    space = DesignSpace(doc.get("name", path.stem), box, tuple(points),
+                        tuple(float(p) for p in pressures), base=base,
+                        mesh_size_mm=None if mesh is None else float(mesh),
+                        axial_size_mm=None if axial is None else float(axial), mesh_pair=pair,
+                        prior=prior,
+                        **{k: float(v) for k, v in numbers.items()})
+    space.designs()  # validates every design now
+    return space
+
+
+def _number(value) -> bool:
+    return isinstance(value, (int, float)) and not isinstance(value, bool)
+
+
+def _box(table, src: str) -> dict:
+    if not isinstance(table, dict) or set(table) != set(VARIABLES):
+        raise InputError(f"{src}: space", table, f"must give [min, max] of {', '.join(VARIABLES)}")
+    box = {}
+    for key in VARIABLES:
+        span = table[key]
+        if not (isinstance(span, list) and len(span) == 2 and all(map(_number, span))
+                and 0 < span[0] <= span[1]):
+            raise InputError(f"{src}: space.{key}", span, "must be [min, max] with 0 < min <= max [mm]")
+        box[key] = (float(span[0]), float(span[1]))
+    return box
+
+
+def _point(table, box: dict, where: str) -> dict:
+    if not isinstance(table, dict) or not set(VARIABLES) <= set(table) <= set(VARIABLES + _PATH_KEYS):
+        raise InputError(where, table, f"must give {', '.join(VARIABLES)} (and optionally "
+                                       f"{', '.join(_PATH_KEYS)})")
+    for key in VARIABLES:
+        if not _number(table[key]) or not box[key][0] <= table[key] <= box[key][1]:
+            raise InputError(f"{where}.{key}", table[key], f"must be in [{box[key][0]}, {box[key][1]}]")
+    for key in set(table) & set(_PATH_KEYS):
+        if not _number(table[key]) or not table[key] > 0:
+            raise InputError(f"{where}.{key}", table[key], "must be a positive number [MPa]")
+    return {key: float(value) for key, value in table.items()}
+
+
+@dataclass(frozen=True)
+class SpaceStudy(Study):
+    """A design space as a study of the batch runner: one ``finger_bend`` case per design."""
+
+    case_list: tuple[tuple[dict, HandDesign], ...] = ()  #: (params, design) of every case
+
+    def cases(self) -> list[tuple[dict, HandDesign]]:
+        return list(self.case_list)
+
+
+def as_study(space: DesignSpace) -> SpaceStudy:
+    """The runner's study of a design space (results/<name>/, resumable)."""
+    return SpaceStudy(name=space.name, kind="finger_bend", design=space.base,
+                      axes=tuple((key, ()) for key in VARIABLES), params=space_params(space),
+                      description="finger FEM over a design space",
+                      case_list=tuple(design_cases(space) + mesh_pair_cases(space)))
+
+
+def space_params(space: DesignSpace) -> dict:
+    """The case parameters every design of the space shares (load path and mesh)."""
+    params = {"pressures_mpa": list(space.pressures_mpa), "theta_target_deg": space.theta_target_deg,
+              "p_max_mpa": space.p_max_mpa, "p_step_mpa": space.p_step_mpa}
+    if space.mesh_size_mm is not None:
+        params["mesh_size_mm"] = space.mesh_size_mm
+    if space.axial_size_mm is not None:
+        params["axial_size_mm"] = space.axial_size_mm
+    return params
+
+
+def design_cases(space: DesignSpace) -> list[tuple[dict, HandDesign]]:
+    """(params, design) of each design, with its own load-path keys."""
+    shared = space_params(space)
+    return [({**shared, **{k: p[k] for k in _PATH_KEYS if k in p}}, d)
+            for p, d in zip(space.points, space.designs())]
+
+
+def mesh_pair_cases(space: DesignSpace) -> list[tuple[dict, HandDesign]]:
+    """The [mesh_pair] design on the space's mesh and on the default mesh (none if absent)."""
+    if space.mesh_pair is None:
+        return []
+    point, pressures = space.mesh_pair
+    design = finger_design(point, space.base)
+    path = {"pressures_mpa": list(pressures), "theta_target_deg": space.theta_target_deg,
+            "p_max_mpa": pressures[-1], "p_step_mpa": space.p_step_mpa}
+    coarse = {k: v for k, v in space_params(space).items() if k in ("mesh_size_mm", "axial_size_mm")}
+    return [({**path, **coarse}, design), (path, design)]
+
+
+# ---------------------------------------------------------------------- one case
+def load_path(theta_08: float, space: dict) -> list[float]:
+    """Pressures [MPa] after the listed ones: on to theta_target (linear estimate from the
+    bend ``theta_08`` [rad] reached at the last listed pressure), in steps <= p_step_mpa."""
+    last = space["pressures_mpa"][-1]
+    target = math.radians(space["theta_target_deg"])
+    if theta_08 >= target or last >= space["p_max_mpa"]:
+        return []
+    P_end = min(space["p_max_mpa"], last * target / max(theta_08, 1e-6))
+    n = math.ceil((P_end - last) / space["p_step_mpa"] - 1e-9)
+    return [round(last + (P_end - last) * k / n, 4) for k in range(1, n + 1)]
+
+
+def bend_case(params: dict, design: HandDesign, outdir: Path) -> dict:
+    """Kind ``finger_bend``: the free-bending FEM of one design on the default mesh.
+
+    params: ``pressures_mpa`` (list), ``theta_target_deg``, ``p_max_mpa``, ``p_step_mpa``;
+    ``mesh_size_mm`` (optional): a uniform gmsh mesh of that size instead of the default mesh;
+    ``axial_size_mm`` (optional): the default (layered) mesh with slices of at most that length.
+    Returns P_MPa, theta_deg, dQ_mm3 (whole finger) per converged pressure.
+    """
+    from softhand.fem.hand.finger import FingerModel, FingerOptions, solve_pressures
+
+    options = FingerOptions() if "mesh_size_mm" not in params else \
+        FingerOptions(mesher="gmsh", mesh_size=float(params["mesh_size_mm"]))
+    if "axial_size_mm" in params:  # the layered mesh with longer slices
+        options = FingerOptions(axial_size=float(params["axial_size_mm"]))
+    model = FingerModel(design, options)
+    states, stats = solve_pressures(model, params["pressures_mpa"])
+    more = load_path(states[-1].theta, params)
+    its, wall = stats.newton_iterations, stats.wall_seconds
+    if more:  # restart at the last pressure (its state is converged: ~1 iteration) for the history
+        extra, s2 = solve_pressures(model, [states[-1].P, *more], y0=states[-1].y)
+        states, its, wall = states + extra[1:], its + s2.newton_iterations, wall + s2.wall_seconds
+    return {"P_MPa": [s.P for s in states], "theta_deg": [math.degrees(s.theta) for s in states],
+            "dQ_mm3": [s.dQ for s in states],
+            "mesh": {"mesher": model.options.mesher, "dofs": model.ndofs,
+                     "elements": model.mesh.nelements},
+            "solver": {"newton_iterations": its, "wall_time_s": wall}}
+
+
+def single_design_space(path: str | Path) -> DesignSpace:
+    """The design space of one design file (its own box), for a table of that design alone."""
+    from softhand.reduced.finger_fem import groups_of
+
+    design = load_design(path)
+    groups_of(design)  # 5 equal hinges, or one error line
+    point = {"a_mm": design.a, "b_mm": design.b, "d_mm": design.d, "l0_mm": design.l0,
+             "tie_width_mm": design.tie_width}
+    return DesignSpace(f"finger_{Path(path).stem}", {k: (v, v) for k, v in point.items()}, (point,),
+                       base=design)

@@ -1,0 +1,157 @@
+"""The table of the reduced finger model ``"fem"`` from finished FEM cases, and its check.
+
+:func:`write_table` turns the ``finger_bend`` cases of a design space
+(:mod:`studies.finger_calibration`) into the nondimensional CSV of
+:mod:`reduced.finger_fem` with its provenance (code version, mesh, date, command);
+:func:`heldout_rows` compares the calibrated model with FEM cases it was not built from.
+"""
+from __future__ import annotations
+
+import math
+from datetime import datetime, timezone
+from pathlib import Path
+
+import numpy as np
+from scipy.interpolate import PchipInterpolator
+
+from softhand.reduced import finger, hand
+from softhand.reduced.design import HandDesign
+from softhand.reduced.finger_fem import COLUMNS, GROUPS, groups_of
+from softhand.studies.calibration.finger import DesignSpace, VARIABLES, finger_design
+from softhand.studies.io.files import write_atomic
+
+
+def space_ranges(box: dict) -> dict:
+    """group -> (min, max) over a box of a, b, d, l0, tie width (the groups are monotone in
+    each variable, so the extremes are at the box's corners)."""
+    corners = [dict(zip(VARIABLES, c)) for c in np.array(np.meshgrid(*[box[v] for v in VARIABLES]))
+               .reshape(len(VARIABLES), -1).T]
+    # the groups of each corner, which need not be a finger (a + b >= d at some corners)
+    values = [{"b_a": c["b_mm"] / c["a_mm"], "d_a": c["d_mm"] / c["a_mm"],
+               "link_a": c["l0_mm"] / 6.0 / c["a_mm"], "tie_link": c["tie_width_mm"] / (c["l0_mm"] / 6.0)}
+              for c in corners]
+    return {g: (min(v[g] for v in values), max(v[g] for v in values)) for g in GROUPS}
+
+
+def table_rows(results: list[tuple[HandDesign, dict]]) -> list[dict]:
+    """Nondimensional table rows from (design, numbers of its finger_bend case), P > 0 only."""
+    rows = []
+    for i, (design, numbers) in enumerate(results):
+        groups = groups_of(design)
+        for P, theta, dQ in zip(numbers["P_MPa"], numbers["theta_deg"], numbers["dQ_mm3"]):
+            if P > 0:
+                rows.append({"design": i, **groups, "theta": math.radians(theta),
+                             "p_tilde": P / design.mu_sf, "q_tilde": dQ / design.a**3})
+    return rows
+
+
+def fit_degrees(n_designs: int, n_varying: int) -> tuple[int, int]:
+    """(design_degree, theta_degree) of the fit for a table of n_designs over n_varying groups:
+    quadratic in the groups with 2 designs per coefficient, else linear (n_varying + 1 designs
+    at least), else constant; linear in theta."""
+    quadratic = 1 + n_varying + n_varying * (n_varying + 1) // 2
+    if n_varying and n_designs >= 2 * quadratic:
+        return 2, 1
+    return (1, 1) if n_varying and n_designs >= n_varying + 1 else (0, 1)
+
+
+def table_csv(rows: list[dict], ranges: dict, provenance: list[str], degrees: tuple[int, int],
+              prior: str = "paper") -> str:
+    """The calibration CSV of :mod:`reduced.finger_fem`: provenance, range and fit lines, rows."""
+    lines = [f"# {line}" for line in provenance]
+    lines.append("# groups: b_a = b/a, d_a = d/a, link_a = (l0/6)/a, tie_link = tie width/(l0/6); "
+                 "theta [rad]; p_tilde = P/mu_sf; q_tilde = dQ/a^3 (one finger)")
+    lines.append("# range: " + ", ".join(f"{g}={ranges[g][0]:.10g}:{ranges[g][1]:.10g}" for g in GROUPS))
+    lines.append(f"# fit: design_degree={degrees[0]}, theta_degree={degrees[1]}, prior={prior}")
+    lines.append(",".join(COLUMNS))
+    for r in rows:
+        lines.append(",".join(str(int(r[c])) if c == "design" else f"{r[c]:.10g}" for c in COLUMNS))
+    return "\n".join(lines) + "\n"
+
+
+def provenance_lines(command: str, results: list[tuple[HandDesign, dict]], records: list[dict]) -> list[str]:
+    """Who wrote the table, when, with which code and mesh."""
+    from softhand.studies.cli.verbs.reservoir import _git_commit
+    from softhand.studies.batch.runner import code_version
+
+    code = code_version()
+    mesh = {f"{(r.get('mesh') or {}).get('mesher')}"
+            + (f" (slices {r['inputs']['axial_size_mm']} mm)" if "axial_size_mm" in r["inputs"] else "")
+            for r in records}
+    dofs = sorted((r.get("mesh") or {}).get("dofs", 0) for r in records)
+    wall = sum((r.get("solver") or {}).get("wall_time_s", 0.0) for r in records)
+    return [f"FEM calibration of reduced/finger_fem.py, written {datetime.now(timezone.utc):%Y-%m-%d %H:%M} "
+            f"UTC at commit {_git_commit()} (softhand {code['softhand']}, sources {code['source_sha256']}) by",
+            command,
+            f"model: finger FEM (fem/hand/finger.py), FingerOptions, mesher {', '.join(sorted(mesh))}, "
+            f"{dofs[0]}..{dofs[-1]} unknowns; {len(results)} designs, {wall / 60:.1f} min of solver wall time"]
+
+
+def mesh_correction(coarse: dict, fine: dict) -> tuple[float, float]:
+    """(ln P_fine/P_coarse, dQ_fine/dQ_coarse) at equal bend, averaged over the pair's points:
+    the same design on the space's mesh (``coarse`` numbers) and on the default mesh."""
+    th_c, P_c, dQ_c = (np.array(coarse[k], float) for k in ("theta_deg", "P_MPa", "dQ_mm3"))
+    th_f, P_f, dQ_f = (np.array(fine[k], float) for k in ("theta_deg", "P_MPa", "dQ_mm3"))
+    inside = th_c <= th_f.max()
+    at = th_c[inside]
+    P_fine = PchipInterpolator(np.r_[0.0, th_f], np.r_[0.0, P_f])(at)
+    dQ_fine = PchipInterpolator(np.r_[0.0, th_f], np.r_[0.0, dQ_f])(at)
+    return float(np.mean(np.log(P_fine / P_c[inside]))), float(np.mean(dQ_fine / dQ_c[inside]))
+
+
+def write_table(path, space: DesignSpace, results: list[tuple[HandDesign, dict]], command: str) -> Path:
+    """Write the calibration CSV of ``results`` [(design, case record)], in the order of
+    ``as_study(space).cases()`` (the designs, then the mesh pair if any), over ``space``'s box."""
+    n = len(space.points)
+    pairs = [(design, record["numbers"]) for design, record in results[:n]]
+    rows = table_rows(pairs)
+    records = [record["provenance"] for _, record in results]
+    notes = provenance_lines(command, pairs, records)
+    if space.mesh_pair is not None:  # scale the coarse mesh's points to the default mesh
+        dy, rq = mesh_correction(results[n][1]["numbers"], results[n + 1][1]["numbers"])
+        for row in rows:
+            row["p_tilde"] *= math.exp(dy)
+            row["q_tilde"] *= rq
+        notes.append(f"mesh correction to the default mesh (the mesh_pair design on both meshes, at "
+                     f"equal bend): P x {math.exp(dy):.5f}, dQ x {rq:.5f}, applied to every row")
+    ranges = space_ranges(space.box)
+    varying = sum(ranges[g][1] > ranges[g][0] * (1 + 1e-9) for g in GROUPS)
+    degrees = fit_degrees(len(pairs), varying)
+    text = table_csv(rows, ranges, notes, degrees, prior=space.prior)
+    return write_atomic(path, text)
+
+
+def write_design_with_table(design: HandDesign, table: Path) -> Path:
+    """FILE.toml next to FILE.csv: the design with finger_model = "fem" and this table."""
+    table = Path(table)
+    path = table.with_suffix(".toml")
+    text = design.replace(finger_model="fem", finger_table=table.name).to_toml()
+    return write_atomic(path, text)
+
+
+def heldout_rows(results: list[tuple[HandDesign, dict]], table: str | None = None):
+    """Per FEM point of each design: theta and dQ by FEM and by the calibrated model, errors
+    [%]; per design with an FEM bend >= 60 deg, the model's bend at the FEM's pressure of 60 deg
+    (monotone cubic interpolation of the FEM points). Returns (rows, worst |error| per column)."""
+    rows = []
+    for design, record in results:
+        model = design.replace(finger_model="fem", finger_table=str(table or ""))
+        n = record["numbers"]
+        P, th, dQ = (np.array(n[k], float) for k in ("P_MPa", "theta_deg", "dQ_mm3"))
+        keep = P > 0
+        P, th, dQ = P[keep], th[keep], dQ[keep]
+        th_m = np.degrees(hand.bend_angle(P, model, reservoir=False))
+        dQ_m = finger.oil_taken(np.radians(th), model)
+        point = " ".join(f"{design.to_dict()[k]:g}" for k in VARIABLES)
+        for k in range(P.size):
+            rows.append({"design": point, "P_MPa": P[k], "theta_fem_deg": th[k], "theta_model_deg": th_m[k],
+                         "theta_err_pct": 100 * (th_m[k] / th[k] - 1), "dQ_fem_mm3": dQ[k],
+                         "dQ_model_mm3": dQ_m[k], "dQ_err_pct": 100 * (dQ_m[k] / dQ[k] - 1)})
+        if th.max() >= 60.0:
+            P60 = float(PchipInterpolator(np.r_[0.0, th], np.r_[0.0, P])(60.0))
+            t60 = float(np.degrees(hand.bend_angle(P60, model, reservoir=False)))
+            rows.append({"design": point, "P_MPa": P60, "theta_fem_deg": 60.0, "theta_model_deg": t60,
+                         "theta_err_pct": 100 * (t60 / 60.0 - 1), "dQ_fem_mm3": math.nan,
+                         "dQ_model_mm3": math.nan, "dQ_err_pct": math.nan})
+    worst = {k: float(np.nanmax([abs(r[k]) for r in rows])) for k in ("theta_err_pct", "dQ_err_pct")}
+    return rows, worst

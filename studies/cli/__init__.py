@@ -1,0 +1,1 @@
+"""softhand.studies.cli."""

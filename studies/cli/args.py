@@ -1,0 +1,102 @@
+"""Argument helpers shared by the verbs: value lists, the design option, tables."""
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import sys
+
+import numpy as np
+
+from softhand.reduced.design import HandDesign, load_design
+from softhand.reduced.errors import InputError
+from softhand.studies.io.files import jsonable
+
+
+#: most values one range or list may give: reduced-model verbs, and FEM runs (one solve each)
+MAX_POINTS, MAX_FEM_POINTS = 100_000, 200
+#: longest range or list text read [characters]
+MAX_TEXT = 100_000
+_FORMS = "start:stop:step (step > 0, stop >= start) or a comma-separated list of finite numbers"
+
+
+def parse_values(text: str, field: str, max_count: int = MAX_POINTS) -> np.ndarray:
+    """``'0:90:10'`` (start:stop:step, stop included) or ``'1,2.5,3'`` -> float array.
+
+    Every value finite; at most ``max_count`` of them (InputError otherwise).
+    """
+    if len(text) > MAX_TEXT:
+        raise InputError(field, text, f"is longer than {MAX_TEXT} characters")
+    try:
+        numbers = [float(x) for x in (text.split(":") if ":" in text else text.split(","))
+                   if x.strip() or ":" in text]
+    except ValueError:
+        numbers = []
+    if ":" in text:
+        if len(numbers) != 3 or not all(map(math.isfinite, numbers)) or not numbers[2] > 0 \
+                or numbers[1] < numbers[0]:
+            raise InputError(field, text, f"must be {_FORMS}")
+        start, stop, step = numbers
+        count = (stop - start) / step + 1
+        if not count <= max_count:
+            raise InputError(field, text, f"gives {_count(count)} values; at most {max_count} allowed")
+        values = start + step * np.arange(int(math.floor(count - 1 + 1e-9)) + 1)
+    else:
+        values = np.array(numbers, dtype=float)
+        if values.size > max_count:
+            raise InputError(field, text, f"gives {values.size} values; at most {max_count} allowed")
+    if values.size == 0 or not np.all(np.isfinite(values)):
+        raise InputError(field, text, f"must be {_FORMS}")
+    return values
+
+
+def _count(count: float) -> str:
+    return f"{count:.3g}" if math.isfinite(count) else "too many"
+
+
+def check_range(field: str, value: float, lo: float, hi: float, unit: str = "") -> float:
+    """``value`` if finite and in [lo, hi], else InputError naming ``field``."""
+    if not (math.isfinite(value) and lo <= value <= hi):
+        raise InputError(field, value, f"must be a number in [{lo:g}, {hi:g}]{unit and ' ' + unit}")
+    return value
+
+
+def add_design_option(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--design", metavar="FILE", default=None,
+                        help="design TOML file (default: the paper's, studies/designs/paper.toml)")
+
+
+def add_json_option(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--json", action="store_true", help="print one JSON object on stdout")
+
+
+def design_from_args(args) -> HandDesign:
+    return load_design(args.design)
+
+
+def print_json(obj) -> None:
+    """One JSON object on stdout (numpy arrays and scalars converted)."""
+    json.dump(obj, sys.stdout, indent=1, default=jsonable)
+    sys.stdout.write("\n")
+
+
+def print_table(rows: list[dict], columns: list[str] | None = None, *, digits: int = 4,
+                file=None) -> None:
+    """A plain aligned text table of ``rows`` (dicts with the same keys)."""
+    file = file or sys.stdout
+    if not rows:
+        return
+    columns = columns or list(rows[0])
+    cells = [[_fmt(row[c], digits) for c in columns] for row in rows]
+    widths = [max(len(c), *(len(r[i]) for r in cells)) for i, c in enumerate(columns)]
+    print("  ".join(c.rjust(w) for c, w in zip(columns, widths)), file=file)
+    for r in cells:
+        print("  ".join(x.rjust(w) for x, w in zip(r, widths)), file=file)
+
+
+def _fmt(value, digits: int) -> str:
+    if isinstance(value, (float, np.floating)):
+        return f"{value:.{digits}g}" if abs(value) >= 1e-3 or value == 0 else f"{value:.3e}"
+    if isinstance(value, (list, tuple, np.ndarray)):
+        return "[" + ", ".join(_fmt(v, digits) for v in value) + "]"
+    return str(value)

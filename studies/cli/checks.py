@@ -1,0 +1,113 @@
+"""Checks the CLI runs on every verb's arguments before any work starts.
+
+* every float option is finite (argparse's ``float`` accepts ``nan`` and ``inf``);
+* every output (``--out``, ``--plot``, ``--results``, ``--write-calibration``) can be
+  written: the right kind of path (folder or file, a known picture suffix) under a folder
+  this process can create files in; probed with a temporary file that is removed at once,
+  so a refused command leaves nothing behind;
+* the cache folder (``SOFTHAND_CACHE``): if it cannot be written, a warning; results are
+  then computed without caching them.
+"""
+from __future__ import annotations
+
+import argparse
+import math
+import os
+import sys
+import tempfile
+from pathlib import Path
+
+from softhand.reduced.errors import InputError
+
+#: picture suffixes of matplotlib's writers (--plot) and of the 3D renderer (inspect --out)
+PLOT_SUFFIXES = (".png", ".pdf", ".svg", ".jpg", ".jpeg", ".eps", ".ps", ".tif", ".tiff", ".webp")
+RENDER_SUFFIXES = (".png", ".jpg", ".jpeg")
+
+#: argument name -> kind of output, per verb where it differs from the default
+OUTPUTS = {"out": "dir", "plot": "plot", "results": "dir", "write_calibration": "file"}
+VERB_OUTPUTS = {"fit": {"out": "file"}, "inspect": {"out": "render"}}
+#: verbs that may use the on-disk caches (meshes, grasp weights)
+CACHE_VERBS = ("bend", "weights", "grasp", "study", "reproduce", "reservoir")
+
+
+def option_name(dest: str, parser) -> str:
+    """The option string the user typed for argparse destination ``dest`` (also in sub-commands)."""
+    for action in parser._actions:
+        if action.dest == dest and action.option_strings:
+            return max(action.option_strings, key=len)
+        for sub in (getattr(action, "choices", None) or {}).values() \
+                if isinstance(action, argparse._SubParsersAction) else ():
+            name = option_name(dest, sub)
+            if name != dest:
+                return name
+    return dest
+
+
+def check_finite(args, parser) -> None:
+    """Every float argument finite; InputError naming its option."""
+    for dest, value in vars(args).items():
+        if isinstance(value, float) and not math.isfinite(value):
+            raise InputError(option_name(dest, parser), value, "must be a finite number")
+
+
+def check_outputs(verb: str, args, parser) -> None:
+    """Every output argument given can be written; InputError naming the option."""
+    kinds = {**OUTPUTS, **VERB_OUTPUTS.get(verb, {})}
+    for dest, kind in kinds.items():
+        value = getattr(args, dest, None)
+        if value is not None:
+            check_writable(value, kind, option_name(dest, parser))
+
+
+def check_writable(path, kind: str, field: str) -> None:
+    """``path`` can be written as a ``kind`` ('dir', 'file', 'plot', 'render') output."""
+    text = str(path)
+    if not text.strip() or "\0" in text:
+        raise InputError(field, text, "must be a file or folder name")
+    p = Path(text)
+    if kind == "dir":
+        if p.exists() and not p.is_dir():
+            raise InputError(field, text, "exists and is not a folder; give a folder")
+        folder = p
+    else:
+        if p.is_dir() or text.endswith(os.sep):
+            raise InputError(field, text, "is a folder; give a file name")
+        suffixes = {"plot": PLOT_SUFFIXES, "render": RENDER_SUFFIXES}.get(kind)
+        if suffixes and p.suffix.lower() not in suffixes:
+            raise InputError(field, text, f"must end in one of {', '.join(suffixes)}")
+        folder = p.parent
+    _probe(folder, field, text)
+
+
+def _probe(folder: Path, field: str, text: str) -> None:
+    existing = folder
+    while not existing.exists() and existing != existing.parent:
+        existing = existing.parent
+    if not existing.is_dir():
+        raise InputError(field, text, f"cannot be created: {existing} is not a folder")
+    try:
+        with tempfile.TemporaryFile(dir=existing):
+            pass
+    except OSError as exc:
+        raise InputError(field, text, f"cannot be written: {existing}: "
+                         f"{exc.strerror or exc}") from None
+
+
+def cache_writable() -> bool:
+    """True if the cache folder (``SOFTHAND_CACHE``) can be written."""
+    from softhand.meshes.cache import cache_dir
+
+    try:
+        check_writable(cache_dir().parent, "dir", "SOFTHAND_CACHE")
+    except InputError:
+        return False
+    return True
+
+
+def warn_cache(verb: str) -> None:
+    """A warning on stderr if a verb that caches cannot write its cache."""
+    if verb in CACHE_VERBS and not cache_writable():
+        from softhand.meshes.cache import cache_dir
+
+        print(f"softhand {verb}: warning: the cache {cache_dir().parent} cannot be written; "
+              f"computing without caching", file=sys.stderr)

@@ -1,0 +1,140 @@
+"""The ``softhand`` command line.
+
+Each verb lives in ``studies/cli/verbs/<verb>.py`` and defines
+
+* ``HELP``: one line for ``softhand --help``;
+* ``configure(parser)``: adds its arguments to an :class:`argparse.ArgumentParser`;
+* ``run(args) -> int``: does the work, prints, returns the exit code.
+
+Verb modules are imported only when their verb is called, so ``softhand curve``
+never pays for importing the FEM stack. Bad input anywhere (an
+:class:`reduced.errors.InputError`, or an argparse error) becomes one line on
+stderr and exit code 2.
+"""
+from __future__ import annotations
+
+import argparse
+import importlib
+import os
+import signal
+import sys
+
+from softhand.reduced.errors import InputError, short
+
+#: verb -> module under studies.commands; the order is the order of ``--help``.
+VERBS = (
+    "curve", "grasp", "control", "fit",
+    "verify", "reservoir", "bend", "weights",
+    "design", "study", "calibrate", "inspect", "reproduce", "material",
+)
+
+
+class ArgumentParser(argparse.ArgumentParser):
+    """argparse, but a usage error is one line and exit code 2."""
+
+    def error(self, message):
+        self.exit(2, f"{self.prog}: error: {short(message, 400)}\n")
+
+
+def _version() -> str:
+    from importlib.metadata import PackageNotFoundError, version
+
+    try:
+        return version("softhand")
+    except PackageNotFoundError:
+        return "unknown"
+
+
+def _verb_module(verb: str):
+    return importlib.import_module(f"softhand.studies.cli.verbs.{verb}")
+
+
+def _available_verbs() -> list[tuple[str, str]]:
+    verbs = []
+    for verb in VERBS:
+        try:
+            verbs.append((verb, _verb_module(verb).HELP))
+        except ModuleNotFoundError:
+            continue  # a verb not built yet is simply not listed
+    return verbs
+
+
+def _top_parser() -> ArgumentParser:
+    lines = "\n".join(f"  {verb:<10} {help_}" for verb, help_ in _available_verbs())
+    parser = ArgumentParser(
+        prog="softhand",
+        description="Model fluid-driven soft robot hands: reduced model and FEM.",
+        epilog=f"verbs:\n{lines}\n\n'softhand VERB --help' shows a verb's options.",
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    parser.add_argument("--version", action="version", version=f"softhand {_version()}")
+    parser.add_argument("verb", help="what to do (see below)")
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    argv = list(sys.argv[1:] if argv is None else argv)
+    if not argv or argv[0].startswith("-"):
+        _top_parser().parse_args(argv or ["--help"])
+        return 0
+    verb, rest = argv[0], argv[1:]
+    if verb not in VERBS:
+        print(f"softhand: error: unknown verb {short(repr(verb), 80)}; allowed: {', '.join(VERBS)}",
+              file=sys.stderr)
+        return 2
+    module = _verb_module(verb)
+    parser = ArgumentParser(prog=f"softhand {verb}", description=module.HELP)
+    module.configure(parser)
+    args = parser.parse_args(rest)
+    previous = _sigterm_as_interrupt()
+    try:
+        _check(verb, args, parser)
+        code = int(module.run(args) or 0)
+        sys.stdout.flush()  # a closed pipe shows here, not in Python's exit
+        return code
+    except InputError as exc:
+        print(f"softhand {verb}: error: {exc}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print(f"softhand {verb}: interrupted; finished results are kept", file=sys.stderr)
+        return 130
+    except BrokenPipeError:  # e.g. 'softhand study status FILE | head': the reader left
+        _silence_stdout()
+        return 141
+    finally:
+        if previous is not None:
+            signal.signal(signal.SIGTERM, previous)
+
+
+def _check(verb: str, args, parser) -> None:
+    """The checks every verb gets before it runs: finite numbers, writable outputs, cache."""
+    from softhand.studies.cli.checks import check_finite, check_outputs, warn_cache
+
+    check_finite(args, parser)
+    if not (verb == "study" and args.action == "status"):
+        check_outputs(verb, args, parser)
+    warn_cache(verb)
+
+
+def _sigterm_as_interrupt():
+    """SIGTERM raises KeyboardInterrupt, as Ctrl-C does (main thread only); the old handler."""
+    def interrupt(signum, frame):
+        raise KeyboardInterrupt
+
+    try:
+        return signal.signal(signal.SIGTERM, interrupt)
+    except ValueError:  # not the main thread
+        return None
+
+
+def _silence_stdout() -> None:
+    """Point stdout at /dev/null so that Python's exit flush cannot fail again."""
+    try:
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+    except (OSError, ValueError):
+        pass
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())

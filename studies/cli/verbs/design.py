@@ -1,0 +1,135 @@
+"""``softhand design``: size finger and reservoir for a task on the reduced model, prove it by FEM.
+
+The task file (see ``studies/designs/tasks/``) names the object, the grasp requirement, the
+pump, the limits and the free design keys with their bounds. The optimum of the reduced
+model (differential evolution, seeded) goes through the FEM -- free bend with the reservoir
+and the grasp at the task's object -- unless ``--no-fem``. Written to ``--out DIR``: the
+design TOML (usable by every verb), ``result.json``, with ``--pareto`` the front's plot, and
+the VTK of the verified grasp (``grasp.pvd``). A task that cannot be met: one paragraph
+naming the binding constraint and the nearest design, exit code 1.
+"""
+from __future__ import annotations
+
+import math
+import sys
+from pathlib import Path
+
+from softhand.reduced.errors import InputError
+from softhand.studies.cli.args import add_json_option, print_json, print_table
+
+HELP = "size finger and reservoir for an object (reduced model, optimiser) and prove it with the FEM"
+
+
+def configure(parser) -> None:
+    parser.add_argument("--task", required=True, metavar="FILE.toml", help="the design task")
+    parser.add_argument("--seed", type=int, default=1, help="optimiser seed (default 1)")
+    parser.add_argument("--pareto", action="store_true",
+                        help="also trace pump pressure against peak stretch (front, knee, plot)")
+    parser.add_argument("--out", metavar="DIR", help="output folder (default results/design/TASK)")
+    parser.add_argument("--plot", metavar="FILE.png", help="the Pareto plot (default DIR/pareto.png)")
+    parser.add_argument("--no-fem", action="store_true", help="skip the FEM proof (reduced model only)")
+    parser.add_argument("--mesh-size-mm", type=float, metavar="H",
+                        help="finger element size of the FEM proof [mm] (default: the task's, 6)")
+    add_json_option(parser)
+
+
+def run(args) -> int:
+    from softhand.studies.design import optimise as design_opt
+    from softhand.studies.design.task import load_task
+    from softhand.studies.io.files import write_atomic, write_json
+
+    task = load_task(args.task)
+    if args.mesh_size_mm is not None and not args.mesh_size_mm > 0:
+        raise InputError("--mesh-size-mm", args.mesh_size_mm, "must be a positive number")
+    if args.seed < 0:
+        raise InputError("--seed", args.seed, "must be a whole number >= 0")
+    say = (lambda text: print(f"softhand design: {text}", file=sys.stderr)) if args.json else print
+    options = design_opt.OptimiserOptions(seed=args.seed)
+    opt = design_opt.optimise(task, options)
+    ev = opt.evaluation
+    base = design_opt.evaluate(task.base, task)
+    out = Path(args.out) if args.out else Path("results") / "design" / task.name
+    out.mkdir(parents=True, exist_ok=True)
+    design_file = write_atomic(out / "design.toml", ev.design.to_toml())
+    result = _result(task, opt, base, design_file, args.seed)
+    if args.pareto:
+        from softhand.studies.design import pareto as design_pareto
+
+        rows = design_pareto.front(task, opt, options)
+        plot = design_pareto.plot(rows, args.plot or out / "pareto.png", task=task, base=base)
+        result["pareto"] = {"rows": rows, "knee": design_pareto.knee(rows), "plot": str(plot)}
+    if not ev.feasible:
+        result["report"] = design_opt.infeasible_report(task, opt)
+    elif not args.no_fem:
+        result["fem"] = _prove(ev, task, args, out, say)
+    write_json(out / "result.json", result)
+    if args.json:
+        print_json(result)
+    else:
+        _print(result, task, opt)
+    return 0 if ev.feasible else 1
+
+
+def _prove(ev, task, args, out, say) -> dict:
+    from softhand.fem.newton import NotConverged
+    from softhand.studies.design.proof import ProofOptions, prove
+
+    h = args.mesh_size_mm if args.mesh_size_mm is not None else task.mesh_size
+    try:
+        options = ProofOptions(mesh_size_mm=h, dP_mpa=task.dP, edge_ratio=task.edge_ratio)
+        return prove(ev, task, options, out=out, progress=say)
+    except (NotConverged, RuntimeError) as exc:
+        say(f"the FEM proof failed: {str(exc)[:300]}")
+        return {"error": str(exc)[:300]}
+
+
+def _result(task, opt, base, design_file, seed: int) -> dict:
+    ev = opt.evaluation
+    return {
+        "task": task.name, "feasible": ev.feasible, "objective": task.objective,
+        "design": ev.design.to_dict(),
+        "free": {k: float(v) for (k, _, _), v in zip(task.free, opt.x)},
+        "predicted": ev.predicted(),
+        "fem": None,
+        "base_design": {"design": task.base.to_dict(), "predicted": base.predicted(),
+                        "feasible": base.feasible},
+        "constraints": [c.as_dict() for c in ev.constraints],
+        "design_file": str(design_file),
+        "optimiser": {"method": "differential_evolution + SLSQP polish", "seed": seed,
+                      "evaluations": opt.evaluations, "generations": opt.generations,
+                      "seconds": opt.seconds, "message": opt.message},
+    }
+
+
+def _print(result: dict, task, opt) -> None:
+    free = ", ".join(f"{k} = {v:.5g}" for k, v in result["free"].items())
+    print(f"task {task.name}: {task.diameter:g} mm, {task.mass:g} kg, F_v >= {task.required_F_v():.4g} N "
+          f"per finger, pump <= {task.max_pressure:g} MPa; objective: {task.objective}")
+    print(f"optimum: {free}  ({opt.evaluations} model evaluations, {opt.seconds:.1f} s)")
+    if "report" in result:
+        print(result["report"])
+    rows = [{"constraint": c["name"], "value": c["value"], "sense": c["sense"], "limit": c["limit"],
+             "satisfied": c["satisfied"]} for c in result["constraints"]]
+    print_table(rows)
+    keys = ("P_grasp_MPa", "P_contact_MPa", "theta_grasp_deg", "F_v_N", "max_principal_stretch", "w")
+    fem = result.get("fem") or {}
+    base = result["base_design"]["predicted"]
+    table = [{"quantity": k, "base design": base.get(k), "predicted": result["predicted"].get(k),
+              "FEM": fem.get(k), "FEM / predicted - 1": _rel(fem.get(k), result["predicted"].get(k))}
+             for k in keys]
+    print_table(table)
+    if fem.get("wall_seconds"):
+        print(f"# FEM proof: finger {fem['finger_ndofs']} unknowns (mesh {fem['mesh_size_mm']:g} mm), "
+              f"sheet {fem['sheet_ndofs']}, {fem['wall_seconds']:.0f} s; F_v at the FEM's P_grasp "
+              f"{fem['F_v_at_P_grasp_N']:.4g} N")
+    if "pareto" in result:
+        k = result["pareto"]["knee"]
+        print(f"Pareto front: {len(result['pareto']['rows'])} points, knee at stretch "
+              f"{result['pareto']['rows'][k]['max_principal_stretch']:.4g}; plot {result['pareto']['plot']}")
+    print(f"design: {result['design_file']}")
+
+
+def _rel(a, b):
+    if isinstance(a, (int, float)) and isinstance(b, (int, float)) and b and math.isfinite(b):
+        return a / b - 1.0
+    return None

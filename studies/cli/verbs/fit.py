@@ -1,0 +1,181 @@
+"""``softhand fit``: calibrate design parameters to measured points (bounded least squares).
+
+    softhand fit --data studies/data/example_bending.csv --params V0_mm3,mu_sf_MPa \\
+        [--design FILE] [--model reduced] [--no-reservoir] [--bounds V0_mm3=1e4:3e4] \\
+        [--shore-a 70] [--diameter-mm 180 | --weights w1,..,w5] \\
+        [--json] [--plot FILE.png] [--out DESIGN.toml]
+
+Prints the fitted values with standard errors, their correlation, RMSE and max error in
+the data's units, and every identifiability warning (also on stderr). ``--out`` writes
+the calibrated design as a TOML file that every verb reads with ``--design``.
+"""
+from __future__ import annotations
+
+import sys
+import warnings
+
+from softhand.studies.cli.args import add_design_option, add_json_option, design_from_args, parse_values, print_json
+
+HELP = "calibrate design parameters (V0, mu, ...) to measured bend angles or grasp forces"
+
+
+def configure(parser) -> None:
+    parser.add_argument("--data", required=True, metavar="FILE.csv",
+                        help="measurements: columns P_MPa,theta_deg[,finger] (free bending) or "
+                             "P_MPa,theta_deg,mass_kg,F_v_N[,diameter_mm] (grasp); '#' comments")
+    parser.add_argument("--params", required=True, metavar="KEYS",
+                        help="design keys to fit, comma-separated, e.g. V0_mm3,mu_sf_MPa")
+    parser.add_argument("--model", default="reduced", help="model to fit (default: reduced)")
+    parser.add_argument("--no-reservoir", action="store_true",
+                        help="fit the hand without reservoir (eq. (28)) instead of eq. (27)")
+    parser.add_argument("--bounds", default=None, metavar="KEY=LO:HI,...",
+                        help="bounds of fitted keys (default: start/100..start*100)")
+    parser.add_argument("--shore-a", type=float, default=None, metavar="S",
+                        help="start fitted mu_sf_MPa / mu_sr_MPa from Gent's Shore A relation")
+    parser.add_argument("--diameter-mm", type=float, default=None, metavar="D",
+                        help="grasp data without diameter_mm column: the paper's w for D (180, 240)")
+    parser.add_argument("--weights", default=None, metavar="w1,..,wn",
+                        help="grasp data without diameter_mm column: the weight vector w")
+    parser.add_argument("--normalise", action="store_true",
+                        help="scale w to sum 1 (eq. (23); the paper's 180 mm w sums to 1.40)")
+    add_design_option(parser)
+    add_json_option(parser)
+    parser.add_argument("--plot", default=None, metavar="FILE.png",
+                        help="write data vs fitted model and the residuals")
+    parser.add_argument("--out", default=None, metavar="DESIGN.toml",
+                        help="write the calibrated design (readable by every verb via --design)")
+
+
+def run(args) -> int:
+    from softhand.reduced.csvdata import read_measurements
+    from softhand.reduced.fit import check_params, fit, make_predictor
+
+    design = design_from_args(args)
+    data = read_measurements(args.data)
+    keys = check_params(args.params, len(data))
+    design = _start_from_shore_a(design, keys, args.shore_a)
+
+    def predictor_for(points):
+        return make_predictor(points, args.model, reservoir=not args.no_reservoir,
+                              weights=weights, normalise=args.normalise, design=design)
+
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        weights = _weights(args, design)
+        predictor = predictor_for(data)
+        result = fit(data, keys, predictor, design, bounds=_parse_bounds(args.bounds))
+    notes = [str(w.message) for w in caught] + list(result.warnings)
+    if args.out:
+        from softhand.studies.io.files import kept_if_unwritable, write_atomic
+
+        with kept_if_unwritable(args.out, "fit"):
+            write_atomic(args.out, _design_toml(result, data, args))
+    if args.plot:
+        from softhand.studies.io.fit_plot import plot_fit
+        from softhand.studies.io.files import kept_if_unwritable
+
+        with kept_if_unwritable(args.plot, "fit"):
+            plot_fit(result, data, predictor_for, args.plot)
+    if args.json:
+        print_json({**result.to_dict(), "data": args.data, "model": args.model,
+                    "reservoir": not args.no_reservoir, "notes": notes})
+    else:
+        _print_report(result, data, args)
+    for note in notes:
+        print(f"softhand fit: warning: {note}", file=sys.stderr)
+    return 0
+
+
+def _start_from_shore_a(design, keys, shore_a):
+    if shore_a is None:
+        return design
+    from softhand.reduced.design import design_from_dict
+    from softhand.reduced.materials_data import shear_modulus_from_shore_a
+
+    from softhand.reduced.errors import InputError
+
+    try:
+        mu = shear_modulus_from_shore_a(shore_a)
+    except InputError as exc:
+        raise exc.renamed("--shore-a") from None
+    start = {k: mu for k in ("mu_sf_MPa", "mu_sr_MPa") if k in keys}
+    if not start:
+        from softhand.reduced.errors import InputError
+
+        raise InputError("--shore-a", shore_a, "only sets the start of a fitted mu_sf_MPa "
+                         "or mu_sr_MPa; name one in --params")
+    return design_from_dict(start, design)
+
+
+def _weights(args, design):
+    from softhand.reduced.errors import InputError
+
+    if args.weights is not None and args.diameter_mm is not None:
+        raise InputError("--weights", args.weights, "give --weights or --diameter-mm, not both")
+    if args.diameter_mm is not None:
+        from softhand.reduced.grasp import weights_for_diameter
+
+        try:
+            return weights_for_diameter(args.diameter_mm, design)
+        except InputError as exc:
+            raise exc.renamed("--diameter-mm") from None
+    if args.weights is not None:
+        return parse_values(args.weights, "--weights")
+    return None
+
+
+def _parse_bounds(text):
+    """'K=lo:hi,K2=lo:hi' -> {K: (lo, hi)}."""
+    if not text:
+        return None
+    from softhand.reduced.errors import InputError
+
+    bounds = {}
+    for item in text.split(","):
+        key, _, rng = item.partition("=")
+        try:
+            lo, hi = (float(x) for x in rng.split(":"))
+        except ValueError:
+            raise InputError("--bounds", item, "must be KEY=LOW:HIGH, e.g. V0_mm3=1e4:3e4") from None
+        bounds[key.strip()] = (lo, hi)
+    return bounds
+
+
+def _design_toml(result, data, args) -> str:
+    fitted = ", ".join(f"{k} = {v:.6g} +- {se:.2g}"
+                       for k, v, se in zip(result.params, result.values, result.stderr))
+    head = (f"# calibrated by softhand fit from {args.data} ({len(data)} points, model "
+            f"{args.model}{', no reservoir' if args.no_reservoir else ''})\n"
+            f"# fitted: {fitted}; RMSE {result.rmse:.4g} {data.unit}\n")
+    return head + result.design.to_toml()
+
+
+def _print_report(result, data, args) -> None:
+    from softhand.studies.cli.args import print_table
+
+    kind = "free-bending" if data.kind == "bending" else "grasp"
+    print(f"{data.source}: {len(data)} {kind} points; model {args.model} "
+          f"({'without' if args.no_reservoir else 'with'} reservoir); fitted {data.quantity}")
+    rows = [{"parameter": k, "start": f"{p0:.6g}", "fitted": f"{v:.6g}",
+             "std_error": f"{se:.2g}", "rel_error": f"{100 * se / abs(v):.2g} %" if v else "-"}
+            for k, p0, v, se in zip(result.params, result.initial, result.values, result.stderr)]
+    print_table(rows)
+    if len(result.params) > 1:
+        print("correlation:")
+        print_table([{"": k, **{k2: c for k2, c in zip(result.params, row)}}
+                     for k, row in zip(result.params, result.correlation)], digits=3)
+    u = data.unit
+    print(f"RMSE {result.rmse:.4g} {u} (at the start {result.initial_rmse:.4g} {u}), "
+          f"max |error| {result.max_error:.4g} {u}, residual scatter {result.sigma:.4g} {u} "
+          f"on {result.dof} degrees of freedom")
+    by_finger = result.rmse_by_finger()
+    if by_finger:
+        print("RMSE by finger: " + ", ".join(f"{f}: {e:.3g} {u}" for f, e in by_finger.items()))
+    print(f"condition number of the scaled Jacobian: {result.condition:.3g}; "
+          f"{result.nfev} model evaluations")
+    for w in result.warnings:
+        print(f"WARNING: {w}")
+    if args.out:
+        print(f"calibrated design: {args.out}")
+    if args.plot:
+        print(f"plot: {args.plot}")

@@ -1,0 +1,121 @@
+"""``softhand grasp``: tip forces of a finger holding an object, eqs. (24), (25), (29).
+
+Given the pump pressure, the bend angle, the object's mass and a weight vector w, prints
+F_x (25), F_y (24) and the normal force F_v (29) in N and kgf. w is given as numbers, by the
+name of one of the paper's vectors (``--weights paper180``), or from the grasp FEM for any
+object diameter (``--diameter-mm D``: :mod:`studies.weights`, cached; the first call for a
+new diameter runs the FEM). ``w_source`` in the output says which. Axes and signs:
+docs/conventions.md (F_v > 0: the finger squeezes).
+"""
+from __future__ import annotations
+
+import math
+import sys
+import warnings
+
+import numpy as np
+
+from softhand.reduced import grasp, hand
+from softhand.reduced.errors import InputError
+from softhand.studies.cli.args import add_design_option, add_json_option, design_from_args, parse_values, \
+    print_json
+
+#: the paper's weight vectors by name (--weights paper180)
+PAPER_NAMES = {f"paper{D:g}": D for D in grasp.PAPER_WEIGHTS}
+
+HELP = "grasping forces F_x, F_y, F_v at a pressure, bend angle and mass (eqs. 24, 25, 29)"
+
+
+def configure(parser) -> None:
+    parser.add_argument("--pressure-mpa", required=True, metavar="P", help="pump pressure [MPa]")
+    parser.add_argument("--theta-deg", required=True, metavar="T", help="bend angle [deg]")
+    parser.add_argument("--mass-kg", required=True, metavar="M", help="mass of the object [kg]")
+    which = parser.add_mutually_exclusive_group(required=True)
+    which.add_argument("--weights", metavar="W1,..",
+                       help="weight vector w, n_s comma-separated numbers "
+                            "(write --weights=-0.13,0,... when the first is negative), or the "
+                            f"paper's by name: {', '.join(PAPER_NAMES)}")
+    which.add_argument("--diameter-mm", metavar="D",
+                       help="object diameter [mm]: w from the grasp FEM (cached; see softhand weights)")
+    parser.add_argument("--normalise", action="store_true", help="scale w to sum to 1 (eq. (23))")
+    add_design_option(parser)
+    add_json_option(parser)
+
+
+#: option -> (lowest, highest) allowed
+LIMITS = {"--pressure-mpa": (-5.0, 5.0), "--theta-deg": (-90.0, 180.0), "--mass-kg": (0.0, 100.0),
+          "--diameter-mm": (60.0, 500.0)}
+
+
+def _scalar(text: str, field: str) -> float:
+    values = parse_values(text, field, max_count=1)
+    lo, hi = LIMITS[field]
+    if not lo <= values[0] <= hi:
+        raise InputError(field, text, f"must be one number in [{lo:g}, {hi:g}]")
+    return float(values[0])
+
+
+def _fem_weights(diameter: float, mass: float, design) -> tuple[np.ndarray, str]:
+    """w from the grasp FEM (studies.weights, cached) at its default pressure and mesh."""
+    from softhand.studies.weights import WeightsCase, weights
+
+    if not diameter > 0:
+        raise InputError("diameter_mm", diameter, "must be a positive number")
+    case = WeightsCase(design=design, diameter_mm=diameter, mass_kg=mass)
+    result = weights(case)
+    return np.array(result["w"]), (f"FEM: D = {diameter:g} mm, m = {mass:g} kg, P = "
+                                   f"{case.pressure_mpa:g} + {case.dP_mpa:g} MPa, mesh "
+                                   f"{case.mesh_size_mm:g} mm{' (cached)' if result['cached'] else ''}")
+
+
+def _weights(args, design, mass: float) -> tuple[np.ndarray, str, list[str]]:
+    """The w asked for (checked, maybe normalised), where it came from, the warnings about it."""
+    if args.weights is not None and args.weights.strip() in PAPER_NAMES:
+        D = PAPER_NAMES[args.weights.strip()]
+        w, source = grasp.weights_for_diameter(D, design), f"paper, {D:g} mm (section III-C)"
+    elif args.weights is not None:
+        w, source = parse_values(args.weights, "--weights"), "given"
+    else:
+        w, source = _fem_weights(_scalar(args.diameter_mm, "--diameter-mm"), mass, design)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", grasp.WeightSumWarning)
+        w = grasp.check_weights(w, design, normalise=args.normalise)
+    return w, source, [str(warning.message) for warning in caught]
+
+
+def evaluate(P: float, theta_deg: float, mass: float, w, design) -> dict:
+    """One grasp state -> the flat result (forces in N and kgf, the w used, the free pressure)."""
+    theta = math.radians(theta_deg)
+    F = grasp.grasp_forces(P, theta, mass, w, design)
+    return {"P_MPa": P, "theta_deg": theta_deg, "mass_kg": mass,
+            "F_x_N": float(F.F_x), "F_y_N": float(F.F_y), "F_v_N": float(F.F_v),
+            "F_v_kgf": float(F.F_v) / grasp.KGF,
+            "w": [float(x) for x in w], "w_sum": float(np.sum(w)),
+            "P_free_MPa": float(hand.pressure(theta, design))}
+
+
+def run(args) -> int:
+    design = design_from_args(args)
+    P = _scalar(args.pressure_mpa, "--pressure-mpa")
+    theta_deg = _scalar(args.theta_deg, "--theta-deg")
+    mass = _scalar(args.mass_kg, "--mass-kg")
+    if args.weights is not None and args.weights.strip() not in PAPER_NAMES:
+        try:
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore", grasp.WeightSumWarning)
+                grasp.check_weights(parse_values(args.weights, "--weights", max_count=1000), design)
+        except InputError as exc:
+            raise exc.renamed("--weights") from None
+    w, source, notes = _weights(args, design, mass)
+    result = evaluate(P, theta_deg, mass, w, design) | {"w_source": source}
+    for note in notes:  # only once the inputs are known to be good
+        print(f"softhand grasp: warning: {note}", file=sys.stderr)
+    if args.json:
+        print_json(result)
+    else:
+        width = max(map(len, result))
+        for key, value in result.items():
+            text = "[" + ", ".join(f"{v:g}" for v in value) + "]" if isinstance(value, list) \
+                else value if isinstance(value, str) else f"{value:.4g}"
+            print(f"{key:<{width}}  {text}")
+    return 0

@@ -1,0 +1,40 @@
+"""``softhand reproduce [--out DIR] [--quick]``: the paper's results, end to end, in one report."""
+from __future__ import annotations
+
+from softhand.studies.cli.args import add_design_option, design_from_args
+
+HELP = "recompute every result of the paper into a report (Markdown + PNG + CSV + VTK)"
+
+
+def configure(parser) -> None:
+    parser.add_argument("--out", default="results/reproduce", metavar="DIR",
+                        help="output folder (default: results/reproduce)")
+    parser.add_argument("--quick", action="store_true",
+                        help="CI-sized meshes and fewer points (a few minutes)")
+    parser.add_argument("--only", default=None, metavar="KEY,KEY",
+                        help="build only these sections (keys as in the report's folders)")
+    parser.add_argument("--fresh", action="store_true",
+                        help="recompute every section, even those a previous run finished")
+    parser.add_argument("--no-progress", action="store_true", help="no progress bar")
+    add_design_option(parser)
+
+
+def run(args) -> int:
+    from softhand.reduced.errors import InputError
+    from softhand.studies.reproduce.core import exit_code, reproduce, sections
+
+    keys = [s.key for s in sections()]
+    only = None
+    if args.only is not None:
+        only = tuple(k.strip() for k in args.only.split(",") if k.strip())
+        unknown = [k for k in only if k not in keys]
+        if unknown or not only:
+            raise InputError("--only", args.only, f"allowed section keys: {', '.join(keys)}")
+    outcomes = reproduce(args.out, quick=args.quick, design=design_from_args(args), only=only,
+                         fresh=args.fresh, progress=not args.no_progress)
+    width = max(len(o.section.key) for o in outcomes)
+    for o in outcomes:
+        detail = f"  {o.detail}" if o.status in ("failed", "not available") else ""
+        print(f"{o.section.key:<{width}}  {o.status:<13} {o.wall_time_s:7.1f} s{detail}")
+    print(f"report: {args.out}/report.md")
+    return exit_code(outcomes)

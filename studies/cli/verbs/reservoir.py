@@ -1,0 +1,200 @@
+"""``softhand reservoir``: FEM inflation of the reservoir sheet vs the paper's ellipse model.
+
+Per volume: FEM pressure, apex height, strain energy; the ellipse model's (13)–(18) at the
+same volume; the mean stretches and the largest gap between the profiles. Then the pressure
+maximum (if the path passes one) and the verdict over the operating range (V0 - stroke .. V0).
+``--plot``: profiles, p(V) of both models, and the hand's P(theta) with both reservoir
+models. ``--out DIR``: result.json (rows, verdict, wet-surface profiles z(r) and mid-surface
+stretches per volume, the whole p(V), W(V) path), rows.csv, VTK of the deformed sheet per
+volume (r–z and revolved to 3D). ``--write-calibration FILE.csv``: the table of ``reduced/reservoir_fem.py``.
+"""
+from __future__ import annotations
+
+import math
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+
+from softhand.reduced.errors import InputError
+from softhand.studies.cli.args import MAX_FEM_POINTS, add_design_option, add_json_option, design_from_args, \
+    parse_values, print_json, print_table
+from softhand.studies.io.files import kept_if_unwritable
+
+HELP = "inflate the reservoir sheet (FEM) and measure the ellipse assumption (eqs. 11-18)"
+
+
+def configure(parser) -> None:
+    parser.add_argument("--volume-mm3", metavar="LIST",
+                        help="oil volumes [mm^3]: start:stop:step or a,b,c "
+                             "(default: V0 - stroke at 90 deg, V0, V0 + 2000)")
+    parser.add_argument("--plot", metavar="FILE.png", help="profiles, p(V) and P(theta), both models")
+    parser.add_argument("--out", metavar="DIR", help="write result.json, rows.csv and VTK here")
+    parser.add_argument("--n-radial", type=int, default=40, help="Q2 elements along the radius")
+    parser.add_argument("--n-thick", type=int, default=2, help="Q2 elements through the thickness")
+    parser.add_argument("--write-calibration", metavar="FILE.csv",
+                        help="write the FEM calibration table of the 'fem' reservoir model")
+    add_design_option(parser)
+    add_json_option(parser)
+
+
+def _study(args):
+    from softhand.studies.reservoir import ReservoirStudy
+
+    design = design_from_args(args)
+    for name, hi in (("n_radial", 400), ("n_thick", 20)):
+        if not 1 <= getattr(args, name) <= hi:
+            raise InputError(f"--{name.replace('_', '-')}", getattr(args, name),
+                             f"must be a whole number in [1, {hi}]")
+    volumes = ()
+    if args.volume_mm3 is not None:
+        volumes = tuple(parse_values(args.volume_mm3, "--volume-mm3", MAX_FEM_POINTS))
+        if min(volumes) <= 0 or max(volumes) > 100 * design.V0:
+            raise InputError("--volume-mm3", args.volume_mm3,
+                             f"volumes must be in (0, {100 * design.V0:g}] mm^3 (100 V0)")
+    return ReservoirStudy(design=design, volumes_mm3=volumes, n_radial=args.n_radial,
+                          n_thick=args.n_thick)
+
+
+def run(args) -> int:
+    study = _study(args)
+    if args.write_calibration:
+        return _write_calibration(study, args.write_calibration)
+    from tqdm import tqdm
+
+    from softhand.studies.reservoir import COLUMNS, run as run_study
+
+    from softhand.fem.volume_path import NotConverged
+
+    try:
+        with tqdm(desc="inflating", unit=" mm³", leave=False) as bar:  # whole mm³ of oil
+            result = run_study(study, progress=lambda v: bar.update(round(v) - bar.n))
+    except NotConverged as exc:
+        last = exc.last
+        print(f"softhand reservoir: error: {str(exc).split(';')[0]} (Newton failed at the smallest "
+              f"volume step); last converged state V = {last.volume:.6g} mm^3, "
+              f"p = {last.pressure:.6g} MPa", file=sys.stderr)
+        return 1
+    summary = _summary(result)
+    if args.out:
+        with kept_if_unwritable(args.out, "reservoir"):
+            _write_outputs(Path(args.out), result, summary)
+    if args.plot:
+        with kept_if_unwritable(args.plot, "reservoir"):
+            plot_reservoir(args.plot, result)
+    if args.json:
+        print_json({"rows": result.rows, **summary})
+    else:
+        print_table(result.rows, COLUMNS)
+        pm = summary["pressure_max"]
+        print("pressure maximum: " + ("none in 0..%.0f mm^3" % summary["path_max_volume_mm3"] if pm is None
+                                      else f"p = {pm['p_MPa']:.4g} MPa at V = {pm['V_mm3']:.0f} mm^3"))
+        v = result.verdict
+        print(f"stroke {v['stroke_mm3']:.0f} mm^3: dp FEM {v['stroke_dp_fem_MPa']:.4g} MPa, "
+              f"ellipse {v['stroke_dp_ellipse_MPa']:.4g} MPa ({100 * v['stroke_dp']:+.1f} %)")
+        th, fem, ell = v["offset_theta_deg"], v["offset_fem_MPa"], v["offset_ellipse_MPa"]
+        print(f"reservoir offset p_r over theta {th[-1]:.0f}..{th[0]:.0f} deg: FEM {fem[-1]:.4g}..{fem[0]:.4g} MPa, "
+              f"ellipse {ell[-1]:.4g}..{ell[0]:.4g} MPa, ellipse - FEM "
+              f"{v['offset_difference_MPa'][0]:.4g}..{v['offset_difference_MPa'][1]:.4g} MPa")
+    return 0
+
+
+def _summary(result) -> dict:
+    fem = result.fem
+    pm = fem.pressure_max
+    return {
+        "pressure_max": None if pm is None else {"V_mm3": pm[0], "p_MPa": pm[1]},
+        "path_max_volume_mm3": float(fem.path_volume[-1]),
+        "verdict": result.verdict, "design": result.study.design.to_dict(),
+        "design_hash": result.study.design.hash(),
+        "mesh": {"n_radial": fem.model.n_radial, "n_thick": fem.model.n_thick, "ndofs": fem.ndofs,
+                 "element": "Q2/P1disc axisymmetric", "kappa_over_mu": fem.model.kappa_ratio},
+        "newton_iterations": fem.newton_iterations, "load_steps": len(fem.path_volume) - 1,
+        "wall_time_s": fem.wall_time,
+    }
+
+
+def _write_outputs(out: Path, result, summary) -> None:
+    from softhand.studies.io.files import write_csv, write_json
+    from softhand.studies.reproduce.fem_sections import write_sheet_vtk
+
+    profiles = [{"V_mm3": s.volume, "r_mm": s.r, "z_mm": s.z, "r0_mid_mm": s.r0_mid,
+                 "lambda_meridian": s.lambda_meridian, "lambda_hoop": s.lambda_hoop,
+                 "lambda_thickness": s.lambda_thickness} for s in result.states]
+    path = {"V_mm3": result.fem.path_volume, "p_MPa": result.fem.path_pressure,
+            "W_Nmm": result.fem.path_energy}
+    write_json(out / "result.json", {"rows": result.rows, **summary, "profiles": profiles,
+                                     "path": path})
+    write_csv(out / "rows.csv", result.rows)
+    write_sheet_vtk(result, out)  # sheet.pvd (3D scenes) and sheet_V<volume>_rz.vtu (r–z)
+
+
+def _git_commit() -> str:
+    try:
+        return subprocess.run(["git", "rev-parse", "--short", "HEAD"], capture_output=True,
+                              text=True, cwd=Path(__file__).parent, check=True).stdout.strip()
+    except (OSError, subprocess.CalledProcessError):
+        return "unknown"
+
+
+def _write_calibration(study, path) -> int:
+    """FEM tables at the design's thickness t and at 2t (twice the layers: same element shape)."""
+    if not study.design.reservoir_is_neo_hookean:
+        raise InputError("--write-calibration", str(path), "the calibration table of the 'fem' "
+                         "reservoir model is for a Neo-Hookean sheet; this design's sheet is "
+                         f"{study.design.reservoir_material.model}")
+    from dataclasses import replace
+    from datetime import datetime, timezone
+
+    from softhand.studies.io.files import write_atomic
+    from softhand.studies.reservoir import calibration_csv, calibration_rows
+
+    thin = study.model()
+    thick = replace(thin, t=2 * thin.t, n_thick=2 * thin.n_thick)
+    rows = calibration_rows(thin) + calibration_rows(thick)
+    provenance = (f"FEM calibration of reduced/reservoir_fem.py, written "
+                  f"{datetime.now(timezone.utc):%Y-%m-%d %H:%M} UTC at commit {_git_commit()} by\n"
+                  f"softhand reservoir --write-calibration {Path(path).name} "
+                  f"--n-radial {thin.n_radial} --n-thick {thin.n_thick}")
+    write_atomic(path, calibration_csv([thin, thick], rows, provenance))
+    print(f"wrote {len(rows)} rows to {path}")
+    return 0
+
+
+def plot_reservoir(path, result) -> None:
+    """Profiles (FEM vs ellipse), p(V) of both models, P(theta) with both reservoir models."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from softhand.reduced import hand, reservoir
+    from softhand.studies.io.files import save_figure
+
+    d = result.study.design
+    fig, ax = plt.subplots(1, 3, figsize=(15, 4.2))
+    r = np.linspace(0, d.R, 200)
+    for k, s in enumerate(result.states):
+        c = f"C{k}"
+        ax[0].plot(s.r, s.z, "-", color=c, label=f"FEM V={s.volume:.0f}")
+        h = float(reservoir.height(s.volume, d))
+        ax[0].plot(r, h * np.sqrt(1 - (r / d.R) ** 2), "--", color=c)
+    ax[0].set(xlabel="r [mm]", ylabel="z [mm] (wet surface)", title="profiles: FEM (-), ellipse (--)",
+              aspect="equal")
+    fem = result.fem
+    V = fem.path_volume[1:]
+    ax[1].plot(V, fem.path_pressure[1:], "-", label="FEM")
+    ax[1].plot(V, reservoir.ellipse_pressure(V, d), "--", label="ellipse (11)-(18)")
+    ax[1].axvspan(*result.verdict["V_range_mm3"], color="0.9", label="operating range")
+    ax[1].set(xlabel="V [mm^3]", ylabel="p_r [MPa]", title="reservoir pressure p(V)")
+    theta = np.linspace(0, math.pi / 2, 91)
+    models = (("ellipse", "--"), ("fem", "-")) if d.reservoir_is_neo_hookean else (("ellipse", "--"),)
+    for name, style in models:  # the FEM-calibrated table is Neo-Hookean only
+        P = hand.pressure(theta, d.replace(reservoir_model=name))
+        ax[2].plot(np.degrees(theta), P, style, label=f"reservoir model '{name}'")
+    ax[2].plot(np.degrees(theta), hand.pressure(theta, d, reservoir=False), ":", label="no reservoir")
+    ax[2].set(xlabel="theta [deg]", ylabel="P [MPa]", title="pump pressure P(theta), eq. (27)")
+    for a in ax:
+        a.grid(alpha=0.3)
+        a.legend(fontsize=8)
+    save_figure(fig, path)

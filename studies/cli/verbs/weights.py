@@ -1,0 +1,175 @@
+"""``softhand weights``: hinge weight vectors w from the grasp FEM (eqs. (21)-(25)).
+
+One diameter: w (n_s values, sum 1), theta, hinge angles, contact forces, F_v from the FEM
+and from eq. (25) with this w at the same P, theta, m. Results are cached by input
+(``~/.cache/softhand/weights``), so a repeated call is instant.
+Several diameters (``--diameter-mm 120:300:30``): the w(D) table, ``--check-mm D`` compares
+the interpolated w with the FEM there, ``--plot FILE.png`` draws w(D).
+``--fig8 P1,P2,..``: the Fig. 8 analogue for one object (F_v vs theta at those pressures,
+theta varied by the object's depth), ``--plot`` draws it.
+"""
+from __future__ import annotations
+
+import sys
+
+from softhand.reduced.errors import InputError
+from softhand.studies.cli.args import add_design_option, add_json_option, design_from_args, parse_values, \
+    print_json, print_table
+from softhand.studies.io.files import kept_if_unwritable
+
+HELP = "hinge weight vectors w for an object diameter from the grasp FEM; F_v vs eq. (25)"
+
+COLUMNS = ["diameter_mm", "w", "theta_deg", "F_v_fem_N", "F_v_reduced_N", "contact_force_N"]
+
+
+def configure(parser) -> None:
+    from softhand.studies.weights import MESH_SIZE
+
+    parser.add_argument("--diameter-mm", required=True, metavar="D",
+                        help="object diameter(s) [mm]: one number, a,b,c or start:stop:step")
+    parser.add_argument("--mass-kg", default="0", metavar="M", help="object mass [kg] (default 0)")
+    parser.add_argument("--pressure-mpa", default="0.8", metavar="P",
+                        help="finger cavity pressure [MPa] (default 0.8)")
+    parser.add_argument("--dp-mpa", default="0.05", metavar="DP",
+                        help="pressure step between the two contact states [MPa] (default 0.05)")
+    parser.add_argument("--mesh-size-mm", default=str(MESH_SIZE), metavar="H",
+                        help=f"finger element size [mm] (default {MESH_SIZE:g})")
+    parser.add_argument("--depth-mm", metavar="Y",
+                        help="object centre below the palm [mm] (default: docs/grasp.md placement)")
+    parser.add_argument("--check-mm", metavar="D", help="several diameters: an unseen one to check "
+                                                        "the interpolated w against the FEM")
+    parser.add_argument("--fig8", metavar="P1,P2,..", help="Fig. 8 analogue at these pressures [MPa]")
+    parser.add_argument("--plot", metavar="FILE.png", help="draw w(D) or the Fig. 8 analogue")
+    parser.add_argument("--out", metavar="DIR", help="one diameter: write result.json and the VTK "
+                                                     "series grasp.pvd of both contact states (recomputes)")
+    parser.add_argument("--no-cache", action="store_true", help="recompute, do not read or write the cache")
+    add_design_option(parser)
+    add_json_option(parser)
+
+
+#: option -> (lowest, highest) allowed, in the option's unit
+LIMITS = {"--diameter-mm": (60.0, 500.0), "--mass-kg": (0.0, 20.0), "--pressure-mpa": (0.01, 3.0),
+          "--dp-mpa": (0.001, 0.5), "--mesh-size-mm": (2.0, 12.0), "--depth-mm": (-1000.0, 1000.0),
+          "--check-mm": (60.0, 500.0), "--fig8": (0.01, 3.0)}
+#: most diameters of one sweep and pressures of one --fig8 (one grasp FEM each)
+MAX_DIAMETERS, MAX_FIG8 = 50, 20
+
+
+def _values(text, field: str, max_count: int = 1):
+    values = parse_values(str(text), field, max_count)
+    lo, hi = LIMITS[field]
+    if values.min() < lo or values.max() > hi:
+        raise InputError(field, text, f"must be {'numbers' if max_count > 1 else 'a number'} "
+                                      f"in [{lo:g}, {hi:g}]")
+    return values
+
+
+def _scalar(text, field: str) -> float:
+    return float(_values(text, field)[0])
+
+
+def case_from_args(args):
+    from softhand.studies.weights import WeightsCase
+
+    return WeightsCase(design=design_from_args(args), diameter_mm=180.0,
+                       mass_kg=_scalar(args.mass_kg, "--mass-kg"),
+                       pressure_mpa=_scalar(args.pressure_mpa, "--pressure-mpa"),
+                       dP_mpa=_scalar(args.dp_mpa, "--dp-mpa"),
+                       mesh_size_mm=_scalar(args.mesh_size_mm, "--mesh-size-mm"),
+                       depth_mm=None if args.depth_mm is None else _scalar(args.depth_mm, "--depth-mm"))
+
+
+def run(args) -> int:
+    from softhand.fem.newton import NotConverged
+
+    try:
+        return _run(args)
+    except NotConverged as exc:  # the FEM's own failure: one line, exit 1
+        print(f"softhand weights: error: the grasp FEM did not converge: {str(exc)[:300]}",
+              file=sys.stderr)
+        return 1
+
+
+def _run(args) -> int:
+    from dataclasses import replace
+
+    case = case_from_args(args)
+    diameters = _values(args.diameter_mm, "--diameter-mm", MAX_DIAMETERS)
+    check = None if args.check_mm is None else _scalar(args.check_mm, "--check-mm")
+    if check is not None and not diameters.min() <= check <= diameters.max():
+        raise InputError("--check-mm", args.check_mm, f"must lie within the diameters "
+                         f"[{diameters.min():g}, {diameters.max():g}] mm")
+    if args.fig8 is not None:
+        pressures = _values(args.fig8, "--fig8", MAX_FIG8)
+        return _fig8(args, replace(case, diameter_mm=float(diameters[0])), pressures)
+    if diameters.size == 1:
+        result = _one(replace(case, diameter_mm=float(diameters[0])), args)
+        print_json(result) if args.json else _print_one(result)
+        return 0
+    return _sweep(args, case, diameters)
+
+
+def _one(case, args) -> dict:
+    from softhand.studies.weights import weights
+
+    if not args.no_cache:
+        print("softhand weights: running the grasp FEM (or reading the cache)...", file=sys.stderr)
+    return weights(case, cache=not args.no_cache, out=args.out)
+
+
+def _print_one(result: dict) -> None:
+    width = max(map(len, result))
+    for key, value in result.items():
+        if isinstance(value, list):
+            text = "[" + ", ".join(f"{v:.4g}" for v in value) + "]"
+        elif isinstance(value, float):
+            text = f"{value:.4g}"
+        else:
+            text = str(value)
+        print(f"{key:<{width}}  {text}")
+
+
+def _sweep(args, case, diameters) -> int:
+    from tqdm import tqdm
+
+    from softhand.studies.weights import WeightsStudy, run as run_study
+
+    check = None if args.check_mm is None else _scalar(args.check_mm, "--check-mm")
+    study = WeightsStudy(case=case, diameters_mm=tuple(float(D) for D in diameters), check_mm=check)
+    with tqdm(total=len(diameters), desc="weights", unit="D", file=sys.stderr) as bar:
+        result = run_study(study, cache=not args.no_cache, progress=lambda row: bar.update())
+    if args.plot:
+        from softhand.studies.io.weights_plot import plot_weights
+
+        with kept_if_unwritable(args.plot, "weights"):
+            plot_weights(args.plot, result)
+    if args.json:
+        print_json({"rows": result.rows, "check": result.check})
+    else:
+        print_table(result.rows, COLUMNS, digits=3)
+        if result.check:
+            print_table([result.check], digits=3)
+    return 0
+
+
+def _fig8(args, case, pressures) -> int:
+    from softhand.studies.weights import fig8, fig8_errors
+
+    rows = fig8(case, pressures)
+    if args.plot:
+        from softhand.studies.io.weights_plot import plot_fig8
+
+        with kept_if_unwritable(args.plot, "weights"):
+            plot_fig8(args.plot, case, rows)
+    summary = fig8_errors(rows)
+    if args.json:
+        print_json({"rows": rows, **summary})
+    else:
+        print_table(rows, ["depth_mm", "P_MPa", "theta_deg", "F_v_fem_N", "F_v_reduced_N",
+                           "F_v_error_kgf", "w"], digits=3)
+        for prefix, what in (("", "the FEM's w"), ("paper_w_", "the paper's w, normalised")):
+            if summary[f"{prefix}rms_error_kgf"] is not None:
+                print(f"F_v error, eq. (25) with {what} - FEM: rms {summary[f'{prefix}rms_error_kgf']:.3g} "
+                      f"kgf, max {summary[f'{prefix}max_abs_error_kgf']:.3g} kgf "
+                      "(paper: model vs measured 0.22 / 0.39 kgf)")
+    return 0

@@ -1,0 +1,191 @@
+r"""The FEM proof of a design: free bend with the reservoir, and the grasp at the task's object.
+
+Three FEM models check the reduced model's answer (:class:`studies.design_opt.Evaluation`):
+
+1. **Free bend** (finger FEM, :mod:`fem.finger`): cavity pressures in steps of at most
+   ``max_step_mpa`` up to eq. (28)'s pressure at the grasp angle theta_g, then 1.25, 1.5, ...
+   times it, until the finger bends past theta_g; the
+   cavity pressure p_finger, the cavity volume change dQ and the peak principal stretch at
+   theta_g are interpolated (monotone cubic in theta).
+2. **Reservoir** (sheet FEM, :mod:`fem.reservoir`, one path from flat to V0): p_r at the oil
+   left, V = V0 - n dQ (at the grasp: interpolated on the path), so that the hand's pump
+   pressure at contact is
+   P_contact = p_finger(theta_g) - p_r(V) -- as :func:`studies.compare.whole_hand`.
+3. **Grasp** (:mod:`fem.grasp`, the finger closing on the rigid object with its weight share):
+   first at the cavity pressure that the *predicted* pump pressure gives with the FEM
+   reservoir (F_v there is the FEM's answer to the prediction), then secant steps in the
+   cavity pressure until the FEM's F_v is the required one within ``rtol``: that state is the
+   verified grasp (its pump pressure P_grasp, bend, w, peak stretch, VTK).
+
+The finger mesh is the grasp FEM's (:func:`studies.weights.finger_options`) for both finger
+runs, so that the free bend and the grasp share one discretisation.
+"""
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+from scipy.interpolate import PchipInterpolator
+
+from softhand.reduced import hand
+from softhand.studies.design.optimise import Evaluation
+from softhand.studies.design.task import Task
+
+
+@dataclass(frozen=True)
+class ProofOptions:
+    mesh_size_mm: float = 6.0   #: finger element size (gmsh, graded as the grasp FEM) [mm]
+    dP_mpa: float = 0.05        #: first secant step of the grasp's cavity pressure [MPa]
+    rtol: float = 0.01          #: the verified grasp's F_v within this of the requirement
+    max_secant: int = 2         #: secant steps at most
+    max_step_mpa: float = 0.2   #: largest cavity-pressure step of the continuation from contact [MPa]
+    edge_ratio: float = 0.5     #: finger mesh grading at the ring edges (1: uniform)
+    sheet: dict = field(default_factory=dict)  #: sheet FEM mesh keywords (fem.reservoir.SheetModel)
+    bend_factors: tuple = (1.0, 1.25, 1.5, 1.75, 2.0, 2.5, 3.0, 4.0)  #: free bend: x eq. (28)'s pressure
+
+
+class _Past(Exception):
+    """Raised by the free-bend callback once the finger has bent past the grasp angle."""
+
+
+def free_bend(finger, theta_g: float, options: ProofOptions) -> dict:
+    """The free finger FEM up to theta_g [rad]: cavity pressure, dQ, stretch at theta_g."""
+    from softhand.fem.hand.finger import solve_pressures
+    from softhand.fem.newton import NotConverged
+
+    design = finger.design
+    P28 = float(hand.pressure(theta_g, design, reservoir=False))
+    states = []
+
+    def keep(state):
+        states.append(state)
+        if state.theta > theta_g:
+            raise _Past
+
+    t0 = time.perf_counter()
+    try:
+        targets = P28 * np.asarray(options.bend_factors)
+        ramp = np.arange(options.max_step_mpa, targets[0], options.max_step_mpa)  # no big first step
+        solve_pressures(finger, np.concatenate([ramp, targets]), callback=keep)
+    except _Past:
+        pass
+    except NotConverged as exc:
+        last = states[-1] if states else None
+        reached = f"{math.degrees(last.theta):.1f} deg at {last.P:.3g} MPa" if last else "nothing"
+        raise RuntimeError(f"free-bend FEM: Newton failed on the way to the grasp angle "
+                           f"{math.degrees(theta_g):.1f} deg (converged: {reached}): "
+                           f"{str(exc).split(';')[0]}") from None
+    if not states or states[-1].theta <= theta_g:
+        raise RuntimeError(f"free-bend FEM: {math.degrees(states[-1].theta) if states else 0:.2f} deg "
+                           f"at {states[-1].P if states else 0:.3g} MPa, below the grasp angle")
+    theta = np.array([0.0, *(s.theta for s in states)])
+    at = lambda values: float(PchipInterpolator(theta, values)(theta_g))  # noqa: E731
+    return {"P_finger_MPa": at([0.0, *(s.P for s in states)]),
+            "dQ_mm3": at([0.0, *(s.dQ for s in states)]),
+            "max_principal_stretch": at([1.0, *(s.max_principal_stretch for s in states)]),
+            "pressures_MPa": [s.P for s in states], "theta_deg": np.degrees(theta[1:]).tolist(),
+            "seconds": time.perf_counter() - t0}
+
+
+def grasp_secant(model, ladder, F_req: float, options: ProofOptions, say=None) -> dict:
+    """Grasp states up the cavity pressures ``ladder`` [MPa] (each from the last; the last is
+    the start), then a secant on F_v_fem(P) = F_req [N]."""
+    from softhand.fem.hand.grasp import weight_vector
+
+    t0 = time.perf_counter()
+
+    def solve(P, start=None):
+        state = model.solve(P, start=start)
+        if say is not None:
+            say(f"  grasp state: cavity {state.P:.4g} MPa, theta {math.degrees(state.theta):.2f} deg, "
+                f"F_v {state.F_v:.4g} N ({time.perf_counter() - t0:.0f} s)")
+        return state
+
+    P_start, first, known = ladder[-1], None, []
+    for P in ladder:  # continuation through contact: the Uzawa loop fails on big jumps
+        first = solve(P, start=first)
+        known.append(first)
+    second = solve(P_start + options.dP_mpa, start=first)
+    pair, steps = [first, second], 0
+    while abs(pair[-1].F_v - F_req) > options.rtol * F_req and steps < options.max_secant:
+        a, b = pair[-2], pair[-1]
+        if b.F_v == a.F_v:
+            break
+        P = max(b.P + (F_req - b.F_v) * (b.P - a.P) / (b.F_v - a.F_v), 0.5 * b.P)
+        below = [s for s in known + pair if s.P <= P]  # continue from the nearest state below P
+        pair.append(solve(P, start=max(below, key=lambda s: s.P) if below else None))
+        steps += 1
+    best = min(pair, key=lambda s: abs(s.F_v - F_req))
+    near = min((s for s in pair if s is not best), key=lambda s: abs(s.P - best.P))
+    w = weight_vector(*sorted((best, near), key=lambda s: s.P))
+    return {"first": first, "best": best, "w": w, "states": pair, "secant_steps": steps,
+            "seconds": time.perf_counter() - t0}
+
+
+def prove(ev: Evaluation, task: Task, options: ProofOptions = ProofOptions(), *, out=None,
+          progress=None) -> dict:
+    """Run the three FEM models for the evaluated design; the FEM's numbers (see module doc)."""
+    from softhand.fem.hand.finger import FingerModel
+    from softhand.fem.hand.grasp import GraspModel
+    from softhand.fem.hand.reservoir import SheetModel, inflate
+    from softhand.studies.weights import _write_vtk, finger_options
+
+    say = progress or (lambda text: None)
+    design = ev.design
+    t0 = time.perf_counter()
+    finger = FingerModel(design, replace(finger_options(options.mesh_size_mm), edge_ratio=options.edge_ratio))
+    say(f"free bend FEM to the grasp angle {math.degrees(ev.theta_grasp):.2f} deg "
+        f"({finger.ndofs} unknowns)")
+    bend = free_bend(finger, ev.theta_grasp, options)
+    say("reservoir sheet FEM at the oil left at contact")
+    V_contact = design.V0 - design.n * bend["dQ_mm3"]
+    if not V_contact > 0:
+        raise RuntimeError(f"the FEM fingers take {design.n * bend['dQ_mm3']:.0f} mm^3 of oil to reach "
+                           f"the grasp angle, more than V0 = {design.V0:.0f} mm^3 (eq. (2) says "
+                           f"{design.n * design.a**2 * math.pi * design.d * ev.theta_grasp:.0f})")
+    sheet_model = SheetModel.from_design(design, **options.sheet)
+    sheet = inflate(sheet_model, [V_contact, design.V0])
+    p_contact = sheet.states[0].pressure
+    model = GraspModel(finger, task.diameter, mass=task.mass)
+    P_cav = ev.P_grasp + p_contact  # the predicted pump pressure with the FEM reservoir
+    P_touch = bend["P_finger_MPa"] + 0.5 * options.dP_mpa  # just past the FEM's contact
+    P_start = max(P_cav, P_touch)
+    say(f"grasp FEM from the cavity pressure {P_start:.4g} MPa (object depth {model.depth:.1f} mm)")
+    steps = max(1, math.ceil((P_start - P_touch) / options.max_step_mpa - 1e-9))
+    near = P_start - P_touch < 0.5 * options.dP_mpa  # no continuation needed
+    g = grasp_secant(model, [P_start] if near else np.linspace(P_touch, P_start, steps + 1),
+                     ev.F_v, options, say)
+    best = g["best"]
+    fs = finger.state(best.y, best.P)
+    V_grasp = design.V0 - design.n * fs.dQ
+    # the sheet's path from flat to V0 passes V_grasp (steps <= R^2 t / 2): interpolated
+    p_grasp = float(np.interp(V_grasp, sheet.path_volume, sheet.path_pressure))
+    if out is not None:
+        _write_vtk(out, model, (best,))
+    first = g["first"]
+    return {
+        "P_grasp_MPa": best.P - p_grasp,
+        "P_contact_MPa": bend["P_finger_MPa"] - p_contact,
+        "theta_grasp_deg": math.degrees(best.theta),
+        # below the FEM's contact pressure the finger does not reach the object: F_v = 0
+        "F_v_N": first.F_v if P_start == P_cav else 0.0,
+        "touches_at_predicted_pressure": P_start == P_cav,
+        "F_v_at_P_grasp_N": best.F_v,
+        "w": g["w"].tolist(),
+        "max_principal_stretch": fs.max_principal_stretch,
+        "max_principal_stretch_at_contact": bend["max_principal_stretch"],
+        "contact_force_N": best.N.tolist(),
+        "cavity_pressure_MPa": best.P,
+        "reservoir_pressure_MPa": p_grasp,
+        "reservoir_offset_MPa": sheet.states[1].pressure,
+        "reservoir_pressure_maximum": sheet.pressure_max,
+        "depth_mm": model.depth,
+        "free_bend": bend,
+        "grasp_states": [{"P_MPa": s.P, "theta_deg": math.degrees(s.theta), "F_v_N": s.F_v}
+                         for s in g["states"]],
+        "finger_ndofs": finger.ndofs, "sheet_ndofs": sheet.ndofs,
+        "mesh_size_mm": options.mesh_size_mm,
+        "wall_seconds": time.perf_counter() - t0,
+    }

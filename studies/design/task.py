@@ -1,0 +1,175 @@
+"""A design task: the object to hold, the pump, the limits, and which design keys are free.
+
+A task is a TOML file (``studies/designs/tasks/paper_task.toml`` is the paper's)::
+
+    base_design = "studies/designs/paper.toml"   # optional; default the paper's
+    [object]
+    diameter_mm = 180.0
+    mass_kg = 2.0
+    [grasp]
+    force_factor = 2.0        # F_v >= force_factor * m g / n  (or margin_N: F_v >= m g / n + margin)
+    objective = "pressure"    # "pressure": least pump pressure; "margin": largest F_v margin at the pump limit
+    opening_mm = 180.0        # optional: the open hand's tip span must pass this (default: the diameter)
+    [pump]
+    max_pressure_MPa = 1.0
+    [limits]                  # optional
+    max_principal_stretch = 1.5
+    min_wall_mm = 1.0
+    [material]                # optional: mu per part, over the base design
+    mu_sf_MPa = 1.15
+    [design]                  # optional: any other design key over the base design
+    [free]                    # design variables and their bounds
+    a_mm = [3.0, 6.0]
+    [fem]                     # optional: the FEM proof's finger mesh (gmsh)
+    mesh_size_mm = 6.0
+    edge_ratio = 0.5          # element size at the ring edges / mesh_size (1: uniform)
+
+``base_design`` is looked up as given, then next to the task file, then in the package.
+Every mistake is one :class:`InputError` naming the key.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from softhand.reduced.design import PAPER_DESIGN_FILE, PUBLIC_KEYS, HandDesign, design_from_dict, load_design, read_toml
+from softhand.reduced.errors import InputError
+
+#: design keys the optimiser may vary; "l0_mm" scales the hinge positions with the tube
+FREE_KEYS = ("a_mm", "b_mm", "d_mm", "l0_mm", "R_mm", "t_mm", "V0_mm3", "tie_width_mm")
+OBJECTIVES = ("pressure", "margin")
+_SECTIONS = {
+    "object": {"diameter_mm", "mass_kg"},
+    "grasp": {"force_factor", "margin_N", "objective", "opening_mm"},
+    "pump": {"max_pressure_MPa"},
+    "limits": {"max_principal_stretch", "min_wall_mm"},
+    "material": {"mu_sf_MPa", "mu_sr_MPa"},
+    "fem": {"mesh_size_mm", "edge_ratio", "dP_MPa"},
+}
+_TOP = {"base_design", "object", "grasp", "pump", "limits", "material", "design", "free", "fem"}
+
+
+@dataclass(frozen=True)
+class Task:
+    """What the hand must do and what may change (mm, kg, N, MPa)."""
+
+    base: HandDesign                       #: the design the free keys vary (with material, design overrides)
+    diameter: float                        #: object diameter [mm]
+    mass: float                            #: object mass [kg]
+    free: tuple[tuple[str, float, float], ...]  #: (public key, lower, upper)
+    max_pressure: float                    #: pump pressure limit [MPa]
+    force_factor: float = 2.0              #: F_v >= force_factor m g / n
+    margin: float | None = None            #: ... or F_v >= m g / n + margin [N]
+    objective: str = "pressure"            #: one of OBJECTIVES
+    opening: float | None = None           #: open tip span to pass [mm]; None: the diameter
+    max_stretch: float = 1.5               #: peak principal stretch of the tube
+    min_wall: float = 1.0                  #: least tube wall and sheet thickness [mm]
+    mesh_size: float = 6.0                 #: FEM proof: finger element size [mm]
+    edge_ratio: float = 0.5                #: FEM proof: element size at the ring edges / mesh_size
+    dP: float = 0.05                       #: FEM proof: pressure step of the secant [MPa]
+    name: str = "task"
+    source: dict = field(default_factory=dict, compare=False, repr=False)  #: the file's tables
+
+    def required_F_v(self) -> float:
+        """The normal force each finger must press with [N]."""
+        share = self.mass * self.base.g / self.base.n
+        return share + self.margin if self.margin is not None else self.force_factor * share
+
+    @property
+    def opening_mm(self) -> float:
+        return self.diameter if self.opening is None else self.opening
+
+
+def load_task(path: str | Path) -> Task:
+    """Read and validate a task TOML file."""
+    path = Path(path)
+    data = read_toml(path, "--task", "a task TOML file")
+    return task_from_dict(data, folder=path.parent, name=path.stem)
+
+
+def task_from_dict(data: dict, *, folder: Path = Path("."), name: str = "task") -> Task:
+    """A :class:`Task` from the task file's tables (see the module docstring)."""
+    for key in data:
+        if key not in _TOP:
+            raise InputError(key, data[key], f"unknown task key; allowed: {', '.join(sorted(_TOP))}")
+    tables = {s: _table(data, s) for s in (*_SECTIONS, "design", "free")}
+    for section, allowed in _SECTIONS.items():
+        for key in tables[section]:
+            if key not in allowed:
+                raise InputError(f"{section}.{key}", tables[section][key],
+                                 f"unknown key; allowed: {', '.join(sorted(allowed))}")
+    base = _base_design(data.get("base_design"), folder)
+    base = design_from_dict({**tables["design"], **tables["material"]}, base, source="design")
+    obj, grasp, pump, limits, fem = (tables[s] for s in ("object", "grasp", "pump", "limits", "fem"))
+    if "force_factor" in grasp and "margin_N" in grasp:
+        raise InputError("grasp.margin_N", grasp["margin_N"], "give force_factor or margin_N, not both")
+    objective = grasp.get("objective", "pressure")
+    if objective not in OBJECTIVES:
+        raise InputError("grasp.objective", objective, f"must be one of {', '.join(OBJECTIVES)}")
+    return Task(
+        base=base, name=name, source=data,
+        diameter=_number(obj, "object", "diameter_mm", required=True),
+        mass=_number(obj, "object", "mass_kg", required=True, positive=False),
+        free=_free(tables["free"], base),
+        max_pressure=_number(pump, "pump", "max_pressure_MPa", required=True),
+        force_factor=_number(grasp, "grasp", "force_factor", default=2.0),
+        margin=_number(grasp, "grasp", "margin_N", default=None, positive=False),
+        objective=objective,
+        opening=_number(grasp, "grasp", "opening_mm", default=None),
+        max_stretch=_number(limits, "limits", "max_principal_stretch", default=1.5, above=1.0),
+        min_wall=_number(limits, "limits", "min_wall_mm", default=1.0),
+        mesh_size=_number(fem, "fem", "mesh_size_mm", default=6.0),
+        edge_ratio=_number(fem, "fem", "edge_ratio", default=0.5),
+        dP=_number(fem, "fem", "dP_MPa", default=0.05))
+
+
+def _table(data: dict, section: str) -> dict:
+    value = data.get(section, {})
+    if not isinstance(value, dict):
+        raise InputError(section, value, "must be a table ([" + section + "])")
+    return value
+
+
+def _base_design(value, folder: Path) -> HandDesign:
+    if value is None:
+        return load_design(None)
+    if not isinstance(value, str):
+        raise InputError("base_design", value, "must be a file name (string)")
+    for candidate in (Path(value), folder / value, PAPER_DESIGN_FILE.parents[2] / value):
+        if candidate.is_file():
+            return load_design(candidate)
+    raise InputError("base_design", value, "no such design file (looked as given, next to the "
+                                           "task file and in the package)")
+
+
+def _number(table: dict, section: str, key: str, *, required: bool = False, default=None,
+            positive: bool = True, above: float | None = None):
+    if key not in table:
+        if required:
+            raise InputError(f"{section}.{key}", None, "is required")
+        return default
+    value = table[key]
+    ok = isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
+    limit = above if above is not None else 0.0
+    if not ok or (value <= limit if positive or above is not None else value < 0):
+        what = f"must be a number > {limit:g}" if positive or above is not None else "must be a number >= 0"
+        raise InputError(f"{section}.{key}", value, what)
+    return float(value)
+
+
+def _free(table: dict, base: HandDesign) -> tuple[tuple[str, float, float], ...]:
+    if not table:
+        raise InputError("free", table, f"must name at least one design key with [lower, upper] "
+                                        f"bounds; allowed: {', '.join(FREE_KEYS)}")
+    out = []
+    for key, bounds in table.items():
+        if key not in FREE_KEYS or key not in PUBLIC_KEYS:
+            allowed = [k for k in FREE_KEYS if k in PUBLIC_KEYS]
+            raise InputError(f"free.{key}", bounds, f"not a free design key; allowed: {', '.join(allowed)}")
+        if not (isinstance(bounds, list) and len(bounds) == 2
+                and all(isinstance(b, (int, float)) and not isinstance(b, bool) and math.isfinite(b)
+                        for b in bounds) and 0 < bounds[0] < bounds[1]):
+            raise InputError(f"free.{key}", bounds, "must be [lower, upper] with 0 < lower < upper")
+        out.append((key, float(bounds[0]), float(bounds[1])))
+    return tuple(out)

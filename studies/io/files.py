@@ -1,0 +1,73 @@
+"""Writing results: atomic (temp file + rename), so nothing half-written is left behind."""
+from __future__ import annotations
+
+import csv
+import io
+import json
+import sys
+from contextlib import contextmanager
+from pathlib import Path
+
+import numpy as np
+
+from softhand.meshes.atomic import atomic_path
+
+
+def write_atomic(path: str | Path, data: bytes | str) -> Path:
+    """Write ``data`` to ``path`` through a temporary file in the same folder and a rename."""
+    payload = data.encode() if isinstance(data, str) else data
+    with atomic_path(path) as tmp:
+        tmp.write_bytes(payload)
+    return Path(path)
+
+
+def write_json(path: str | Path, obj) -> Path:
+    return write_atomic(path, json.dumps(obj, indent=1, default=jsonable) + "\n")
+
+
+def write_csv(path: str | Path, rows: list[dict], columns: list[str] | None = None) -> Path:
+    columns = columns or (list(rows[0]) if rows else [])
+    buf = io.StringIO()
+    writer = csv.DictWriter(buf, fieldnames=columns, extrasaction="ignore", lineterminator="\n")
+    writer.writeheader()
+    for row in rows:
+        writer.writerow({k: _csv_cell(row.get(k)) for k in columns})
+    return write_atomic(path, buf.getvalue())
+
+
+def save_figure(fig, path: str | Path, *, dpi: int = 150) -> Path:
+    """Save a matplotlib figure atomically (format from the suffix) and close it."""
+    import matplotlib.pyplot as plt
+
+    path = Path(path)
+    buf = io.BytesIO()
+    fig.savefig(buf, format=path.suffix.lstrip(".") or "png", dpi=dpi, bbox_inches="tight")
+    plt.close(fig)
+    return write_atomic(path, buf.getvalue())
+
+
+def _csv_cell(value):
+    if isinstance(value, (list, tuple, np.ndarray)):
+        return ";".join(str(v) for v in np.ravel(value))
+    return value
+
+
+def jsonable(value):
+    if isinstance(value, np.ndarray):
+        return value.tolist()
+    if isinstance(value, np.generic):
+        return value.item()
+    if isinstance(value, Path):
+        return str(value)
+    raise TypeError(f"not JSON serialisable: {type(value).__name__}")
+
+
+@contextmanager
+def kept_if_unwritable(what, verb: str):
+    """Write ``what`` inside this block; if the disk refuses (full, gone, read-only) after the
+    computation, a warning instead of losing the results, which the verb still prints."""
+    try:
+        yield
+    except OSError as exc:
+        print(f"softhand {verb}: warning: {what} not written ({exc.strerror or exc}); "
+              f"the results are printed on stdout", file=sys.stderr)

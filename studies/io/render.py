@@ -1,0 +1,307 @@
+"""Render a VTK result (a ``.vtm`` scene, a ``.vtu``, or one step of a ``.pvd``) with pyvista.
+
+This is the one module of the project that imports pyvista (and imageio, for animations).
+Rendering is off-screen by default (no display needed). The picture shows the *body* (the
+finger's ``tube``, the reservoir's ``sheet``, or a plain file's mesh) deformed by its
+``displacement_mm`` (true scale) and coloured by a field, with a colour bar labelled with
+the field's unit; its undeformed shape as a faint ghost; the links and hinges of a finger;
+the object of a grasp; the contact forces as arrows ending at the pads, labelled in N.
+The title gives the file, the step and the pressure (and bend angle or volume).
+
+A field is named as in the file (``von_mises_MPa``, ``J``, ...; :func:`describe` lists
+them); a vector or tensor field is shown by its magnitude, or by one component with
+``NAME[i]`` (e.g. ``principal_stretches[0]``, the largest stretch). Point data are
+preferred to cell data of the same name.
+"""
+from __future__ import annotations
+
+import contextlib
+import importlib.util
+import logging
+import re
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import pyvista as pv
+
+from softhand.meshes.atomic import atomic_path
+from softhand.reduced.errors import InputError
+from softhand.studies.io.render_style import (VIEWS, body_name, camera, clim_of, colour_label, default_field,
+                                   default_png, has_display, step_index, title_of)
+
+SUFFIXES = (".vtu", ".vtm", ".pvd", ".vtk")
+ANIMATIONS = (".gif", ".mp4")
+
+
+@dataclass(frozen=True)
+class FieldSummary:
+    file: str      #: the file rendered
+    step: int      #: index of the step in a .pvd (0 otherwise)
+    n_steps: int   #: steps in the file (1 for a .vtu/.vtm)
+    field: str     #: field shown (with [i] for a component)
+    location: str  #: "point" or "cell"
+    minimum: float
+    maximum: float
+    peak_at: tuple[float, float, float]  #: reference position of the maximum [mm]
+    png: str | None  #: picture (or animation) written, or None (interactive only)
+
+
+def load_scene(path: str | Path, step: int | None = None) -> tuple[pv.MultiBlock, int, int]:
+    """(named blocks, step index, number of steps) of a VTK file; a single dataset is one
+    block named after the file."""
+    path = Path(path)
+    if path.suffix not in SUFFIXES or not path.is_file():
+        raise InputError("file", str(path), f"must be an existing {'/'.join(SUFFIXES)} file")
+    _sniff(path)
+    with pv.vtk_verbosity("off"), _quiet_logging():
+        try:
+            reader = pv.get_reader(str(path))
+            n = len(reader.time_values) if path.suffix == ".pvd" else 1
+            index = step_index(step, n)
+            if path.suffix == ".pvd":
+                reader.set_active_time_point(index)
+            data = reader.read()
+        except InputError:
+            raise
+        except Exception as exc:  # VTK reports bad files through many exception types
+            raise InputError("file", str(path), f"must be a readable VTK file: {_first_line(exc)}") from None
+    scene = _flatten(data, path.stem)
+    if not any(b.n_points for b in scene):
+        raise InputError("file", str(path), "must be a VTK file with a mesh (found no points)")
+    return scene, index, n
+
+
+def _flatten(data, name: str) -> pv.MultiBlock:
+    """Nested multiblocks (a .pvd step of a .vtm) -> one level of named non-empty datasets."""
+    out = pv.MultiBlock()
+    if not isinstance(data, pv.MultiBlock):
+        out[name] = data
+        return out
+    for key, block in zip(data.keys(), data):
+        if isinstance(block, pv.MultiBlock):
+            inner = _flatten(block, key)
+            for k, b in zip(inner.keys(), inner):
+                out[k] = b
+        elif block is not None and block.n_points:  # a .vtu in a .pvd: named after the file
+            out[name if re.fullmatch(r"Block-\d+", key or "Block-0") else key] = block
+    return out
+
+
+def field_values(mesh: pv.DataSet, name: str) -> tuple[np.ndarray, str]:
+    """(scalar values, "point"|"cell") of field ``name`` or ``name[i]`` on ``mesh``."""
+    match = re.fullmatch(r"(.+?)(?:\[(\d+)\])?", name)
+    base, component = match.group(1), match.group(2)
+    for location, data in (("point", mesh.point_data), ("cell", mesh.cell_data)):
+        if base in data:
+            values = np.asarray(data[base], dtype=float)
+            break
+    else:
+        raise InputError("field", name, f"allowed: {', '.join(field_names(mesh))}")
+    if values.ndim == 1:
+        if component not in (None, "0"):
+            raise InputError("field", name, f"{base} is a scalar; use it without [i]")
+        return values, location
+    if component is None:
+        return np.linalg.norm(values, axis=1), location
+    if int(component) >= values.shape[1]:
+        raise InputError("field", name, f"{base} has components [0]..[{values.shape[1] - 1}]")
+    return values[:, int(component)], location
+
+
+def field_names(mesh: pv.DataSet) -> list[str]:
+    """The names of the point and cell arrays, each once."""
+    return list(dict.fromkeys([*mesh.point_data.keys(), *mesh.cell_data.keys()]))
+
+
+def describe(path: str | Path, step: int | None = None) -> list[dict]:
+    """Every array of every block: block, name, location (point/cell/field), components."""
+    scene, _, _ = load_scene(path, step)
+    rows = []
+    for name, block in zip(scene.keys(), scene):
+        for location in ("point", "cell", "field"):
+            for key, value in getattr(block, f"{location}_data").items():
+                value = np.asarray(value)
+                rows.append({"block": name, "field": key, "location": location,
+                             "components": 1 if value.ndim == 1 else int(value.shape[1])})
+    return rows
+
+
+def inspect(path: str | Path, *, field: str | None = None, step: int | None = None,
+            out: str | Path | None = None, view: str | None = None, hand: bool = True,
+            interactive: bool = False) -> FieldSummary:
+    """Render ``path`` coloured by ``field``; write ``out`` (PNG) unless only interactive."""
+    _check_view(view)
+    scene, index, n_steps = load_scene(path, step)
+    body = scene[body_name(scene.keys())]
+    field = field or default_field(field_names(body))
+    values, location = _checked_values(body, field)
+    centres = body.points if location == "point" else body.cell_centers().points
+    peak = np.asarray(centres[int(np.nanargmax(values))], dtype=float)
+    if interactive and not has_display():
+        raise InputError("--interactive", True, "needs a display (DISPLAY is not set); "
+                                                "omit it to render off-screen")
+    png = None if interactive and out is None else Path(out or default_png(path, index, field))
+    plotter = _plotter(interactive=interactive)
+    _draw(plotter, scene, field, title=title_of(path, scene, index, n_steps), view=view, hand=hand)
+    if png is not None:
+        with atomic_path(png) as tmp:
+            plotter.screenshot(str(tmp))
+    if interactive:
+        plotter.show()
+    plotter.close()
+    return FieldSummary(str(path), index, n_steps, field, location, float(np.nanmin(values)),
+                        float(np.nanmax(values)), tuple(peak.tolist()), None if png is None else str(png))
+
+
+def animate(path: str | Path, out: str | Path, *, field: str | None = None,
+            view: str | None = None, hand: bool = True, fps: float = 4.0) -> FieldSummary:
+    """Render every step of a ``.pvd`` with one camera and colour range into a GIF or MP4."""
+    import imageio.v2 as imageio
+
+    _check_view(view)
+    out = Path(out)
+    if out.suffix not in ANIMATIONS:
+        raise InputError("--animate", str(out), f"must end in {' or '.join(ANIMATIONS)}")
+    if Path(path).suffix != ".pvd":
+        raise InputError("file", str(path), "must be a .pvd series to animate")
+    if out.suffix == ".mp4" and importlib.util.find_spec("imageio_ffmpeg") is None:
+        raise InputError("--animate", str(out), "MP4 needs imageio-ffmpeg (pip install imageio-ffmpeg); "
+                                                "or write a .gif")
+    scenes = [load_scene(path, k) for k in range(load_scene(path)[2])]
+    bodies = [s[body_name(s.keys())] for s, _, _ in scenes]
+    field = field or default_field(field_names(bodies[-1]))
+    ranges = np.array([[np.nanmin(v), np.nanmax(v)] for v in (_checked_values(b, field)[0] for b in bodies)])
+    clim = (float(ranges[:, 0].min()), float(ranges[:, 1].max()))
+    plotter = _plotter(window_size=(800, 600))
+    frames = []
+    for scene, index, n in scenes[::-1]:  # the last (largest) state first: it sets the camera
+        plotter.clear()
+        _draw(plotter, scene, field, title=title_of(path, scene, index, n), view=view, clim=clim,
+              keep_camera=bool(frames), hand=hand)
+        frames.append(plotter.screenshot(return_img=True))
+    plotter.close()
+    frames = frames[::-1]
+    with atomic_path(out) as tmp:
+        if out.suffix == ".gif":
+            imageio.mimsave(tmp, frames, format="GIF", duration=1000.0 / fps, loop=0)
+        else:
+            imageio.mimsave(tmp, frames, fps=fps)
+    return FieldSummary(str(path), len(scenes) - 1, len(scenes), field, "point", clim[0], clim[1],
+                        (np.nan,) * 3, str(out))
+
+
+def _check_view(view) -> None:
+    if view is not None and view not in VIEWS:
+        raise InputError("--view", view, f"allowed: {', '.join(VIEWS)}")
+
+
+def _checked_values(body, field):
+    if field is None:
+        raise InputError("field", None, f"no default field; allowed: {', '.join(field_names(body))}")
+    values, location = field_values(body, field)
+    if not np.any(np.isfinite(values)):
+        raise InputError("field", field, "has no finite values in this file")
+    return values, location
+
+
+def _plotter(*, interactive=False, window_size=(1200, 900)) -> pv.Plotter:
+    with pv.vtk_verbosity("off"):
+        plotter = pv.Plotter(off_screen=not interactive, window_size=window_size)
+    plotter.set_background("white")
+    return plotter
+
+
+def _draw(plotter, scene, field, *, title, view, clim=None, keep_camera=False, hand=True) -> None:
+    """Add the scene's actors: ghost, coloured body, links, hinges, object, force arrows;
+    with ``hand`` the hand's other fingers (copies turned about the hand's axis y)."""
+    names = scene.keys()
+    body_key = body_name(names)
+    body = scene[body_key]
+    values, location = field_values(body, field)
+    shown = _deformed(body)
+    shown.clear_data()
+    getattr(shown, f"{location}_data")["field"] = values
+    plotter.add_mesh(_surface(body), color="grey", opacity=0.12)
+    parts = [(_surface(shown), {"scalars": "field", "cmap": "viridis", "clim": clim or clim_of(values)})]
+    for name, block in zip(names, scene):
+        if name.startswith("link_"):
+            parts.append((block.extract_surface(algorithm="dataset_surface"), {"color": "#b0b4bb"}))
+        elif name.startswith("hinge_"):
+            parts.append((block.extract_surface(algorithm="dataset_surface"), {"color": "#4a4f57"}))
+        elif name == "object":
+            plotter.add_mesh(block, color="#e0a060", opacity=0.3, smooth_shading=True)
+        elif name == "contact_forces":
+            _draw_forces(plotter, block)
+    n = int(np.asarray(body.field_data["n_fingers"]).ravel()[0]) if "n_fingers" in body.field_data and hand else 1
+    actors = [plotter.add_mesh(mesh.rotate_y(360.0 * k / n, point=(0.0, 0.0, 0.0), inplace=False)
+                               if k else mesh, show_scalar_bar=False, **style)
+              for k in range(n) for mesh, style in parts]
+    plotter.add_scalar_bar(colour_label(field), mapper=actors[0].mapper, vertical=True, position_x=0.8, position_y=0.12,
+                           width=0.05, height=0.7, color="black", fmt="%.3g", title_font_size=14,
+                           label_font_size=13)
+    plotter.add_text(title, font_size=10, color="black")
+    if not keep_camera:
+        camera(plotter, view, sheet=body_key != "tube", zoom=1.0 if body_key == "tube" and n == 1 else 1.3)
+
+
+def _draw_forces(plotter, forces) -> None:
+    """Arrows of the force of the object on each touching pad, tip at the pad, length
+    proportional to the force (the largest 40 mm), labelled in N."""
+    f = np.asarray(forces.point_data["force_N"], dtype=float)
+    size = np.linalg.norm(f, axis=1)
+    touching = size > 1e-6 * max(size.max(), 1e-300)
+    if not touching.any():
+        return
+    scale = 40.0 / size.max()
+    tails = forces.points[touching] - scale * f[touching]
+    arrows = pv.PolyData(tails)
+    arrows["vectors"] = scale * f[touching]
+    glyphs = arrows.glyph(orient="vectors", scale="vectors", factor=1.0,
+                          geom=pv.Arrow(tip_length=0.25, tip_radius=0.12, shaft_radius=0.04))
+    plotter.add_mesh(glyphs, color="#d62728", name="forces")
+    plotter.add_point_labels(tails, [f"{s:.3g} N" for s in size[touching]], font_size=14,
+                             text_color="#d62728", shape=None, show_points=False,
+                             always_visible=True, name="force_labels")
+
+
+def _deformed(mesh):
+    shown = mesh.copy()
+    for name in ("displacement_mm", "displacement"):
+        if name in mesh.point_data:
+            shown.points = mesh.points + np.asarray(mesh.point_data[name], dtype=float)
+            break
+    return shown
+
+
+def _surface(mesh):
+    """The outer surface (quadratic cells tessellated), for fast, smooth drawing."""
+    return mesh.extract_surface(nonlinear_subdivision=2, algorithm="dataset_surface") if isinstance(mesh, pv.UnstructuredGrid) else mesh
+
+
+def _sniff(path: Path) -> None:
+    """A VTK file starts with its XML header or the legacy '# vtk DataFile' line."""
+    with path.open("rb") as f:
+        head = f.read(256).lstrip()
+    if not (head.startswith(b"<?xml") or head.startswith(b"<VTKFile")
+            or head.startswith(b"# vtk DataFile")):
+        raise InputError("file", str(path), "must be a VTK file (XML .vtu/.vtm/.pvd or legacy .vtk)")
+
+
+@contextlib.contextmanager
+def _quiet_logging():
+    """pyvista forwards VTK errors to the logging module; the CLI reports one line instead."""
+    logging.disable(logging.CRITICAL)
+    try:
+        yield
+    finally:
+        logging.disable(logging.NOTSET)
+
+
+def _first_line(exc: Exception) -> str:
+    return next((line.strip() for line in str(exc).splitlines() if line.strip()),
+                type(exc).__name__)
+
+
+__all__ = ["FieldSummary", "VIEWS", "animate", "describe", "field_names", "field_values",
+           "inspect", "load_scene"]

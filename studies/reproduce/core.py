@@ -1,0 +1,216 @@
+"""``softhand reproduce``: every result of the paper, end to end, into one report.
+
+The report is a list of :class:`Section` s. Each calls the owning module's library
+function (never the CLI), writes its PNG/CSV/VTK files and a ``section.md`` into its
+own folder ``<out>/<section>/``, and returns its headline numbers. A section is
+
+* **not available** when a module or function it needs is not in this build;
+* **failed** when it raises: the error is reported and the other sections go on;
+* **reused** when ``<out>/<section>/result.json`` holds the same inputs (section,
+  size, design hash, code version): a killed or repeated run resumes where it
+  stopped. ``fresh=True`` recomputes everything.
+
+A section's folder is written through the batch runner (:func:`studies.runner.execute_case`
+in a private temporary folder, then :func:`studies.runner.commit`: one rename), so an
+interrupted run leaves nothing half-written. ``<out>/report.md`` and
+``<out>/summary.csv`` are assembled from the section folders at the end.
+"""
+from __future__ import annotations
+
+import hashlib
+import importlib
+import json
+import re
+import sys
+from dataclasses import dataclass
+from datetime import datetime, timezone
+from pathlib import Path
+from typing import Callable
+
+from softhand.reduced.design import HandDesign
+from softhand.studies.io.files import write_atomic, write_csv
+from softhand.studies.batch.runner import FAILED, RESULT, code_version, commit, execute_case, outcome_record
+
+SECTION_MD = "section.md"
+_ACTIVE: dict = {}  #: the sections of the current reproduce() call, by key
+
+
+@dataclass(frozen=True)
+class Context:
+    """What every section receives."""
+
+    design: HandDesign  #: the hand (default: the paper's Table I)
+    quick: bool = False  #: CI-sized meshes and fewer points
+
+
+@dataclass(frozen=True)
+class Section:
+    """One result of the paper: ``build(ctx, outdir) -> (markdown, numbers)``."""
+
+    key: str  #: folder name under the output directory
+    title: str
+    needs: tuple[str, ...]  #: "module" or "module:attribute" that must exist
+    build: Callable  #: writes files into outdir; returns (markdown body, {name: number})
+    in_quick: bool = True  #: False: skipped by --quick (reported as such)
+
+
+@dataclass
+class Outcome:
+    section: Section
+    status: str  #: 'done', 'reused', 'failed', 'not available', 'not selected', 'skipped'
+    detail: str = ""  #: error or missing module
+    wall_time_s: float = 0.0
+    numbers: dict | None = None
+
+
+def sections() -> list[Section]:
+    """Every section of the report, in order (imported here to keep start-up light)."""
+    from softhand.studies.reproduce import fem_sections as reproduce_fem
+    from softhand.studies.reproduce import sections as reproduce_sections
+
+    return reproduce_sections.REDUCED_SECTIONS + reproduce_fem.SECTIONS
+
+
+def missing(section: Section) -> str:
+    """'' if everything ``section`` needs exists, else what is missing."""
+    for need in section.needs:
+        module_name, _, attr = need.partition(":")
+        try:
+            module = importlib.import_module(module_name)
+        except ModuleNotFoundError as exc:
+            return f"module {exc.name} is not in this build"
+        if attr and not hasattr(module, attr):
+            return f"{module_name}.{attr} is not in this build"
+    return ""
+
+
+def section_key(section: Section, ctx: Context) -> str:
+    text = json.dumps({"section": section.key, "quick": ctx.quick, "design": ctx.design.hash(),
+                       "code": code_version()}, sort_keys=True)
+    return hashlib.sha256(text.encode()).hexdigest()[:16]
+
+
+def run_section(params: dict, design: HandDesign, outdir: Path) -> dict:
+    """A batch-runner kind: build one section into ``outdir``; return its numbers."""
+    section = _ACTIVE.get(params["section"]) or next(
+        s for s in sections() if s.key == params["section"])
+    markdown, numbers = section.build(Context(design=design, quick=params["quick"]), outdir)
+    (outdir / SECTION_MD).write_text(markdown.strip() + "\n")
+    return numbers
+
+
+def reproduce(out: str | Path = "results/reproduce", *, quick: bool = False,
+              design: HandDesign | None = None, only: tuple[str, ...] | None = None,
+              fresh: bool = False, progress: bool = True,
+              section_list: list[Section] | None = None) -> list[Outcome]:
+    """Build every section (or those in ``only``) and write ``<out>/report.md``."""
+    out = Path(out)
+    ctx = Context(design=design or HandDesign(), quick=quick)
+    todo = section_list if section_list is not None else sections()
+    _ACTIVE.clear()
+    _ACTIVE.update((s.key, s) for s in todo)
+    outcomes = []
+    from tqdm import tqdm
+
+    bar = tqdm(todo, desc="reproduce", unit="section", file=sys.stderr, disable=not progress)
+    try:
+        for section in bar:
+            bar.set_postfix_str(section.key)
+            outcomes.append(_one(section, ctx, out, only, fresh))
+    finally:
+        bar.close()
+        write_report(out, ctx, outcomes + [Outcome(s, "not run", "interrupted")
+                                           for s in todo[len(outcomes):]])
+    return outcomes
+
+
+def _one(section: Section, ctx: Context, out: Path, only, fresh: bool) -> Outcome:
+    if only is not None and section.key not in only:
+        return Outcome(section, "not selected")
+    if ctx.quick and not section.in_quick:
+        return Outcome(section, "skipped", "not part of --quick")
+    try:
+        lack = missing(section)
+    except Exception as exc:  # the module exists but does not import: a failure, not absence
+        return Outcome(section, "failed", f"{type(exc).__name__}: {exc}")
+    if lack:
+        return Outcome(section, "not available", lack)
+    folder, key = out / section.key, section_key(section, ctx)
+    previous = _read(folder / RESULT)
+    if not fresh and previous and previous.get("case") == key:
+        return Outcome(section, "reused", previous["provenance"]["finished_utc"],
+                       previous["provenance"]["wall_time_s"], previous["numbers"])
+    params = {"section": section.key, "quick": ctx.quick}
+    output = execute_case(run_section, params, ctx.design)
+    commit(folder, {"section": section.key, "case": key,
+                    **outcome_record(params, ctx.design, output)}, output.get("files", {}))
+    if output["status"] != "done":
+        return Outcome(section, "failed", output["error"], output["wall_time_s"])
+    return Outcome(section, "done", "", output["wall_time_s"], output["numbers"])
+
+
+def _read(path: Path) -> dict | None:
+    try:
+        return json.loads(path.read_text())
+    except (OSError, ValueError):
+        return None
+
+
+# ---------------------------------------------------------------------- the report
+def write_report(out: Path, ctx: Context, outcomes: list[Outcome]) -> Path:
+    """``report.md`` (sections in order, with their figures) and ``summary.csv``."""
+    code = code_version()
+    lines = ["# softhand reproduce: the paper's results, recomputed", "",
+             f"- generated {datetime.now(timezone.utc).isoformat(timespec='seconds')}, "
+             f"softhand {code['softhand']} (sources {code['source_sha256']})",
+             f"- mode: {'quick (CI-sized meshes)' if ctx.quick else 'full'}; "
+             f"design hash `{ctx.design.hash()}`",
+             "- every number below was computed by this code for these inputs; a section "
+             "marked *reused* was computed by an earlier run of the identical code and inputs",
+             "", "| section | status | wall time [s] | note |", "|---|---|---|---|"]
+    lines += [f"| [{o.section.title}](#{_anchor(o.section.title)}) | {o.status} | "
+              f"{o.wall_time_s:.1f} | {_one_line(o.detail)} |" for o in outcomes]
+    for o in outcomes:
+        lines += ["", f"## {o.section.title}", ""] + _body(out, o)
+    write_csv(out / "summary.csv", _summary_rows(outcomes), ["section", "status", "name", "value"])
+    return write_atomic(out / "report.md", "\n".join(lines) + "\n")
+
+
+def _body(out: Path, o: Outcome) -> list[str]:
+    if o.status in ("done", "reused"):
+        text = (out / o.section.key / SECTION_MD).read_text()
+        note = [f"*reused: computed {o.detail}*", ""] if o.status == "reused" else []
+        return note + [_relink(text, o.section.key)]
+    if o.status == "failed":
+        return [f"**failed**: `{_one_line(o.detail)}` (traceback in "
+                f"`{o.section.key}/{FAILED}`)"]
+    return [f"*{o.status}*" + (f": {o.detail}" if o.detail else "")]
+
+
+def _relink(markdown: str, folder: str) -> str:
+    """Make a section's relative links (images, files) relative to the report."""
+    return re.sub(r"\]\((?![a-z]+:|#|/)([^)]+)\)", rf"]({folder}/\1)", markdown)
+
+
+def _anchor(title: str) -> str:
+    return re.sub(r"[^a-z0-9 -]", "", title.lower()).replace(" ", "-")
+
+
+def _one_line(text: str) -> str:
+    return " ".join(str(text).split())[:200].replace("|", "/")
+
+
+def _summary_rows(outcomes: list[Outcome]) -> list[dict]:
+    rows = []
+    for o in outcomes:
+        for name, value in (o.numbers or {}).items():
+            rows.append({"section": o.section.key, "status": o.status, "name": name,
+                         "value": value})
+        if not o.numbers:
+            rows.append({"section": o.section.key, "status": o.status, "name": "", "value": ""})
+    return rows
+
+
+def exit_code(outcomes: list[Outcome]) -> int:
+    return 1 if any(o.status == "failed" for o in outcomes) else 0
+
