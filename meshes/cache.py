@@ -16,7 +16,6 @@ import json
 import os
 import sys
 import tempfile
-from functools import lru_cache
 from pathlib import Path
 
 import skfem
@@ -46,14 +45,10 @@ def mesh_key(geometry: Geometry, params, *, size: float, order: int, refine: int
     return hashlib.sha256(blob.encode()).hexdigest()[:20]
 
 
-@lru_cache(maxsize=1)
 def _softhand_version() -> str:
-    from importlib.metadata import PackageNotFoundError, version
+    from softhand.reduced.versions import package_version
 
-    try:
-        return version("softhand")
-    except PackageNotFoundError:
-        return "unknown"
+    return package_version()
 
 
 def _sha256(path: Path) -> str:

@@ -37,14 +37,9 @@ from . import hand
 from .design import HandDesign
 from .errors import InputError
 from .grasp import grasp_forces
+from .paper import TABLE_II as PAPER_TABLE_II
 from .plant import HandTables, PlantParams, Push, equilibrium
 
-#: the paper's Table II: state -> (P [MPa], theta [deg], F_v [kgf])
-PAPER_TABLE_II = {
-    "a_no_push": (0.89, 50.0, 0.61),
-    "b_push_pressure_control": (0.89, 45.0, 0.82),
-    "c_push_angle_control": (0.79, 45.0, 0.53),
-}
 
 
 @dataclass(frozen=True)

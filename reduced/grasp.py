@@ -19,7 +19,7 @@ the finger just stops pressing on the object):
 * :func:`angle_at`: the bend angle reached at pump pressure P under the same load -- the
   inverse of :func:`pressure_to_hold` in theta.
 
-The paper's two weight vectors ship as :data:`PAPER_WEIGHTS`; the 180 mm one sums to 1.40,
+The paper's two weight vectors ship as :data:`PAPER_WEIGHTS` (from :mod:`reduced.paper`); the 180 mm one sums to 1.40,
 violating (23): :func:`check_weights` warns and can normalise.
 """
 from __future__ import annotations
@@ -33,14 +33,10 @@ import numpy as np
 from . import finger, hand
 from .design import HandDesign
 from .errors import InputError
+from .paper import WEIGHTS as PAPER_WEIGHTS
 
 #: newtons per kilogram-force (standard gravity, by definition of the kgf)
 KGF = 9.80665
-#: the paper's weight vectors w (section III-C), by object diameter [mm], exactly as printed
-PAPER_WEIGHTS = {
-    180.0: (-0.13, 0.0, 0.67, 0.33, 0.53),
-    240.0: (-0.2, 0.0, 0.1, 0.3, 0.8),
-}
 #: |sum(w) - 1| above which check_weights warns (the paper prints w to two decimals)
 SUM_TOLERANCE = 5e-3
 

@@ -55,12 +55,9 @@ class WeightsCase:
 
 
 def _package_version() -> str:
-    from importlib.metadata import PackageNotFoundError, version
+    from softhand.reduced.versions import package_version
 
-    try:
-        return version("softhand")
-    except PackageNotFoundError:
-        return "unknown"
+    return package_version()
 
 
 def cache_dir():

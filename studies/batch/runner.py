@@ -104,12 +104,9 @@ def package_versions() -> dict:
 
 
 def _version(name: str) -> str:
-    from importlib.metadata import PackageNotFoundError, version
+    from softhand.reduced.versions import package_version
 
-    try:
-        return version(name)
-    except PackageNotFoundError:
-        return "not installed"
+    return package_version(name, "not installed")
 
 
 def case_key(kind: str, params: dict, design: HandDesign) -> str:

@@ -20,6 +20,7 @@ import signal
 import sys
 
 from softhand.reduced.errors import InputError, short
+from softhand.reduced.versions import package_version
 
 #: verb -> module under studies.commands; the order is the order of ``--help``.
 VERBS = (
@@ -34,15 +35,6 @@ class ArgumentParser(argparse.ArgumentParser):
 
     def error(self, message):
         self.exit(2, f"{self.prog}: error: {short(message, 400)}\n")
-
-
-def _version() -> str:
-    from importlib.metadata import PackageNotFoundError, version
-
-    try:
-        return version("softhand")
-    except PackageNotFoundError:
-        return "unknown"
 
 
 def _verb_module(verb: str):
@@ -67,7 +59,7 @@ def _top_parser() -> ArgumentParser:
         epilog=f"verbs:\n{lines}\n\n'softhand VERB --help' shows a verb's options.",
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
-    parser.add_argument("--version", action="version", version=f"softhand {_version()}")
+    parser.add_argument("--version", action="version", version=f"softhand {package_version()}")
     parser.add_argument("verb", help="what to do (see below)")
     return parser
 
