@@ -8,14 +8,21 @@ one row per pressure with the reduced model's values next to the FEM's:
   checks the volume-angle relation on its own (the angle error is in the theta column).
 
 Optionally the path continues to ``peak_mpa`` (2.0 MPa: the pressure the paper's FEM
-says the finger withstands) and reports the peak stretch and stress there. No files and
-no printing here: the CLI (``softhand bend``) writes them.
+says the finger withstands) and reports the peak stretch and stress there; with ``hand``
+the whole hand follows, P = p_finger - p_r(V0 - n dQ) with the reservoir-sheet FEM
+(:func:`studies.compare.whole_hand`).
+
+The result is computed, plotted and written here once: :meth:`BendingResult.write` (result.json,
+table.csv, hand.csv), :meth:`BendingResult.plot` (Fig. 7 with FEM points) and
+:func:`vtk_writer` (the VTK series, state by state as the path converges). ``softhand bend``
+and ``softhand reproduce`` only choose the inputs and print.
 """
 from __future__ import annotations
 
 import math
 import time
 from dataclasses import asdict, dataclass, field
+from pathlib import Path
 
 import numpy as np
 
@@ -34,6 +41,7 @@ class BendingStudy:
     options: FingerOptions = field(default_factory=FingerOptions)
     peak_mpa: float = 0.0  #: continue to this pressure after the sweep [MPa]; 0: no
     peak_step_mpa: float = 0.2  #: pressure increment on the way to peak_mpa [MPa]
+    hand: bool = False  #: also the whole hand with the reservoir-sheet FEM
 
     def __post_init__(self):
         P = np.asarray(self.pressures_mpa, dtype=float)
@@ -53,14 +61,35 @@ class BendingResult:
     build_seconds: float        #: meshing (cached) and setting up the model
     model: FingerModel = field(repr=False)
     states: list[FingerState] = field(repr=False)
+    hand: dict | None = None    #: the whole hand (:func:`studies.compare.whole_hand`), or None
 
     def summary(self) -> dict:
         """Numbers and provenance for result.json."""
-        return {"rows": self.rows, "peak": self.peak, "ndofs": self.ndofs,
-                "nelements": self.nelements, "build_seconds": self.build_seconds,
-                "stats": asdict(self.stats), "options": {**asdict(self.model.options),  # the ring width in effect
-                                  "tie_width": ring_width(self.model.design, self.model.options)},
-                "design": self.model.design.to_dict(), "design_hash": self.model.design.hash()}
+        out = {"rows": self.rows, "peak": self.peak, "ndofs": self.ndofs,
+               "nelements": self.nelements, "build_seconds": self.build_seconds,
+               "stats": asdict(self.stats), "options": {**asdict(self.model.options),  # the ring width in effect
+                                 "tie_width": ring_width(self.model.design, self.model.options)},
+               "design": self.model.design.to_dict(), "design_hash": self.model.design.hash()}
+        return out if self.hand is None else {**out, "hand": self.hand}
+
+    def write(self, out) -> list[str]:
+        """result.json (:meth:`summary`), table.csv (the rows) and, with the hand, hand.csv
+        into the folder ``out``; the names written."""
+        from softhand.studies.io.files import write_csv, write_json
+
+        out = Path(out)
+        names = ["result.json", "table.csv"] + (["hand.csv"] if self.hand else [])
+        if self.hand:
+            write_csv(out / "hand.csv", self.hand["rows"])
+        write_json(out / "result.json", self.summary())
+        write_csv(out / "table.csv", self.rows)
+        return names
+
+    def plot(self, path, **labels) -> None:
+        """Fig. 7 with FEM points (:func:`studies.io.bend_plot.plot_bending`)."""
+        from softhand.studies.io.bend_plot import plot_bending
+
+        plot_bending(path, self.rows, self.model.design, self.hand, **labels)
 
 
 def row(state: FingerState, design: HandDesign) -> dict:
@@ -90,8 +119,35 @@ def run(study: BendingStudy, *, on_state=None) -> BendingResult:
     callback = None if on_state is None else (lambda s: on_state(model, s))
     states, stats = solve_pressures(model, study.pressures_mpa, callback=callback)
     peak = _peak(model, study, states[-1], on_state) if study.peak_mpa else None
-    return BendingResult([row(s, study.design) for s in states], peak, model.ndofs,
-                         model.mesh.nelements, stats, build, model, states)
+    rows = [row(s, study.design) for s in states]
+    hand_result = None
+    if study.hand:
+        from softhand.studies.compare import whole_hand
+
+        hand_result = whole_hand(rows, study.design)
+    return BendingResult(rows, peak, model.ndofs, model.mesh.nelements, stats, build, model,
+                         states, hand_result)
+
+
+def vtk_writer(path, then=None):
+    """An ``on_state`` callback for :func:`run` that adds each converged state to the VTK scene
+    series at ``path`` (finger.pvd: tube, links, hinges per pressure), then calls
+    ``then(model, state)``. Its ``write(model, y, P)`` adds any other state."""
+    from softhand.fem.hand.scene import finger_scene
+    from softhand.fem.io import SceneSeries
+
+    series = SceneSeries(path)
+
+    def write(model, y, P):
+        series.write(P, *finger_scene(model, y, P))
+
+    def on_state(model, state):
+        write(model, state.y, state.P)
+        if then is not None:
+            then(model, state)
+
+    on_state.write = write
+    return on_state
 
 
 def _peak(model: FingerModel, study: BendingStudy, start: FingerState, on_state) -> dict:

@@ -4,8 +4,10 @@
 volumes and through the operating range, and returns per volume the FEM pressure, apex
 height, strain energy, the ellipse model's values at the same volume, the largest vertical
 gap between the FEM wet-surface profile and the half-ellipse, and the verdict: the ellipse
-model's errors over the operating range (fingers from 0 to ``theta_max``). No printing,
-no files: the CLI (``softhand reservoir``) writes those.
+model's errors over the operating range (fingers from 0 to ``theta_max``). The result is
+summarised, written and plotted by its own methods (:meth:`ReservoirStudyResult.summary`,
+``write``, ``plot``); ``softhand reservoir``, the batch kind and ``softhand reproduce``
+only choose the inputs.
 
 The operating range is V0 - n a² π d θ_max <= V <= V0 (eq. (15)); the stroke pressure change
 Δp = p(V0) - p(V0 - ΔV) is what the reservoir takes off the pump pressure between a straight
@@ -15,6 +17,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from pathlib import Path
 
 import numpy as np
 
@@ -51,6 +54,50 @@ class ReservoirStudyResult:
     states: tuple = field(repr=False)  #: fem.reservoir.SheetState per requested volume
     fem: ReservoirResult = field(repr=False)  #: the whole FEM path
     verdict: dict = field(default_factory=dict)  #: ellipse-model errors over the operating range
+
+    def summary(self) -> dict:
+        """The pressure maximum, the verdict, the mesh, cost and provenance (for result.json)."""
+        fem = self.fem
+        pm = fem.pressure_max
+        return {
+            "pressure_max": None if pm is None else {"V_mm3": pm[0], "p_MPa": pm[1]},
+            "path_max_volume_mm3": float(fem.path_volume[-1]),
+            "verdict": self.verdict, "design": self.study.design.to_dict(),
+            "design_hash": self.study.design.hash(),
+            "mesh": {"n_radial": fem.model.n_radial, "n_thick": fem.model.n_thick, "ndofs": fem.ndofs,
+                     "element": "Q2/P1disc axisymmetric", "kappa_over_mu": fem.model.kappa_ratio},
+            "newton_iterations": fem.newton_iterations, "load_steps": len(fem.path_volume) - 1,
+            "wall_time_s": fem.wall_time,
+        }
+
+    def write(self, out) -> list[str]:
+        """Into the folder ``out``: result.json (rows, :meth:`summary`, the wet-surface profiles
+        z(r) and mid-surface stretches per volume, the whole p(V), W(V) path), rows.csv and
+        the VTK of the deformed sheet per volume; the names written."""
+        from softhand.studies.io.files import write_csv, write_json
+
+        out = Path(out)
+        profiles = [{"V_mm3": s.volume, "r_mm": s.r, "z_mm": s.z, "r0_mid_mm": s.r0_mid,
+                     "lambda_meridian": s.lambda_meridian, "lambda_hoop": s.lambda_hoop,
+                     "lambda_thickness": s.lambda_thickness} for s in self.states]
+        path = {"V_mm3": self.fem.path_volume, "p_MPa": self.fem.path_pressure,
+                "W_Nmm": self.fem.path_energy}
+        write_json(out / "result.json", {"rows": self.rows, **self.summary(), "profiles": profiles,
+                                         "path": path})
+        write_csv(out / "rows.csv", self.rows)
+        return ["result.json", "rows.csv", *self.write_vtk(out)]
+
+    def write_vtk(self, out) -> list[str]:
+        """sheet.pvd (3D scenes) and sheet_V<volume>_rz.vtu (r-z sections) into ``out``."""
+        from softhand.studies.io.reservoir_files import write_sheet_vtk
+
+        return write_sheet_vtk(self, Path(out))
+
+    def plot(self, path) -> None:
+        """Profiles, p(V) of both models and P(theta) with both reservoir models."""
+        from softhand.studies.io.reservoir_files import plot_reservoir
+
+        plot_reservoir(path, self)
 
 
 def stroke_volume(design: HandDesign, theta_max: float) -> float:

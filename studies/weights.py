@@ -23,7 +23,7 @@ from pathlib import Path
 
 import numpy as np
 
-from softhand.reduced import grasp
+from softhand.reduced import grasp, paper
 from softhand.reduced.design import HandDesign
 from softhand.reduced.errors import InputError
 from softhand.studies.io.files import jsonable, write_json
@@ -125,7 +125,8 @@ def _write_vtk(out, model, states) -> None:
 
 def weights(case: WeightsCase, *, cache: bool = True, out=None) -> dict:
     """:func:`compute`, through the JSON cache keyed by :meth:`WeightsCase.key` (``cached`` says
-    which); ``out``: a folder for result.json and the VTK series (always computes).
+    which); ``out``: a folder for the VTK series grasp.pvd (always computes). The result is
+    returned, not written: the caller decides where it goes.
 
     A cache entry is used only if it is valid (:func:`read_entry`); an invalid one is
     recomputed and replaced, with a warning. A cache that cannot be written is a warning.
@@ -135,12 +136,7 @@ def weights(case: WeightsCase, *, cache: bool = True, out=None) -> dict:
         entry = read_entry(path, case.key())
         if entry is not None:
             return {**entry, "cached": True}
-    result = compute(case) if out is None else compute(case, out)
-    if out is not None:
-        from softhand.studies.io.files import kept_if_unwritable
-
-        with kept_if_unwritable(Path(out) / "result.json", "weights"):
-            write_json(Path(out) / "result.json", result)
+    result = compute(case, out)
     if cache:
         write_entry(path, case.key(), result)
     return {**result, "cached": False}
@@ -250,7 +246,7 @@ def fig8(case: WeightsCase, pressures_mpa, depth_offsets_mm=(0.0, 10.0, 20.0)) -
 
 def paper_w_F_v(P: float, theta: float, case: WeightsCase) -> float | None:
     """Eq. (25) -> (29) with the paper's w for this diameter, normalised (None if it has none)."""
-    w = grasp.PAPER_WEIGHTS.get(float(case.diameter_mm))
+    w = paper.WEIGHTS.get(float(case.diameter_mm))
     if w is None:
         return None
     return reduced_F_v(P, theta, case.mass_kg, np.array(w) / np.sum(w), case.design)

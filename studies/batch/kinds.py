@@ -88,9 +88,7 @@ def reservoir(params: dict, design: HandDesign, outdir: Path) -> dict:
     out |= {"p_V0_MPa": at_v0["p_MPa"], "p_ellipse_V0_MPa": at_v0["p_ellipse_MPa"],
             "stroke_dp_fem_MPa": v["stroke_dp_fem_MPa"],
             "stroke_dp_ellipse_MPa": v["stroke_dp_ellipse_MPa"], "max_gap_mm": v["max_gap_mm"]}
-    from softhand.studies.reproduce.fem_sections import write_sheet_vtk
-
-    write_sheet_vtk(result, outdir)
+    result.write_vtk(outdir)
     fem = result.fem
     return {**out, "mesh": {**(mesh or {"n_radial": result.study.n_radial,
                                         "n_thick": result.study.n_thick}), "dofs": fem.ndofs},
@@ -104,8 +102,7 @@ def weights(params: dict, design: HandDesign, outdir: Path) -> dict:
     names = {"diameter_mm": "diameter_mm", "mass_kg": "mass_kg", "pressure_mpa": "pressure_mpa",
              "dP_mpa": "dP_mpa", "mesh_size_mm": "mesh_size_mm"}
     case = WeightsCase(design=design, **{names[k]: float(v) for k, v in params.items()})
-    r = grasp_weights(case, out=outdir)
-    (outdir / "result.json").unlink(missing_ok=True)  # the runner writes its own result.json
+    r = grasp_weights(case, out=outdir)  # the VTK series; the runner writes result.json
     keep = ("w", "w_sum", "theta_deg", "hinge_deg", "F_v_fem_N", "F_v_reduced_N", "contact_force_N")
     return {**{k: r[k] for k in keep if r.get(k) is not None},
             "mesh": {"mesh_size_mm": r["mesh_size_mm"], "dofs": r["ndofs"]},

@@ -35,6 +35,17 @@ def write_csv(path: str | Path, rows: list[dict], columns: list[str] | None = No
     return write_atomic(path, buf.getvalue())
 
 
+def figure(ncols: int = 1, *, width: float = 5.5, height: float = 4.0):
+    """A matplotlib figure (Agg, no display) with ``ncols`` axes side by side: (fig, axes)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, axes = plt.subplots(1, ncols, figsize=(width * ncols, height), squeeze=False)
+    return fig, axes[0]
+
+
 def save_figure(fig, path: str | Path, *, dpi: int = 150) -> Path:
     """Save a matplotlib figure atomically (format from the suffix) and close it."""
     import matplotlib.pyplot as plt

@@ -25,33 +25,14 @@ import sys
 from dataclasses import dataclass
 from datetime import datetime, timezone
 from pathlib import Path
-from typing import Callable
 
 from softhand.reduced.design import HandDesign
 from softhand.studies.io.files import write_atomic, write_csv
+from softhand.studies.reproduce.section import Context, Section
 from softhand.studies.batch.runner import FAILED, RESULT, code_version, commit, execute_case, outcome_record
 
 SECTION_MD = "section.md"
 _ACTIVE: dict = {}  #: the sections of the current reproduce() call, by key
-
-
-@dataclass(frozen=True)
-class Context:
-    """What every section receives."""
-
-    design: HandDesign  #: the hand (default: the paper's Table I)
-    quick: bool = False  #: CI-sized meshes and fewer points
-
-
-@dataclass(frozen=True)
-class Section:
-    """One result of the paper: ``build(ctx, outdir) -> (markdown, numbers)``."""
-
-    key: str  #: folder name under the output directory
-    title: str
-    needs: tuple[str, ...]  #: "module" or "module:attribute" that must exist
-    build: Callable  #: writes files into outdir; returns (markdown body, {name: number})
-    in_quick: bool = True  #: False: skipped by --quick (reported as such)
 
 
 @dataclass

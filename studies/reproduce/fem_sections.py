@@ -1,7 +1,8 @@
-"""The FEM sections of ``softhand reproduce`` (see :mod:`studies.reproduce_sections`).
+"""The FEM sections of ``softhand reproduce`` (see :mod:`studies.reproduce.sections`).
 
-Each calls the owning study module's library function with the section's mesh size:
-CI-sized with ``--quick``, the module's default otherwise.
+Each runs the owning study with the section's mesh size (CI-sized with ``--quick``, the
+study's default otherwise) and lets the study's result write, plot and summarise itself;
+the section adds only its Markdown text and headline numbers.
 """
 from __future__ import annotations
 
@@ -11,9 +12,9 @@ from pathlib import Path
 
 import numpy as np
 
-from softhand.studies.io.files import save_figure, write_csv
-from softhand.studies.reproduce.core import Context, Section
-from softhand.studies.reproduce.sections import figure, md_table
+from softhand.reduced import paper
+from softhand.studies.io.files import figure, save_figure, write_csv
+from softhand.studies.reproduce.section import Context, Section, md_table
 
 
 # ---------------------------------------------------------------------- FEM verification
@@ -48,71 +49,49 @@ def verify(ctx: Context, outdir: Path):
 
 # ---------------------------------------------------------------------- Fig. 7 with FEM points
 def fig7_fem(ctx: Context, outdir: Path):
-    """Free bending by finger FEM against eq. (28), and the whole hand against eq. (27)."""
+    """Free bending by finger FEM against eq. (28), and the whole hand (finger FEM + reservoir-
+    sheet FEM) against eq. (27)."""
     from softhand.fem.hand.finger import FingerOptions
-    from softhand.fem.io import SceneSeries
-    from softhand.fem.hand.scene import finger_scene
-    from softhand.reduced import hand, reservoir
-    from softhand.studies.bending import BendingStudy, run
+    from softhand.studies.bending import BendingStudy, run, vtk_writer
 
-    d = ctx.design
     step = 0.2 if ctx.quick else 0.1
     pressures = tuple(np.round(np.arange(0.0, 0.8 + 1e-9, step), 10))
     options = FingerOptions(mesher="gmsh", mesh_size=6.0, edge_ratio=1.0, mesh_refine=0) if ctx.quick else FingerOptions()
-    series = SceneSeries(outdir / "finger.pvd")
+    folder = outdir / "bend"  # the files of `softhand bend --hand --out bend`
     with progress_bar("  bending the finger", "pressure") as bar:
-        def on_state(model, state):
-            series.write(state.P, *finger_scene(model, state.y, state.P))
-            bar.update(1)
-
-        result = run(BendingStudy(d, pressures, options), on_state=on_state)
-    rows = result.rows
-    for r in rows:  # the whole hand: the finger's FEM pressure minus the reservoir's at its oil
-        theta = math.radians(r["theta_deg"])
-        p_r = float(reservoir.pressure(d.V0 - d.n * r["dQ_mm3"], d))
-        r["P_hand_MPa"] = r["P_MPa"] - p_r
-        r["P_hand_eq27_MPa"] = float(hand.pressure(theta, d, reservoir=True))
-    columns = ["P_MPa", "theta_deg", "theta_reduced_deg", "dQ_mm3", "dQ_reduced_mm3",
-               "radial_stretch_max", "max_principal_stretch", "P_hand_MPa", "P_hand_eq27_MPa"]
-    write_csv(outdir / "fig7_fem.csv", rows, columns + ["hinge_deg", "newton_iterations"])
-    _fig7_fem_plot(rows, d, outdir / "fig7_fem.png")
-    err = [r["theta_deg"] - r["theta_reduced_deg"] for r in rows]
+        result = run(BendingStudy(ctx.design, pressures, options, hand=True),
+                     on_state=vtk_writer(folder / "finger.pvd", then=lambda model, state: bar.update(1)))
+    result.write(folder)
+    result.plot(outdir / "fig7_fem.png", title="Fig. 7 with FEM points")
+    rows = [{**r, **h} for r, h in zip(result.rows, result.hand["rows"])]
+    hand_error = [r["P_hand_fem_MPa"] - r["P_hand_eq27_MPa"] for r in rows]
     numbers = {"theta_fem_at_max_P_deg": rows[-1]["theta_deg"],
                "theta_eq28_at_max_P_deg": rows[-1]["theta_reduced_deg"],
-               "max_abs_theta_difference_deg": float(np.max(np.abs(err))),
+               "max_abs_theta_difference_deg": float(np.max(np.abs(
+                   [r["theta_deg"] - r["theta_reduced_deg"] for r in rows]))),
+               "max_abs_hand_pressure_difference_MPa": float(np.max(np.abs(hand_error))),
+               "reservoir_offset_fem_MPa": result.hand["offset_fem_MPa"],
                "max_radial_stretch": float(max(r["radial_stretch_max"] for r in rows)),
                "dofs": result.ndofs, "newton_iterations": result.stats.newton_iterations,
                "fem_wall_time_s": result.stats.wall_seconds}
+    columns = ["P_MPa", "theta_deg", "theta_reduced_deg", "dQ_mm3", "dQ_reduced_mm3",
+               "radial_stretch_max", "p_reservoir_fem_MPa", "P_hand_fem_MPa", "P_hand_eq27_MPa"]
     text = f"""The finger FEM (half model, rigid links on hinges, {result.ndofs} unknowns,
 {'CI mesh 6 mm' if ctx.quick else 'default mesh'}) at {len(rows)} pressures, against eq. (28)
-at the same pressure; the whole hand P = p_finger − p_r(V0 − n ΔQ_FEM) with the reduced
-reservoir model, against eq. (27) at the FEM angle ([fig7_fem.csv](fig7_fem.csv), VTK series
-[finger.pvd](finger.pvd)). Largest |θ_FEM − θ_eq.(28)| = {numbers['max_abs_theta_difference_deg']:.2f}°;
-largest radial stretch {numbers['max_radial_stretch']:.4f} (the model assumes 1).
+at the same pressure; the whole hand P = p_finger − p_r(V0 − n ΔQ_FEM) with the
+reservoir-sheet FEM ({result.hand['reservoir_ndofs']} DOFs), against eq. (27) at the FEM angle
+([bend/table.csv](bend/table.csv), [bend/hand.csv](bend/hand.csv), VTK series
+[bend/finger.pvd](bend/finger.pvd)). Largest |θ_FEM − θ_eq.(28)| =
+{numbers['max_abs_theta_difference_deg']:.2f}°; largest |P_hand,FEM − P_eq.(27)| =
+{numbers['max_abs_hand_pressure_difference_MPa']:.4f} MPa; reservoir offset p_r(V0) by FEM
+{result.hand['offset_fem_MPa']:.4f} MPa (paper: about {paper.RESERVOIR_OFFSET_MPA} MPa); largest
+radial stretch {numbers['max_radial_stretch']:.4f} (the model assumes 1).
 
 {md_table(rows, columns)}
 
 ![Fig. 7 with FEM points](fig7_fem.png)
 """
     return text, numbers
-
-
-def _fig7_fem_plot(rows, design, path: Path) -> None:
-    from softhand.reduced import hand
-
-    theta_deg = np.arange(0.0, 90.0 + 1e-9, 1.0)
-    theta = np.radians(theta_deg)
-    fig, (ax,) = figure()
-    ax.plot(hand.pressure(theta, design, reservoir=True), theta_deg, "-", label="eq. (27), with reservoir")
-    ax.plot(hand.pressure(theta, design, reservoir=False), theta_deg, ":", label="eq. (28), without")
-    ax.plot([r["P_MPa"] for r in rows], [r["theta_deg"] for r in rows], "o", label="finger FEM")
-    ax.plot([r["P_hand_MPa"] for r in rows], [r["theta_deg"] for r in rows], "s", mfc="none",
-            label="FEM finger + reservoir")
-    ax.set(xlabel="pump pressure P [MPa]", ylabel="bend angle θ [deg]", title="Fig. 7 with FEM points",
-           xlim=(-0.15, None))
-    ax.grid(alpha=0.3)
-    ax.legend(fontsize=8)
-    save_figure(fig, path)
 
 
 # ---------------------------------------------------------------------- reservoir vs ellipse
@@ -124,7 +103,9 @@ def reservoir_fem(ctx: Context, outdir: Path):
     with progress_bar("  inflating the sheet", " mm³") as bar:  # whole mm³ of oil
         result = run(ReservoirStudy(design=ctx.design, **mesh),
                      progress=lambda v: bar.update(round(v) - bar.n))
-    write_csv(outdir / "reservoir.csv", result.rows, COLUMNS)
+    folder = outdir / "reservoir"  # the files of `softhand reservoir --out reservoir`
+    files = result.write(folder)
+    result.plot(outdir / "reservoir.png")
     v = result.verdict
     verdict = [{"quantity": name, "min": v[key]["min"], "max": v[key]["max"], "at_V0": v[key]["at_V0"]}
                for name, key in (("apex height", "apex_height"), ("mean stretch", "mean_stretch"),
@@ -132,19 +113,18 @@ def reservoir_fem(ctx: Context, outdir: Path):
     verdict.append({"quantity": "pressure change over the stroke", "min": v["stroke_dp"],
                     "max": v["stroke_dp"], "at_V0": v["stroke_dp"]})
     write_csv(outdir / "reservoir_verdict.csv", verdict)
-    _reservoir_plot(result, ctx.design, outdir / "reservoir.png")
-    vtk = write_sheet_vtk(result, outdir)
     fem = result.fem
     numbers = {f"{row['quantity'].replace(' ', '_').replace('/', '_')}_max_rel_error":
                max(abs(row["min"]), abs(row["max"])) for row in verdict}
     numbers |= {"stroke_dp_fem_MPa": v["stroke_dp_fem_MPa"],
                 "stroke_dp_ellipse_MPa": v["stroke_dp_ellipse_MPa"], "max_gap_mm": v["max_gap_mm"],
                 "dofs": fem.ndofs, "newton_iterations": fem.newton_iterations}
+    vtk = [name for name in files if name.endswith((".pvd", ".vtu"))]
     text = f"""The clamped NBR sheet (R = {ctx.design.R} mm, t = {ctx.design.t} mm), axisymmetric
 FEM under volume control, against the half-ellipse model at the same oil volume
-([reservoir.csv](reservoir.csv); {fem.ndofs} DOFs, {fem.newton_iterations} Newton iterations,
-{fem.wall_time:.1f} s). Operating range: V = {v['V_range_mm3'][0]:.0f}–{v['V_range_mm3'][1]:.0f} mm³
-(fingers 0–90°).
+([reservoir/rows.csv](reservoir/rows.csv), [reservoir/result.json](reservoir/result.json);
+{fem.ndofs} DOFs, {fem.newton_iterations} Newton iterations, {fem.wall_time:.1f} s).
+Operating range: V = {v['V_range_mm3'][0]:.0f}–{v['V_range_mm3'][1]:.0f} mm³ (fingers 0–90°).
 
 {md_table(result.rows, COLUMNS)}
 
@@ -159,55 +139,29 @@ ellipse model; the largest gap between the profiles is {v['max_gap_mm']:.2f} mm.
 
 ![reservoir](reservoir.png)
 
-VTK of the deformed sheet (ParaView, `softhand inspect`): {", ".join(f"[{n}]({n})" for n in vtk)}.
+VTK of the deformed sheet (ParaView, `softhand inspect`): {", ".join(f"[{n}](reservoir/{n})" for n in vtk)}.
 """
     return text, numbers
 
 
-def _reservoir_plot(result, design, path: Path) -> None:
-    from softhand.reduced import reservoir as ellipse
-
-    fig, (ax1, ax2) = figure(2)
-    r = np.linspace(0.0, design.R, 101)
-    for state, color in zip(result.states, ("C0", "C1", "C2", "C3")):
-        h = float(ellipse.height(state.volume, design))
-        ax1.plot(r, state.profile_at(r), color=color, label=f"FEM, V = {state.volume:.0f} mm³")
-        ax1.plot(r, h * np.sqrt(1 - (r / design.R) ** 2), ":", color=color)
-    ax1.set(xlabel="r [mm]", ylabel="z [mm]", title="profiles: FEM (solid), half-ellipse (dotted)")
-    V = np.asarray(result.fem.path_volume)
-    ax2.plot(V, result.fem.path_pressure, label="FEM")
-    keep = V > 0
-    ax2.plot(V[keep], ellipse.ellipse_pressure(V[keep], design), ":", label="ellipse model")
-    ax2.set(xlabel="V [mm³]", ylabel="p [MPa]", title="reservoir pressure p(V)")
-    for ax in (ax1, ax2):
-        ax.grid(alpha=0.3)
-        ax.legend(fontsize=8)
-    save_figure(fig, path)
-
-
 # ---------------------------------------------------------------------- w and Fig. 8 by grasp FEM
-#: diameter [mm], mass [kg], the paper's grasp pressures [MPa], the pressure w is taken at [MPa]
-GRASPS = ((180.0, 2.0, (0.6, 0.7, 0.8, 0.9), 0.8), (240.0, 6.0, (1.1, 1.2, 1.3, 1.4), 1.2))
-
-
 def weights_fem(ctx: Context, outdir: Path):
     """w for the 180 mm / 2 kg and 240 mm / 6 kg objects by grasp FEM, against the paper's."""
-    from softhand.reduced.grasp import PAPER_WEIGHTS
     from softhand.studies.weights import WeightsCase, weights
 
     rows, numbers = [], {}
-    for D, mass, _, P in GRASPS:
+    for D, mass, _, P, _ in paper.FIG8:
         r = weights(WeightsCase(design=ctx.design, diameter_mm=D, mass_kg=mass, pressure_mpa=P),
                     out=outdir / f"D{D:.0f}")
-        paper = np.asarray(PAPER_WEIGHTS[D])
+        w_paper = np.asarray(paper.WEIGHTS[D])
         rows.append({"diameter_mm": D, "mass_kg": mass, "P_MPa": r["P_MPa"],
                      "theta_deg": r["theta_deg"], "w_fem": r["w"],
-                     "w_paper_normalised": (paper / paper.sum()).tolist(),
+                     "w_paper_normalised": (w_paper / w_paper.sum()).tolist(),
                      "F_v_fem_N": r["F_v_fem_N"], "F_v_reduced_N": r["F_v_reduced_N"],
                      "ndofs": r["ndofs"]})
         numbers |= {f"w{i + 1}_{D:.0f}mm": v for i, v in enumerate(r["w"])}
         numbers[f"max_abs_w_difference_{D:.0f}mm"] = float(np.max(np.abs(
-            np.asarray(r["w"]) - paper / paper.sum())))
+            np.asarray(r["w"]) - w_paper / w_paper.sum())))
     write_csv(outdir / "weights.csv", rows)
     text = f"""Hinge weight vectors w = Δθ̂/Δθ between two converged contact states (P, P + ΔP),
 normalised to Σw = 1, for the paper's two objects at a pressure inside the paper's grasp range ([weights.csv](weights.csv); VTK series
@@ -223,19 +177,18 @@ are shown normalised (its 180 mm vector sums to 1.40 as printed).
 def fig8_fem(ctx: Context, outdir: Path):
     """Fig. 8 analogue with FEM points: F_v by grasp FEM and by eq. (25) at the same (P, θ)."""
     from softhand.reduced.grasp import KGF
-    from softhand.studies.reproduce.sections import PAPER_FIG8_ERROR_KGF
     from softhand.studies.weights import WeightsCase, fig8, fig8_errors
 
     fig, axes = figure(2)
     summary, numbers = [], {}
-    for ax, (D, mass, pressures, _) in zip(axes, GRASPS):
+    for ax, (D, mass, pressures, _, paper_error) in zip(axes, paper.FIG8):
         chosen = (pressures[0], pressures[-1]) if ctx.quick else pressures
         offsets = (0.0,) if ctx.quick else (0.0, 10.0, 20.0)
         rows = fig8(WeightsCase(design=ctx.design, diameter_mm=D, mass_kg=mass), chosen, offsets)
         write_csv(outdir / f"fig8_fem_{D:.0f}mm.csv", rows)
         errors = fig8_errors(rows)
         summary.append({"diameter_mm": D, "mass_kg": mass, "points": len(rows), **errors,
-                        "paper_error_vs_measurement_kgf": PAPER_FIG8_ERROR_KGF[D]})
+                        "paper_error_vs_measurement_kgf": paper_error})
         numbers |= {f"{k}_{D:.0f}mm": v for k, v in errors.items() if v is not None}
         theta = [r["theta_deg"] for r in rows]
         ax.plot(theta, [r["F_v_fem_N"] / KGF for r in rows], "o", label="FEM")
@@ -257,26 +210,6 @@ errors against its measurements:
     return text, numbers
 
 
-def write_sheet_vtk(result, outdir: Path) -> list[str]:
-    """The deformed sheet per volume: the scene series sheet.pvd (the sheet revolved in 3D,
-    one .vtm per volume, by increasing volume) and the r-z sections sheet_V<volume>_rz.vtu."""
-    from softhand.fem.io import SceneSeries
-    from softhand.fem.hand.reservoir import sheet_vtk
-    from softhand.fem.hand.scene import sheet_block
-    from softhand.meshes.convert import write_vtu
-
-    solid, names = result.fem.model.build()[0], []
-    series = SceneSeries(outdir / "sheet.pvd")
-    for state in sorted({s.volume: s for s in result.states}.values(), key=lambda s: s.volume):
-        series.write(state.volume, [sheet_block(solid, state)],
-                     {"volume_mm3": state.volume, "pressure_MPa": state.pressure})
-        name = f"sheet_V{state.volume:.0f}_rz.vtu"
-        points, cells, data = sheet_vtk(solid, state)
-        write_vtu(outdir / name, points, cells, point_data=data)
-        names.append(name)
-    return ["sheet.pvd", *names]
-
-
 def progress_bar(desc: str, unit: str):
     """A nested tqdm bar (stderr, removed when done) for a long FEM path."""
     from tqdm import tqdm
@@ -286,11 +219,10 @@ def progress_bar(desc: str, unit: str):
 
 SECTIONS: list[Section] = [
     Section("fig7_fem", "Fig. 7 with finger-FEM points, and the whole hand",
-            ("softhand.studies.bending:run", "softhand.studies.bending:BendingStudy", "softhand.fem.io:SceneSeries",
-             "softhand.fem.hand.scene:finger_scene"), fig7_fem),
+            ("softhand.studies.bending:run", "softhand.studies.bending:BendingStudy",
+             "softhand.studies.bending:vtk_writer", "softhand.studies.compare:whole_hand"), fig7_fem),
     Section("reservoir_fem", "Reservoir: FEM against the ellipse model",
-            ("softhand.studies.reservoir:run", "softhand.fem.hand.reservoir:sheet_vtk", "softhand.fem.hand.scene:sheet_block",
-             "softhand.meshes.convert:write_vtu"),
+            ("softhand.studies.reservoir:run", "softhand.studies.io.reservoir_files:write_sheet_vtk"),
             reservoir_fem),
     Section("weights_fem", "w for the 180 mm and 240 mm objects by grasp FEM",
             ("softhand.studies.weights:weights", "softhand.studies.weights:WeightsCase"), weights_fem),

@@ -3,7 +3,8 @@
 Each builder ``build(ctx, outdir) -> (markdown, numbers)`` calls the owning library
 function, writes its CSV/PNG/VTK files into ``outdir`` and returns the Markdown body
 (links relative to ``outdir``) and its headline numbers. No printing; no CLI calls.
-The FEM sections live in :mod:`studies.reproduce_fem`.
+The FEM sections live in :mod:`studies.reproduce.fem_sections`; the paper's numbers they
+compare with come from :mod:`reduced.paper`.
 """
 from __future__ import annotations
 
@@ -13,39 +14,9 @@ from pathlib import Path
 
 import numpy as np
 
-from softhand.studies.io.files import save_figure, write_csv
-from softhand.studies.reproduce.core import Context, Section
-
-#: the paper's statements that the sections compare with
-PAPER_RESERVOIR_OFFSET_MPA = 0.1  #: "bent at 0.1 MPa lower pressure" (Fig. 7)
-PAPER_FIG8_ERROR_KGF = {180.0: 0.22, 240.0: 0.39}  #: F_v estimation errors vs measurement
-FIG8_CASES = ((2.0, 180.0, (0.6, 0.7, 0.8, 0.9)), (6.0, 240.0, (1.1, 1.2, 1.3, 1.4)))
-
-
-def figure(ncols: int = 1, *, width: float = 5.5):
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    fig, axes = plt.subplots(1, ncols, figsize=(width * ncols, 4.0), squeeze=False)
-    return fig, axes[0]
-
-
-def md_table(rows: list[dict], columns: list[str] | None = None, *, digits: int = 4) -> str:
-    """A Markdown table of ``rows`` (dicts); floats to ``digits`` significant digits."""
-    columns = columns or list(rows[0])
-
-    def cell(v):
-        if isinstance(v, (float, np.floating)):
-            return f"{v:.{digits}g}"
-        if isinstance(v, (list, tuple, np.ndarray)):
-            return "(" + ", ".join(cell(x) for x in v) + ")"
-        return str(v)
-
-    lines = ["| " + " | ".join(columns) + " |", "|" + "---|" * len(columns)]
-    lines += ["| " + " | ".join(cell(r.get(c, "")) for c in columns) + " |" for r in rows]
-    return "\n".join(lines)
+from softhand.studies.io.files import figure, save_figure, write_csv
+from softhand.reduced import paper
+from softhand.studies.reproduce.section import Context, Section, md_table
 
 
 # ---------------------------------------------------------------------- Fig. 7, reduced
@@ -87,7 +58,7 @@ def fig7_reduced(ctx: Context, outdir: Path):
 
 The reservoir lowers the pressure needed for a bend by {offset.mean():.4f} MPa on average
 over 0–90° (from {offset.min():.4f} to {offset.max():.4f} MPa); the paper says about
-{PAPER_RESERVOIR_OFFSET_MPA} MPa. With the reservoir P(0) = {P[0]:.4f} MPa < 0: at zero pump
+{paper.RESERVOIR_OFFSET_MPA} MPa. With the reservoir P(0) = {P[0]:.4f} MPa < 0: at zero pump
 pressure the charged sheet already bends the fingers a little.
 {_fem_reservoir_note(P0, P_fem, why)}
 
@@ -135,14 +106,13 @@ def _angles_at(pressures, design) -> list[dict]:
 # ---------------------------------------------------------------------- Table II, reduced
 def table2_reduced(ctx: Context, outdir: Path):
     """F_v by eqs. (24), (25), (29) at the three (P, θ) of Table II, m = 2 kg, 180 mm w."""
-    from softhand.reduced.control import PAPER_TABLE_II
-    from softhand.reduced.grasp import KGF, PAPER_WEIGHTS, WeightSumWarning, check_weights, grasp_forces
+    from softhand.reduced.grasp import KGF, WeightSumWarning, check_weights, grasp_forces
 
     d = ctx.design
-    w_paper = np.asarray(PAPER_WEIGHTS[180.0])
+    w_paper = np.asarray(paper.WEIGHTS[180.0])
     w_unit = check_weights(w_paper, d, normalise=True)
     rows = []
-    for state, (P, theta_deg, F_paper) in PAPER_TABLE_II.items():
+    for state, (P, theta_deg, F_paper) in paper.TABLE_II.items():
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", WeightSumWarning)  # stated in the text below
             F = grasp_forces(P, math.radians(theta_deg), 2.0, w_paper, d).F_v / KGF
@@ -180,14 +150,14 @@ def _ordering_verdict(F_b: float, F_c: float) -> str:
 # ---------------------------------------------------------------------- Fig. 8, reduced
 def fig8_reduced(ctx: Context, outdir: Path):
     """F_v(θ) by eq. (25), (29) at the paper's pressures for 2 kg/180 mm and 6 kg/240 mm."""
-    from softhand.reduced.grasp import KGF, PAPER_WEIGHTS, WeightSumWarning, angle_at, grasp_forces
+    from softhand.reduced.grasp import KGF, WeightSumWarning, angle_at, grasp_forces
 
     d = ctx.design
     theta_deg = np.arange(0.0, 90.0 + 1e-9, 1.0)
     fig, axes = figure(2)
     rows, numbers = [], {}
-    for ax, (mass, D, pressures) in zip(axes, FIG8_CASES):
-        w = np.asarray(PAPER_WEIGHTS[D])
+    for ax, (D, mass, pressures, *_) in zip(axes, paper.FIG8):
+        w = np.asarray(paper.WEIGHTS[D])
         for P in pressures:
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore", WeightSumWarning)
@@ -206,11 +176,11 @@ def fig8_reduced(ctx: Context, outdir: Path):
     write_csv(outdir / "fig8_reduced.csv", rows)
     free = [{"diameter_mm": D, "mass_kg": m, "P_MPa": P,
              "theta_at_F_v_0_deg": numbers[f"theta_F0_{D:.0f}mm_{P}MPa_deg"]}
-            for m, D, ps in FIG8_CASES for P in ps]
+            for D, m, ps, *_ in paper.FIG8 for P in ps]
     text = f"""Eq. (25) solved for F_x, with F_y = mg/n (24) and F_v by (29), against θ at the
 paper's grasp pressures, with the paper's w vectors as printed
 ([fig8_reduced.csv](fig8_reduced.csv)). The paper compares such lines with measured
-points (errors {PAPER_FIG8_ERROR_KGF[180.0]} and {PAPER_FIG8_ERROR_KGF[240.0]} kgf); the
+points (errors {' and '.join(f'{g.error_kgf:g}' for g in paper.FIG8)} kgf); the
 measurements are not public, so only the model side is reproduced here. The angle at
 which F_v falls to 0 (the finger just stops pressing) at each pressure:
 
@@ -228,9 +198,7 @@ PUSH_N, PUSH_AT_S, T_END_S = 5.0, 5.0, 10.0  #: the push of `softhand control` (
 def _flexibility(ctx: Context):
     """Angle control to 50 deg holding 2 kg, a push at 5 s; then pressure control (Table II)."""
     from softhand.reduced.control import flexibility, ramp
-    from softhand.reduced.grasp import PAPER_WEIGHTS
-
-    return flexibility(ctx.design, math.radians(50.0), 2.0, PAPER_WEIGHTS[180.0],
+    return flexibility(ctx.design, math.radians(50.0), 2.0, paper.WEIGHTS[180.0],
                        ramp(PUSH_N, PUSH_AT_S), t_end=T_END_S)
 
 
@@ -256,7 +224,7 @@ next to it ([table2_control.csv](table2_control.csv)).
 The paper's flexibility result — the push under angle control (c) leaves a lower force
 than under pressure control (b) — {verdict} in this simulation:
 F_v(c) = {F['c_push_angle_control']:.3f} kgf, F_v(b) = {F['b_push_pressure_control']:.3f} kgf
-(paper: 0.53 and 0.82 kgf).
+(paper: {paper.TABLE_II['c_push_angle_control'][2]} and {paper.TABLE_II['b_push_pressure_control'][2]} kgf).
 """
     return text, numbers
 
@@ -304,7 +272,7 @@ REDUCED_SECTIONS: list[Section] = [
     Section("fig7_reduced", "Fig. 7: pressure and bend angle, reduced model",
             ("softhand.reduced.hand:pressure",), fig7_reduced),
     Section("table2_reduced", "Table II: grasping force, reduced model",
-            ("softhand.reduced.grasp:grasp_forces", "softhand.reduced.control:PAPER_TABLE_II"), table2_reduced),
+            ("softhand.reduced.grasp:grasp_forces", "softhand.reduced.paper:TABLE_II"), table2_reduced),
     Section("fig8_reduced", "Fig. 8 analogue: grasping force against bend angle",
             ("softhand.reduced.grasp:angle_at",), fig8_reduced),
     Section("table2_control", "Table II: angle control vs pressure control, simulated",

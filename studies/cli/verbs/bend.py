@@ -111,11 +111,9 @@ def _options(args):
 def run(args) -> int:
     from tqdm import tqdm
 
-    from softhand.fem.io import SceneSeries
-    from softhand.fem.hand.scene import finger_scene
     from softhand.fem.newton import NotConverged
-    from softhand.studies.bending import BendingStudy, run as run_study
-    from softhand.studies.io.files import kept_if_unwritable, write_csv, write_json
+    from softhand.studies.bending import BendingStudy, run as run_study, vtk_writer
+    from softhand.studies.io.files import kept_if_unwritable
 
     pressures = _check(args)
     design = design_from_args(args)
@@ -127,38 +125,32 @@ def run(args) -> int:
     if args.tie_width_mm is not None:
         design = design.replace(tie_width=args.tie_width_mm)
     study = BendingStudy(design, pressures, _options(args),
-                         peak_mpa=args.peak_mpa if args.peak_mpa > pressures[-1] else 0.0)
+                         peak_mpa=args.peak_mpa if args.peak_mpa > pressures[-1] else 0.0,
+                         hand=args.hand)
     out = Path(args.out)
     clear_outputs(out)
-    series = SceneSeries(out / "finger.pvd")
     n_steps = len(pressures) + (1 if study.peak_mpa else 0)
     bar = tqdm(total=n_steps, desc="bend", unit="pressure", file=sys.stderr, leave=False)
     converged = []
 
-    def on_state(model, state):
+    def progress(model, state):
         converged.append((model, state))
-        series.write(state.P, *finger_scene(model, state.y, state.P))
         bar.set_postfix(P=f"{state.P:.2f}", theta=f"{state.theta * 57.29578:.1f}deg")
         bar.update(0 if state.P > pressures[-1] and state.P < study.peak_mpa else 1)
 
+    on_state = vtk_writer(out / "finger.pvd", then=progress)
     try:
         result = run_study(study, on_state=on_state)
     except NotConverged as exc:
-        return _failed(exc, converged, study, series, out)
+        return _failed(exc, converged, study, on_state.write, out)
     finally:
         bar.close()
     summary = result.summary()
-    if args.hand:
-        from softhand.studies.compare import whole_hand
-        summary["hand"] = whole_hand(result.rows, study.design)
     with kept_if_unwritable(f"{out}/result.json, table.csv", "bend"):
-        if args.hand:
-            write_csv(out / "hand.csv", summary["hand"]["rows"])
-        write_json(out / "result.json", summary)
-        write_csv(out / "table.csv", result.rows)
+        result.write(out)
     if args.plot:
         with kept_if_unwritable(args.plot, "bend"):
-            plot_bending(args.plot, result.rows, study.design, summary.get("hand"))
+            result.plot(args.plot)
     if args.json:
         print_json(summary)
     else:
@@ -196,10 +188,9 @@ def clear_outputs(out: Path) -> None:
             shutil.rmtree(path) if path.is_dir() else path.unlink()
 
 
-def _failed(exc, converged, study, series, out: Path) -> int:
+def _failed(exc, converged, study, write_vtk, out: Path) -> int:
     """Newton gave up: the last converged state (VTK + result.json) and one error line naming
-    the pressure reached; exit code 1."""
-    from softhand.fem.hand.scene import finger_scene
+    the pressure reached; exit code 1. ``write_vtk(model, y, P)`` adds a state to the VTK series."""
     from softhand.studies.bending import row
     from softhand.studies.io.files import write_csv, write_json
 
@@ -209,7 +200,7 @@ def _failed(exc, converged, study, series, out: Path) -> int:
     if converged and reached is not None and last_y is not None and reached > converged[-1][1].P:
         model = converged[-1][0]  # the cut-back's last converged state, past the last requested P
         state = model.state(last_y, reached)
-        series.write(reached, *finger_scene(model, last_y, reached))
+        write_vtk(model, last_y, reached)
         rows.append(row(state, study.design))
     message = str(exc).split(";")[0]
     last = rows[-1]["P_MPa"] if rows else 0.0
@@ -220,33 +211,3 @@ def _failed(exc, converged, study, series, out: Path) -> int:
     print(f"softhand bend: error: the finger FEM stopped: {message}; the last converged state "
           f"(P = {last:.4g} MPa) is in {out}/result.json and {out}/finger.pvd", file=sys.stderr)
     return 1
-
-
-def plot_bending(path, rows: list[dict], design, hand_result: dict | None = None) -> None:
-    """theta vs P (Fig. 7): FEM points and eq. (28); with the hand, its FEM points and eq. (27)."""
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-    import numpy as np
-
-    from softhand.reduced import hand
-    from softhand.studies.io.files import save_figure
-
-    P = np.array([r["P_MPa"] for r in rows])
-    Pl = np.linspace(0.0, max(P.max(), 1e-3), 101)
-    fig, ax = plt.subplots(figsize=(5.5, 4))
-    ax.plot(Pl, np.degrees(hand.bend_angle(Pl, design, reservoir=False)), "k:",
-            label="eq. (28), no reservoir")
-    ax.plot(P, [r["theta_deg"] for r in rows], "o", label="finger FEM (no reservoir)")
-    if hand_result is not None:
-        th = np.radians(np.linspace(0.0, max(r["theta_deg"] for r in rows), 101))
-        ax.plot(hand.pressure(th, design, reservoir=True), np.degrees(th), "k-",
-                label="eq. (27), with reservoir")
-        ax.plot([r["P_hand_fem_MPa"] for r in hand_result["rows"]],
-                [r["theta_deg"] for r in hand_result["rows"]], "s", mfc="none",
-                label="finger FEM + reservoir FEM")
-    ax.set_xlabel("pressure P [MPa]")
-    ax.set_ylabel("bend angle θ [deg]")
-    ax.legend()
-    ax.grid(alpha=0.3)
-    save_figure(fig, path)

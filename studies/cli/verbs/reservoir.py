@@ -6,16 +6,13 @@ maximum (if the path passes one) and the verdict over the operating range (V0 - 
 ``--plot``: profiles, p(V) of both models, and the hand's P(theta) with both reservoir
 models. ``--out DIR``: result.json (rows, verdict, wet-surface profiles z(r) and mid-surface
 stretches per volume, the whole p(V), W(V) path), rows.csv, VTK of the deformed sheet per
-volume (r–z and revolved to 3D). ``--write-calibration FILE.csv``: the table of ``reduced/reservoir_fem.py``.
+volume (r–z and revolved to 3D); see :class:`studies.reservoir.ReservoirStudyResult`. ``--write-calibration FILE.csv``: the table of ``reduced/reservoir_fem.py``.
 """
 from __future__ import annotations
 
-import math
 import subprocess
 import sys
 from pathlib import Path
-
-import numpy as np
 
 from softhand.reduced.errors import InputError
 from softhand.studies.cli.args import MAX_FEM_POINTS, add_design_option, add_json_option, design_from_args, \
@@ -76,13 +73,13 @@ def run(args) -> int:
               f"volume step); last converged state V = {last.volume:.6g} mm^3, "
               f"p = {last.pressure:.6g} MPa", file=sys.stderr)
         return 1
-    summary = _summary(result)
+    summary = result.summary()
     if args.out:
         with kept_if_unwritable(args.out, "reservoir"):
-            _write_outputs(Path(args.out), result, summary)
+            result.write(args.out)
     if args.plot:
         with kept_if_unwritable(args.plot, "reservoir"):
-            plot_reservoir(args.plot, result)
+            result.plot(args.plot)
     if args.json:
         print_json({"rows": result.rows, **summary})
     else:
@@ -98,36 +95,6 @@ def run(args) -> int:
               f"ellipse {ell[-1]:.4g}..{ell[0]:.4g} MPa, ellipse - FEM "
               f"{v['offset_difference_MPa'][0]:.4g}..{v['offset_difference_MPa'][1]:.4g} MPa")
     return 0
-
-
-def _summary(result) -> dict:
-    fem = result.fem
-    pm = fem.pressure_max
-    return {
-        "pressure_max": None if pm is None else {"V_mm3": pm[0], "p_MPa": pm[1]},
-        "path_max_volume_mm3": float(fem.path_volume[-1]),
-        "verdict": result.verdict, "design": result.study.design.to_dict(),
-        "design_hash": result.study.design.hash(),
-        "mesh": {"n_radial": fem.model.n_radial, "n_thick": fem.model.n_thick, "ndofs": fem.ndofs,
-                 "element": "Q2/P1disc axisymmetric", "kappa_over_mu": fem.model.kappa_ratio},
-        "newton_iterations": fem.newton_iterations, "load_steps": len(fem.path_volume) - 1,
-        "wall_time_s": fem.wall_time,
-    }
-
-
-def _write_outputs(out: Path, result, summary) -> None:
-    from softhand.studies.io.files import write_csv, write_json
-    from softhand.studies.reproduce.fem_sections import write_sheet_vtk
-
-    profiles = [{"V_mm3": s.volume, "r_mm": s.r, "z_mm": s.z, "r0_mid_mm": s.r0_mid,
-                 "lambda_meridian": s.lambda_meridian, "lambda_hoop": s.lambda_hoop,
-                 "lambda_thickness": s.lambda_thickness} for s in result.states]
-    path = {"V_mm3": result.fem.path_volume, "p_MPa": result.fem.path_pressure,
-            "W_Nmm": result.fem.path_energy}
-    write_json(out / "result.json", {"rows": result.rows, **summary, "profiles": profiles,
-                                     "path": path})
-    write_csv(out / "rows.csv", result.rows)
-    write_sheet_vtk(result, out)  # sheet.pvd (3D scenes) and sheet_V<volume>_rz.vtu (r–z)
 
 
 def _git_commit() -> str:
@@ -160,41 +127,3 @@ def _write_calibration(study, path) -> int:
     write_atomic(path, calibration_csv([thin, thick], rows, provenance))
     print(f"wrote {len(rows)} rows to {path}")
     return 0
-
-
-def plot_reservoir(path, result) -> None:
-    """Profiles (FEM vs ellipse), p(V) of both models, P(theta) with both reservoir models."""
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    from softhand.reduced import hand, reservoir
-    from softhand.studies.io.files import save_figure
-
-    d = result.study.design
-    fig, ax = plt.subplots(1, 3, figsize=(15, 4.2))
-    r = np.linspace(0, d.R, 200)
-    for k, s in enumerate(result.states):
-        c = f"C{k}"
-        ax[0].plot(s.r, s.z, "-", color=c, label=f"FEM V={s.volume:.0f}")
-        h = float(reservoir.height(s.volume, d))
-        ax[0].plot(r, h * np.sqrt(1 - (r / d.R) ** 2), "--", color=c)
-    ax[0].set(xlabel="r [mm]", ylabel="z [mm] (wet surface)", title="profiles: FEM (-), ellipse (--)",
-              aspect="equal")
-    fem = result.fem
-    V = fem.path_volume[1:]
-    ax[1].plot(V, fem.path_pressure[1:], "-", label="FEM")
-    ax[1].plot(V, reservoir.ellipse_pressure(V, d), "--", label="ellipse (11)-(18)")
-    ax[1].axvspan(*result.verdict["V_range_mm3"], color="0.9", label="operating range")
-    ax[1].set(xlabel="V [mm^3]", ylabel="p_r [MPa]", title="reservoir pressure p(V)")
-    theta = np.linspace(0, math.pi / 2, 91)
-    models = (("ellipse", "--"), ("fem", "-")) if d.reservoir_is_neo_hookean else (("ellipse", "--"),)
-    for name, style in models:  # the FEM-calibrated table is Neo-Hookean only
-        P = hand.pressure(theta, d.replace(reservoir_model=name))
-        ax[2].plot(np.degrees(theta), P, style, label=f"reservoir model '{name}'")
-    ax[2].plot(np.degrees(theta), hand.pressure(theta, d, reservoir=False), ":", label="no reservoir")
-    ax[2].set(xlabel="theta [deg]", ylabel="P [MPa]", title="pump pressure P(theta), eq. (27)")
-    for a in ax:
-        a.grid(alpha=0.3)
-        a.legend(fontsize=8)
-    save_figure(fig, path)

@@ -11,8 +11,10 @@ theta varied by the object's depth), ``--plot`` draws it.
 from __future__ import annotations
 
 import sys
+from pathlib import Path
 
 from softhand.reduced.errors import InputError
+from softhand.reduced.paper import FIG8
 from softhand.studies.cli.args import add_design_option, add_json_option, design_from_args, parse_values, \
     print_json, print_table
 from softhand.studies.io.files import kept_if_unwritable
@@ -114,7 +116,13 @@ def _one(case, args) -> dict:
 
     if not args.no_cache:
         print("softhand weights: running the grasp FEM (or reading the cache)...", file=sys.stderr)
-    return weights(case, cache=not args.no_cache, out=args.out)
+    result = weights(case, cache=not args.no_cache, out=args.out)
+    if args.out:
+        from softhand.studies.io.files import write_json
+
+        with kept_if_unwritable(Path(args.out) / "result.json", "weights"):
+            write_json(Path(args.out) / "result.json", result)
+    return result
 
 
 def _print_one(result: dict) -> None:
@@ -171,5 +179,5 @@ def _fig8(args, case, pressures) -> int:
             if summary[f"{prefix}rms_error_kgf"] is not None:
                 print(f"F_v error, eq. (25) with {what} - FEM: rms {summary[f'{prefix}rms_error_kgf']:.3g} "
                       f"kgf, max {summary[f'{prefix}max_abs_error_kgf']:.3g} kgf "
-                      "(paper: model vs measured 0.22 / 0.39 kgf)")
+                      f"(paper: model vs measured {' / '.join(f'{g.error_kgf:g}' for g in FIG8)} kgf)")
     return 0

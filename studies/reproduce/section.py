@@ -1,0 +1,49 @@
+"""What a section of ``softhand reproduce`` is: the context it receives, its record, and the
+Markdown table its text uses. The section builders (:mod:`studies.reproduce.sections`,
+:mod:`studies.reproduce.fem_sections`) and the report (:mod:`studies.reproduce.core`) import
+this module, never each other.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Callable
+
+import numpy as np
+
+from softhand.reduced.design import HandDesign
+
+
+@dataclass(frozen=True)
+class Context:
+    """What every section receives."""
+
+    design: HandDesign  #: the hand (default: the paper's Table I)
+    quick: bool = False  #: CI-sized meshes and fewer points
+
+
+@dataclass(frozen=True)
+class Section:
+    """One result of the paper: ``build(ctx, outdir) -> (markdown, numbers)``."""
+
+    key: str  #: folder name under the output directory
+    title: str
+    needs: tuple[str, ...]  #: "module" or "module:attribute" that must exist
+    build: Callable  #: writes files into outdir; returns (markdown body, {name: number})
+    in_quick: bool = True  #: False: skipped by --quick (reported as such)
+
+
+
+def md_table(rows: list[dict], columns: list[str] | None = None, *, digits: int = 4) -> str:
+    """A Markdown table of ``rows`` (dicts); floats to ``digits`` significant digits."""
+    columns = columns or list(rows[0])
+
+    def cell(v):
+        if isinstance(v, (float, np.floating)):
+            return f"{v:.{digits}g}"
+        if isinstance(v, (list, tuple, np.ndarray)):
+            return "(" + ", ".join(cell(x) for x in v) + ")"
+        return str(v)
+
+    lines = ["| " + " | ".join(columns) + " |", "|" + "---|" * len(columns)]
+    lines += ["| " + " | ".join(cell(r.get(c, "")) for c in columns) + " |" for r in rows]
+    return "\n".join(lines)
