@@ -136,7 +136,7 @@ class SplitLaw(Law):
 class NeoHookean(SplitLaw):
     r"""Nearly incompressible Neo-Hookean rubber: mu/2 (J^{-2/3} I1 - 3) + kappa/2 (J - 1)^2.
 
-    The default kappa = 1000 mu (Poisson's ratio 0.4995) follows DESIGN.md.
+    The default kappa = 1000 mu (Poisson's ratio 0.4995) makes the rubber nearly incompressible.
     """
 
     mu: float = 1.15  #: initial shear modulus [MPa]

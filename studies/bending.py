@@ -1,6 +1,6 @@
 """Free bending of the finger under pressure: the FEM against eqs. (28) and (2).
 
-:func:`run` builds the finger FEM (:mod:`fem.finger`), follows the pressures and returns
+:func:`run` builds the finger FEM (:mod:`fem.hand.finger`), follows the pressures and returns
 one row per pressure with the reduced model's values next to the FEM's:
 
 * ``theta_reduced_deg``: eq. (28) (one finger, no reservoir) solved for theta at the same P;

@@ -6,7 +6,7 @@ Eq. (25) without grasp forces, with the reservoir's pressure p_r(V) = dW_r/dV, g
 
 where p_finger(theta) is the cavity pressure that bends a free finger to theta and
 Delta Q(theta) its cavity volume change. Here both come from the finger FEM (a bending
-sweep's (P, theta, dQ) rows), p_r from the reservoir-sheet FEM (:mod:`fem.reservoir`) at
+sweep's (P, theta, dQ) rows), p_r from the reservoir-sheet FEM (:mod:`fem.hand.reservoir`) at
 the oil volumes left; the reduced counterpart is eq. (27) (eq. (28) + the ellipse model with
 eq. (2)'s volume). The reservoir's pressure offset p_r(V0) is what the paper reads off
 Fig. 7 as "0.1 MPa lower pressure".

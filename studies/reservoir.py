@@ -1,6 +1,6 @@
 """The reservoir study: FEM inflation of the sheet against the paper's ellipse model (11)–(18).
 
-``run(study)`` inflates the clamped sheet (:mod:`fem.reservoir`) through the requested oil
+``run(study)`` inflates the clamped sheet (:mod:`fem.hand.reservoir`) through the requested oil
 volumes and through the operating range, and returns per volume the FEM pressure, apex
 height, strain energy, the ellipse model's values at the same volume, the largest vertical
 gap between the FEM wet-surface profile and the half-ellipse, and the verdict: the ellipse
@@ -51,7 +51,7 @@ class ReservoirStudy:
 class ReservoirStudyResult:
     study: ReservoirStudy
     rows: list  #: one dict per requested volume, keys COLUMNS
-    states: tuple = field(repr=False)  #: fem.reservoir.SheetState per requested volume
+    states: tuple = field(repr=False)  #: fem.hand.reservoir.SheetState per requested volume
     fem: ReservoirResult = field(repr=False)  #: the whole FEM path
     verdict: dict = field(default_factory=dict)  #: ellipse-model errors over the operating range
 

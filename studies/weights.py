@@ -1,7 +1,7 @@
 """Hinge weight vectors w from the grasp FEM, over object diameters; F_v against eq. (25).
 
 * :func:`weights` -- one grasp case (diameter, mass, cavity pressure, mesh) through the FEM
-  (:mod:`fem.grasp`), cached on disk by its inputs: w, theta, hinge angles, contact forces,
+  (:mod:`fem.hand.grasp`), cached on disk by its inputs: w, theta, hinge angles, contact forces,
   F_v from the FEM and from eq. (25) with this w at the same P, theta, m.
 * :func:`run` (:class:`WeightsStudy`) -- w(D) over diameters, and w at an unseen diameter
   by interpolation checked against the FEM there.
@@ -44,7 +44,7 @@ class WeightsCase:
     pressure_mpa: float = 0.8      #: cavity pressure of the first state
     dP_mpa: float = 0.05           #: pressure step to the second state
     mesh_size_mm: float = MESH_SIZE
-    depth_mm: float | None = None  #: object centre below the palm; None: fem.grasp.default_depth
+    depth_mm: float | None = None  #: object centre below the palm; None: fem.hand.grasp.default_depth
 
     def key(self) -> str:
         """Hash of the inputs, the cache format and the package version."""
@@ -114,7 +114,7 @@ def compute(case: WeightsCase, out=None) -> dict:
 
 
 def _write_vtk(out, model, states) -> None:
-    """The contact states as the scene series grasp.pvd (see :mod:`fem.scene`)."""
+    """The contact states as the scene series grasp.pvd (see :mod:`fem.hand.scene`)."""
     from softhand.fem.io import SceneSeries
     from softhand.fem.hand.scene import grasp_scene
 

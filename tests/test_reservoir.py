@@ -1,5 +1,5 @@
 """Reservoir sheet FEM: energy balance, plate limit, mesh convergence, the calibrated reduced
-model, the study and the CLI (issue 4). Coarse meshes; the default mesh only for one step."""
+model, the study and the CLI. Coarse meshes; the default mesh only for one step."""
 import json
 import math
 

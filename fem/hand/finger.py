@@ -1,6 +1,6 @@
 r"""The finger FEM: a fiber-reinforced rubber tube held by a hinged rigid shell, under pressure.
 
-Model (DESIGN.md, "The FEM models"; the paper's section II-B):
+Model (the paper's section II-B, with the choices the paper leaves open made explicit):
 
 * the NBR tube of :mod:`meshes.finger` (inner radius a, wall b, length l0 with an end cap
   of thickness ``cap`` at the tip), half model on the bending plane z = 0;

@@ -1,7 +1,7 @@
 """Case functions of the batch runner's kinds that have no module of their own.
 
 Each has the kind signature ``fn(case_params: dict, design, outdir) -> dict of numbers``
-(see :mod:`studies.studyfile`) and calls the owning library; imports stay inside the
+(see :mod:`studies.batch.studyfile`) and calls the owning library; imports stay inside the
 functions so a worker only imports what its kind needs.
 """
 from __future__ import annotations

@@ -10,8 +10,8 @@ own folder ``<out>/<section>/``, and returns its headline numbers. A section is
   size, design hash, code version): a killed or repeated run resumes where it
   stopped. ``fresh=True`` recomputes everything.
 
-A section's folder is written through the batch runner (:func:`studies.runner.execute_case`
-in a private temporary folder, then :func:`studies.runner.commit`: one rename), so an
+A section's folder is written through the batch runner (:func:`studies.batch.runner.execute_case`
+in a private temporary folder, then :func:`studies.batch.runner.commit`: one rename), so an
 interrupted run leaves nothing half-written. ``<out>/report.md`` and
 ``<out>/summary.csv`` are assembled from the section folders at the end.
 """

@@ -1,4 +1,5 @@
-r"""Verification cases of the 3D solid (issue 3, cases 1, 2, 3, 5, 6): closed form vs FEM.
+r"""Verification cases of the 3D solid (uniaxial tension, tubes in plane strain,
+locking, a fiber-wound tube, convergence rates, tangent and Newton): closed form vs FEM.
 
 All cases use the mean-dilatation P2-P0 solid of :mod:`fem.solid` on quadratic
 (isoparametric) tetrahedra, the follower pressure of :mod:`fem.loads` and Newton with
