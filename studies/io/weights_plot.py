@@ -44,6 +44,13 @@ def plot_fig8(path, case, rows: list[dict]) -> None:
 
     plt = _pyplot()
     fig, ax = plt.subplots(figsize=(6, 4))
+    draw_fig8(ax, case, rows)
+    ax.set_title(f"D = {case.diameter_mm:g} mm, m = {case.mass_kg:g} kg (cavity pressure)")
+    save_figure(fig, path)
+
+
+def draw_fig8(ax, case, rows: list[dict]) -> None:
+    """The Fig. 8 analogue of :func:`studies.weights.fig8`'s ``rows`` on the axes ``ax``."""
     for k, P in enumerate(sorted({r["P_MPa"] for r in rows})):
         pts = [r for r in rows if r["P_MPa"] == P]
         color = f"C{k}"
@@ -56,6 +63,5 @@ def plot_fig8(path, case, rows: list[dict]) -> None:
                 label=f"eq. (25) {P:g} MPa")
     ax.set_xlabel("bend angle theta [deg]")
     ax.set_ylabel("F_v [kgf]")
-    ax.set_title(f"D = {case.diameter_mm:g} mm, m = {case.mass_kg:g} kg (cavity pressure)")
+    ax.grid(alpha=0.3)
     ax.legend(fontsize=7)
-    save_figure(fig, path)

@@ -176,7 +176,7 @@ are shown normalised (its 180 mm vector sums to 1.40 as printed).
 
 def fig8_fem(ctx: Context, outdir: Path):
     """Fig. 8 analogue with FEM points: F_v by grasp FEM and by eq. (25) at the same (P, θ)."""
-    from softhand.reduced.grasp import KGF
+    from softhand.studies.io.weights_plot import draw_fig8
     from softhand.studies.weights import WeightsCase, fig8, fig8_errors
 
     fig, axes = figure(2)
@@ -184,18 +184,15 @@ def fig8_fem(ctx: Context, outdir: Path):
     for ax, (D, mass, pressures, _, paper_error) in zip(axes, paper.FIG8):
         chosen = (pressures[0], pressures[-1]) if ctx.quick else pressures
         offsets = (0.0,) if ctx.quick else (0.0, 10.0, 20.0)
-        rows = fig8(WeightsCase(design=ctx.design, diameter_mm=D, mass_kg=mass), chosen, offsets)
+        case = WeightsCase(design=ctx.design, diameter_mm=D, mass_kg=mass)
+        rows = fig8(case, chosen, offsets)
         write_csv(outdir / f"fig8_fem_{D:.0f}mm.csv", rows)
         errors = fig8_errors(rows)
         summary.append({"diameter_mm": D, "mass_kg": mass, "points": len(rows), **errors,
                         "paper_error_vs_measurement_kgf": paper_error})
         numbers |= {f"{k}_{D:.0f}mm": v for k, v in errors.items() if v is not None}
-        theta = [r["theta_deg"] for r in rows]
-        ax.plot(theta, [r["F_v_fem_N"] / KGF for r in rows], "o", label="FEM")
-        ax.plot(theta, [r["F_v_reduced_N"] / KGF for r in rows], "x", label="eq. (25), FEM w")
-        ax.set(xlabel="bend angle θ [deg]", ylabel="F_v [kgf]", title=f"{mass:g} kg, {D:g} mm")
-        ax.grid(alpha=0.3)
-        ax.legend(fontsize=8)
+        draw_fig8(ax, case, rows)
+        ax.set_title(f"{mass:g} kg, {D:g} mm")
     save_figure(fig, outdir / "fig8_fem.png")
     text = f"""Grasp FEM at the paper's grasp pressures ({'two pressures, one object depth' if ctx.quick
 else 'four pressures, three object depths'}); each point is a converged contact state, and

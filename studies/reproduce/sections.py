@@ -231,26 +231,13 @@ F_v(c) = {F['c_push_angle_control']:.3f} kgf, F_v(b) = {F['b_push_pressure_contr
 
 def fig10_control(ctx: Context, outdir: Path):
     """Fig. 10 analogue: finger angles and pressure against time, angle vs pressure control."""
+    from softhand.studies.io.control_files import plot_fig10, series_rows
+
     result = _flexibility(ctx)
-    sim, sp = result.angle, result.pressure
-    fig, (ax1, ax2) = figure(2)
-    ax1.plot(sim.t, np.degrees(sim.theta), lw=0.8)
-    ax1.plot(sim.t, np.degrees(sim.theta_mean), "k", lw=1.5, label="mean, angle control")
-    ax1.plot(sp.t, np.degrees(sp.theta_mean), "k:", lw=1.5, label="mean, pressure control")
-    ax1.set(xlabel="t [s]", ylabel="bend angle θ [deg]", title="Fig. 10 (c) analogue")
-    ax2.plot(sim.t, sim.P, label="angle control")
-    ax2.plot(sp.t, sp.P, ":", label="pressure control")
-    ax2.set(xlabel="t [s]", ylabel="pump pressure P [MPa]", title="Fig. 10 (d) analogue")
-    for ax in (ax1, ax2):
-        ax.axvline(PUSH_AT_S, color="grey", lw=0.6)
-        ax.grid(alpha=0.3)
-        ax.legend(fontsize=8)
-    save_figure(fig, outdir / "fig10_control.png")
+    sim = result.angle
+    plot_fig10(outdir / "fig10_control.png", result, "angle", 50.0)
     every = max(1, int(round(0.01 / (sim.t[1] - sim.t[0]))))  # the CSV at 100 Hz
-    write_csv(outdir / "fig10_control.csv", [
-        {"t_s": t, "P_MPa": P, "theta_mean_deg": m, **{f"theta_{j + 1}_deg": a for j, a in enumerate(th)}}
-        for t, P, m, th in zip(sim.t[::every], sim.P[::every], np.degrees(sim.theta_mean[::every]),
-                               np.degrees(sim.theta[::every]))])
+    write_csv(outdir / "fig10_control.csv", series_rows(sim, every))
     s = result.angle_summary
     numbers = {"settling_time_s": s.settling_time, "theta_error_deg": math.degrees(s.theta_error),
                "P_before_MPa": s.P_before, "P_during_MPa": s.P_during,
@@ -261,7 +248,7 @@ def fig10_control(ctx: Context, outdir: Path):
 Settling time {s.settling_time:.2f} s (±1°), steady error {math.degrees(s.theta_error):.3f}°;
 pressure {s.P_before:.3f} MPa before and {s.P_during:.3f} MPa during the push; mean angle
 {math.degrees(s.theta_before):.2f}° before and {math.degrees(s.theta_during):.2f}° during it.
-In the paper the pressure drops under the push (0.89 → 0.79 MPa).
+In the paper the pressure drops under the push ({paper.TABLE_II['b_push_pressure_control'][0]} → {paper.TABLE_II['c_push_angle_control'][0]} MPa).
 
 ![Fig. 10 analogue](fig10_control.png)
 """

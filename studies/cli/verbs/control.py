@@ -27,7 +27,8 @@ from softhand.reduced.errors import InputError
 from softhand.reduced.plant import HandTables, PlantParams, Push
 from softhand.studies.cli.args import add_design_option, add_json_option, check_range, design_from_args, \
     print_json, print_table
-from softhand.studies.io.files import kept_if_unwritable, save_figure, write_csv, write_json
+from softhand.studies.io.control_files import plot_fig10, series_rows
+from softhand.studies.io.files import kept_if_unwritable, write_csv, write_json
 
 HELP = "simulate angle control (eqs. 30, 31) vs pressure control under a push (Table II, Fig. 10)"
 DISTURBANCE_HEADER = ("t_s", "force_N")
@@ -182,45 +183,6 @@ def _summary_dict(s) -> dict:
             "push_start_s": s.push_start, "push_end_s": s.push_end}.items()}
 
 
-def _series_rows(sim, every: int) -> list[dict]:
-    """The time series at the sensor rate (every ``every``-th integration step)."""
-    theta = np.degrees(sim.theta[::every])
-    columns = {"t_s": sim.t[::every], "P_MPa": sim.P[::every], "P_ref_MPa": sim.P_ref[::every],
-               "theta_mean_deg": theta.mean(axis=1),
-               **{f"theta_{j + 1}_deg": theta[:, j] for j in range(theta.shape[1])},
-               "V_mm3": sim.V[::every], "push_N": sim.force[::every], "flow_limit": sim.flow_limit[::every]}
-    return [dict(zip(columns, row)) for row in zip(*(c.tolist() for c in columns.values()))]
-
-
-def _plot(result, mode: str, theta_ref_deg: float, path: str) -> None:
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    sim, other = (result.angle, result.pressure) if mode == "angle" else (result.pressure, result.angle)
-    fig, (ax1, ax2) = plt.subplots(2, 1, figsize=(7, 6), sharex=True)
-    for j in range(sim.theta.shape[1]):
-        ax1.plot(sim.t, np.degrees(sim.theta[:, j]), lw=0.9, label=f"finger {j + 1}")
-    ax1.plot(sim.t, np.degrees(sim.theta_mean), "k", lw=1.6, label=f"mean, {mode} control")
-    ax1.plot(other.t, np.degrees(other.theta_mean), "k:", lw=1.4, label="mean, other mode")
-    ax1.axhline(theta_ref_deg, color="grey", ls="--", lw=0.8, label="θ_ref")
-    ax1.set(ylabel="bend angle θ [deg]", title="Fig. 10 (c) analogue")
-    ax2.plot(sim.t, sim.P, lw=1.4, label=f"P, {mode} control")
-    ax2.plot(sim.t, sim.P_ref, lw=0.8, alpha=0.7, label="P_ref (controller)")
-    ax2.plot(other.t, other.P, ":", lw=1.2, label="P, other mode")
-    ax2.set(xlabel="t [s]", ylabel="pump pressure P [MPa]", title="Fig. 10 (d) analogue")
-    twin = ax2.twinx()
-    twin.plot(sim.t, sim.force, color="tab:red", lw=0.8, alpha=0.6, label="external push (right axis)")
-    twin.set_ylabel("push [N]", color="tab:red")
-    ax1.grid(alpha=0.3)
-    ax1.legend(fontsize=7, loc="lower right", ncol=2, title="bend angle of each finger and their mean",
-               title_fontsize=7)
-    ax2.grid(alpha=0.3)
-    lines = ax2.get_lines() + twin.get_lines()
-    ax2.legend(lines, [line.get_label() for line in lines], fontsize=7, loc="lower right")
-    save_figure(fig, path)
-
-
 def run(args) -> int:
     _check_inputs(args)
     design, plant_design, plant, w, push, force, gains = _setup(args)
@@ -241,12 +203,12 @@ def run(args) -> int:
     if args.out:
         out = Path(args.out)
         with kept_if_unwritable(out, "control"):
-            write_csv(out / "control_angle.csv", _series_rows(result.angle, plant.steps_per_sample))
-            write_csv(out / "control_pressure.csv", _series_rows(result.pressure, plant.steps_per_sample))
+            write_csv(out / "control_angle.csv", series_rows(result.angle, plant.steps_per_sample))
+            write_csv(out / "control_pressure.csv", series_rows(result.pressure, plant.steps_per_sample))
             write_json(out / "summary.json", report)
     if args.plot:
         with kept_if_unwritable(args.plot, "control"):
-            _plot(result, args.mode, args.theta_ref_deg, args.plot)
+            plot_fig10(args.plot, result, args.mode, args.theta_ref_deg)
     if result.angle_summary.P_before >= plant.P_max - 1e-3:
         print(f"softhand control: warning: angle control saturates the pump at P_max = {plant.P_max:g} MPa "
               f"before the push; theta_ref is not reached", file=sys.stderr)
