@@ -1,41 +1,42 @@
-"""The hinge weight vector w for an object the paper did not grasp, and the force it predicts.
+"""The hinge weight vector w for an object the paper did not grasp, and the pressure to hold it.
 
 The paper gives w (eqs. (21)-(23)) for a 180 mm and a 240 mm object only. For another
-diameter the grasp FEM closes the finger on the rigid object at a cavity pressure P and at
-P + dP; w is how the hinges share the extra bend between the two contact states,
-w = dq / sum(dq). With it the reduced model's eq. (25) -> (29) gives the grasping force F_v.
-Results are cached on disk by their inputs, so a second run takes about a second.
+diameter the kinematics give one in milliseconds: place the object as the grasp FEM does,
+close the finger until a pad touches it, and take the smallest hinge motion, summing to 1,
+that keeps that pad rolling on the object (the hinges beyond it share equally, those
+before it roll the pad). With that w, eqs. (25), (29) give the pump pressure that holds
+a mass with a given normal force.
+
+The grasp FEM computes w with the rubber's stiffness in it (minutes per diameter, cached):
+``softhand weights --diameter-mm 210`` or ``studies.weights.weights(WeightsCase(diameter_mm=210))``.
 """
 import math
 
 import numpy as np
 
-from softhand.reduced import contact
+from softhand.reduced import contact, grasp, kinematics
 from softhand.reduced.design import load_design
-from softhand.reduced.grasp import KGF, grasp_forces
-from softhand.studies.weights import WeightsCase, weights
 
 design = load_design()
-case = WeightsCase(design=design, diameter_mm=210.0, mass_kg=0.0, pressure_mpa=0.8,
-                   dP_mpa=0.05, mesh_size_mm=10.0)    # the coarse CI mesh (~4 400 unknowns)
-r = weights(case)
-w = np.array(r["w"])
-N = np.array(r["contact_force_N"])                    # per link pad, base .. tip [N]
-link = int(np.argmax(N))
-print(f"D = {case.diameter_mm:g} mm, P = {r['P_MPa']} MPa: theta = {r['theta_deg']:.2f} deg, "
-      f"pad {link} touches (N = {N[link]:.2f} N); w = {np.round(w, 3)}")
+D, mass = 210.0, 2.0                                   # object diameter [mm], mass [kg]
+depth = contact.object_depth(D, design)               # centre below the palm [mm]
+theta, link = contact.contact_angle(D, design, depth=depth)   # first touch, closing freely
+q = kinematics.hinge_angles(theta, np.full(design.n_s, 1.0 / design.n_s))
+w = contact.rolling_weights(q, D, link, design, depth=depth)
+print(f"D = {D:g} mm at depth {depth:.1f} mm: pad {link} touches at theta = "
+      f"{math.degrees(theta):.2f} deg; w = {np.round(w, 3)} (sum {w.sum():.3f})")
 
-# The reduced model with this w, at the FEM's own (P, theta); eq. (25) without the reservoir
-# term at the cavity pressure, as the FEM has none.
-F = grasp_forces(r["P_MPa"], math.radians(r["theta_deg"]), case.mass_kg, w, design, reservoir=False)
-print(f"F_v: eq. (25) with the FEM's w {F.F_v / KGF:.3f} kgf, grasp FEM {r['F_v_fem_N'] / KGF:.3f} kgf")
+for F_v in (0.0, 5.0):                                 # just touching; pressing with 5 N
+    P = grasp.pressure_to_hold(mass, theta, w, design, F_v=F_v)
+    print(f"pump pressure to hold {mass:g} kg with F_v = {F_v:g} N: {float(P):.4f} MPa")
 
-# An independent estimate of w from kinematics alone: the least hinge motion, summing to 1,
-# that keeps the touching pad rolling on the object (no FEM, no rubber, no pressure) at the
-# FEM's hinge angles and object placement. The FEM's tube is not equally stiff at every
-# hinge, so the two differ by a few hundredths where the contact regime is the same.
-rolling = contact.rolling_weights(np.radians(r["hinge_deg"]), case.diameter_mm, link, design,
-                                  depth=r["depth_mm"])
-difference = float(np.max(np.abs(rolling - w)))
-print(f"rolling kinematics: w = {np.round(rolling, 3)}; largest difference {difference:.3f}")
-assert difference < 0.05, difference
+# The check, by finite differences of the pad's gap (not the analytic gradient w is built
+# from): moving the hinges along w keeps the touching pad on the object, to first order,
+# while closing all hinges equally would push it into the object.
+gap = lambda hinges: contact.pad_gaps(hinges, (0.0, depth), D / 2, design)[link]
+h = 1e-5
+rate = (gap(q + h * w) - gap(q - h * w)) / (2 * h)     # [mm/rad]
+uniform = np.full(design.n_s, 1.0 / design.n_s)
+rate_uniform = (gap(q + h * uniform) - gap(q - h * uniform)) / (2 * h)
+print(f"d gap / d theta along w {rate:.2e} mm/rad; closing uniformly {rate_uniform:.2f} mm/rad")
+assert abs(rate) < 1e-6 * abs(rate_uniform), (rate, rate_uniform)
