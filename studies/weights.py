@@ -136,7 +136,7 @@ def weights(case: WeightsCase, *, cache: bool = True, out=None) -> dict:
         entry = read_entry(path, case.key())
         if entry is not None:
             return {**entry, "cached": True}
-    result = compute(case, out)
+    result = compute(case) if out is None else compute(case, out)
     if cache:
         write_entry(path, case.key(), result)
     return {**result, "cached": False}
