@@ -23,7 +23,8 @@ from pathlib import Path
 import numpy as np
 
 from softhand.reduced.design import design_from_dict, load_design
-from softhand.reduced.grasp import PAPER_WEIGHTS, angle_at
+from softhand.reduced import paper
+from softhand.reduced.grasp import angle_at
 from softhand.reduced.hand import bend_angle
 from softhand.studies.io.files import write_atomic
 
@@ -51,9 +52,10 @@ def bending(design, rng) -> str:
 
 
 def grasp(design, rng) -> str:
-    w, mass, diameter = PAPER_WEIGHTS[180.0], 2.0, 180.0
+    fig8 = paper.FIG8[0]  # the paper's 180 mm / 2 kg object at its Fig. 8 pressures
+    w, mass, diameter = paper.WEIGHTS[fig8.diameter_mm], fig8.mass_kg, fig8.diameter_mm
     rows = []
-    for P in (0.6, 0.7, 0.8, 0.9):
+    for P in fig8.pressures_mpa:
         for F_v in (2.0, 4.0, 6.0):
             theta = float(np.degrees(angle_at(P, mass, w, design, F_v=F_v)))
             rows.append((P, round(theta, 2), F_v + SIGMA_F_V_N * rng.standard_normal()))
