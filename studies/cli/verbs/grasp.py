@@ -6,6 +6,11 @@ name of one of the paper's vectors (``--weights paper180``), or from the grasp F
 object diameter (``--diameter-mm D``: :mod:`studies.weights`, cached; the first call for a
 new diameter runs the FEM). ``w_source`` in the output says which. Axes and signs:
 docs/conventions.md (F_v > 0: the finger squeezes).
+
+``--model fem`` (with ``--diameter-mm D``) replaces eq. (25) by the FEM-informed estimate of
+:mod:`reduced.grasp_fem`: the calibrated finger in equilibrium hinge by hinge against the
+object, touching where the geometry says; P is converted to the cavity pressure with the
+reservoir at theta, and the object's depth is the one that gives theta.
 """
 from __future__ import annotations
 
@@ -24,6 +29,8 @@ from softhand.studies.cli.args import add_design_option, add_json_option, design
 PAPER_NAMES = {f"paper{D:g}": D for D in grasp.PAPER_WEIGHTS}
 
 HELP = "grasping forces F_x, F_y, F_v at a pressure, bend angle and mass (eqs. 24, 25, 29)"
+#: --model: eq. (25) as printed, or the FEM-informed estimate (reduced.grasp_fem)
+MODELS = ("paper", "fem")
 
 
 def configure(parser) -> None:
@@ -38,6 +45,9 @@ def configure(parser) -> None:
     which.add_argument("--diameter-mm", metavar="D",
                        help="object diameter [mm]: w from the grasp FEM (cached; see softhand weights)")
     parser.add_argument("--normalise", action="store_true", help="scale w to sum to 1 (eq. (23))")
+    parser.add_argument("--model", default="paper", metavar="|".join(MODELS),
+                        help="paper: eq. (25) with w (default); fem: the calibrated finger in "
+                             "equilibrium against the object where it touches (needs --diameter-mm)")
     add_design_option(parser)
     add_json_option(parser)
 
@@ -94,11 +104,40 @@ def evaluate(P: float, theta_deg: float, mass: float, w, design) -> dict:
             "P_free_MPa": float(hand.pressure(theta, design))}
 
 
+def evaluate_fem(P: float, theta_deg: float, mass: float, diameter: float, design) -> dict:
+    """One grasp state by the FEM-informed model at pump pressure P [MPa] -> the flat result."""
+    from softhand.reduced import grasp_fem
+
+    theta = math.radians(theta_deg)
+    fem = grasp_fem.fem_finger(design)
+    P_cavity = P + float(hand.pressure(theta, fem, reservoir=False) - hand.pressure(theta, fem))
+    s = grasp_fem.grasp_state_at_angle(design, diameter, P_cavity, theta, mass)
+    return {"P_MPa": P, "theta_deg": theta_deg, "mass_kg": mass,
+            "F_x_N": float(s.F[0]), "F_y_N": float(s.F[1]), "F_v_N": s.F_v, "F_v_kgf": s.F_v / grasp.KGF,
+            "model": "fem", "diameter_mm": diameter, "P_cavity_MPa": P_cavity,
+            "contact_link": s.link, "contact_force_N": s.N, "contact_point_mm": s.point.tolist() if s.link >= 0 else None,
+            "depth_mm": s.depth, "hinge_deg": np.degrees(s.q).tolist(),
+            "P_free_MPa": float(hand.pressure(theta, fem))}
+
+
+def _model(args) -> str:
+    model = args.model.strip()
+    if model not in MODELS:
+        raise InputError("--model", args.model, f"must be one of {', '.join(MODELS)}")
+    if model == "fem" and (args.weights is not None or args.normalise):
+        raise InputError("--model", args.model, "takes the object's --diameter-mm, not --weights "
+                                                "or --normalise")
+    return model
+
+
 def run(args) -> int:
     design = design_from_args(args)
     P = _scalar(args.pressure_mpa, "--pressure-mpa")
     theta_deg = _scalar(args.theta_deg, "--theta-deg")
     mass = _scalar(args.mass_kg, "--mass-kg")
+    if _model(args) == "fem":
+        diameter = _scalar(args.diameter_mm, "--diameter-mm")
+        return _print(args, evaluate_fem(P, theta_deg, mass, diameter, design))
     if args.weights is not None and args.weights.strip() not in PAPER_NAMES:
         try:
             with warnings.catch_warnings():
@@ -107,9 +146,13 @@ def run(args) -> int:
         except InputError as exc:
             raise exc.renamed("--weights") from None
     w, source, notes = _weights(args, design, mass)
-    result = evaluate(P, theta_deg, mass, w, design) | {"w_source": source}
+    result = evaluate(P, theta_deg, mass, w, design) | {"model": "paper", "w_source": source}
     for note in notes:  # only once the inputs are known to be good
         print(f"softhand grasp: warning: {note}", file=sys.stderr)
+    return _print(args, result)
+
+
+def _print(args, result: dict) -> int:
     if args.json:
         print_json(result)
     else:

@@ -1,0 +1,136 @@
+"""softhand.reduced.grasp_fem: the energy's gradient by differences, the lever law on one link in
+closed form, virtual work of the contact force by differences of positions, the angle mode,
+and agreement with stored grasp FEM states (tests/data/grasp_fem_states.json)."""
+import json
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from softhand.reduced import contact, grasp, grasp_fem, hand, kinematics
+from softhand.reduced.design import HandDesign
+from softhand.reduced.errors import InputError
+from softhand.studies.cli.main import main
+
+DESIGN = grasp_fem.fem_finger(HandDesign())
+STATES = json.loads((Path(__file__).parent / "data" / "grasp_fem_states.json").read_text())
+
+
+def test_hinge_moments_are_the_gradient_of_the_hinge_energy():
+    q, h = np.radians([1.0, 3.0, 5.0, -2.0, 8.0]), 1e-6
+    fd = [(grasp_fem.hinge_energy(q + h * e, 0.7, DESIGN) - grasp_fem.hinge_energy(q - h * e, 0.7, DESIGN))
+          / (2 * h) for e in np.eye(DESIGN.n_s)]
+    np.testing.assert_allclose(grasp_fem.hinge_moments(q, 0.7, DESIGN), fd, rtol=1e-6, atol=1e-5)
+
+
+def test_without_contact_every_hinge_bends_as_the_free_finger():
+    s = grasp_fem.grasp_state(DESIGN, 180.0, 0.8, depth_mm=400.0)  # far below the finger
+    free = float(hand.bend_angle(0.8, DESIGN, reservoir=False))
+    assert s.link == -1 and s.F_v == 0.0
+    assert s.theta == pytest.approx(free, rel=1e-12)
+    np.testing.assert_allclose(grasp_fem.hinge_moments(s.q, 0.8, DESIGN), 0.0, atol=1e-6)
+
+
+def test_one_link_contact_is_the_lever_law():
+    """Pad 1 touches (160 mm object at depth 70 mm): only hinge 1 is held; the pad is tangent to
+    the circle, closed form for its angle, and N s = -M_1 with s the distance from hinge 1."""
+    D, depth, P = 160.0, 70.0, 1.0
+    s = grasp_fem.grasp_state(DESIGN, D, P, depth_mm=depth)
+    assert s.link == 1
+    p1 = kinematics.joint_positions(np.zeros(DESIGN.n_s), DESIGN)[1]   # hinge 1 does not move
+    v, R = np.array([0.0, depth]) - p1, 0.5 * D
+    # inward distance of the centre from the pad's line = R: -(v_x cos a + v_y sin a) = R
+    phi = math.atan2(v[1], v[0])
+    alphas = phi + np.array([1.0, -1.0]) * math.acos(-R / np.hypot(*v))
+    alpha = alphas[np.argmin(np.abs(alphas + DESIGN.theta0))]
+    assert s.q[0] == pytest.approx(alpha + DESIGN.theta0, abs=1e-9)
+    n_out = np.array([math.cos(alpha), math.sin(alpha)])
+    x = np.array([0.0, depth]) + R * n_out
+    lever = (x - p1) @ [-math.sin(alpha), math.cos(alpha)]
+    np.testing.assert_allclose(s.point, x, atol=1e-7)
+    M1 = grasp_fem.hinge_moments(s.q, P, DESIGN)[0]
+    assert s.N == pytest.approx(-M1 / lever, rel=1e-8)
+    tip = s.q.sum() - DESIGN.theta0
+    assert s.F_v == pytest.approx(s.N * math.cos(tip - alpha), rel=1e-8)
+
+
+@pytest.mark.parametrize("diameter, P, mass", [(180.0, 0.8, 2.0), (210.0, 1.0, 0.0), (240.0, 1.25, 6.0)])
+def test_the_contact_force_does_the_energys_virtual_work(diameter, P, mass):
+    """dE = F . dx for every virtual hinge motion, x the pad's material point at the contact,
+    both sides by central differences (kinematics only, not the contact code)."""
+    s = grasp_fem.grasp_state(DESIGN, diameter, P, mass)
+    assert s.link >= 1
+    joints = kinematics.joint_positions(s.q, DESIGN)
+    along = float(np.linalg.norm(s.point - joints[s.link]))
+
+    def point(q):
+        a = kinematics.link_angles(q, DESIGN)[s.link]
+        return kinematics.joint_positions(q, DESIGN)[s.link] + along * np.array([-math.sin(a), math.cos(a)])
+
+    h = 1e-6
+    for dq in np.random.default_rng(5).normal(size=(4, DESIGN.n_s)):
+        dE = (grasp_fem.hinge_energy(s.q + h * dq, P, DESIGN) - grasp_fem.hinge_energy(s.q - h * dq, P, DESIGN)) / (2 * h)
+        dW = s.F @ (point(s.q + h * dq) - point(s.q - h * dq)) / (2 * h)
+        assert dE == pytest.approx(dW, rel=1e-5, abs=1e-3)
+
+
+def test_tip_contact_is_eq_25s_virtual_work_balance():
+    """The tip corner touching (150 mm object at depth 180 mm): eq. (25)'s balance, the tip force
+    through the tip Jacobian (20) of eq. (25) at theta_hat = w theta, holds along the state's
+    own w = q / theta, and with the tip Jacobian at the state along any w."""
+    P, mass = 1.4, 2.0
+    s = grasp_fem.grasp_state(DESIGN, 150.0, P, mass, depth_mm=180.0)
+    assert s.link == DESIGN.n_s
+    np.testing.assert_allclose(s.point, kinematics.tip_position(s.q, DESIGN), atol=1e-9)
+    M = grasp_fem.hinge_moments(s.q, P, DESIGN)
+    w = s.q / s.theta
+    J_xw, J_yw = grasp.projected_jacobian(s.theta, w, DESIGN)
+    assert w @ M == pytest.approx(s.F[0] * J_xw + s.F[1] * J_yw, rel=1e-8)
+    J_x, J_y = kinematics.jacobian(s.q, DESIGN)
+    for v in np.random.default_rng(2).normal(size=(3, DESIGN.n_s)):
+        assert v @ M == pytest.approx(s.F[0] * (J_x @ v) + s.F[1] * (J_y @ v), rel=1e-8, abs=1e-6)
+
+
+def test_angle_mode_inverts_the_placement():
+    s = grasp_fem.grasp_state(DESIGN, 180.0, 0.8, 2.0, depth_mm=110.0)
+    t = grasp_fem.grasp_state_at_angle(DESIGN, 180.0, 0.8, s.theta, 2.0)
+    assert t.depth == pytest.approx(110.0, abs=1e-6)
+    assert t.F_v == pytest.approx(s.F_v, rel=1e-6)
+    assert grasp_fem.vertical_force(DESIGN, 180.0, 0.8, s.theta, 2.0) == pytest.approx(s.F_v, rel=1e-6)
+    free = float(hand.bend_angle(0.8, DESIGN, reservoir=False))
+    assert grasp_fem.vertical_force(DESIGN, 180.0, 0.8, free + 0.01, 2.0) == 0.0  # not pressing
+
+
+def test_an_angle_the_object_cannot_hold_is_refused():
+    with pytest.raises(InputError, match="theta_deg"):
+        grasp_fem.grasp_state_at_angle(DESIGN, 240.0, 1.25, math.radians(0.5), 6.0)
+
+
+@pytest.mark.parametrize("state", STATES["states"], ids=lambda s: s["label"])
+def test_agrees_with_the_grasp_fem(state):
+    """Same object, placement, cavity pressure and mass as a stored grasp FEM state (the command
+    that made it is stored with it): F_v within 10 % or 0.05 kgf, the larger."""
+    F_v = grasp_fem.vertical_force(DESIGN, state["diameter_mm"], state["P_MPa"], mass_kg=state["mass_kg"],
+                                   depth_mm=state["depth_mm"])
+    assert abs(F_v - state["F_v_fem_N"]) <= max(0.1 * state["F_v_fem_N"], 0.05 * grasp.KGF)
+
+
+def test_cli_model_fem_and_its_bad_inputs(capsys):
+    argv = ["grasp", "--pressure-mpa", "0.7", "--theta-deg", "15", "--mass-kg", "2"]
+    assert main([*argv, "--diameter-mm", "180", "--model", "fem", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["model"] == "fem" and out["contact_link"] == 2
+    P_cavity = 0.7 + float(hand.pressure(math.radians(15), DESIGN, reservoir=False)
+                           - hand.pressure(math.radians(15), DESIGN))
+    assert out["P_cavity_MPa"] == pytest.approx(P_cavity, rel=1e-12)
+    assert out["F_v_N"] == pytest.approx(grasp_fem.vertical_force(
+        DESIGN, 180.0, P_cavity, math.radians(15), 2.0), rel=1e-9)
+    assert main([*argv, "--weights", "paper180", "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["model"] == "paper"
+    for extra, field in ((["--diameter-mm", "180", "--model", "fe"], "--model"),
+                         (["--weights", "paper180", "--model", "fem"], "--model"),
+                         (["--diameter-mm", "100", "--model", "fem"], "theta_deg")):
+        assert main([*argv, *extra]) == 2
+        err = capsys.readouterr().err
+        assert err.count("\n") == 1 and field in err
