@@ -65,12 +65,12 @@ def pad_gaps(theta_hat, centre, radius: float, design: HandDesign):
     return np.where(facing, rho - radius, np.inf)
 
 
-def pad_motion(theta_hat, centre, link: int, design: HandDesign):
-    """(x*, nu, dx): the closest point x* (2,) [mm] of pad ``link`` to ``centre``, the unit
-    vector nu (2,) from x* to the centre, and dx*/d theta_hat (n_s, 2) [mm/rad] (zero beyond
-    the link) at hinge angles theta_hat (n_s,) [rad]."""
+def pad_motion(theta_hat, centre, link: int, design: HandDesign, *, end: bool = False):
+    """(x*, nu, dx): the closest point x* (2,) [mm] of pad ``link`` to ``centre`` (``end``: the
+    pad's far end, the next joint), the unit vector nu (2,) from x* to the centre, and
+    dx*/d theta_hat (n_s, 2) [mm/rad] (zero beyond the link) at hinge angles theta_hat (n_s,) [rad]."""
     x, _, p = _closest(np.asarray(theta_hat, float), centre, design)
-    xs = x[link]
+    xs = p[link + 1] if end else x[link]
     nu = (np.asarray(centre, float) - xs) / np.linalg.norm(np.asarray(centre, float) - xs)
     turns = np.arange(1, design.n_s + 1) <= link      # hinge j turns link k when j <= k
     dx = np.where(turns[:, None], (xs - p[1:-1]) @ OMEGA.T, 0.0)  # hinge j turns x* about x_j

@@ -143,34 +143,36 @@ def hinge_energy(q, P: float, design: HandDesign) -> float:
     return total
 
 
-def _load(q, centre, link: int, weight: float, design: HandDesign):
-    """(centre distance, dg/dq, generalised weight force (n_s,), x*, nu, tangent) of pad ``link``."""
-    xs, nu, dx = contact.pad_motion(q, centre, link, design)
+def _load(q, centre, link: int, weight: float, design: HandDesign, corner: bool = False):
+    """(centre distance, dg/dq, generalised weight force (n_s,), x*, nu, tangent) of pad ``link``
+    (``corner``: touching with its far end, the hinge it shares with the next pad)."""
+    xs, nu, dx = contact.pad_motion(q, centre, link, design, end=corner)
     alpha = kinematics.link_angles(q, design)[link]
     t = np.array([-math.sin(alpha), math.cos(alpha)])
     rho = float(np.linalg.norm(np.asarray(centre) - xs))  # the caller subtracts the radius
     return rho, -dx @ nu, weight * (dx @ t), xs, nu, t
 
 
-def _state(P, depth, q, link, N, weight, design) -> GraspState:
+def _state(P, depth, q, link, N, weight, design, corner=False) -> GraspState:
     if link < 0:
         return GraspState(P, depth, q, -1, 0.0, np.full(2, np.nan), np.zeros(2), 0.0)
-    _, _, _, xs, nu, t = _load(q, (0.0, depth), link, weight, design)
+    _, _, _, xs, nu, t = _load(q, (0.0, depth), link, weight, design, corner)
     F = -N * nu + weight * t
     alpha = q.sum() - design.theta0
     return GraspState(P, depth, q, link, float(N), xs, F, float(F @ [math.cos(alpha), math.sin(alpha)]))
 
 
-def _solve_link(P, depth, radius, link, weight, q0, design):
-    """Hinges 1..link and N with pad ``link`` on the object; distal hinges as q0's."""
+def _solve_link(P, depth, radius, link, weight, q0, design, corner=False):
+    """Hinges 1..link and N with pad ``link`` (its far end if ``corner``) on the object; distal
+    hinges as q0's."""
     centre, k = (0.0, depth), link
 
     def residual(x):
         q = np.concatenate([x[:k], q0[k:]])
-        rho, grad, Tq, *_ = _load(q, centre, k, weight, design)
+        rho, grad, Tq, *_ = _load(q, centre, k, weight, design, corner)
         return np.concatenate([(hinge_moments(q, P, design) - x[k] * grad - Tq)[:k], [rho - radius]])
 
-    _, grad, Tq, *_ = _load(q0, centre, k, weight, design)
+    _, grad, Tq, *_ = _load(q0, centre, k, weight, design, corner)
     M = (hinge_moments(q0, P, design) - Tq)[:k]
     N0 = max(float(M @ grad[:k]) / max(float(grad[:k] @ grad[:k]), 1e-12), 0.0)
     sol = root(residual, np.concatenate([q0[:k], [N0]]), method="hybr", options={"xtol": _XTOL})
@@ -193,17 +195,24 @@ def grasp_state(design: HandDesign, diameter_mm: float, P: float, mass_kg: float
         return _state(P, depth, q_free, -1, 0.0, weight, design)
     theta_c, link = contact.contact_angle(diameter_mm, design, depth=depth)
     q0 = np.concatenate([np.full(link, theta_c / design.n_s), q_free[link:]])
-    for _ in range(design.n_s + 1):
+    corner, seen = False, set()
+    for _ in range(design.n_s + 2):
         if link == 0:
             raise InputError("diameter_mm", diameter_mm, "touches the base link, which cannot press")
-        q, N = _solve_link(P, depth, radius, link, weight, q0, design)
+        q, N = _solve_link(P, depth, radius, link, weight, q0, design, corner)
         gaps = contact.pad_gaps(q, (0.0, depth), radius, design)
-        gaps[link] = np.inf
+        seen.add(link)
+        gaps[link + (1 if corner else 0)] = gaps[link] = np.inf
         if np.min(gaps) >= -_PENETRATION:
             if N < 0.0:  # the pad would pull on the object: it does not touch
                 return _state(P, depth, q_free, -1, 0.0, weight, design)
-            return _state(P, depth, q, link, N, weight, design)
-        link, q0 = int(np.argmin(gaps)), np.concatenate([q[:int(np.argmin(gaps))], q_free[int(np.argmin(gaps)):]])
+            return _state(P, depth, q, link, N, weight, design, corner)
+        nxt = int(np.argmin(gaps))
+        if nxt in seen and abs(nxt - link) == 1 and not corner:  # both sides of a hinge: its corner
+            link, corner = min(nxt, link), True
+        else:
+            link, corner = nxt, False
+        q0 = np.concatenate([q[:link], q_free[link:]])
     raise InputError("diameter_mm", diameter_mm, "the contact does not settle on one pad")
 
 
@@ -221,13 +230,20 @@ def grasp_state_at_angle(design: HandDesign, diameter_mm: float, P: float, theta
         q = np.full(design.n_s, theta_free / design.n_s)
         return _state(P, hi, q, -1, 0.0, 0.0, design)
     at = lambda y: grasp_state(design, diameter_mm, P, mass_kg, depth_mm=y)  # noqa: E731
-    lowest = at(lo).theta
-    if theta < lowest:
-        raise InputError("theta_deg", round(math.degrees(theta), 6),
-                         f"the object holds this finger at {math.degrees(lowest):.4g} deg or more "
-                         f"at P = {P:g} MPa (its highest placement)")
-    depth = brentq(lambda y: at(y).theta - theta, lo, hi, xtol=1e-10)
-    return at(depth)
+    f = lambda y: at(y).theta - theta  # noqa: E731
+    y0 = float(np.clip(contact.object_depth(diameter_mm, design), lo, hi))
+    f0, step = f(y0), 1.0
+    while f0 != 0.0:  # the root nearest the default placement: theta(depth) need not be monotone
+        a, b = max(lo, y0 - step), min(hi, y0 + step)
+        bracket = next(((x, y0) if x < y0 else (y0, x) for x in (a, b) if f(x) * f0 <= 0.0), None)
+        if bracket is not None:
+            return at(brentq(f, *bracket, xtol=1e-10))
+        if a == lo and b == hi:
+            raise InputError("theta_deg", round(math.degrees(theta), 6),
+                             f"no placement of the object holds this finger there at P = {P:g} MPa "
+                             f"(from its highest placement it bends {math.degrees(at(lo).theta):.4g} deg)")
+        step *= 2.0
+    return at(y0)
 
 
 def vertical_force(design: HandDesign, diameter_mm: float, P, theta=None, mass_kg: float = 0.0, *,
