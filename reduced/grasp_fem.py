@@ -59,7 +59,7 @@ from .errors import InputError
 
 #: a pad other than the touching one penetrating by more than this [mm] moves the contact there
 _PENETRATION = 1e-6
-#: the finger FEM's held-hinge moments (written by ``python -m softhand.studies.calibration.hinges``)
+#: the finger FEM's locked-hinge volume rates A_j(theta) (written by ``python -m softhand.studies.calibration.hinges``)
 HINGE_TABLE = Path(__file__).resolve().parent / "data" / "grasp_hinges.csv"
 #: the equilibrium's tolerance (scipy hybr, relative on the unknowns)
 _XTOL = 1e-12
@@ -117,7 +117,8 @@ def volume_rate(theta, design: HandDesign) -> np.ndarray:
 
 def hinge_moments(q, P: float, design: HandDesign) -> np.ndarray:
     """M_j = dE/d theta_hat_j = -A_j(theta_j) (P - P_free(theta_j)) [N mm/rad] (n_s,) at hinge
-    angles q (n_s,) [rad] and cavity pressure P [MPa], theta_j = n_s q_j."""
+    angles q (n_s,) [rad] and cavity pressure P [MPa], theta_j = n_s q_j; P_free of finger_model "fem"."""
+    design = fem_finger(design)
     theta = design.n_s * np.asarray(q, float)
     return -volume_rate(theta, design) * (P - hand.finger_pressure(theta, design))
 
