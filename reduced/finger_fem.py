@@ -7,20 +7,24 @@ L = l0 / 6 (5 equal hinges) and the tie width w. So
 .. math:: \frac{P}{\mu_{sf}} = \tilde p\Big(\theta; \frac{b}{a}, \frac{d}{a}, \frac{L}{a},
           \frac{w}{L}\Big), \qquad \frac{\Delta Q}{a^3} = \tilde q(\theta; \dots).
 
-The physics already known carries most of it: the paper's eqs. (28) and (2), which give
-P and Delta Q = a^2 pi d theta for the same groups (the table's ``prior``: ``"paper"``, or
-``"rings"``: eq. (28) with the tube stretching only over its untied length l0 - 6 w, the
-finger FEM's kinematic bound, see :func:`prior_pressure`). The table ``reduced/data/finger_fem.csv``
-holds the FEM's (theta, P/mu, Delta Q/a^3) at the sampled designs; this model fits the
-slowly varying residuals
+The physics already known carries most of it: the paper's eq. (28) for P (the table's
+``prior``: ``"paper"``, or ``"rings"``: eq. (28) with the tube stretching only over its untied
+length l0 - 6 w, the finger FEM's kinematic bound, see :func:`prior_pressure`), and for the oil
+the kinematic a^2 pi d theta of eq. (2) (the tube's axis lengthens by d theta) plus the tube's
+own dilation under pressure, a^3 kappa P / mu_sf. The table ``reduced/data/finger_fem.csv``
+holds the FEM's (theta, P/mu, Delta Q/a^3) at the sampled designs; this model fits
 
-.. math:: y = \ln\frac{P_{FEM}}{P_{prior}}, \qquad z = \frac{\Delta Q_{FEM}}{a^2\pi d\,\theta}
+.. math:: y = \ln\frac{P_{FEM}}{P_{prior}}, \qquad
+          \ln\kappa = \ln\frac{\Delta Q_{FEM}/a^3 - \pi (d/a)\,\theta}{P_{FEM}/\mu_{sf}}
 
-by least squares as polynomials in x = the groups' logarithms (with -ln(1 - w/L) for the
-tie, the tied share of the length) scaled to [-1, 1] over the table's range, times 1, theta,
-... (degrees from the table's ``# fit:`` line). So P(theta) = P_prior(theta) e^{y} and
-Delta Q = a^2 pi d theta z. Beyond the table's largest angle theta_max (and below -theta_max)
-y and z are held at their end values.
+by least squares, each as a polynomial (total degree from the table's ``# fit:`` line) in its
+design features scaled to [-1, 1] over the table's range, plus theta, ..., theta^T. The
+features are those a free tube segment's physics names. For y: s^2, s = b / (L - w) the
+wall over the untied gap (a short bonded segment cannot contract, so it stiffens as the
+square of its shape factor), ln(b/a) and ln(d/a). For ln kappa: the four groups' logarithms
+(with -ln(1 - w/L) for the tie, the tied share of the length). So P(theta) = P_prior(theta)
+e^{y} and Delta Q = a^2 pi d theta + a^3 kappa P(theta) / mu_sf. Beyond the table's largest
+angle theta_max (and below -theta_max) y and ln kappa are held at their end values.
 
 Energy consistency. Per design, P(theta) and Delta Q(theta) are sampled at 0.5 deg and
 interpolated by cubic Hermite polynomials; dW_f/dtheta is defined as P dQ/dtheta (a quintic
@@ -146,26 +150,43 @@ def groups_of(design: HandDesign) -> dict:
             "tie_link": design.tie_width / L}
 
 
-def _x(groups: dict, table: Table) -> np.ndarray:
-    """Scaled log-groups in [-1, 1] over the table's ranges, only those the table varies; (..., k)."""
+def _scaled(value, lo: float, hi: float):
+    return 2 * (np.asarray(value, float) - lo) / (hi - lo) - 1
+
+
+def _x(groups: dict, table: Table, kind: str) -> np.ndarray:
+    """The design features of y (kind "p") or ln kappa (kind "q"), scaled to [-1, 1] over the
+    table's ranges, only those the table varies; (..., k)."""
+    r = table.ranges
+    varies = {g: r[g][1] > r[g][0] * (1 + 1e-9) for g in GROUPS}
     cols = []
-    for g in GROUPS:
-        lo, hi = table.ranges[g]
-        if hi > lo * (1 + 1e-9):
+    if kind == "p":
+        if varies["b_a"] or varies["link_a"] or varies["tie_link"]:
+            shape2 = lambda b, link, tie: (b / (link * (1.0 - tie)))**2  # noqa: E731
+            lo = shape2(r["b_a"][0], r["link_a"][1], r["tie_link"][0])
+            hi = shape2(r["b_a"][1], r["link_a"][0], r["tie_link"][1])
+            cols.append(_scaled(shape2(*(np.asarray(groups[g], float) for g in ("b_a", "link_a", "tie_link"))),
+                                lo, hi))
+        names = ("b_a", "d_a")
+    else:
+        names = GROUPS
+    for g in names:
+        if varies[g]:
             f = (lambda v: -np.log1p(-v)) if g == "tie_link" else np.log
-            cols.append(2 * (f(np.asarray(groups[g], float)) - f(lo)) / (f(hi) - f(lo)) - 1)
+            cols.append(_scaled(f(np.asarray(groups[g], float)), f(r[g][0]), f(r[g][1])))
     return np.stack(cols, axis=-1) if cols else np.zeros(np.shape(groups[GROUPS[0]]) + (0,))
 
 
 def _features(x: np.ndarray, theta, table: Table) -> np.ndarray:
-    """Monomials of x (total degree <= design_degree) times theta^k (k <= theta_degree); (..., m)."""
+    """Monomials of x (total degree <= design_degree), then theta^k (1 <= k <= theta_degree); (..., m)."""
     k = x.shape[-1]
     monos = [np.ones(x.shape[:-1])]
     for degree in range(1, table.design_degree + 1):
         for combo in combinations_with_replacement(range(k), degree):
             monos.append(np.prod(x[..., list(combo)], axis=-1))
     theta = np.asarray(theta, float)
-    return np.stack([m * theta**j for j in range(table.theta_degree + 1) for m in monos], axis=-1)
+    return np.stack(monos + [np.broadcast_to(theta**j, monos[0].shape)
+                             for j in range(1, table.theta_degree + 1)], axis=-1)
 
 
 class _Tube(NamedTuple):
@@ -201,23 +222,27 @@ def prior_pressure(theta, groups: dict, prior: str):
 
 @lru_cache(maxsize=8)
 def _fit(path: str) -> tuple[Table, np.ndarray, np.ndarray, float]:
-    """(table, beta_y, beta_z, theta_max): least-squares coefficients of y and z."""
+    """(table, beta_y, beta_k, theta_max): least-squares coefficients of y and ln kappa."""
     table = read_table(path)
     r = table.rows
     ids = np.unique(r["design"])
     y = np.empty(r["theta"].size)
-    for i in ids:  # eq. (28) per design, all its angles at once
+    for i in ids:  # the prior per design, all its angles at once
         at = r["design"] == i
         g = {k: float(r[k][at][0]) for k in GROUPS}
         y[at] = np.log(r["p_tilde"][at] / prior_pressure(r["theta"][at], g, table.prior))
-    z = r["q_tilde"] / (math.pi * r["d_a"] * r["theta"])
-    A = _features(_x(r, table), r["theta"], table)
-    if np.linalg.matrix_rank(A) < A.shape[1]:
-        raise _bad(path, f"has too few designs ({ids.size}) for the fit's degrees "
-                         f"({table.design_degree}, {table.theta_degree}); lower them in '# fit:'")
-    beta_y = np.linalg.lstsq(A, y, rcond=None)[0]
-    beta_z = np.linalg.lstsq(A, z, rcond=None)[0]
-    return table, beta_y, beta_z, float(r["theta"].max())
+    dilation = r["q_tilde"] - math.pi * r["d_a"] * r["theta"]
+    if np.any(dilation <= 0):
+        raise _bad(path, "has dQ/a^3 <= pi (d/a) theta in a row: below the tube's kinematic "
+                         "oil volume of eq. (2)")
+    betas = []
+    for kind, target in (("p", y), ("q", np.log(dilation / r["p_tilde"]))):
+        A = _features(_x(r, table, kind), r["theta"], table)
+        if np.linalg.matrix_rank(A) < A.shape[1]:
+            raise _bad(path, f"has too few designs ({ids.size}) for the fit's degrees "
+                             f"({table.design_degree}, {table.theta_degree}); lower them in '# fit:'")
+        betas.append(np.linalg.lstsq(A, target, rcond=None)[0])
+    return table, betas[0], betas[1], float(r["theta"].max())
 
 
 def check_space(design: HandDesign, table: Table) -> dict:
@@ -234,12 +259,16 @@ def check_space(design: HandDesign, table: Table) -> dict:
 
 
 def residuals(theta, design: HandDesign) -> tuple[np.ndarray, np.ndarray]:
-    """(y, z) of the fit at theta [rad] for this design: P = P_(28) e^y, Delta Q = a^2 pi d theta z."""
-    table, beta_y, beta_z, theta_max = _fit(_table_path(design))
+    """(y, ln kappa) of the fit at theta [rad] for this design:
+    P = P_prior e^y, Delta Q = a^2 pi d theta + a^3 kappa P / mu_sf."""
+    table, beta_y, beta_k, theta_max = _fit(_table_path(design))
     groups = check_space(design, table)
     t = np.clip(np.asarray(theta, float), -theta_max, theta_max)
-    F = _features(np.broadcast_to(_x(groups, table), t.shape + (len(_x(groups, table)),)), t, table)
-    return F @ beta_y, F @ beta_z
+    out = []
+    for kind, beta in (("p", beta_y), ("q", beta_k)):
+        x = _x(groups, table, kind)
+        out.append(_features(np.broadcast_to(x, t.shape + x.shape), t, table) @ beta)
+    return out[0], out[1]
 
 
 def _table_path(design: HandDesign) -> str:
@@ -310,9 +339,12 @@ def curves(design: HandDesign) -> Curves:
     """The calibrated curves of ``design`` (cached per design)."""
     table = _fit(_table_path(design))[0]
     groups = check_space(design, table)
-    P = _with_slopes(lambda t: design.mu_sf * prior_pressure(t, groups, table.prior)
-                     * np.exp(residuals(t, design)[0]))
-    dQ = _with_slopes(lambda t: design.a**2 * math.pi * design.d * t * residuals(t, design)[1])
+    def pressure(t):
+        return design.mu_sf * prior_pressure(t, groups, table.prior) * np.exp(residuals(t, design)[0])
+
+    P = _with_slopes(pressure)
+    dQ = _with_slopes(lambda t: design.a**2 * math.pi * design.d * t
+                      + design.a**3 * np.exp(residuals(t, design)[1]) * pressure(t) / design.mu_sf)
     pieces = np.empty(_KNOTS.size)
     pieces[0] = 0.0
     tau = _KNOTS[:-1, None] + (_KNOTS[1] - _KNOTS[0]) * _GAUSS_X

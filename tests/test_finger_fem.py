@@ -13,45 +13,59 @@ from softhand.studies.calibration.finger_table import table_csv
 
 BOX = {"a_mm": (3.0, 6.0), "b_mm": (3.0, 7.0), "d_mm": (10.0, 20.0), "l0_mm": (120.0, 200.0),
        "tie_width_mm": (5.0, 15.0)}
-#: a known residual the fit's model class holds exactly: y = ln(P / P_28), z = dQ / (a^2 pi d theta)
-Y = (0.25, 0.05, 0.1)   # y = Y0 + Y1 x_tie + Y2 theta
-Z = (1.7, -0.03, 0.08)  # z = Z0 + Z1 x_tie + Z2 theta
+#: a known residual the fit's model class holds exactly: y = ln(P / P_28) and ln kappa, where
+#: dQ = a^2 pi d theta + a^3 kappa P / mu_sf
+Y = (0.25, 0.05, 0.1)   # y = Y0 + Y1 x_shape + Y2 theta, x_shape: (b / (L - w))^2 scaled
+K = (1.2, -0.3, 0.08)   # ln kappa = K0 + K1 x_tie + K2 theta, x_tie: -ln(1 - w / L) scaled
+
+
+def _scaled(v, lo, hi):
+    return 2 * (v - lo) / (hi - lo) - 1
+
+
+def _truth(d, theta, ties):
+    """(P, dQ) of the model class at design d from Y, K (the scalings over the ties' range)."""
+    L = d.l0 / 6
+    shape = lambda w: (d.b / (L - w))**2  # noqa: E731
+    tie = lambda w: -math.log1p(-w / L)  # noqa: E731
+    xs = _scaled(shape(d.tie_width), shape(ties[0]), shape(ties[-1]))
+    xt = _scaled(tie(d.tie_width), tie(ties[0]), tie(ties[-1]))
+    P = hand.finger_pressure(theta, d.replace(finger_model="paper")) * np.exp(Y[0] + Y[1] * xs + Y[2] * theta)
+    kappa = np.exp(K[0] + K[1] * xt + K[2] * theta)
+    return P, d.a**2 * math.pi * d.d * theta + d.a**3 * kappa * P / d.mu_sf
 
 
 def _synthetic_table(tmp_path, ties=(5.0, 10.0, 15.0)):
-    """A table whose 'FEM' points follow Y, Z exactly, over the tie width only."""
+    """A table whose 'FEM' points follow Y, K exactly, over the tie width only."""
     designs = [finger_design({"a_mm": 4.0, "b_mm": 5.0, "d_mm": 15.0, "l0_mm": 180.0,
                               "tie_width_mm": t}) for t in ties]
     groups = [finger_fem.groups_of(d) for d in designs]
-    lo, hi = (-math.log1p(-g) for g in (groups[0]["tie_link"], groups[-1]["tie_link"]))
     rows = []
     for i, (d, g) in enumerate(zip(designs, groups)):
-        x = 2 * (-math.log1p(-g["tie_link"]) - lo) / (hi - lo) - 1
         for theta in (0.2, 0.6, 1.0):
-            P28 = float(hand.finger_pressure(theta, d))
-            rows.append({"design": i, **g, "theta": theta,
-                         "p_tilde": P28 * math.exp(Y[0] + Y[1] * x + Y[2] * theta) / d.mu_sf,
-                         "q_tilde": math.pi * d.d * theta * (Z[0] + Z[1] * x + Z[2] * theta) * d.a**2 / d.a**3})
+            P, dQ = _truth(d, theta, ties)
+            rows.append({"design": i, **g, "theta": theta, "p_tilde": float(P) / d.mu_sf,
+                         "q_tilde": float(dQ) / d.a**3})
     ranges = {k: (v, v) for k, v in groups[0].items()}
     ranges["tie_link"] = (groups[0]["tie_link"], groups[-1]["tie_link"])
     path = tmp_path / "synthetic.csv"
     path.write_text(table_csv(rows, ranges, ["synthetic test table"], (1, 1)))
-    return path, designs, (lo, hi)
+    return path, designs, ties
 
 
 def test_fit_recovers_a_residual_of_its_model_class(tmp_path):
-    """P = P_28 e^y and dQ = a^2 pi d theta z between and beyond the rows: rtol 1e-6 bounds the
-    cubic splines' interpolation error (0.5 deg knots); theta is capped at the table's 1.0 rad."""
-    path, designs, (lo, hi) = _synthetic_table(tmp_path)
+    """P = P_28 e^y and dQ = a^2 pi d theta + a^3 kappa P / mu between and beyond the rows: rtol
+    1e-6 bounds the cubic splines' interpolation error (0.5 deg knots); theta is capped at the
+    table's 1.0 rad in y and kappa (not in P_28 and the kinematic term)."""
+    path, designs, ties = _synthetic_table(tmp_path)
     d = designs[0].replace(tie_width=8.0, finger_model="fem", finger_table=str(path))
-    x = 2 * (-math.log1p(-finger_fem.groups_of(d)["tie_link"]) - lo) / (hi - lo) - 1
     theta = np.array([0.05, 0.4, 0.9, 1.3])
-    t = np.minimum(theta, 1.0)
-    expected_P = hand.finger_pressure(theta, d.replace(finger_model="paper")) * np.exp(Y[0] + Y[1] * x + Y[2] * t)
-    np.testing.assert_allclose(hand.finger_pressure(theta, d), expected_P, rtol=1e-6)
+    P, _ = _truth(d, np.minimum(theta, 1.0), ties)
+    P *= hand.finger_pressure(theta, d.replace(finger_model="paper")) / \
+        hand.finger_pressure(np.minimum(theta, 1.0), d.replace(finger_model="paper"))
+    np.testing.assert_allclose(hand.finger_pressure(theta, d), P, rtol=1e-6)
     inside = theta[:3]
-    expected_dQ = d.a**2 * math.pi * d.d * inside * (Z[0] + Z[1] * x + Z[2] * inside)
-    np.testing.assert_allclose(finger.oil_taken(inside, d), expected_dQ, rtol=1e-6)
+    np.testing.assert_allclose(finger.oil_taken(inside, d), _truth(d, inside, ties)[1], rtol=1e-6)
 
 
 def test_energy_is_the_integral_of_P_dQ(tmp_path):
@@ -128,6 +142,14 @@ def test_missing_table_and_too_few_designs(tmp_path):
     d = designs[0].replace(finger_model="fem", finger_table=str(path))
     with pytest.raises(InputError, match="too few designs"):
         hand.pressure(0.5, d)
+    # a row whose oil volume is below the kinematic a^2 pi d theta of eq. (2): no dilation to fit
+    path, designs, _ = _synthetic_table(tmp_path)
+    lines = path.read_text().splitlines()
+    cells = lines[-1].split(",")
+    cells[-1] = "0.01"
+    path.write_text("\n".join(lines[:-1] + [",".join(cells)]) + "\n")
+    with pytest.raises(InputError, match="below the tube's kinematic oil volume"):
+        hand.pressure(0.5, designs[0].replace(finger_model="fem", finger_table=str(path)))
 
 
 def test_a_design_file_names_its_own_table_relative_to_itself(tmp_path):
@@ -145,3 +167,19 @@ def test_a_design_file_names_its_own_table_relative_to_itself(tmp_path):
     wide = tmp_path / "wide.toml"
     wide.write_text(toml.read_text().replace("b_mm = 5.0", "b_mm = 6.0"))
     assert main(["curve", "--design", str(wide), "--pressure-mpa", "0.5"]) == 2
+
+
+def test_each_design_of_the_package_table_is_predicted_without_it():
+    """Leave-one-out over the shipped table's FEM designs (fit redone without the design):
+    measured theta 2.6 % rms, 6.5 % at worst (a corner: extrapolation), dQ 2.9 % rms, 6.8 % at
+    worst. The same check of the earlier fit (ln(P/P_rings) and dQ / (a^2 pi d theta) linear in
+    the four groups' logarithms and theta, no shape factor, no dilation term) gives theta 14.7 %
+    rms, 53 % at worst, and dQ 33 % rms, 137 % at worst."""
+    from softhand.studies.calibration.finger_table import leave_one_out
+
+    rows = leave_one_out()
+    theta = np.array([r["theta_err_pct"] for r in rows])
+    dQ = np.array([r["dQ_err_pct"] for r in rows])
+    assert len({r["design"] for r in rows}) == 14
+    assert np.sqrt(np.mean(theta**2)) < 3.0 and np.abs(theta).max() < 7.0
+    assert np.sqrt(np.mean(dQ**2)) < 3.5 and np.abs(dQ).max() < 7.5

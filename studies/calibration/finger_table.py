@@ -155,3 +155,41 @@ def heldout_rows(results: list[tuple[HandDesign, dict]], table: str | None = Non
                          "dQ_model_mm3": math.nan, "dQ_err_pct": math.nan})
     worst = {k: float(np.nanmax([abs(r[k]) for r in rows])) for k in ("theta_err_pct", "dQ_err_pct")}
     return rows, worst
+
+
+def leave_one_out(path: str | Path | None = None) -> list[dict]:
+    """Each design of a table predicted by the table without it (its rows removed, the fit
+    redone, the ranges kept): per FEM row, theta at the FEM's pressure and dQ at the FEM's
+    theta, errors [%]. A check of the fit that runs no FEM (the designs are at a = 4 mm, which
+    the groups do not see)."""
+    import tempfile
+
+    from softhand.reduced.finger_fem import TABLE_FILE, read_table
+
+    table = read_table(path or TABLE_FILE)
+    r = table.rows
+    header = [line for line in table.header if "# range:" in line or "# fit:" in line]
+    out = []
+    with tempfile.TemporaryDirectory() as tmp:
+        for i in np.unique(r["design"]):
+            at = r["design"] == i
+            rest = [{c: r[c][k] for c in COLUMNS} for k in np.flatnonzero(~at)]
+            lines = [line.lstrip("#").strip() for line in header]
+            text = "\n".join(f"# {line}" for line in lines) + "\n" + ",".join(COLUMNS) + "\n"
+            text += "".join(",".join(f"{row[c]:.10g}" for c in COLUMNS) + "\n" for row in rest)
+            held = Path(tmp) / f"without_{int(i)}.csv"
+            held.write_text(text)
+            g = {k: float(r[k][at][0]) for k in GROUPS}
+            a, L = 4.0, 4.0 * g["link_a"]
+            design = finger_design({"a_mm": a, "b_mm": a * g["b_a"], "d_mm": a * g["d_a"],
+                                    "l0_mm": 6 * L, "tie_width_mm": g["tie_link"] * L})
+            model = design.replace(finger_model="fem", finger_table=str(held))
+            theta, P = r["theta"][at], r["p_tilde"][at] * design.mu_sf
+            th_m = hand.bend_angle(P, model, reservoir=False)
+            dQ_m = finger.oil_taken(theta, model)
+            for k in range(theta.size):
+                out.append({"design": int(i), **{key: round(v, 4) for key, v in g.items()},
+                            "P_MPa": float(P[k]), "theta_fem_deg": math.degrees(theta[k]),
+                            "theta_err_pct": 100 * (th_m[k] / theta[k] - 1),
+                            "dQ_err_pct": 100 * (dQ_m[k] / (r["q_tilde"][at][k] * a**3) - 1)})
+    return out
