@@ -29,9 +29,11 @@ def _space(path, name, ties):
 
 @pytest.mark.slow
 def test_table_from_two_ties_predicts_the_middle_one(tmp_path, capsys):
-    """Ties of 6 and 14 mm (linear in -ln(1 - tie/link) and theta) predict the 10 mm tie's FEM bend
-    to 1 % (measured 0.23 %; dQ 1.0 %), while the calibration designs bend > 10 % apart at
-    0.8 MPa: the fit predicts, it does not just repeat a neighbour."""
+    """Ties of 6 and 14 mm predict the 10 mm tie's FEM bend to 5 % (measured +4.1 %; dQ 1.0 %),
+    while the calibration designs bend > 10 % apart at 0.8 MPa: the fit predicts, it does not
+    just repeat a neighbour. With the tie the only group varied, y is linear in the shape
+    factor's square (b / gap)^2, which the 14-design table's leave-one-out chose; on this
+    CI mesh y is closer to linear in -ln(1 - tie/link) (the earlier fit: +0.2 %)."""
     results, table = str(tmp_path / "results"), tmp_path / "ties.csv"
     space = _space(tmp_path / "ties.toml", "ties", (6.0, 14.0))
     assert main(["calibrate", "finger", "--space", str(space), "--out", str(table),
@@ -44,7 +46,7 @@ def test_table_from_two_ties_predicts_the_middle_one(tmp_path, capsys):
                  "--results", results, "--no-progress", "--json"]) == 0
     check = json.loads(capsys.readouterr().out)
     errors = [r["theta_err_pct"] for r in check["rows"]]
-    assert len(errors) == 2 and max(map(abs, errors)) < 1.0
+    assert len(errors) == 2 and max(map(abs, errors)) < 5.0
     assert abs(check["worst"]["dQ_err_pct"]) < 2.0  # measured 1.0 %: dQ varies more with the tie
     # the calibration designs themselves at 0.8 MPa: far apart, so 1 % is a real prediction
     d6, d14 = (load_space(space).designs()[i].replace(finger_model="fem", finger_table=str(table))
