@@ -168,6 +168,8 @@ def prove(ev: Evaluation, task: Task, options: ProofOptions = ProofOptions(), *,
     return {
         "P_grasp_MPa": best.P - p_grasp,
         "P_contact_MPa": bend["P_finger_MPa"] - p_contact,
+        "P_finger_at_contact_MPa": bend["P_finger_MPa"],
+        "reservoir_pressure_at_contact_MPa": p_contact,
         "theta_grasp_deg": math.degrees(best.theta),
         # below the FEM's contact pressure the finger does not reach the object: F_v = 0
         "F_v_N": first.F_v if P_start == P_cav else 0.0,
