@@ -277,7 +277,7 @@ class OptimiserOptions:
     seed: int = 1
     popsize: int = 4          #: DE population per free variable (the Sobol start rounds it up to 2^k)
     maxiter: int = 60         #: DE generations at most
-    tol: float = 1e-3         #: DE relative tolerance on the population's objective spread
+    tol: float = 1e-2         #: DE relative tolerance on the population's objective spread
     polish: bool = True       #: SLSQP from the DE optimum
 
 
