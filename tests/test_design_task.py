@@ -235,3 +235,12 @@ def test_oil_constraint_is_the_finger_models_oil():
     assert oil.value == pytest.approx(task.base.n * float(finger.oil_taken(ev.theta_grasp, task.base)), rel=1e-12)
     assert oil.value != pytest.approx(task.base.n * task.base.a**2 * math.pi * task.base.d * ev.theta_grasp,
                                       rel=1e-3)
+
+
+def test_optimum_on_a_bound_is_the_bound():
+    """SLSQP lands a hair beside a bound (4.500000000000008 for 4.5); the design is the bound."""
+    x = design_opt.on_bounds([4.500000000000008, 4.49999999999999, 4.4], [(4.5, 6.0), (3.5, 4.5), (3.5, 4.5)])
+    assert x.tolist() == [4.5, 4.5, 4.4]
+    task = task_from_dict({**CI_TASK, "free": {"b_mm": [4.5, 6.0], "V0_mm3": [12000.0, 30000.0]}})
+    opt = design_opt.optimise(task, FAST)
+    assert opt.evaluation.design.b == 4.5  # a thinner wall is cheaper: the optimum is on the bound

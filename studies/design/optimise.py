@@ -302,8 +302,19 @@ def optimise(task: Task, options: OptimiserOptions = OptimiserOptions()) -> Opti
     x = np.asarray(res.x, dtype=float)
     if options.polish and problem.evaluation(x).feasible:
         x = polish(problem, x)
+    x = on_bounds(x, problem.bounds)
     ev = evaluate(design_at(task, x), task)  # exact kinematics
     return Optimum(x, ev, problem.evaluations, time.perf_counter() - t0, int(res.nit), str(res.message))
+
+
+def on_bounds(x, bounds, rtol: float = 1e-9) -> np.ndarray:
+    """x with the values within rtol (of the bounds' span) of a bound set to that bound: SLSQP
+    ends at 4.500000000000008 for a wall on its bound 4.5, and the FEM proof's mesher would
+    mesh a different wall."""
+    lo, hi = np.array(bounds, dtype=float).T
+    x = np.asarray(x, dtype=float)
+    tol = rtol * (hi - lo)
+    return np.where(np.abs(x - lo) < tol, lo, np.where(np.abs(x - hi) < tol, hi, x))
 
 
 def polish(problem: Problem, x0, *, require_better: bool = True) -> np.ndarray:
