@@ -36,6 +36,29 @@ FILES = {
     "a_file": "not a folder",
     "result.vtu": "<VTKFile>",
 }
+#: design tasks (softhand design --task): a good one, and each of its mistakes
+GOOD_TASK = ("[object]\ndiameter_mm = 180.0\nmass_kg = 2.0\n[pump]\nmax_pressure_MPa = 2.0\n"
+             "[free]\nd_mm = [12.0, 18.0]\n")
+TASKS = {
+    "t_good.toml": GOOD_TASK,
+    "t_bounds.toml": GOOD_TASK.replace("[12.0, 18.0]", "[18.0, 12.0]"),
+    "t_outside.toml": GOOD_TASK.replace("[12.0, 18.0]", "[25.0, 30.0]"),  # the calibrated d: 10-20 mm
+    "t_key.toml": GOOD_TASK.replace("[free]", "[free]\nn = [2, 4]"),
+    "t_no_free.toml": GOOD_TASK.replace("d_mm = [12.0, 18.0]\n", ""),
+    "t_mass.toml": GOOD_TASK.replace("2.0\n[pump]", "-2.0\n[pump]"),
+    "t_no_diameter.toml": GOOD_TASK.replace("diameter_mm = 180.0\n", ""),
+    "t_pump.toml": GOOD_TASK.replace("max_pressure_MPa = 2.0", 'max_pressure_MPa = "high"'),
+    "t_objective.toml": GOOD_TASK + '[grasp]\nobjective = "cheap"\n',
+    "t_both.toml": GOOD_TASK + "[grasp]\nforce_factor = 2.0\nmargin_N = 1.0\n",
+    "t_stretch.toml": GOOD_TASK + "[limits]\nmax_principal_stretch = 0.9\n",
+    "t_model.toml": GOOD_TASK + '[design]\nfinger_model = "magic"\n',
+    "t_base.toml": 'base_design = "nowhere.toml"\n' + GOOD_TASK,
+    "t_unknown.toml": GOOD_TASK + 'colour = "red"\n',
+    "t_section.toml": GOOD_TASK + "[fem]\nmesh = 3\n",
+    "t_table.toml": "object = 3\n" + GOOD_TASK.split("\n", 3)[3],
+    "t_not_toml.toml": "[object\n",
+}
+FILES.update(TASKS)
 
 #: design key -> values outside its table bounds or of the wrong type (TOML literals)
 BAD_DESIGN_VALUES = ["-1e9", "1e9", "nan", "inf", '"ten"', "true"]
@@ -219,6 +242,10 @@ def _cases():
         "inspect": [["missing.vtu"], ["good.csv"], ["/dev/zero"], ["."], ["result.vtu", "--out", "x.txt"]],
         "verify": [["--case", "bogus"], ["--case"]],
         "reproduce": [["--only", "bogus"], ["--only", ","], ["--out", "a_file"]],
+        "design": [["--task", t, "--no-fem"] for t in sorted(TASKS) if t != "t_good.toml"]
+                  + [["--task", t, "--no-fem"] for t in ("missing.toml", ".", "/dev/zero", "binary.toml")]
+                  + [["--task", "t_good.toml", "--no-fem", *extra] for extra in (
+                      ["--seed", "-1"], ["--mesh-size-mm", "0"], ["--mesh-size-mm", "nan"])],
     }
     for verb, variants in options.items():
         for k, extra in enumerate(variants):
@@ -255,7 +282,8 @@ def _run(argv) -> int:
 def test_there_are_enough_cases():
     assert len(CASES) >= 150
     assert {argv[0] for _, argv in CASES} >= {"curve", "grasp", "control", "fit", "bend", "weights",
-                                              "reservoir", "study", "inspect", "verify", "reproduce"}
+                                              "reservoir", "study", "inspect", "verify", "reproduce",
+                                              "design"}
 
 
 @pytest.mark.parametrize("argv", [argv for _, argv in CASES], ids=[name for name, _ in CASES])

@@ -1,5 +1,5 @@
 """The FEM proof of a design on CI-sized meshes (finger 10 mm, sheet 12 elements): its three
-models agree with each other where they must, and the finger FEM is stiffer than eq. (28)."""
+models agree with each other where they must, and with the calibrated models the design uses."""
 import math
 
 import pytest
@@ -24,9 +24,13 @@ def test_fem_proof_of_the_paper_design(tmp_path):
     fem = prove(ev, TASK, CI, out=tmp_path)
     assert (tmp_path / "grasp.pvd").is_file()                      # the verified grasp's VTK
     bend = fem["free_bend"]
-    # the FEM finger bends less than eq. (28) says (docs/finger.md: ~26 % at 0.8 MPa), so it
-    # needs more cavity pressure to reach the grasp angle
-    assert bend["P_finger_MPa"] > float(hand.pressure(ev.theta_grasp, TASK.base, reservoir=False))
+    # the calibrated finger model (fitted on the default mesh) against this coarse mesh, which is
+    # stiffer (+6 % at the paper's optimum); eq. (28) is 30 % below the FEM here
+    assert bend["P_finger_MPa"] == pytest.approx(float(hand.pressure(ev.theta_grasp, TASK.base, reservoir=False)),
+                                                 rel=0.1)
+    # the calibrated reservoir model against the sheet FEM at the oil left at contact
+    assert fem["reservoir_pressure_at_contact_MPa"] == pytest.approx(
+        ev.contact_parts()["reservoir_pressure_at_contact_MPa"], rel=0.05)
     # contact comes before the grasp, and the grasp FEM's finger has reached the object
     assert fem["P_contact_MPa"] < fem["P_grasp_MPa"]
     assert fem["theta_grasp_deg"] > math.degrees(ev.theta_grasp) - 0.5

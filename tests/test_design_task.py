@@ -94,12 +94,16 @@ def test_optimum_beats_a_grid_search_and_is_deterministic():
 
 def test_active_constraint_is_the_stretch_of_the_sheet():
     """With d and V0 free and nothing else in the way, the pressure falls with V0 (a fuller
-    sheet pushes harder) until the sheet's stretch (16) reaches the limit."""
+    sheet pushes harder) until the sheet's stretch (16) reaches the limit; in d the calibrated
+    finger has an inner optimum (eq. (28) alone would take the longest lever arm, d = 20)."""
     task = task_from_dict(CI_TASK)
-    ev = design_opt.optimise(task, FAST).evaluation
-    names = [c.name for c in design_opt.binding(ev)]
+    opt = design_opt.optimise(task, FAST)
+    names = [c.name for c in design_opt.binding(opt.evaluation)]
     assert any(n.startswith("sheet_stretch") for n in names)
-    assert ev.design.d == pytest.approx(20.0)  # the longest lever arm (bound)
+    d, V0 = opt.x
+    assert 10.5 < d < 19.5
+    P = [design_opt.evaluate(design_opt.design_at(task, [d + h, V0]), task).P_grasp for h in (-0.2, 0.0, 0.2)]
+    assert P[1] <= min(P[0], P[2])  # a minimum in d, not a bound
 
 
 def test_infeasible_task_names_the_binding_constraint():
@@ -194,3 +198,49 @@ def test_cli_infeasible_task_is_one_paragraph_exit_1(tmp_path):
     proc = _cli("design", "--task", str(task), "--no-fem", "--out", str(tmp_path / "out"))
     assert proc.returncode == 1, proc.stderr
     assert "The task cannot be met" in proc.stdout
+
+
+def test_a_task_designs_on_the_fem_calibrated_models():
+    task = task_from_dict(CI_TASK)
+    assert (task.base.finger_model, task.base.reservoir_model) == ("fem", "fem")
+    paper = task_from_dict({**CI_TASK, "design": {"finger_model": "paper", "reservoir_model": "ellipse"}})
+    assert (paper.base.finger_model, paper.base.reservoir_model) == ("paper", "ellipse")
+    # the two models answer differently: the calibrated finger is stiffer than eq. (28)
+    assert design_opt.evaluate(task.base, task).P_contact > design_opt.evaluate(paper.base, paper).P_contact
+
+
+def test_free_bounds_are_clipped_to_the_calibrated_space():
+    task = task_from_dict({**CI_TASK, "free": {"d_mm": [8.0, 25.0], "V0_mm3": [12000.0, 30000.0]}})
+    assert task.free == (("d_mm", 10.0, 20.0), ("V0_mm3", 12000.0, 30000.0))  # studies/finger_space.toml
+    assert task.clipped == (("d_mm", 8.0, 25.0),)
+    paper = task_from_dict({**CI_TASK, "free": {"d_mm": [8.0, 25.0]}, "design": {"finger_model": "paper"}})
+    assert paper.free == (("d_mm", 8.0, 25.0),) and paper.clipped == ()
+    with pytest.raises(InputError) as info:
+        task_from_dict({**CI_TASK, "free": {"d_mm": [25.0, 30.0]}})
+    assert info.value.field == "free.d_mm"
+
+
+def test_outside_the_calibrated_groups_is_infeasible_and_named():
+    task = task_from_dict(CI_TASK)
+    ev = design_opt.evaluate(task.base.replace(a=2.5), task)  # link/a = 30 / 2.5 = 12 > 11.1
+    assert not ev.feasible and not math.isfinite(ev.P_grasp)
+    assert any(c.name == "calibrated range of link/a" for c in design_opt.binding(ev))
+
+
+def test_oil_constraint_is_the_finger_models_oil():
+    task = task_from_dict(CI_TASK)
+    ev = design_opt.evaluate(task.base, task)
+    oil = next(c for c in ev.constraints if c.name.startswith("reservoir_oil"))
+    # the calibrated finger takes more oil than eq. (2)'s a^2 pi d theta
+    assert oil.value == pytest.approx(task.base.n * float(finger.oil_taken(ev.theta_grasp, task.base)), rel=1e-12)
+    assert oil.value != pytest.approx(task.base.n * task.base.a**2 * math.pi * task.base.d * ev.theta_grasp,
+                                      rel=1e-3)
+
+
+def test_optimum_on_a_bound_is_the_bound():
+    """SLSQP lands a hair beside a bound (4.500000000000008 for 4.5); the design is the bound."""
+    x = design_opt.on_bounds([4.500000000000008, 4.49999999999999, 4.4], [(4.5, 6.0), (3.5, 4.5), (3.5, 4.5)])
+    assert x.tolist() == [4.5, 4.5, 4.4]
+    task = task_from_dict({**CI_TASK, "free": {"b_mm": [4.5, 6.0], "V0_mm3": [12000.0, 30000.0]}})
+    opt = design_opt.optimise(task, FAST)
+    assert opt.evaluation.design.b == 4.5  # a thinner wall is cheaper: the optimum is on the bound

@@ -32,11 +32,12 @@ import math
 import time
 from dataclasses import dataclass, field
 from functools import lru_cache
+from typing import NamedTuple
 
 import numpy as np
 from scipy.optimize import NonlinearConstraint, differential_evolution, minimize
 
-from softhand.reduced import contact, grasp, reservoir
+from softhand.reduced import contact, finger, grasp, hand, reservoir
 from softhand.reduced.design import HandDesign, design_from_dict
 from softhand.reduced.errors import InputError
 from softhand.studies.design.task import Task
@@ -101,7 +102,17 @@ class Evaluation:
                 "theta_grasp_deg": math.degrees(self.theta_grasp), "F_v_N": self.F_v,
                 "F_v_at_pump_limit_N": self.F_v_at_limit, "margin_N": self.F_v_at_limit - self.F_v,
                 "w": self.w.tolist(), "touching_link": self.link, "depth_mm": self.depth,
-                "max_principal_stretch": self.stretch, "sheet_stretch": self.sheet_stretch}
+                "max_principal_stretch": self.stretch, "sheet_stretch": self.sheet_stretch,
+                **self.contact_parts()}
+
+    def contact_parts(self) -> dict:
+        """P_contact's two parts: the finger's pressure (28) and the reservoir's p_r at theta_g [MPa]."""
+        try:
+            P_finger = float(hand.pressure(self.theta_grasp, self.design, reservoir=False))
+        except InputError:
+            return {}
+        return {"P_finger_at_contact_MPa": P_finger,
+                "reservoir_pressure_at_contact_MPa": P_finger - self.P_contact}
 
 
 def design_at(task: Task, x) -> HandDesign:
@@ -151,25 +162,21 @@ def evaluate(design: HandDesign, task: Task, *, exact: bool = True) -> Evaluatio
     (``exact=False``: the kinematics interpolated in l0, see :func:`grasp_geometry`)."""
     depth, theta, link, w, theta_open = grasp_geometry(design, task, exact=exact)
     F_req = task.required_F_v()
-    oil = design.n * design.a**2 * math.pi * design.d * theta
-    try:  # eq. (25) is linear in F_v: one call for F_v = 0, 1 N, F_req and the free hand (27)
-        P0, P1, P_grasp, P_contact, P_open = (float(p) for p in grasp.pressure_to_hold(
-            np.array([task.mass, task.mass, task.mass, 0.0, 0.0]),
-            np.array([theta] * 4 + [theta_open if math.isfinite(theta_open) else 0.0]), w, design,
-            F_v=np.array([0.0, 1.0, F_req, 0.0, 0.0])))
-        F_lim = (task.max_pressure - P0) / (P1 - P0)  # [N]: F_v at P0 is 0, at P1 1 N
-    except InputError:  # e.g. V0 too small for the oil the fingers take
-        P_grasp = P_contact = P_open = math.inf
-        F_lim = -math.inf
-    if not math.isfinite(theta_open):
-        P_open = -math.inf
+    try:  # the oil of the design's finger model; outside its calibrated range: none (see below)
+        oil = design.n * float(finger.oil_taken(theta, design))
+    except InputError:
+        oil = math.inf
+    try:
+        P_grasp, P_contact, P_open, F_lim = grasp_relation(design, task, theta, w, theta_open)
+    except InputError:  # e.g. V0 too small for the oil, a design outside the calibrated range
+        P_grasp, P_contact, P_open, F_lim = math.inf, math.inf, -math.inf, -math.inf
     stretch = peak_stretch(theta, design)
     sheet = float(reservoir.stretch(design.V0, design))
     cons = [
         Constraint("tube_fits_links (a + b < d) [mm]", design.a + design.b, design.d, "<="),
         Constraint("tube_wall b [mm]", design.b, task.min_wall, ">="),
         Constraint("sheet_thickness t [mm]", design.t, 0.0, ">=", 1.0),
-        Constraint("reservoir_oil at the grasp [mm^3]", oil, design.V0, "<="),
+        Constraint("reservoir_oil the fingers take at the grasp [mm^3]", oil, design.V0, "<="),
         Constraint("reservoir_below_limit_point V0 [mm^3]", design.V0, limit_point_volume(design), "<="),
         Constraint("max_principal_stretch", stretch, task.max_stretch, "<="),
         Constraint("sheet_stretch at V0, eq. (16)", sheet, task.max_stretch, "<="),
@@ -181,6 +188,27 @@ def evaluate(design: HandDesign, task: Task, *, exact: bool = True) -> Evaluatio
     ]
     return Evaluation(design, depth, theta, link, w, P_grasp, P_contact, F_req, F_lim, stretch, sheet,
                       tuple(cons))
+
+
+class GraspRelation(NamedTuple):
+    P_grasp: float     #: pump pressure at which each finger presses with the required F_v [MPa]
+    P_contact: float   #: free hand's pump pressure at the grasp angle (27) [MPa]
+    P_open: float      #: free hand's pump pressure where the tips span the opening [MPa]; -inf: never
+    F_at_limit: float  #: F_v at the pump limit [N]
+
+
+def grasp_relation(design: HandDesign, task: Task, theta: float, w, theta_open: float) -> GraspRelation:
+    """The design's pump pressure <-> normal force F_v at the grasp angle theta [rad] with the
+    rolling w: eqs. (25), (29) of the design's finger and reservoir models. The one place where
+    the design's F_v is computed (another grasp-force estimate replaces this function alone)."""
+    F_req = task.required_F_v()
+    # eq. (25) is linear in F_v: one call for F_v = 0, 1 N, F_req and the free hand (27)
+    P0, P1, P_grasp, P_contact, P_open = (float(p) for p in grasp.pressure_to_hold(
+        np.array([task.mass, task.mass, task.mass, 0.0, 0.0]),
+        np.array([theta] * 4 + [theta_open if math.isfinite(theta_open) else 0.0]), w, design,
+        F_v=np.array([0.0, 1.0, F_req, 0.0, 0.0])))
+    F_lim = (task.max_pressure - P0) / (P1 - P0)  # [N]: F_v at P0 is 0, at P1 1 N
+    return GraspRelation(P_grasp, P_contact, P_open if math.isfinite(theta_open) else -math.inf, F_lim)
 
 
 def calibrated_range(design: HandDesign) -> list[Constraint]:
@@ -247,9 +275,9 @@ class Problem:
 @dataclass(frozen=True)
 class OptimiserOptions:
     seed: int = 1
-    popsize: int = 8          #: DE population per free variable
-    maxiter: int = 100        #: DE generations at most
-    tol: float = 1e-3         #: DE relative tolerance on the population's objective spread
+    popsize: int = 4          #: DE population per free variable (the Sobol start rounds it up to 2^k)
+    maxiter: int = 60         #: DE generations at most
+    tol: float = 1e-2         #: DE relative tolerance on the population's objective spread
     polish: bool = True       #: SLSQP from the DE optimum
 
 
@@ -274,8 +302,19 @@ def optimise(task: Task, options: OptimiserOptions = OptimiserOptions()) -> Opti
     x = np.asarray(res.x, dtype=float)
     if options.polish and problem.evaluation(x).feasible:
         x = polish(problem, x)
+    x = on_bounds(x, problem.bounds)
     ev = evaluate(design_at(task, x), task)  # exact kinematics
     return Optimum(x, ev, problem.evaluations, time.perf_counter() - t0, int(res.nit), str(res.message))
+
+
+def on_bounds(x, bounds, rtol: float = 1e-9) -> np.ndarray:
+    """x with the values within rtol (of the bounds' span) of a bound set to that bound: SLSQP
+    ends at 4.500000000000008 for a wall on its bound 4.5, and the FEM proof's mesher would
+    mesh a different wall."""
+    lo, hi = np.array(bounds, dtype=float).T
+    x = np.asarray(x, dtype=float)
+    tol = rtol * (hi - lo)
+    return np.where(np.abs(x - lo) < tol, lo, np.where(np.abs(x - hi) < tol, hi, x))
 
 
 def polish(problem: Problem, x0, *, require_better: bool = True) -> np.ndarray:

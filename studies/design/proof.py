@@ -82,7 +82,9 @@ def free_bend(finger, theta_g: float, options: ProofOptions) -> dict:
                            f"at {states[-1].P if states else 0:.3g} MPa, below the grasp angle")
     theta = np.array([0.0, *(s.theta for s in states)])
     at = lambda values: float(PchipInterpolator(theta, values)(theta_g))  # noqa: E731
+    share = np.array([s.q / s.theta for s in states])  # the hinges' shares of the bend
     return {"P_finger_MPa": at([0.0, *(s.P for s in states)]),
+            "hinge_share": [at([share[0, i], *share[:, i]]) for i in range(share.shape[1])],
             "dQ_mm3": at([0.0, *(s.dQ for s in states)]),
             "max_principal_stretch": at([1.0, *(s.max_principal_stretch for s in states)]),
             "pressures_MPa": [s.P for s in states], "theta_deg": np.degrees(theta[1:]).tolist(),
@@ -124,6 +126,19 @@ def grasp_secant(model, ladder, F_req: float, options: ProofOptions, say=None) -
             "seconds": time.perf_counter() - t0}
 
 
+def _touch(bend: dict, ev: Evaluation, task: Task) -> float | None:
+    """The bend [deg] at which the FEM finger, closing with its own hinge shares (at theta_g),
+    touches the object in the reduced model's geometry (None: it does not reach it)."""
+    from softhand.reduced import contact
+    from softhand.reduced.errors import InputError
+
+    try:
+        theta, _ = contact.contact_angle(task.diameter, ev.design, depth=ev.depth, w=bend["hinge_share"])
+    except InputError:
+        return None
+    return math.degrees(theta)
+
+
 def prove(ev: Evaluation, task: Task, options: ProofOptions = ProofOptions(), *, out=None,
           progress=None) -> dict:
     """Run the three FEM models for the evaluated design; the FEM's numbers (see module doc)."""
@@ -139,6 +154,7 @@ def prove(ev: Evaluation, task: Task, options: ProofOptions = ProofOptions(), *,
     say(f"free bend FEM to the grasp angle {math.degrees(ev.theta_grasp):.2f} deg "
         f"({finger.ndofs} unknowns)")
     bend = free_bend(finger, ev.theta_grasp, options)
+    touch = _touch(bend, ev, task)
     say("reservoir sheet FEM at the oil left at contact")
     V_contact = design.V0 - design.n * bend["dQ_mm3"]
     if not V_contact > 0:
@@ -168,6 +184,9 @@ def prove(ev: Evaluation, task: Task, options: ProofOptions = ProofOptions(), *,
     return {
         "P_grasp_MPa": best.P - p_grasp,
         "P_contact_MPa": bend["P_finger_MPa"] - p_contact,
+        "P_finger_at_contact_MPa": bend["P_finger_MPa"],
+        "theta_touch_deg": touch,
+        "reservoir_pressure_at_contact_MPa": p_contact,
         "theta_grasp_deg": math.degrees(best.theta),
         # below the FEM's contact pressure the finger does not reach the object: F_v = 0
         "F_v_N": first.F_v if P_start == P_cav else 0.0,

@@ -18,6 +18,8 @@ A task is a TOML file (``studies/designs/tasks/paper_task.toml`` is the paper's)
     [material]                # optional: mu per part, over the base design
     mu_sf_MPa = 1.15
     [design]                  # optional: any other design key over the base design
+    finger_model = "fem"      # the default: the FEM-calibrated finger and reservoir models
+    reservoir_model = "fem"
     [free]                    # design variables and their bounds
     a_mm = [3.0, 6.0]
     [fem]                     # optional: the FEM proof's finger mesh (gmsh)
@@ -25,6 +27,11 @@ A task is a TOML file (``studies/designs/tasks/paper_task.toml`` is the paper's)
     edge_ratio = 0.5          # element size at the ring edges / mesh_size (1: uniform)
 
 ``base_design`` is looked up as given, then next to the task file, then in the package.
+A task designs on the FEM-calibrated models (``finger_model = "fem"``, ``reservoir_model =
+"fem"``, :data:`MODELS`) unless its ``[design]`` table names others: those are the models the
+FEM proof checks. With the packaged finger table, the free bounds are clipped to the box the
+table was calibrated on (:data:`CALIBRATED_SPACE`, its ``[space]``); the table's group ranges
+are the optimiser's constraints (:func:`studies.design.optimise.calibrated_range`).
 Every mistake is one :class:`InputError` naming the key.
 """
 from __future__ import annotations
@@ -47,6 +54,10 @@ _SECTIONS = {
     "material": {"mu_sf_MPa", "mu_sr_MPa"},
     "fem": {"mesh_size_mm", "edge_ratio", "dP_MPa"},
 }
+#: the reduced models a task designs with unless its [design] table says otherwise
+MODELS = {"finger_model": "fem", "reservoir_model": "fem"}
+#: the design space the packaged finger table was calibrated on (its [space] box)
+CALIBRATED_SPACE = PAPER_DESIGN_FILE.parents[1] / "finger_space.toml"
 _TOP = {"base_design", "object", "grasp", "pump", "limits", "material", "design", "free", "fem"}
 
 
@@ -57,7 +68,7 @@ class Task:
     base: HandDesign                       #: the design the free keys vary (with material, design overrides)
     diameter: float                        #: object diameter [mm]
     mass: float                            #: object mass [kg]
-    free: tuple[tuple[str, float, float], ...]  #: (public key, lower, upper)
+    free: tuple[tuple[str, float, float], ...]  #: (public key, lower, upper), inside the calibrated box
     max_pressure: float                    #: pump pressure limit [MPa]
     force_factor: float = 2.0              #: F_v >= force_factor m g / n
     margin: float | None = None            #: ... or F_v >= m g / n + margin [N]
@@ -70,6 +81,7 @@ class Task:
     dP: float = 0.05                       #: FEM proof: pressure step of the secant [MPa]
     name: str = "task"
     source: dict = field(default_factory=dict, compare=False, repr=False)  #: the file's tables
+    clipped: tuple[tuple[str, float, float], ...] = ()  #: free bounds as given, where clipped
 
     def required_F_v(self) -> float:
         """The normal force each finger must press with [N]."""
@@ -100,7 +112,8 @@ def task_from_dict(data: dict, *, folder: Path = Path("."), name: str = "task") 
                 raise InputError(f"{section}.{key}", tables[section][key],
                                  f"unknown key; allowed: {', '.join(sorted(allowed))}")
     base = _base_design(data.get("base_design"), folder)
-    base = design_from_dict({**tables["design"], **tables["material"]}, base, source="design")
+    base = design_from_dict({**MODELS, **tables["design"], **tables["material"]}, base, source="design")
+    free, clipped = _calibrated(_free(tables["free"], base), base)
     obj, grasp, pump, limits, fem = (tables[s] for s in ("object", "grasp", "pump", "limits", "fem"))
     if "force_factor" in grasp and "margin_N" in grasp:
         raise InputError("grasp.margin_N", grasp["margin_N"], "give force_factor or margin_N, not both")
@@ -111,7 +124,7 @@ def task_from_dict(data: dict, *, folder: Path = Path("."), name: str = "task") 
         base=base, name=name, source=data,
         diameter=_number(obj, "object", "diameter_mm", required=True),
         mass=_number(obj, "object", "mass_kg", required=True, positive=False),
-        free=_free(tables["free"], base),
+        free=free, clipped=clipped,
         max_pressure=_number(pump, "pump", "max_pressure_MPa", required=True),
         force_factor=_number(grasp, "grasp", "force_factor", default=2.0),
         margin=_number(grasp, "grasp", "margin_N", default=None, positive=False),
@@ -173,3 +186,25 @@ def _free(table: dict, base: HandDesign) -> tuple[tuple[str, float, float], ...]
             raise InputError(f"free.{key}", bounds, "must be [lower, upper] with 0 < lower < upper")
         out.append((key, float(bounds[0]), float(bounds[1])))
     return tuple(out)
+
+
+def _calibrated(free, base: HandDesign):
+    """(free bounds clipped to the packaged finger table's box, the bounds that were clipped)."""
+    if base.finger_model != "fem" or base.finger_table:
+        return free, ()
+    from softhand.studies.calibration.finger import load_space
+
+    box = load_space(CALIBRATED_SPACE).box
+    out, clipped = [], []
+    for key, lo, hi in free:
+        if key not in box:
+            out.append((key, lo, hi))
+            continue
+        c_lo, c_hi = max(lo, box[key][0]), min(hi, box[key][1])
+        if not c_lo < c_hi:
+            raise InputError(f"free.{key}", [lo, hi], f'must overlap [{box[key][0]:g}, {box[key][1]:g}], '
+                             'the calibrated space of finger_model "fem"')
+        out.append((key, c_lo, c_hi))
+        if (c_lo, c_hi) != (lo, hi):
+            clipped.append((key, lo, hi))
+    return tuple(out), tuple(clipped)

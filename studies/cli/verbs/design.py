@@ -89,6 +89,8 @@ def _result(task, opt, base, design_file, seed: int) -> dict:
         "task": task.name, "feasible": ev.feasible, "objective": task.objective,
         "design": ev.design.to_dict(),
         "free": {k: float(v) for (k, _, _), v in zip(task.free, opt.x)},
+        "free_bounds": {k: [lo, hi] for k, lo, hi in task.free},
+        "bounds_clipped_from": {k: [lo, hi] for k, lo, hi in task.clipped},
         "predicted": ev.predicted(),
         "fem": None,
         "base_design": {"design": task.base.to_dict(), "predicted": base.predicted(),
@@ -106,6 +108,9 @@ def _print(result: dict, task, opt) -> None:
     print(f"task {task.name}: {task.diameter:g} mm, {task.mass:g} kg, F_v >= {task.required_F_v():.4g} N "
           f"per finger, pump <= {task.max_pressure:g} MPa; objective: {task.objective}")
     print(f"optimum: {free}  ({opt.evaluations} model evaluations, {opt.seconds:.1f} s)")
+    for key, lo, hi in task.clipped:
+        print(f"# free {key} = [{lo:g}, {hi:g}] clipped to {result['free_bounds'][key]}: the space "
+              f"finger_model \"fem\" is calibrated on")
     if "report" in result:
         print(result["report"])
     rows = [{"constraint": c["name"], "value": c["value"], "sense": c["sense"], "limit": c["limit"],
