@@ -27,7 +27,8 @@ step: the tangent (Euler) direction :math:`-K^{-1}(R + \partial_t R\,\Delta t)`
 with :math:`\partial_t R` by a forward difference in t (default: it keeps a
 prescribed boundary displacement from distorting the boundary elements alone), or
 the secant of the last two converged states, or none; a step that fails is
-halved (cut-back) down to ``min_dt``; easy steps let the increment grow again.
+halved (cut-back) down to ``min_dt``; easy steps let the increment grow again, and so do
+``grow_after`` converged steps in a row after a cut-back.
 On final failure :class:`NotConverged` carries the last converged (t, x).
 """
 from __future__ import annotations
@@ -244,6 +245,10 @@ class PathOptions:
     min_dt: float = 1e-4  #: smallest load increment before giving up
     grow: float = 1.5  #: increment growth after a step converging in <= easy_iter iterations
     easy_iter: int = 4  #: iterations counted as an easy step
+    #: after a cut-back, this many converged steps in a row let the increment grow even when
+    #: they were not easy (a problem that always needs more than easy_iter iterations, e.g.
+    #: the mixed (u, p) iteration's 5-6, would otherwise keep the cut-back increment for good)
+    grow_after: int = 2
     #: "tangent": Euler predictor every step (best with prescribed displacements);
     #: "secant": extrapolate the last two converged states (tangent for the first step);
     #: "none": start each step from the last converged state (pure load control needs no more)
@@ -280,7 +285,7 @@ def solve_path(fun_t, x0, options: PathOptions = PathOptions(), *, solver=None, 
     res = PathResult([0.0], [np.array(x0, dtype=float)], [], 0, [])
     factorizations0 = getattr(solver, "n_factorizations", 0)
     reuse = options.newton.refactor == "adaptive"
-    dt = 1.0 / options.steps
+    dt, streak = 1.0 / options.steps, None  # streak: converged steps since the last cut-back
     while res.t[-1] < 1.0 - 1e-12:
         t = min(1.0, res.t[-1] + dt)
         if on_accept is not None:
@@ -292,7 +297,7 @@ def solve_path(fun_t, x0, options: PathOptions = PathOptions(), *, solver=None, 
                        residual=None if residual_t is None else (lambda x: residual_t(x, t)))
         except NotConverged as err:
             res.cutbacks += 1
-            dt *= 0.5
+            dt, streak = 0.5 * dt, 0
             if dt < options.min_dt:
                 raise NotConverged(f"load step cut back below {options.min_dt} at t = {t:.4g}",
                                    err.history, err.x, (res.t[-1], res.x[-1])) from err
@@ -305,8 +310,11 @@ def solve_path(fun_t, x0, options: PathOptions = PathOptions(), *, solver=None, 
         res.solve_seconds += r.solve_seconds
         if callback is not None:
             callback(t, r.x)
+        streak = None if streak is None else streak + 1
         if r.iterations <= options.easy_iter or (reuse and r.factorizations <= 1):
             dt *= options.grow  # easy: few iterations, or (quasi-Newton) at most one factorisation
+        elif streak is not None and streak >= options.grow_after:
+            dt, streak = dt * options.grow, 0  # steady progress since the cut-back
     res.factorizations = getattr(solver, "n_factorizations", 0) - factorizations0
     return res
 

@@ -20,8 +20,9 @@ and the volume functional (``tests/test_reservoir.py``).
 
 Steps: a secant predictor from the last two converged states, Newton with a backtracking
 line search on the residual norm, and load-step cut-back (halve ΔV*) when Newton fails;
-the step grows again after easy steps. Raises :class:`NotConverged` with the residual
-history and the last converged state.
+the step grows again after easy steps. Raises :class:`VolumeNotConverged` (a
+:class:`fem.newton.NotConverged`, the one failure type of the FEM solvers) with the
+residual history and the last converged state.
 """
 from __future__ import annotations
 
@@ -31,8 +32,9 @@ import numpy as np
 import scipy.sparse as sp
 
 from softhand.fem.linsolve import make_solver
+from softhand.fem.newton import NotConverged
 
-__all__ = ["PathOptions", "PathState", "NotConverged", "follow_volume"]
+__all__ = ["PathOptions", "PathState", "NotConverged", "VolumeNotConverged", "follow_volume"]
 
 
 @dataclass(frozen=True)
@@ -64,12 +66,12 @@ class PathState:
     iterations: int = 0  #: Newton iterations of this step
 
 
-class NotConverged(RuntimeError):
-    """Newton failed at the smallest step; carries the history and the last converged state."""
+class VolumeNotConverged(NotConverged):
+    """Newton failed at the smallest volume step; ``last``: the last converged :class:`PathState`
+    (also as ``last_converged`` = (volume, u) and ``x`` = its u, like every :class:`NotConverged`)."""
 
     def __init__(self, message, history, last: PathState):
-        super().__init__(f"{message}; residual history {['%.2e' % r for r in history]}")
-        self.history = history
+        super().__init__(message, history, last.u, (last.volume, last.u))
         self.last = last
 
 
@@ -161,7 +163,7 @@ def follow_volume(solid, volume, fixed_dofs, targets, *, options=PathOptions(),
             if result is None:
                 step /= 2
                 if step < options.min_step:
-                    raise NotConverged(f"no equilibrium at V = {nxt:.6g} mm^3", history, path[-1])
+                    raise VolumeNotConverged(f"no equilibrium at V = {nxt:.6g} mm^3", history, path[-1])
                 continue
             uf, p, its = result
             u = prob.full(uf)

@@ -165,3 +165,19 @@ def test_mixed_precision_refines_to_double_accuracy_and_falls_back_when_ill_cond
     x = mixed.solve(K, b)
     assert mixed.precision == "double" and "stalled" in mixed.fallback and mixed.n_analyses == 2
     assert np.linalg.norm(K @ x - b) <= 1e-6 * np.linalg.norm(b)  # backward stable: ~ cond * eps_double
+
+
+def test_increment_grows_again_after_a_cut_back():
+    """x^3 + x = 30 t with plain Newton: the full step fails, and no step counts as easy
+    (easy_iter = 0), so only the steady progress after the cut-back may let it grow."""
+    def fun_t(x, t):
+        return np.array([x[0] ** 3 + x[0] - 30 * t]), sp.csr_matrix([[3 * x[0] ** 2 + 1]])
+    newton_options = NewtonOptions(max_iter=5, line_search=False)
+    res = solve_path(fun_t, [0.0], PathOptions(steps=1, easy_iter=0, newton=newton_options))
+    dt = np.diff(res.t)
+    assert res.cutbacks >= 1 and res.t[-1] == 1.0
+    assert dt.max() >= 1.4 * dt[0]  # grown after two converged steps (x 1.5, the last one clipped at t = 1)
+    assert res.x[-1][0] ** 3 + res.x[-1][0] == pytest.approx(30.0, rel=2e-8)
+    never = solve_path(fun_t, [0.0], PathOptions(steps=1, easy_iter=0, grow_after=10 ** 6, newton=newton_options))
+    assert np.allclose(np.diff(never.t), np.diff(never.t)[0])  # without it: the cut-back increment for good
+    assert len(never.t) > len(res.t)

@@ -183,10 +183,10 @@ def test_oil_leaving_retraces_the_inflation_path(study):
 
 
 def test_cli_reports_newton_failure_in_one_line(monkeypatch, capsys):
-    from softhand.fem.volume_path import NotConverged
+    from softhand.fem.volume_path import VolumeNotConverged
 
     def fail(*args, **kwargs):
-        raise NotConverged("no equilibrium at V = 123 mm^3", [1.0, 0.5], PathState(100.0, 0.01, 1.0, None))
+        raise VolumeNotConverged("no equilibrium at V = 123 mm^3", [1.0, 0.5], PathState(100.0, 0.01, 1.0, None))
 
     monkeypatch.setattr("softhand.studies.reservoir.inflate", fail)
     assert main(["reservoir", "--volume-mm3", "17800"]) == 1

@@ -87,7 +87,7 @@ class Problem:
             return self.fun(q, t, anchor=mixed.anchor)
 
         res = solve_path(fun_t, np.zeros(self.T.shape[1]),
-                         PathOptions(steps=steps, easy_iter=8, newton=NEWTON),
+                         PathOptions(steps=steps, newton=NEWTON),
                          solver=linear_solver(), on_accept=mixed.accept)
         return self.u(res.x[-1])
 
