@@ -32,6 +32,7 @@ from scipy.optimize import brentq
 
 from softhand.fem.contact import Circle, Pads, contact_load, gaps
 from softhand.fem.hand.finger import FingerModel
+from softhand.fem.hand.frame import hand_frame, to_finger_frame
 from softhand.fem.linsolve import make_solver
 from softhand.fem.newton import NewtonOptions, NotConverged, PathOptions, solve_path
 from softhand.reduced.design import HandDesign
@@ -59,18 +60,6 @@ class GraspOptions:
                 raise InputError(name, getattr(self, name), "must be a positive number")
         if not self.clearance >= 0 or not self.palm_gap >= 0:
             raise InputError("clearance", (self.palm_gap, self.clearance), "must be >= 0 [mm]")
-
-
-def _frame(design: HandDesign):
-    """(M, origin): hand = origin + M (finger - (0, d)); see :func:`fem.finger.to_hand_frame`."""
-    c, s = math.cos(design.theta0), math.sin(design.theta0)
-    return np.array([[s, -c], [c, s]]), np.array([design.base_offset, 0.0])
-
-
-def to_finger_frame(points, design: HandDesign) -> np.ndarray:
-    """Hand-frame points (..., 2) [mm] -> the finger frame (inverse of fem.finger.to_hand_frame)."""
-    M, origin = _frame(design)
-    return np.array([0.0, design.d]) + (np.asarray(points, dtype=float) - origin) @ M
 
 
 def pads_of(finger_chain, design: HandDesign, options: GraspOptions) -> Pads:
@@ -197,7 +186,7 @@ class GraspModel:
 
     def _state(self, P, y, L, g, updates, its, penalty) -> GraspState:
         q = np.array(self.finger.constraint.q(y))
-        M, _ = _frame(self.design)
+        M, _ = hand_frame(self.design)
         F = L.forces.sum(axis=0)
         n_tip = np.array([-math.sin(q.sum()), math.cos(q.sum())])  # tip pad normal, finger frame
         return GraspState(P=float(P), q=q, N=L.N, gap=g, F=M @ F, F_v=float(-F @ n_tip),

@@ -31,6 +31,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from softhand.fem.hand.frame import hand_frame
+
 LINK_GAP = 1.0    #: gap drawn between neighbouring links [mm]
 PIN_RADIUS = 2.0  #: radius of the hinge pins drawn [mm]
 #: point fields that are vectors (rotated and reflected with the geometry)
@@ -51,9 +53,8 @@ class Block:
 
 
 def hand_rotation(design) -> np.ndarray:
-    """3 x 3 rotation finger frame -> hand frame (z kept); see :func:`fem.finger.to_hand_frame`."""
-    c, s = math.cos(design.theta0), math.sin(design.theta0)
-    return np.array([[s, -c, 0.0], [c, s, 0.0], [0.0, 0.0, 1.0]])
+    """3 x 3 rotation finger frame -> hand frame (z kept); see :func:`fem.hand.frame.to_hand_frame`."""
+    return np.block([[hand_frame(design)[0], np.zeros((2, 1))], [np.zeros((1, 2)), np.ones((1, 1))]])
 
 
 def to_hand(points, design) -> np.ndarray:

@@ -1,0 +1,103 @@
+"""The finger FEM's discretisation and modelling options, the tie bands and the mesh they give."""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from skfem.quadrature import get_quadrature
+from skfem.refdom import RefTet
+
+from softhand.meshes.finger import FingerTube, finger_tube_mesh, layered_tube_mesh
+from softhand.reduced.design import HandDesign
+from softhand.reduced.errors import InputError
+
+TIES = ("ring", "full")
+MESHERS = ("layered", "gmsh")
+
+
+@dataclass(frozen=True)
+class FingerOptions:
+    """Discretisation and modelling choices of the finger FEM."""
+
+    #: the default mesh is layered (meshes.finger.layered_tube_mesh): 4 sectors over the half
+    #: circumference, 5 wall layers from 0.2 mm at the cavity, axial slices of at most 2.5 mm
+    #: (38k unknowns); theta(0.8 MPa) 0.3 % below the extrapolated value (docs/finger.md: mesh
+    #: convergence). "gmsh": an unstructured mesh of size mesh_size (the CI mesh: 6 mm, uniform,
+    #: unrefined; 3.6 % below)
+    mesher: str = "layered"    #: "layered" (structured, no gmsh) or "gmsh"
+    n_phi: int = 4             #: layered: sectors over the half circumference (180 deg)
+    layer_first: float = 0.2   #: layered: thickness of the wall layer at the cavity [mm]
+    layer_ratio: float = 2.0   #: layered: growth of the layer thickness towards the outside
+    axial_size: float = 2.5   #: layered: largest slice length along the finger [mm]
+    mesh_size: float = 6.0     #: gmsh: target element size, before mesh_refine [mm]
+    edge_ratio: float = 1.0    #: gmsh: element size at the ring edges and cap corner / mesh_size (1: uniform)
+    edge_reach: float = 3.0    #: gmsh: distance over which the size grows back to mesh_size [mm]
+    mesh_refine: int = 0       #: split every element / halve every spacing this many times (nested meshes)
+    tie: str = "ring"          #: which outer surface the links hold: "ring" or "full"
+    tie_width: float | None = None  #: width of each link's tied ring [mm]; None: the design's tie_width_mm
+    hinge_gap: float = 4.0     #: untied tube length around each hinge, tie = "full" [mm]
+    cap: float | None = None   #: end-cap thickness at the tip [mm]; None: the wall b
+    kappa_ratio: float = 1000.0  #: bulk over shear modulus of the rubber
+    fiber_ratio: float = 1000.0  #: fiber stiffness over mu (Kevlar >> rubber)
+    fiber_toe: float = 0.0     #: fiber strain over which the windings' stiffness sets in (0: a jump)
+    fiber_intorder: int = 5    #: degree of the quadrature rule of the windings' energy (2: the rubber's)
+
+    def __post_init__(self):
+        if self.mesher not in MESHERS:
+            raise InputError("mesher", self.mesher, f"must be one of {', '.join(MESHERS)}")
+        if not (isinstance(self.n_phi, int) and self.n_phi >= 2):
+            raise InputError("n_phi", self.n_phi, "must be an integer >= 2")
+        if not self.layer_ratio >= 1:
+            raise InputError("layer_ratio", self.layer_ratio, "must be >= 1")
+        if self.tie not in TIES:
+            raise InputError("tie", self.tie, f"must be one of {', '.join(TIES)}")
+        if not get_quadrature(RefTet, self.fiber_intorder)[1].min() > 0:
+            raise InputError("fiber_intorder", self.fiber_intorder,
+                             "must name a tetrahedral rule with positive weights (e.g. 2, 5, 6)")
+        if not 0 < self.edge_ratio <= 1:
+            raise InputError("edge_ratio", self.edge_ratio, "must be in (0, 1]")
+        if self.mesh_refine not in range(0, 4):
+            raise InputError("mesh_refine", self.mesh_refine, "must be 0, 1, 2 or 3")
+        for name in ("layer_first", "axial_size", "mesh_size", "edge_reach", "tie_width", "hinge_gap", "kappa_ratio", "fiber_ratio"):
+            if getattr(self, name) is not None and not getattr(self, name) > 0:
+                raise InputError(name, getattr(self, name), "must be a positive number")
+
+
+def ring_width(design: HandDesign, options: FingerOptions) -> float:
+    """Width of each link's tied ring [mm]: the options' if given, else the design's tie_width."""
+    return design.tie_width if options.tie_width is None else options.tie_width
+
+
+def tie_bands(design: HandDesign, options: FingerOptions) -> tuple[tuple[float, float], ...]:
+    """(x_start, x_end) of the tube band each link holds [mm] (see :class:`FingerOptions`)."""
+    s = np.array((0.0, *design.hinge_s, design.l0))
+    if options.tie == "ring":
+        width = ring_width(design, options)
+        mid, half = 0.5 * (s[:-1] + s[1:]), 0.5 * width
+        if width >= np.diff(s).min():
+            raise InputError("tie_width_mm", width, "must be shorter than every link")
+        return tuple((float(m - half), float(m + half)) for m in mid)
+    gap = 0.5 * options.hinge_gap
+    if options.hinge_gap >= np.diff(s).min():
+        raise InputError("hinge_gap", options.hinge_gap, "must be shorter than every link")
+    start, end = s[:-1] + gap, s[1:] - gap
+    start[0], end[-1] = 0.0, design.l0
+    return tuple((float(a), float(b)) for a, b in zip(start, end))
+
+
+
+def build_mesh(tube: FingerTube, options: FingerOptions):
+    if options.mesher == "layered":
+        return layered_tube_mesh(tube, n_phi=options.n_phi, layer_first=options.layer_first,
+                                 layer_ratio=options.layer_ratio, axial_size=options.axial_size,
+                                 refine=options.mesh_refine)
+    return finger_tube_mesh(tube, size=options.mesh_size, refine=options.mesh_refine)
+
+
+def describe_mesh(options: FingerOptions) -> str:
+    if options.mesher == "layered":
+        return (f"layered n_phi={options.n_phi} layer_first={options.layer_first} "
+                f"layer_ratio={options.layer_ratio} axial_size={options.axial_size} refine={options.mesh_refine}")
+    return (f"gmsh mesh_size={options.mesh_size} edge_ratio={options.edge_ratio} "
+            f"refine={options.mesh_refine}")
+
