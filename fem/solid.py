@@ -196,6 +196,13 @@ class Solid:
         """(residual, CSR data array) for callers that add terms in the same pattern."""
         return self._assemble(u, tangent=True, anchor=anchor)
 
+    def residual_element_matrices(self, u: np.ndarray, anchor: "PressureAnchor | None" = None):
+        """(residual, element matrices in the block layout of :func:`element_matrices`, not yet
+        scattered) for callers that add element terms of their own before the one scatter
+        (:meth:`fem.assembly.ElementScatter.block_matrix_data`); the buffer is reused by the
+        next call."""
+        return self._assemble(u, tangent=True, anchor=anchor, scatter=False)
+
     def anchor(self, u: np.ndarray) -> "PressureAnchor | None":
         """The element pressures linearised at u (None for the displacement formulation)."""
         if self._vol is None:

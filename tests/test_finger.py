@@ -50,8 +50,10 @@ def test_windings_kernel_equals_the_general_solid_kernel(model):
     w = model.windings
     general = Solid(model.mesh, w.law, intorder=CI.fiber_intorder, formulation="displacement")
     u = 0.05 * np.random.default_rng(0).standard_normal(model.solid.ndofs)
-    R, data = np.zeros(model.solid.ndofs), np.zeros(model.solid.scatter.nnz)
-    w.add_residual_tangent(u, R, data)
+    nel, nloc = model.solid.scatter.dofs.shape
+    R, Ke = np.zeros(model.solid.ndofs), np.zeros((nel, nloc, 3, 3, nloc))
+    w.add_residual_tangent(u, R, Ke)
+    data = model.solid.scatter.block_matrix_data(Ke)
     R_ref, K_ref = general.residual_tangent(u)
     assert 0.1 < np.mean(w.stretch(u)[1] > 1.0) < 0.9
     assert np.abs(R - R_ref).max() < 1e-12 * np.abs(R_ref).max()

@@ -181,3 +181,15 @@ def test_increment_grows_again_after_a_cut_back():
     never = solve_path(fun_t, [0.0], PathOptions(steps=1, easy_iter=0, grow_after=10 ** 6, newton=newton_options))
     assert np.allclose(np.diff(never.t), np.diff(never.t)[0])  # without it: the cut-back increment for good
     assert len(never.t) > len(res.t)
+
+
+def test_one_failure_type_for_load_and_volume_paths():
+    """A failed volume path is caught like a failed load path, and carries the same fields."""
+    from softhand.fem.volume_path import PathState, VolumeNotConverged
+
+    last = PathState(100.0, 0.01, 1.0, np.arange(3.0))
+    with pytest.raises(NotConverged) as err:
+        raise VolumeNotConverged("no equilibrium at V = 123 mm^3", [1.0, 0.5], last)
+    assert err.value.last is last and err.value.x is last.u
+    assert err.value.last_converged == (100.0, last.u) and err.value.history == [1.0, 0.5]
+    assert "residual history" in str(err.value)

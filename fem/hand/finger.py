@@ -144,10 +144,12 @@ class FingerModel:
         [N mm] and their derivative (e.g. from :meth:`PlanarChain.point_load`).
         """
         u = self.constraint.expand(y)
-        R, data = self.solid.residual_tangent_data(u)
-        self.windings.add_residual_tangent(u, R, data)
+        R, Ke = self.solid.residual_element_matrices(u)
+        self.windings.add_residual_tangent(u, R, Ke)  # rubber + windings: one scatter
         R = R - P * self.cavity.gradient(u)
-        K = self.solid.scatter.csr(data - P * self.cavity.hessian_data(u))
+        data = self.solid.scatter.block_matrix_data(Ke)
+        data -= P * self.cavity.hessian_data(u)
+        K = self.solid.scatter.csr(data)
         Q, dQ = (None, None) if link_load is None else link_load(self.constraint.q(y))
         r, Kr = self.constraint.reduce(y, R, K, None if dQ is None else -np.asarray(dQ))
         if Q is not None:

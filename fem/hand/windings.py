@@ -89,8 +89,9 @@ class Windings:
     G'/lam^3), c2 = k G'/lam: r_na = sum_q w k G'/lam f_a g_n and
     K_(na)(mb) = sum_q w (c1 f_a g_n f_b g_m + c2 delta_ab g_n g_m): two batched products,
     far cheaper than the general anisotropic tangent of :mod:`fem.solid`, written in the
-    block layout K[e, n, a, b, m] of :func:`fem.solid.element_matrices` into a whole-mesh
-    buffer and scattered like the rubber's (:meth:`fem.assembly.ElementScatter.block_matrix_data`).
+    block layout K[e, n, a, b, m] of :func:`fem.solid.element_matrices` and added to the
+    rubber's element matrices, so the two are scattered together, once
+    (:meth:`fem.assembly.ElementScatter.block_matrix_data`).
     """
 
     def __init__(self, mesh, fibers_k: float, toe: float, intorder: int, scatter, chunk=2048):
@@ -103,7 +104,7 @@ class Windings:
         self.scatter = scatter
         nel = self.W.shape[0]
         self.chunks = [slice(i, min(i + chunk, nel)) for i in range(0, nel, chunk)]
-        self._ke = None  # element matrices of the whole mesh, block layout; allocated at first use
+        self._ke = None  # element matrices of one chunk, block layout; allocated at first use
 
     def stretch(self, u: np.ndarray, elements=slice(None)):
         """(f = F a0 (3, ne, nq), fiber stretch lam (ne, nq)) at the rule's points."""
@@ -129,22 +130,22 @@ class Windings:
             _, lam, G1, _, v = self._chunk(u, c)
             self.scatter.add_vector(R, np.einsum("eq,eqi->ei", self.W[c] * self.law.k * G1 / lam, v), c)
 
-    def add_residual_tangent(self, u: np.ndarray, R: np.ndarray, data: np.ndarray) -> None:
-        """R += the windings' internal force; data (the CSR data of ``scatter``) += tangent."""
+    def add_residual_tangent(self, u: np.ndarray, R: np.ndarray, Ke_all: np.ndarray) -> None:
+        """R += the windings' internal force; Ke_all (element matrices of the whole mesh in the
+        block layout of :func:`fem.solid.element_matrices`, e.g. the rubber's) += their tangent."""
         k = self.law.k
         nel, nq, nloc = self.g.shape
         if self._ke is None:
-            self._ke = np.empty((nel, nloc, 3, 3, nloc))
+            self._ke = np.empty((len(range(nel)[self.chunks[0]]), nloc, 3, 3, nloc))
         for c in self.chunks:
             f, lam, G1, G2, v = self._chunk(u, c)
             g, W = self.g[c], self.W[c]
             self.scatter.add_vector(R, np.einsum("eq,eqi->ei", W * k * G1 / lam, v), c)
             c1, c2 = W * k * (G2 / lam ** 2 - G1 / lam ** 3), W * k * G1 / lam
             vt = np.einsum("aeq,eqn->eqan", f, g).reshape(*W.shape, -1)     # (ne, nq, (b m))
-            Ke = self._ke[c]
+            Ke = self._ke[:len(W)]
             np.matmul(v.transpose(0, 2, 1) * c1[:, None, :], vt, out=Ke.reshape(len(W), 3 * nloc, 3 * nloc))
             S = np.matmul(g.transpose(0, 2, 1) * c2[:, None, :], g)         # (ne, nloc, nloc)
             for a in range(3):  # + delta_ab S_nm
                 Ke[:, :, a, a, :] += S
-        data += self.scatter.block_matrix_data(self._ke)
-
+            Ke_all[c] += Ke
