@@ -193,3 +193,4 @@ def test_one_failure_type_for_load_and_volume_paths():
     assert err.value.last is last and err.value.x is last.u
     assert err.value.last_converged == (100.0, last.u) and err.value.history == [1.0, 0.5]
     assert "residual history" in str(err.value)
+
