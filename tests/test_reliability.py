@@ -268,7 +268,7 @@ def test_mesh_and_weights_cache_keys_carry_the_package_version(monkeypatch):
 def test_a_failed_load_step_names_the_pressures_reached(monkeypatch):
     import numpy as np
 
-    import softhand.fem.hand.finger as ff
+    import softhand.fem.hand.finger_sweep as ff
     from softhand.fem.newton import NotConverged
 
     y = np.arange(3.0)
