@@ -323,3 +323,38 @@ def test_an_output_that_fails_after_the_computation_loses_nothing(tmp_path, monk
     out, err = capsys.readouterr()
     assert len(json.loads(out)["rows"]) == 4
     assert "warning" in err and "No space left on device" in err and not (tmp_path / "c.png").exists()
+
+
+def test_a_real_reservoir_failure_saves_the_last_converged_state(tmp_path, monkeypatch, capsys):
+    """The reservoir FEM really stops (Newton held to 4 iterations a step and no cut-back below
+    500 mm^3, against 12 and 1e-6 by default, on a 4 x 1 element sheet): exit 1, one line
+    naming the volume and pressure reached, and that state in result.json and the VTK."""
+    import functools
+
+    import softhand.fem.hand.reservoir as fr
+    from softhand.fem.volume_path import PathOptions
+
+    monkeypatch.setattr(fr, "PathOptions", functools.partial(PathOptions, max_iter=4, min_step=500.0))
+    out = tmp_path / "sheet"
+    argv = ["reservoir", "--n-radial", "4", "--n-thick", "1", "--volume-mm3", "20000", "--out", str(out)]
+    assert main(argv) == 1
+    stderr = capsys.readouterr().err
+    err = [line for line in stderr.splitlines() if "error" in line]  # also the progress bar's
+    assert len(err) == 1 and stderr.rstrip().endswith(err[0]) and "Traceback" not in stderr, err
+    result = json.loads((out / "result.json").read_text())
+    last = result["last_converged"]
+    assert result["failed"] and 0 < last["V_mm3"] < 20000 and last["p_MPa"] > 0
+    assert f"V = {last['V_mm3']:.6g} mm^3, p = {last['p_MPa']:.6g} MPa" in err[0]
+    assert "no equilibrium at V = " in err[0] and f"{out}/sheet.pvd" in err[0]
+    import numpy as np
+    import pyvista
+    from scipy.integrate import simpson
+
+    # the VTK holds the state reached: the oil volume under its wet surface (z = 0 before
+    # inflating; Simpson's rule, exact on the quadratic elements) is the volume named
+    sheet = pyvista.read(out / f"sheet_V{last['V_mm3']:.0f}_rz.vtu")
+    points, u = np.asarray(sheet.points), np.asarray(sheet.point_data["displacement_mm"])
+    wet = points[:, 1] == 0.0
+    r, z = points[wet, 0] + u[wet, 0], u[wet, 1]
+    order = np.argsort(r)
+    assert simpson(2 * np.pi * r[order] * z[order], x=r[order]) == pytest.approx(last["V_mm3"], rel=1e-6)

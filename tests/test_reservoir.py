@@ -182,8 +182,10 @@ def test_oil_leaving_retraces_the_inflation_path(study):
         assert hit.pressure == pytest.approx(up.pressure, rel=1e-9)
 
 
-def test_cli_reports_newton_failure_in_one_line(monkeypatch, capsys):
+def test_cli_reports_newton_failure_in_one_line(monkeypatch, capsys, tmp_path):
     from softhand.fem.volume_path import VolumeNotConverged
+
+    monkeypatch.chdir(tmp_path)  # without --out the failure goes to results/reservoir
 
     def fail(*args, **kwargs):
         raise VolumeNotConverged("no equilibrium at V = 123 mm^3", [1.0, 0.5], PathState(100.0, 0.01, 1.0, None))
@@ -191,4 +193,4 @@ def test_cli_reports_newton_failure_in_one_line(monkeypatch, capsys):
     monkeypatch.setattr("softhand.studies.reservoir.inflate", fail)
     assert main(["reservoir", "--volume-mm3", "17800"]) == 1
     err = capsys.readouterr().err.strip().splitlines()[-1]
-    assert "V = 123 mm^3" in err and "last converged state V = 100 mm^3" in err
+    assert "V = 123 mm^3" in err and "last converged state (V = 100 mm^3, p = 0.01 MPa)" in err

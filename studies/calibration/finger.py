@@ -37,7 +37,6 @@ writes it and checks a table against held-out designs.
 from __future__ import annotations
 
 import math
-import tomllib
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -45,7 +44,7 @@ import numpy as np
 
 from softhand.reduced.design import HandDesign, load_design
 from softhand.reduced.errors import InputError
-from softhand.studies.batch.studyfile import Study
+from softhand.studies.batch.studyfile import _NAME_RE, Study
 
 #: the dimensional variables of a design space, in this order
 VARIABLES = ("a_mm", "b_mm", "d_mm", "l0_mm", "tie_width_mm")
@@ -94,43 +93,55 @@ def latin_hypercube(box: dict, n: int, seed: int) -> list[dict]:
     return [dict(zip(VARIABLES, np.round(lo + row * (hi - lo), 3).tolist())) for row in u]
 
 
+#: (lowest, highest) of a design space's numbers: designs sampled, pressures [MPa], the target
+#: angle [deg], the mesh [mm] (the bounds of ``softhand bend``'s options)
+LIMITS = {"lhs": (0, 200), "seed": (0, 2**32 - 1), "pressures_mpa": (0.0, 5.0),
+          "theta_target_deg": (1.0, 180.0), "p_max_mpa": (0.01, 5.0), "p_step_mpa": (0.01, 5.0),
+          "mesh_size_mm": (0.5, 12.0), "axial_size_mm": (0.25, 20.0)}
+#: most pressures of one design's path
+MAX_PRESSURES = 50
+
+
 def load_space(path: str | Path) -> DesignSpace:
     """Read and validate a design-space TOML file (see the module docstring)."""
+    from softhand.reduced.design import read_toml
+
     path = Path(path)
-    try:
-        doc = tomllib.loads(path.read_text())
-    except (FileNotFoundError, IsADirectoryError):
-        raise InputError("--space", str(path), "no such file; give a design-space TOML file") from None
-    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
-        raise InputError("--space", str(path), f"is not valid TOML ({exc})") from None
+    doc = read_toml(path, "--space", "a design-space TOML file")
     src = path.name
     for key in doc:
         if key not in _KEYS:
             raise InputError(f"{src}: {key}", doc[key], f"unknown key; allowed: {', '.join(_KEYS)}")
+    name = doc.get("name", path.stem)
+    if not isinstance(name, str) or not _NAME_RE.match(name) or len(name) > 100:
+        raise InputError(f"{src}: name", name,
+                         "must be a string of at most 100 letters, digits, '_', '-', '.'")
     box = _box(doc.get("space"), src)
-    points = [_point(p, box, f"{src}: design[{i}]") for i, p in enumerate(doc.get("design", []))]
-    lhs = doc.get("lhs", 0)
-    if not isinstance(lhs, int) or isinstance(lhs, bool) or lhs < 0:
-        raise InputError(f"{src}: lhs", lhs, "must be a whole number >= 0")
-    points += latin_hypercube(box, lhs, int(doc.get("seed", 0))) if lhs else []
+    tables = doc.get("design", [])
+    if not isinstance(tables, list):
+        raise InputError(f"{src}: design", tables, "must be [[design]] tables")
+    points = [_point(p, box, f"{src}: design[{i}]") for i, p in enumerate(tables)]
+    lhs, seed = (_whole(doc, key, default, src) for key, default in (("lhs", 0), ("seed", 0)))
+    points += latin_hypercube(box, lhs, seed) if lhs else []
     if not points:
         raise InputError(f"{src}: design", [], "no designs: give lhs > 0 or [[design]] tables")
     pressures = doc.get("pressures_mpa", [0.2, 0.5, 0.8])
-    if not isinstance(pressures, list) or not pressures or any(
-            not _number(p) or p <= 0 for p in pressures) or any(np.diff(pressures) <= 0):
-        raise InputError(f"{src}: pressures_mpa", pressures, "must be increasing numbers > 0 [MPa]")
-    numbers = {}
-    for key, default in (("theta_target_deg", 64.0), ("p_max_mpa", 2.0), ("p_step_mpa", 0.5)):
-        numbers[key] = doc.get(key, default)
-        if not _number(numbers[key]) or not numbers[key] > 0:
-            raise InputError(f"{src}: {key}", numbers[key], "must be a positive number")
-    mesh, axial = doc.get("mesh_size_mm"), doc.get("axial_size_mm")
-    for key, value in (("mesh_size_mm", mesh), ("axial_size_mm", axial)):
-        if value is not None and (not _number(value) or not value > 0):
-            raise InputError(f"{src}: {key}", value, "must be a positive number [mm] (omit: the default mesh)")
+    lo, hi = LIMITS["pressures_mpa"]
+    if not isinstance(pressures, list) or not 0 < len(pressures) <= MAX_PRESSURES or any(
+            not _number(p) or not lo < p <= hi for p in pressures) or any(np.diff(pressures) <= 0):
+        raise InputError(f"{src}: pressures_mpa", pressures,
+                         f"must be 1 to {MAX_PRESSURES} increasing numbers in ({lo:g}, {hi:g}] MPa")
+    numbers = {key: _bounded(doc, key, default, src)
+               for key, default in (("theta_target_deg", 64.0), ("p_max_mpa", 2.0), ("p_step_mpa", 0.5))}
+    mesh, axial = (_bounded(doc, key, None, src) for key in ("mesh_size_mm", "axial_size_mm"))
     if mesh is not None and axial is not None:
         raise InputError(f"{src}: axial_size_mm", axial, "applies to the layered mesh; remove mesh_size_mm")
-    base = load_design(path.parent / doc["base_design"]) if "base_design" in doc else HandDesign()
+    if "base_design" in doc and not isinstance(doc["base_design"], str):
+        raise InputError(f"{src}: base_design", doc["base_design"], "must be a file name")
+    try:
+        base = load_design(path.parent / doc["base_design"]) if "base_design" in doc else HandDesign()
+    except InputError as exc:
+        raise exc.renamed(f"{src}: base_design") from None
     pair = doc.get("mesh_pair")
     if pair is not None:
         if not isinstance(pair, dict) or "pressures_mpa" not in pair:
@@ -147,7 +158,7 @@ def load_space(path: str | Path) -> DesignSpace:
     prior = doc.get("prior", "paper")
     if prior not in PRIORS:
         raise InputError(f"{src}: prior", prior, f"must be one of {', '.join(PRIORS)}")
-    space = DesignSpace(doc.get("name", path.stem), box, tuple(points),
+    space = DesignSpace(name, box, tuple(points),
                         tuple(float(p) for p in pressures), base=base,
                         mesh_size_mm=None if mesh is None else float(mesh),
                         axial_size_mm=None if axial is None else float(axial), mesh_pair=pair,
@@ -158,7 +169,24 @@ def load_space(path: str | Path) -> DesignSpace:
 
 
 def _number(value) -> bool:
-    return isinstance(value, (int, float)) and not isinstance(value, bool)
+    return isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
+
+
+def _whole(doc: dict, key: str, default: int, src: str) -> int:
+    value, (lo, hi) = doc.get(key, default), LIMITS[key]
+    if not isinstance(value, int) or isinstance(value, bool) or not lo <= value <= hi:
+        raise InputError(f"{src}: {key}", value, f"must be a whole number in [{lo}, {hi}]")
+    return value
+
+
+def _bounded(doc: dict, key: str, default, src: str):
+    """``doc[key]`` as a float in LIMITS[key] (``default`` if absent)."""
+    value, (lo, hi) = doc.get(key, default), LIMITS[key]
+    if value is default:
+        return value
+    if not _number(value) or not lo <= value <= hi:
+        raise InputError(f"{src}: {key}", value, f"must be a number in [{lo:g}, {hi:g}]")
+    return float(value)
 
 
 def _box(table, src: str) -> dict:

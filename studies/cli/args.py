@@ -13,8 +13,10 @@ from softhand.reduced.errors import InputError
 from softhand.studies.io.files import jsonable
 
 
-#: most values one range or list may give: reduced-model verbs, and FEM runs (one solve each)
+#: most values one range or list may give: reduced-model verbs, and FEM runs (one solve each),
+#: unless --max-cases says otherwise; and the most --max-cases may allow
 MAX_POINTS, MAX_FEM_POINTS = 100_000, 200
+MOST_POINTS, MOST_FEM_POINTS = 1_000_000, 10_000
 #: longest range or list text read [characters]
 MAX_TEXT = 100_000
 _FORMS = "start:stop:step (step > 0, stop >= start) or a comma-separated list of finite numbers"
@@ -39,19 +41,40 @@ def parse_values(text: str, field: str, max_count: int = MAX_POINTS) -> np.ndarr
         start, stop, step = numbers
         count = (stop - start) / step + 1
         if not count <= max_count:
-            raise InputError(field, text, f"gives {_count(count)} values; at most {max_count} allowed")
+            raise InputError(field, text, _too_many(_count(count), max_count))
         values = start + step * np.arange(int(math.floor(count - 1 + 1e-9)) + 1)
     else:
         values = np.array(numbers, dtype=float)
         if values.size > max_count:
-            raise InputError(field, text, f"gives {values.size} values; at most {max_count} allowed")
+            raise InputError(field, text, _too_many(values.size, max_count))
     if values.size == 0 or not np.all(np.isfinite(values)):
         raise InputError(field, text, f"must be {_FORMS}")
     return values
 
 
+def _too_many(count, max_count: int) -> str:
+    more = "; --max-cases N allows more" if max_count > 1 else ""
+    return f"gives {count} values; at most {max_count} allowed{more}"
+
+
+def add_max_cases_option(parser: argparse.ArgumentParser, default: int, most: int) -> None:
+    """``--max-cases N``: the most values one range may give (``default``; at most ``most``)."""
+    parser.add_argument("--max-cases", type=int, default=None, metavar="N",
+                        help=f"allow ranges of up to N values (default {default}, at most {most})")
+
+
+def max_cases(args, default: int, most: int) -> int:
+    """``--max-cases`` if given (a whole number in [1, most]), else ``default``."""
+    n = getattr(args, "max_cases", None)
+    if n is None:
+        return default
+    if not 1 <= n <= most:
+        raise InputError("--max-cases", n, f"must be a whole number in [1, {most}]")
+    return n
+
+
 def _count(count: float) -> str:
-    return f"{count:.3g}" if math.isfinite(count) else "too many"
+    return f"{math.floor(count + 1e-9):d}" if count < 1e15 else "too many"
 
 
 def check_range(field: str, value: float, lo: float, hi: float, unit: str = "") -> float:

@@ -79,6 +79,15 @@ def check_writable(path, kind: str, field: str) -> None:
     _probe(folder, field, text)
 
 
+def check_readable_folder(path, field: str) -> None:
+    """``path`` is a folder or not there yet (a results root that is only read)."""
+    text = str(path)
+    if not text.strip() or "\0" in text:
+        raise InputError(field, text, "must be a folder name")
+    if Path(text).exists() and not Path(text).is_dir():
+        raise InputError(field, text, "exists and is not a folder; give a folder")
+
+
 def _probe(folder: Path, field: str, text: str) -> None:
     existing = folder
     while not existing.exists() and existing != existing.parent:

@@ -79,6 +79,7 @@ def main(argv: list[str] | None = None) -> int:
     module.configure(parser)
     args = parser.parse_args(rest)
     previous = _sigterm_as_interrupt()
+    float_errors = _quiet_float_warnings()
     try:
         _check(verb, args, parser)
         code = int(module.run(args) or 0)
@@ -94,17 +95,21 @@ def main(argv: list[str] | None = None) -> int:
         _silence_stdout()
         return 141
     finally:
+        _restore_float_warnings(float_errors)
         if previous is not None:
             signal.signal(signal.SIGTERM, previous)
 
 
 def _check(verb: str, args, parser) -> None:
     """The checks every verb gets before it runs: finite numbers, writable outputs, cache."""
-    from softhand.studies.cli.checks import check_finite, check_outputs, warn_cache
+    from softhand.studies.cli.checks import check_finite, check_outputs, check_readable_folder, \
+        option_name, warn_cache
 
     check_finite(args, parser)
     if not (verb == "study" and args.action == "status"):
         check_outputs(verb, args, parser)
+    elif args.results is not None:  # status only reads: a folder, if it is there
+        check_readable_folder(args.results, option_name("results", parser))
     warn_cache(verb)
 
 
@@ -117,6 +122,21 @@ def _sigterm_as_interrupt():
         return signal.signal(signal.SIGTERM, interrupt)
     except ValueError:  # not the main thread
         return None
+
+
+def _quiet_float_warnings() -> dict:
+    """No numpy overflow / invalid-value warnings on stderr: every result the CLI prints is
+    checked to be finite, and bad input is refused in one line, not after a page of warnings.
+    The earlier settings, for :func:`_restore_float_warnings`."""
+    import numpy as np
+
+    return np.seterr(all="ignore")
+
+
+def _restore_float_warnings(settings: dict) -> None:
+    import numpy as np
+
+    np.seterr(**settings)
 
 
 def _silence_stdout() -> None:

@@ -40,7 +40,7 @@ import math
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from softhand.reduced.design import PAPER_DESIGN_FILE, PUBLIC_KEYS, HandDesign, design_from_dict, load_design, read_toml
+from softhand.reduced.design import BOUNDS, PAPER_DESIGN_FILE, PUBLIC_KEYS, HandDesign, design_from_dict, load_design, read_toml
 from softhand.reduced.errors import InputError
 
 #: design keys the optimiser may vary; "l0_mm" scales the hinge positions with the tube
@@ -58,6 +58,12 @@ _SECTIONS = {
 MODELS = {"finger_model": "fem", "reservoir_model": "fem"}
 #: the design space the packaged finger table was calibrated on (its [space] box)
 CALIBRATED_SPACE = PAPER_DESIGN_FILE.parents[1] / "finger_space.toml"
+#: highest value of each number of a task (the lowest: > 0, or >= 0 where zero makes sense)
+UPPER = {"diameter_mm": 500.0, "mass_kg": 20.0, "max_pressure_MPa": 5.0, "force_factor": 100.0,
+         "margin_N": 1000.0, "opening_mm": 1000.0, "max_principal_stretch": 10.0, "min_wall_mm": 50.0,
+         "mesh_size_mm": 12.0, "edge_ratio": 1.0, "dP_MPa": 0.5}
+#: lowest value of the FEM proof's mesh and step (a finer one is refused, not run for hours)
+LOWER = {"mesh_size_mm": 0.5, "edge_ratio": 0.05, "dP_MPa": 0.001}
 _TOP = {"base_design", "object", "grasp", "pump", "limits", "material", "design", "free", "fem"}
 
 
@@ -164,10 +170,12 @@ def _number(table: dict, section: str, key: str, *, required: bool = False, defa
         return default
     value = table[key]
     ok = isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
-    limit = above if above is not None else 0.0
-    if not ok or (value <= limit if positive or above is not None else value < 0):
-        what = f"must be a number > {limit:g}" if positive or above is not None else "must be a number >= 0"
-        raise InputError(f"{section}.{key}", value, what)
+    limit, upper = above if above is not None else 0.0, UPPER[key]
+    if not ok or (value <= limit if positive or above is not None else value < 0) or value > upper \
+            or value < LOWER.get(key, -math.inf):
+        what = f"> {limit:g}" if positive or above is not None else ">= 0"
+        what = f">= {LOWER[key]:g}" if key in LOWER else what
+        raise InputError(f"{section}.{key}", value, f"must be a number {what} and <= {upper:g}")
     return float(value)
 
 
@@ -184,6 +192,9 @@ def _free(table: dict, base: HandDesign) -> tuple[tuple[str, float, float], ...]
                 and all(isinstance(b, (int, float)) and not isinstance(b, bool) and math.isfinite(b)
                         for b in bounds) and 0 < bounds[0] < bounds[1]):
             raise InputError(f"free.{key}", bounds, "must be [lower, upper] with 0 < lower < upper")
+        lo, hi = BOUNDS[key]
+        if bounds[0] < lo or bounds[1] > hi:
+            raise InputError(f"free.{key}", bounds, f"must lie within [{lo:g}, {hi:g}]")
         out.append((key, float(bounds[0]), float(bounds[1])))
     return tuple(out)
 

@@ -46,14 +46,19 @@ def write_sheet_vtk(result, outdir: Path) -> list[str]:
     """The deformed sheet per volume: the scene series sheet.pvd (the sheet revolved in 3D,
     one .vtm per volume, by increasing volume) and the r-z sections sheet_V<volume>_rz.vtu;
     the names written."""
+    return write_sheet_states(result.fem.model.build()[0], result.states, outdir)
+
+
+def write_sheet_states(solid, states, outdir: Path) -> list[str]:
+    """:func:`write_sheet_vtk` of the sheet states ``states`` on the mesh of ``solid``."""
     from softhand.fem.hand.reservoir import sheet_vtk
     from softhand.fem.hand.scene import sheet_block
     from softhand.fem.io import SceneSeries
     from softhand.meshes.convert import write_vtu
 
-    solid, names = result.fem.model.build()[0], []
+    names = []
     series = SceneSeries(Path(outdir) / "sheet.pvd")
-    for state in sorted({s.volume: s for s in result.states}.values(), key=lambda s: s.volume):
+    for state in sorted({s.volume: s for s in states}.values(), key=lambda s: s.volume):
         series.write(state.volume, [sheet_block(solid, state)],
                      {"volume_mm3": state.volume, "pressure_MPa": state.pressure})
         name = f"sheet_V{state.volume:.0f}_rz.vtu"

@@ -12,8 +12,8 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
-from softhand.studies.cli.args import add_design_option, add_json_option, design_from_args, parse_values, \
-    print_json, print_table
+from softhand.studies.cli.args import MAX_FEM_POINTS, MOST_FEM_POINTS, add_design_option, add_json_option, \
+    add_max_cases_option, design_from_args, max_cases, parse_values, print_json, print_table
 
 HELP = "finger FEM: free bending under pressure vs the reduced model (eqs. 28, 2)"
 
@@ -54,6 +54,7 @@ def configure(parser) -> None:
                         help="theta vs P: FEM points, eqs. (28) (and (27) with --hand) as lines")
     parser.add_argument("--out", metavar="DIR", default="results/bend",
                         help="folder for result.json, table.csv and the VTK series")
+    add_max_cases_option(parser, MAX_FEM_POINTS, MOST_FEM_POINTS)
     add_design_option(parser)
     add_json_option(parser)
 
@@ -73,7 +74,7 @@ def _check(args) -> tuple[float, ...]:
     import numpy as np
 
     from softhand.reduced.errors import InputError
-    from softhand.studies.cli.args import MAX_FEM_POINTS, check_range
+    from softhand.studies.cli.args import check_range
 
     for option, (lo, hi) in LIMITS.items():
         value = getattr(args, option[2:].replace("-", "_"))
@@ -82,7 +83,8 @@ def _check(args) -> tuple[float, ...]:
     if args.fiber_intorder is not None and args.fiber_intorder not in FIBER_INTORDERS:
         raise InputError("--fiber-intorder", args.fiber_intorder,
                          f"must be one of {', '.join(map(str, FIBER_INTORDERS))}")
-    pressures = parse_values(args.pressure_mpa, "--pressure-mpa", MAX_FEM_POINTS)
+    pressures = parse_values(args.pressure_mpa, "--pressure-mpa",
+                             max_cases(args, MAX_FEM_POINTS, MOST_FEM_POINTS))
     lo, hi = PRESSURE_RANGE
     if pressures.min() < lo or pressures.max() > hi:
         raise InputError("--pressure-mpa", args.pressure_mpa, f"pressures must be in [{lo:g}, {hi:g}] MPa")
@@ -192,7 +194,8 @@ def _failed(exc, converged, study, write_vtk, out: Path) -> int:
     """Newton gave up: the last converged state (VTK + result.json) and one error line naming
     the pressure reached; exit code 1. ``write_vtk(model, y, P)`` adds a state to the VTK series."""
     from softhand.studies.bending import row
-    from softhand.studies.io.files import write_csv, write_json
+    from softhand.studies.io.failure import save_last_converged
+    from softhand.studies.io.files import write_csv
 
     rows = [row(state, study.design) for _, state in converged]
     reached = getattr(exc, "pressure", None)
@@ -204,10 +207,7 @@ def _failed(exc, converged, study, write_vtk, out: Path) -> int:
         rows.append(row(state, study.design))
     message = str(exc).split(";")[0]
     last = rows[-1]["P_MPa"] if rows else 0.0
-    write_json(out / "result.json", {"failed": True, "error": message, "last_converged_MPa": last,
-                                     "rows": rows, "design": study.design.to_dict()})
-    if rows:
-        write_csv(out / "table.csv", rows)
-    print(f"softhand bend: error: the finger FEM stopped: {message}; the last converged state "
-          f"(P = {last:.4g} MPa) is in {out}/result.json and {out}/finger.pvd", file=sys.stderr)
-    return 1
+    return save_last_converged(
+        out, "bend", "finger FEM", message, f"P = {last:.4g} MPa",
+        {"last_converged_MPa": last, "rows": rows, "design": study.design.to_dict()},
+        write_files=(lambda: write_csv(out / "table.csv", rows)) if rows else None, files="finger.pvd")

@@ -12,8 +12,8 @@ import numpy as np
 
 from softhand.reduced import hand, reservoir
 from softhand.reduced.design import HandDesign
-from softhand.studies.cli.args import add_design_option, add_json_option, design_from_args, parse_values, \
-    print_json, print_table
+from softhand.studies.cli.args import MAX_POINTS, MOST_POINTS, add_design_option, add_json_option, \
+    add_max_cases_option, design_from_args, max_cases, parse_values, print_json, print_table
 
 HELP = "pressure <-> bend angle of the free hand, with and without reservoir (eqs. 27, 28)"
 
@@ -25,6 +25,7 @@ def configure(parser) -> None:
     what.add_argument("--pressure-mpa", metavar="RANGE",
                       help="pump pressures [MPa]: start:stop:step (stop included) or a,b,c")
     parser.add_argument("--plot", metavar="FILE.png", help="draw P vs bend angle (the paper's Fig. 7)")
+    add_max_cases_option(parser, MAX_POINTS, MOST_POINTS)
     add_design_option(parser)
     add_json_option(parser)
 
@@ -53,9 +54,11 @@ def rows_at_pressures(P: np.ndarray, design: HandDesign) -> list[dict]:
 def run(args) -> int:
     from softhand.reduced.errors import InputError
 
+    limit = max_cases(args, MAX_POINTS, MOST_POINTS)
     design = design_from_args(args)
     option = "--theta-deg" if args.theta_deg is not None else "--pressure-mpa"
-    values = parse_values(args.theta_deg if args.theta_deg is not None else args.pressure_mpa, option)
+    values = parse_values(args.theta_deg if args.theta_deg is not None else args.pressure_mpa, option,
+                          limit)
     try:
         rows = (rows_at_angles if args.theta_deg is not None else rows_at_pressures)(values, design)
     except InputError as exc:  # named as the option the user typed

@@ -38,11 +38,14 @@ def run(args) -> int:
     from softhand.studies.design.task import load_task
     from softhand.studies.io.files import write_atomic, write_json
 
+    from softhand.studies.design.task import LOWER, UPPER
+
+    lo, hi = LOWER["mesh_size_mm"], UPPER["mesh_size_mm"]
+    if args.mesh_size_mm is not None and not lo <= args.mesh_size_mm <= hi:
+        raise InputError("--mesh-size-mm", args.mesh_size_mm, f"must be a number in [{lo:g}, {hi:g}]")
+    if not 0 <= args.seed < 2**32:
+        raise InputError("--seed", args.seed, "must be a whole number in [0, 4294967295]")
     task = load_task(args.task)
-    if args.mesh_size_mm is not None and not args.mesh_size_mm > 0:
-        raise InputError("--mesh-size-mm", args.mesh_size_mm, "must be a positive number")
-    if args.seed < 0:
-        raise InputError("--seed", args.seed, "must be a whole number >= 0")
     say = (lambda text: print(f"softhand design: {text}", file=sys.stderr)) if args.json else print
     options = design_opt.OptimiserOptions(seed=args.seed)
     opt = design_opt.optimise(task, options)

@@ -31,8 +31,11 @@ def configure(parser) -> None:
 
 
 def run(args) -> int:
+    from softhand.reduced.errors import InputError
     from softhand.studies.io.render import animate, describe, inspect
 
+    if args.field is not None and not args.field.strip():
+        raise InputError("--field", args.field, "must name a field (see --fields)")
     if args.fields:
         rows = describe(args.file, args.step)
         if args.json:

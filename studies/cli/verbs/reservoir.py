@@ -15,8 +15,8 @@ import sys
 from pathlib import Path
 
 from softhand.reduced.errors import InputError
-from softhand.studies.cli.args import MAX_FEM_POINTS, add_design_option, add_json_option, design_from_args, \
-    parse_values, print_json, print_table
+from softhand.studies.cli.args import MAX_FEM_POINTS, MOST_FEM_POINTS, add_design_option, add_json_option, \
+    add_max_cases_option, design_from_args, max_cases, parse_values, print_json, print_table
 from softhand.studies.io.files import kept_if_unwritable
 
 HELP = "inflate the reservoir sheet (FEM) and measure the ellipse assumption (eqs. 11-18)"
@@ -32,6 +32,7 @@ def configure(parser) -> None:
     parser.add_argument("--n-thick", type=int, default=2, help="Q2 elements through the thickness")
     parser.add_argument("--write-calibration", metavar="FILE.csv",
                         help="write the FEM calibration table of the 'fem' reservoir model")
+    add_max_cases_option(parser, MAX_FEM_POINTS, MOST_FEM_POINTS)
     add_design_option(parser)
     add_json_option(parser)
 
@@ -39,6 +40,7 @@ def configure(parser) -> None:
 def _study(args):
     from softhand.studies.reservoir import ReservoirStudy
 
+    limit = max_cases(args, MAX_FEM_POINTS, MOST_FEM_POINTS)
     design = design_from_args(args)
     for name, hi in (("n_radial", 400), ("n_thick", 20)):
         if not 1 <= getattr(args, name) <= hi:
@@ -46,7 +48,7 @@ def _study(args):
                              f"must be a whole number in [1, {hi}]")
     volumes = ()
     if args.volume_mm3 is not None:
-        volumes = tuple(parse_values(args.volume_mm3, "--volume-mm3", MAX_FEM_POINTS))
+        volumes = tuple(parse_values(args.volume_mm3, "--volume-mm3", limit))
         if min(volumes) <= 0 or max(volumes) > 100 * design.V0:
             raise InputError("--volume-mm3", args.volume_mm3,
                              f"volumes must be in (0, {100 * design.V0:g}] mm^3 (100 V0)")
@@ -68,11 +70,7 @@ def run(args) -> int:
         with tqdm(desc="inflating", unit=" mm³", leave=False) as bar:  # whole mm³ of oil
             result = run_study(study, progress=lambda v: bar.update(round(v) - bar.n))
     except NotConverged as exc:
-        last = exc.last
-        print(f"softhand reservoir: error: {str(exc).split(';')[0]} (Newton failed at the smallest "
-              f"volume step); last converged state V = {last.volume:.6g} mm^3, "
-              f"p = {last.pressure:.6g} MPa", file=sys.stderr)
-        return 1
+        return _failed(exc, study, Path(args.out or FAILED_OUT))
     summary = result.summary()
     if args.out:
         with kept_if_unwritable(args.out, "reservoir"):
@@ -95,6 +93,32 @@ def run(args) -> int:
               f"ellipse {ell[-1]:.4g}..{ell[0]:.4g} MPa, ellipse - FEM "
               f"{v['offset_difference_MPa'][0]:.4g}..{v['offset_difference_MPa'][1]:.4g} MPa")
     return 0
+
+
+#: where a failed inflation without --out leaves its last converged state
+FAILED_OUT = "results/reservoir"
+
+
+def _failed(exc, study, out: Path) -> int:
+    """Newton gave up at the smallest volume step: the last converged state (result.json +
+    the sheet's VTK) and one error line naming the volume and pressure reached; exit code 1."""
+    from softhand.fem.hand.reservoir import _state
+    from softhand.studies.io.failure import save_last_converged
+    from softhand.studies.io.reservoir_files import write_sheet_states
+
+    model = study.model()
+    solid = model.build()[0]
+    state = _state(model, solid, exc.last) if exc.last.u is not None else None
+    reached = f"V = {exc.last.volume:.6g} mm^3, p = {exc.last.pressure:.6g} MPa"
+    record = {"last_converged": {"V_mm3": exc.last.volume, "p_MPa": exc.last.pressure,
+                                 "W_Nmm": exc.last.energy},
+              "design": study.design.to_dict(), "design_hash": study.design.hash(),
+              "mesh": {"n_radial": model.n_radial, "n_thick": model.n_thick}}
+    return save_last_converged(
+        out, "reservoir", "reservoir FEM", f"{str(exc).split(';')[0]} (Newton failed at the "
+        "smallest volume step)", reached, record,
+        write_files=(lambda: write_sheet_states(solid, [state], out)) if state else None,
+        files="sheet.pvd" if state else "")
 
 
 def _git_commit() -> str:

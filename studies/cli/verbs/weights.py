@@ -15,8 +15,8 @@ from pathlib import Path
 
 from softhand.reduced.errors import InputError
 from softhand.reduced.paper import FIG8
-from softhand.studies.cli.args import add_design_option, add_json_option, design_from_args, parse_values, \
-    print_json, print_table
+from softhand.studies.cli.args import MOST_FEM_POINTS, add_design_option, add_json_option, \
+    add_max_cases_option, design_from_args, max_cases, parse_values, print_json, print_table
 from softhand.studies.io.files import kept_if_unwritable
 
 HELP = "hinge weight vectors w for an object diameter from the grasp FEM; F_v vs eq. (25)"
@@ -45,6 +45,7 @@ def configure(parser) -> None:
     parser.add_argument("--out", metavar="DIR", help="one diameter: write result.json and the VTK "
                                                      "series grasp.pvd of both contact states (recomputes)")
     parser.add_argument("--no-cache", action="store_true", help="recompute, do not read or write the cache")
+    add_max_cases_option(parser, MAX_DIAMETERS, MOST_FEM_POINTS)
     add_design_option(parser)
     add_json_option(parser)
 
@@ -96,13 +97,13 @@ def _run(args) -> int:
     from dataclasses import replace
 
     case = case_from_args(args)
-    diameters = _values(args.diameter_mm, "--diameter-mm", MAX_DIAMETERS)
+    diameters = _values(args.diameter_mm, "--diameter-mm", max_cases(args, MAX_DIAMETERS, MOST_FEM_POINTS))
     check = None if args.check_mm is None else _scalar(args.check_mm, "--check-mm")
     if check is not None and not diameters.min() <= check <= diameters.max():
         raise InputError("--check-mm", args.check_mm, f"must lie within the diameters "
                          f"[{diameters.min():g}, {diameters.max():g}] mm")
     if args.fig8 is not None:
-        pressures = _values(args.fig8, "--fig8", MAX_FIG8)
+        pressures = _values(args.fig8, "--fig8", max_cases(args, MAX_FIG8, MOST_FEM_POINTS))
         return _fig8(args, replace(case, diameter_mm=float(diameters[0])), pressures)
     if diameters.size == 1:
         result = _one(replace(case, diameter_mm=float(diameters[0])), args)

@@ -1,0 +1,201 @@
+"""The cases of a study: keys, plan, state on disk, computing one case and committing it.
+
+A case is keyed by a hash of its inputs (kind, case parameters, design hash) and the
+package version. :func:`execute_case` computes it in a private temporary folder and
+returns the numbers and the files; :func:`commit` writes them into a temporary folder
+next to the case's and renames it in one step, so nothing half-written is left.
+"""
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+import shutil
+import sys
+import tempfile
+import time
+import traceback
+import uuid
+from dataclasses import dataclass
+from datetime import datetime, timezone
+from functools import lru_cache
+from pathlib import Path
+
+import numpy as np
+
+from softhand.reduced.design import HandDesign
+from softhand.studies.batch.studyfile import Study, resolve_kind
+from softhand.studies.io.files import write_json
+
+RESULT, FAILED = "result.json", "failed.json"
+_PACKAGES = ("fem", "meshes", "reduced", "studies")
+
+
+@dataclass(frozen=True)
+class Case:
+    """One point of a study's sweep."""
+
+    key: str  #: hash of the inputs and the code version; the case's folder name
+    point: dict  #: the sweep axes' values at this point
+    params: dict  #: what the kind function receives
+    design: HandDesign
+
+
+@lru_cache(maxsize=1)
+def code_version() -> dict:
+    """The package version and a hash of the package's Python sources."""
+    root = Path(__file__).resolve().parents[2]  # the source tree: fem/, meshes/, reduced/, studies/
+    sha = hashlib.sha256()
+    for package in _PACKAGES:
+        for path in sorted((root / package).rglob("*.py")):
+            sha.update(path.relative_to(root).as_posix().encode())
+            sha.update(path.read_bytes())
+    return {"softhand": _version("softhand"), "source_sha256": sha.hexdigest()[:16]}
+
+
+@lru_cache(maxsize=1)
+def package_versions() -> dict:
+    names = ("numpy", "scipy", "scikit-fem", "gmsh", "meshio", "pyvista")
+    return {"python": sys.version.split()[0], **{n: _version(n) for n in names}}
+
+
+def _version(name: str) -> str:
+    from softhand.reduced.versions import package_version
+
+    return package_version(name, "not installed")
+
+
+def case_key(kind: str, params: dict, design: HandDesign) -> str:
+    """16 hex digits of the hash of (kind, params, design hash, package version)."""
+    canon = {k: float(v) if isinstance(v, int) and not isinstance(v, bool) else v
+             for k, v in params.items()}
+    text = json.dumps({"kind": kind, "params": canon, "design": design.hash(),
+                       "softhand": code_version()["softhand"]}, sort_keys=True)
+    return hashlib.sha256(text.encode()).hexdigest()[:16]
+
+
+def plan(study: Study) -> list[Case]:
+    """Every case of the sweep, in sweep order."""
+    names = [name for name, _ in study.axes]
+    cases = []
+    for params, design in study.cases():
+        point = {n: params.get(n, design.to_dict().get(n)) for n in names}
+        cases.append(Case(case_key(study.kind, params, design), point, params, design))
+    return cases
+
+
+def study_dir(study: Study, results_root: str | Path = "results") -> Path:
+    return Path(results_root) / study.name
+
+
+def case_state(sdir: Path, case: Case) -> str:
+    """'done', 'failed', 'pending' or 'corrupt' (a case file that does not parse)."""
+    folder = sdir / case.key
+    for name, state in ((RESULT, "done"), (FAILED, "failed")):
+        if (folder / name).exists():
+            return state if _record(folder / name) is not None else "corrupt"
+    return "corrupt" if folder.exists() else "pending"
+
+
+def read_case(sdir: Path, case: Case) -> dict | None:
+    """The stored result.json or failed.json of a case; None if pending or corrupt."""
+    for name in (RESULT, FAILED):
+        path = sdir / case.key / name
+        if path.exists():
+            return _record(path)
+    return None
+
+
+def _record(path: Path) -> dict | None:
+    """A case file's record if it parses and has the record's shape, else None."""
+    try:
+        record = json.loads(path.read_text())
+    except (OSError, ValueError):
+        return None
+    ok = (isinstance(record, dict) and record.get("status") == ("done" if path.name == RESULT else "failed")
+          and isinstance(record.get("numbers"), dict) and isinstance(record.get("provenance"), dict))
+    return record if ok else None
+
+
+# ---------------------------------------------------------------------- one case
+def execute_case(kind, params: dict, design: HandDesign) -> dict:
+    """Compute one case in a private temporary folder; return numbers, files, timing.
+
+    ``kind``: a registered kind's name, or (for callers inside softhand) the case function.
+
+    Never raises for a failing kind: the error comes back as ``status = 'failed'``.
+    """
+    start = time.perf_counter()
+    with tempfile.TemporaryDirectory(prefix="softhand-case-") as tmp:
+        try:
+            out = (kind if callable(kind) else resolve_kind(kind))(dict(params), design, Path(tmp))
+            numbers, extra = _split_output(out)
+        except Exception as exc:  # a failing case is data, not a crash
+            return {"status": "failed", "error": f"{type(exc).__name__}: {exc}",
+                    "traceback": traceback.format_exc(),
+                    "wall_time_s": time.perf_counter() - start}
+        files = {p.relative_to(tmp).as_posix(): p.read_bytes()
+                 for p in sorted(Path(tmp).rglob("*")) if p.is_file()}
+    return {"status": "done", "numbers": numbers, **extra, "files": files,
+            "wall_time_s": time.perf_counter() - start}
+
+
+def _split_output(out) -> tuple[dict, dict]:
+    """Check a kind's return value: numbers, plus optional 'mesh' and 'solver' dicts."""
+    if not isinstance(out, dict):
+        raise TypeError(f"a kind must return a dict of numbers, got {type(out).__name__}")
+    extra = {k: out[k] for k in ("mesh", "solver") if isinstance(out.get(k), dict)}
+    numbers = {}
+    for key, value in out.items():
+        if key in extra:
+            continue
+        array = np.asarray(value)
+        if array.dtype.kind not in "biuf":
+            raise TypeError(f"a kind's result {key!r} must be a number or list of numbers")
+        numbers[key] = array.tolist()
+    return numbers, extra
+
+
+def commit_case(sdir: Path, study: Study, case: Case, output: dict) -> Path:
+    """Store a case's outcome as ``<sdir>/<key>/result.json`` (or ``failed.json``) + files."""
+    record = {"study": study.name, "case": case.key, "kind": study.kind, "point": case.point,
+              **outcome_record(case.params, case.design, output)}
+    return commit(sdir / case.key, record, output.get("files", {}))
+
+
+def outcome_record(params: dict, design: HandDesign, output: dict) -> dict:
+    """The JSON record of an :func:`execute_case` output: numbers, error, provenance."""
+    return {"status": output["status"], "numbers": output.get("numbers", {}),
+            "files": sorted(output.get("files", {})),
+            "error": output.get("error"), "traceback": output.get("traceback"),
+            "provenance": _provenance(params, design, output)}
+
+
+def commit(final: Path, record: dict, files: dict) -> Path:
+    """Write ``files`` and the record into a temporary folder, then rename it to ``final``.
+
+    The record is ``result.json`` if its status is 'done', else ``failed.json``.
+    """
+    tmp = final.parent / f".{final.name}.{uuid.uuid4().hex[:8]}.tmp"
+    tmp.mkdir(parents=True)
+    for rel, data in files.items():
+        (tmp / rel).parent.mkdir(parents=True, exist_ok=True)
+        (tmp / rel).write_bytes(data)
+    write_json(tmp / (RESULT if record["status"] == "done" else FAILED), record)
+    if final.exists():
+        shutil.rmtree(final)  # an earlier failure, a corrupt file, or a result of other inputs
+    os.rename(tmp, final)
+    return final
+
+
+def _remove_leftovers(sdir: Path, key: str) -> None:
+    """Temporary folders of case ``key`` a killed run left (only its claim holder calls this)."""
+    for tmp in sdir.glob(f".{key}.*.tmp"):
+        shutil.rmtree(tmp, ignore_errors=True)
+
+
+def _provenance(params: dict, design: HandDesign, output: dict) -> dict:
+    return {"inputs": params, "design": design.to_dict(), "design_hash": design.hash(), "code": code_version(),
+            "versions": package_versions(), "mesh": output.get("mesh"),
+            "solver": output.get("solver"), "wall_time_s": output["wall_time_s"],
+            "finished_utc": datetime.now(timezone.utc).isoformat(timespec="seconds")}

@@ -1,0 +1,79 @@
+"""The local process pool of the batch runner; its workers die with the parent process."""
+from __future__ import annotations
+
+import itertools
+import os
+import signal
+import sys
+from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
+from concurrent.futures.process import BrokenProcessPool
+
+from softhand.studies.batch.cases import Case, execute_case
+from softhand.studies.batch.studyfile import Study
+
+
+def pool_outcomes(study: Study, todo, workers: int, restarts: int = 2):
+    """A process pool; if a worker dies, a new pool takes the cases not finished (twice at most)."""
+    remaining = todo
+    for attempt in range(restarts + 1):
+        lost: list[Case] = []
+        yield from _one_pool(study, remaining, workers, lost)
+        if not lost:
+            return
+        remaining = itertools.chain(lost, remaining)
+        again = "; a new pool takes them" if attempt < restarts else "; rerun to finish them"
+        print(f"softhand study: a worker died; {len(lost)} cases not finished{again}",
+              file=sys.stderr)
+        if attempt == restarts:
+            return
+
+
+def _one_pool(study: Study, todo, workers: int, lost: list[Case]):
+    """At most ``workers`` cases in flight; the next one read from ``todo`` as one finishes."""
+    first = next(todo, None)
+    if first is None:
+        return
+    pool = ProcessPoolExecutor(max_workers=workers, initializer=_worker_init, initargs=(os.getpid(),))
+    futures, broken = {}, False
+
+    def submit(case):
+        futures[pool.submit(execute_case, study.kind, case.params, case.design)] = case
+
+    try:
+        submit(first)
+        for case in itertools.islice(todo, workers - 1):
+            submit(case)
+        while futures:
+            finished, _ = wait(futures, return_when=FIRST_COMPLETED)
+            for future in finished:
+                case = futures.pop(future)
+                try:
+                    output = future.result()
+                except BrokenProcessPool:
+                    lost.append(case)
+                    broken = True
+                    continue
+                yield case, output
+                if not broken:
+                    case = next(todo, None)
+                    if case is not None:
+                        submit(case)
+    except BaseException:  # Ctrl-C, SIGTERM, an error here: the workers go with us
+        for process in list((getattr(pool, "_processes", None) or {}).values()):
+            process.terminate()
+        raise
+    finally:
+        pool.shutdown(wait=True, cancel_futures=True)
+
+
+def _worker_init(parent: int) -> None:
+    """In each pool worker: die with the parent (Linux: PR_SET_PDEATHSIG), default SIGTERM."""
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)
+    try:
+        import ctypes
+
+        ctypes.CDLL(None, use_errno=True).prctl(1, signal.SIGKILL)  # 1 = PR_SET_PDEATHSIG
+    except (OSError, AttributeError):
+        pass  # not Linux: workers exit when they find the pool's pipe closed
+    if os.getppid() != parent:  # the parent died before the death signal was armed
+        os._exit(1)

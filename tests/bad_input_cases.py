@@ -1,0 +1,218 @@
+"""Bad inputs of the verbs and file types beyond tests/test_bad_inputs.py's table.
+
+Shared by tests/test_bad_inputs.py (in-process) and benchmarks/bad_input_replay.py (one
+``softhand`` process per case). Each case: (name, argv); its input files are EXTRA_FILES.
+"""
+from __future__ import annotations
+
+GOOD_MATERIAL = "mode,stretch,stress_MPa\nuniaxial,1.5,0.5\nuniaxial,2,0.9\nuniaxial,3,1.6\n"
+SPACE = ('name = "sp"\nlhs = 0\n[space]\na_mm = [3.0, 6.0]\nb_mm = [3.0, 7.0]\nd_mm = [10.0, 20.0]\n'
+         'l0_mm = [120.0, 200.0]\ntie_width_mm = [5.0, 15.0]\n[[design]]\na_mm = 4.0\nb_mm = 5.0\n'
+         'd_mm = 15.0\nl0_mm = 180.0\ntie_width_mm = 10.0\n')
+TASK = ("[object]\ndiameter_mm = 180.0\nmass_kg = 2.0\n[pump]\nmax_pressure_MPa = 2.0\n"
+        "[free]\na_mm = [3.5, 4.5]\n")
+
+
+def _space(extra: str = "", body: str = SPACE) -> str:
+    return extra + body
+
+
+def _task(extra: str = "", body: str = TASK) -> str:
+    return body.replace("[object]", extra + "[object]", 1) if extra and not extra.startswith("[") \
+        else body + extra
+
+
+EXTRA_FILES = {
+    "good_material.csv": GOOD_MATERIAL,
+    "m_header.csv": "mode,stretch\nuniaxial,1.5\n",
+    "m_mode.csv": "mode,stretch,stress_MPa\nshear,1.5,0.5\n",
+    "m_nan.csv": "mode,stretch,stress_MPa\nuniaxial,nan,0.5\nuniaxial,2,0.9\n",
+    "m_inf.csv": "mode,stretch,stress_MPa\nuniaxial,1.5,inf\nuniaxial,2,0.9\n",
+    "m_negative.csv": "mode,stretch,stress_MPa\nuniaxial,-1.5,0.5\nuniaxial,2,0.9\n",
+    "m_huge.csv": "mode,stretch,stress_MPa\nuniaxial,1e300,0.5\nuniaxial,2,0.9\n",
+    "m_text.csv": "mode,stretch,stress_MPa\nuniaxial,1.5,lots\n",
+    "m_empty.csv": "",
+    "m_header_only.csv": "mode,stretch,stress_MPa\n",
+    "m_one_row.csv": "mode,stretch,stress_MPa\nuniaxial,1.5,0.5\n",
+    "m_short.csv": "mode,stretch,stress_MPa\nuniaxial,1.5\n",
+    "m_binary.csv": b"\x00\xff\xfe\x89PNG\r\n",
+    "good_space.toml": SPACE,
+    "sp_unknown.toml": _space("colour = 1\n"),
+    "sp_lhs_text.toml": SPACE.replace("lhs = 0", 'lhs = "six"'),
+    "sp_lhs_huge.toml": SPACE.replace("lhs = 0", "lhs = 1000000000"),
+    "sp_lhs_neg.toml": SPACE.replace("lhs = 0", "lhs = -1"),
+    "sp_seed_text.toml": _space('seed = "x"\n'),
+    "sp_seed_float.toml": _space("seed = 1.5\n"),
+    "sp_press_nan.toml": _space("pressures_mpa = [0.2, nan]\n"),
+    "sp_press_huge.toml": _space("pressures_mpa = [0.2, 1e9]\n"),
+    "sp_press_many.toml": _space("pressures_mpa = [" + ", ".join(f"{0.001 * (i + 1):.3f}"
+                                                               for i in range(5000)) + "]\n"),
+    "sp_press_text.toml": _space('pressures_mpa = "0.2,0.5"\n'),
+    "sp_theta_huge.toml": _space("theta_target_deg = 1e9\n"),
+    "sp_theta_inf.toml": _space("theta_target_deg = inf\n"),
+    "sp_pmax_huge.toml": _space("p_max_mpa = 1e9\n"),
+    "sp_pstep_tiny.toml": _space("p_step_mpa = 1e-12\n"),
+    "sp_mesh_tiny.toml": _space("mesh_size_mm = 1e-9\n"),
+    "sp_axial_tiny.toml": _space("axial_size_mm = 1e-9\n"),
+    "sp_mesh_text.toml": _space('mesh_size_mm = "fine"\n'),
+    "sp_prior.toml": _space('prior = "none"\n'),
+    "sp_no_space.toml": 'name = "sp"\nlhs = 2\n',
+    "sp_box_inverted.toml": SPACE.replace("a_mm = [3.0, 6.0]", "a_mm = [6.0, 3.0]"),
+    "sp_box_nan.toml": SPACE.replace("a_mm = [3.0, 6.0]", "a_mm = [nan, 6.0]"),
+    "sp_point_out.toml": SPACE.replace("a_mm = 4.0", "a_mm = 40.0"),
+    "sp_point_text.toml": SPACE.replace("a_mm = 4.0", 'a_mm = "four"'),
+    "sp_design_number.toml": 'name = "sp"\ndesign = 3\n' + SPACE.split("\n", 2)[2].split("[[design]]")[0],
+    "sp_base_missing.toml": _space('base_design = "nope.toml"\n'),
+    "sp_base_zero.toml": _space('base_design = "/dev/zero"\n'),
+    "sp_name.toml": SPACE.replace('name = "sp"', 'name = "../../x"'),
+    "sp_name_number.toml": SPACE.replace('name = "sp"', "name = 3"),
+    "good_task.toml": TASK,
+    "t_unknown.toml": _task("colour = 1\n"),
+    "t_unknown_section.toml": _task("[colour]\nx = 1\n"),
+    "t_diameter_nan.toml": TASK.replace("diameter_mm = 180.0", "diameter_mm = nan"),
+    "t_diameter_neg.toml": TASK.replace("diameter_mm = 180.0", "diameter_mm = -180.0"),
+    "t_diameter_text.toml": TASK.replace("diameter_mm = 180.0", 'diameter_mm = "big"'),
+    "t_diameter_huge.toml": TASK.replace("diameter_mm = 180.0", "diameter_mm = 1e300"),
+    "t_mass_inf.toml": TASK.replace("mass_kg = 2.0", "mass_kg = inf"),
+    "t_mass_neg.toml": TASK.replace("mass_kg = 2.0", "mass_kg = -2.0"),
+    "t_pump_zero.toml": TASK.replace("max_pressure_MPa = 2.0", "max_pressure_MPa = 0.0"),
+    "t_pump_huge.toml": TASK.replace("max_pressure_MPa = 2.0", "max_pressure_MPa = 1e9"),
+    "t_no_object.toml": "[pump]\nmax_pressure_MPa = 2.0\n[free]\na_mm = [3.5, 4.5]\n",
+    "t_no_free.toml": "[object]\ndiameter_mm = 180.0\nmass_kg = 2.0\n[pump]\nmax_pressure_MPa = 2.0\n",
+    "t_free_unknown.toml": TASK.replace("a_mm = [3.5, 4.5]", "colour_mm = [1, 2]"),
+    "t_free_inverted.toml": TASK.replace("a_mm = [3.5, 4.5]", "a_mm = [4.5, 3.5]"),
+    "t_free_nan.toml": TASK.replace("a_mm = [3.5, 4.5]", "a_mm = [nan, 4.5]"),
+    "t_free_text.toml": TASK.replace("a_mm = [3.5, 4.5]", 'a_mm = "3.5:4.5"'),
+    "t_free_huge.toml": TASK.replace("a_mm = [3.5, 4.5]", "a_mm = [3.5, 1e300]"),
+    "t_free_three.toml": TASK.replace("a_mm = [3.5, 4.5]", "a_mm = [3.5, 4.0, 4.5]"),
+    "t_objective.toml": _task("[grasp]\nobjective = \"speed\"\n"),
+    "t_factor_neg.toml": _task("[grasp]\nforce_factor = -2.0\n"),
+    "t_both_force.toml": _task("[grasp]\nforce_factor = 2.0\nmargin_N = 1.0\n"),
+    "t_stretch.toml": _task("[limits]\nmax_principal_stretch = 0.5\n"),
+    "t_wall_text.toml": _task("[limits]\nmin_wall_mm = \"one\"\n"),
+    "t_material.toml": _task("[material]\nmu_sf_MPa = -1.0\n"),
+    "t_design_key.toml": _task("[design]\ncolour = 1\n"),
+    "t_design_bad.toml": _task("[design]\nb_mm = 30.0\n"),
+    "t_fem_mesh.toml": _task("[fem]\nmesh_size_mm = 1e-9\n"),
+    "t_fem_ratio.toml": _task("[fem]\nedge_ratio = 50.0\n"),
+    "t_fem_dp.toml": _task("[fem]\ndP_MPa = 0.0\n"),
+    "t_base_missing.toml": _task('base_design = "nope.toml"\n'),
+    "t_base_zero.toml": _task('base_design = "/dev/zero"\n'),
+    "t_base_number.toml": _task("base_design = 3\n"),
+    "t_object_number.toml": "object = 3\n[pump]\nmax_pressure_MPa = 2.0\n[free]\na_mm = [3.5, 4.5]\n",
+    "good.vtu": ('<?xml version="1.0"?>\n<VTKFile type="UnstructuredGrid" version="0.1">'
+                 '<UnstructuredGrid><Piece NumberOfPoints="4" NumberOfCells="1"><PointData>'
+                 '<DataArray type="Float64" Name="displacement_mm" NumberOfComponents="3" '
+                 'format="ascii">0 0 0 0 0 0 0 0 0 0 0 1</DataArray></PointData><Points>'
+                 '<DataArray type="Float64" NumberOfComponents="3" format="ascii">0 0 0 1 0 0 '
+                 '0 1 0 0 0 1</DataArray></Points><Cells><DataArray type="Int64" Name="connectivity" '
+                 'format="ascii">0 1 2 3</DataArray><DataArray type="Int64" Name="offsets" '
+                 'format="ascii">4</DataArray><DataArray type="UInt8" Name="types" '
+                 'format="ascii">10</DataArray></Cells></Piece></UnstructuredGrid></VTKFile>\n'),
+    "bad.vtu": b"\x00\x01garbage",
+    "bad.pvd": "<VTKFile type='Collection'><Collection><DataSet file='nope.vtu'/></Collection></VTKFile>",
+    "trunc.vtm": "<VTKFile type='vtkMultiBlockDataSet'",
+    "x.obj": "v 0 0 0\n",
+}
+
+GOOD_TASK, GOOD_SPACE = "good_task.toml", "good_space.toml"
+
+
+def replay_cases() -> list[tuple[str, list[str]]]:
+    """The cases of the verbs with their own files: calibrate, design, material, inspect, ...;
+    range limits of every verb that takes ranges."""
+    cases = []
+    calibrate = [["--space", s, "--out", "t.csv"] for s in sorted(EXTRA_FILES) if s.startswith("sp_")]
+    calibrate += [["--space", f, "--out", "t.csv"] for f in ("missing.toml", ".", "/dev/zero",
+                                                            "binary.toml", "bad_toml.toml",
+                                                            "a_file/x.toml", "good.csv")]
+    calibrate += [["--space", GOOD_SPACE, "--out", o] for o in (".", "a_file/t.csv", "/proc/t.csv", "adir")]
+    calibrate += [["--space", GOOD_SPACE, "--out", "t.csv", *extra] for extra in (
+        ["--workers", "0"], ["--workers", "-3"], ["--workers", "100000"], ["--results", "a_file"],
+        ["--results", "/proc/r"], ["--scheduler", "nowhere:1"], ["--workers", "two"])]
+    calibrate += [["--space", GOOD_SPACE], ["--design", "missing.toml", "--out", "t.csv"],
+                  ["--design", "d_tube_wider.toml", "--out", "t.csv"],
+                  ["--design", "/dev/zero", "--out", "t.csv"],
+                  ["--check", "missing.toml"], ["--check", GOOD_SPACE, "--table", "missing.csv"],
+                  ["--check", GOOD_SPACE, "--table", "/dev/zero"], ["--check", GOOD_SPACE, "--table", "."],
+                  ["--check", GOOD_SPACE, "--table", "good.csv"],
+                  ["--space", GOOD_SPACE, "--check", GOOD_SPACE], []]
+    cases += [("calibrate", ["calibrate", "finger", *c]) for c in calibrate]
+    cases += [("calibrate", ["calibrate"]), ("calibrate", ["calibrate", "thumb"])]
+    design = [["--task", t, "--no-fem"] for t in sorted(EXTRA_FILES) if t.startswith("t_")]
+    design += [["--task", f, "--no-fem"] for f in ("missing.toml", ".", "/dev/zero", "binary.toml",
+                                                   "bad_toml.toml", "a_file/x.toml", "s_empty.toml")]
+    design += [["--task", GOOD_TASK, *extra] for extra in (
+        ["--seed", "-1"], ["--seed", "1e30"], ["--seed", "x"], ["--mesh-size-mm", "0"],
+        ["--mesh-size-mm", "nan"], ["--mesh-size-mm", "1e-9"], ["--mesh-size-mm", "1e9"],
+        ["--out", "a_file"], ["--out", "/proc/d"], ["--plot", "p.txt"], ["--plot", "a_file/p.png"],
+        ["--plot", "adir"])] + [[]]
+    cases += [("design", ["design", *d]) for d in design]
+    material = [["--data", d, "--model", "yeoh"] for d in sorted(EXTRA_FILES) if d.startswith("m_")]
+    material += [["--data", d, "--model", "yeoh"] for d in ("missing.csv", ".", "/dev/zero",
+                                                            "good.csv", "a_file/x.csv")]
+    material += [["--data", "good_material.csv", *extra] for extra in (
+        ["--model", "steel"], ["--model", ""], ["--model", "yeoh", "--stability-range", "5:0.2"],
+        ["--model", "yeoh", "--stability-range", "0:5"], ["--model", "yeoh", "--stability-range", "nan:5"],
+        ["--model", "yeoh", "--stability-range", "1:inf"], ["--model", "yeoh", "--stability-range", "x"],
+        ["--model", "yeoh", "--stability-range", "0.2:5:1"], ["--model", "yeoh", "--stability-range", "1e-300:1e300"],
+        ["--model", "yeoh", "--out", "."], ["--model", "yeoh", "--out", "a_file/m.toml"],
+        ["--model", "yeoh", "--out", "/proc/m.toml"], ["--model", "yeoh", "--plot", "m.txt"],
+        ["--model", "yeoh", "--plot", "adir"])]
+    cases += [("material", ["material", "fit", *m]) for m in material]
+    cases += [("material", ["material"]), ("material", ["material", "unfit"])]
+    inspect = [[f] for f in ("bad.vtu", "bad.pvd", "trunc.vtm", "x.obj", "a_file/x.vtu", "adir",
+                             "binary.toml", "empty.csv")]
+    inspect += [["good.vtu", *extra] for extra in (
+        ["--field", "colour"], ["--field", "displacement_mm[9]"], ["--field", "displacement_mm[x]"],
+        ["--field", ""], ["--step", "99"], ["--step", "-99"], ["--view", "under"],
+        ["--out", "."], ["--out", "a_file/x.png"], ["--out", "/proc/x.png"], ["--out", "x.gif"],
+        ["--animate", "x.txt"], ["--animate", "a_file/x.gif"], ["--animate", "."],
+        ["--fields", "--step", "99"], ["--step", "x"])]
+    cases += [("inspect", ["inspect", *i]) for i in inspect]
+    cases += [("verify", ["verify", *v]) for v in (["--case", ""], ["--case", "x" * 5000], ["--quick", "--case", "nope"])]
+    cases += [("reproduce", ["reproduce", *r]) for r in (
+        ["--only", ""], ["--only", "x" * 5000], ["--out", "/proc/r"], ["--out", "a_file/r"],
+        ["--design", "missing.toml"], ["--design", "/dev/zero"], ["--design", "d_sheet_thick.toml"])]
+    cases += [("study", ["study", *s]) for s in (
+        ["run", "good_study.toml", "--max-cases", "-1"], ["run", "good_study.toml", "--max-cases", "x"],
+        ["run", "good_study.toml", "--max-cases", "1"], ["status", "good_study.toml", "--max-cases", "1"],
+        ["run", "good_study.toml", "--workers", "-1"], ["run", "good_study.toml", "--results", "."
+         "/a_file/r"], ["run", "a_file/x.toml"], ["report", "good_study.toml", "--results", "/proc/r"],
+        ["run", "good_study.toml", "--scheduler", "tcp://nowhere.invalid:1"],
+        ["status", "good_study.toml", "--results", "a_file"], ["report", "missing.toml"],
+        ["run", "good_study.toml", "--workers", "2", "--scheduler", "local", "--max-cases", "0"])]
+    ranges = [
+        ["curve", "--theta-deg", "0:90:0.0001"], ["curve", "--theta-deg", "0:90:1", "--max-cases", "10"],
+        ["curve", "--theta-deg", "0:90:1", "--max-cases", "0"], ["curve", "--theta-deg", "1", "--max-cases", "-5"],
+        ["curve", "--theta-deg", "1", "--max-cases", "1e3"], ["curve", "--pressure-mpa", "0:1:1e-300"],
+        ["curve", "--theta-deg", "-1e308:1e308:1e307"], ["curve", "--theta-deg", "0:90:1e-320"],
+        ["bend", "--pressure-mpa", "0:0.8:0.001"], ["bend", "--pressure-mpa", "0:0.8:0.1", "--max-cases", "3"],
+        ["bend", "--max-cases", "0"], ["weights", "--diameter-mm", "100:300:1"],
+        ["weights", "--diameter-mm", "100:300:10", "--max-cases", "5"],
+        ["weights", "--diameter-mm", "180", "--fig8", "0.1:1:0.01"],
+        ["reservoir", "--volume-mm3", "10000:20000:1"],
+        ["reservoir", "--volume-mm3", "10000:20000:1000", "--max-cases", "3"],
+        ["reservoir", "--max-cases", "0"],
+        ["curve", "--theta-deg", ",".join(["1"] * 60_000)], ["curve", "--theta-deg", "1" * 120_000],
+        ["grasp", "--pressure-mpa", "0:1:0.1", "--theta-deg", "40", "--mass-kg", "1", "--weights", "paper180"],
+        ["control", "--theta-ref-deg", "0:50:1", "--mass-kg", "1"],
+        ["curve", "--theta-deg", "10", "--design", "adir"], ["curve", "--theta-deg", "10", "--design", ""],
+        ["curve", "--theta-deg", "10", "--design", "good.csv"], ["curve", "--theta-deg", "10", "--design", "unreadable.toml"],
+        ["curve", "--theta-deg", "10", "--plot", ""], ["curve", "--theta-deg", "10", "--plot", "x.PNG/"],
+        ["curve", "--theta-deg", "10", "--plot", "/dev/null/x.png"],
+        ["fit", "--data", "good.csv", "--params", "V0_mm3", "--out", "x.txt"],
+        ["fit", "--data", "good.csv", "--params", "V0_mm3", "--out", "adir"],
+        ["fit", "--data", "good.csv", "--params", "V0_mm3", "--bounds", "V0_mm3=nan:1"],
+        ["fit", "--data", "good.csv", "--params", "V0_mm3", "--bounds", "V0_mm3=1:inf"],
+        ["fit", "--data", "good.csv", "--params", "V0_mm3", "--bounds", "V0_mm3=-1e9:1e9"],
+        ["fit", "--data", "unreadable.toml", "--params", "V0_mm3"], ["fit", "--data", "binary.toml", "--params", "V0_mm3"],
+        ["control", "--theta-ref-deg", "50", "--mass-kg", "1", "--disturbance", "binary.toml"],
+        ["control", "--theta-ref-deg", "50", "--mass-kg", "1", "--out", "/dev/null"],
+        ["reservoir", "--write-calibration", "a_file/x.csv"], ["reservoir", "--write-calibration", "/proc/x.csv"],
+        ["bend", "--out", "/dev/null"], ["weights", "--diameter-mm", "180", "--out", "/dev/null"],
+        ["weights", "--diameter-mm", "180", "--check-mm", "200"],
+        ["weights", "--diameter-mm", "180", "--fig8", "0.5", "--check-mm", "180"],
+    ]
+    cases += [("range", r) for r in ranges]
+    return [(f"{name}-{k}-{' '.join(argv[1:])[:40]}", argv) for k, (name, argv) in enumerate(cases)]
