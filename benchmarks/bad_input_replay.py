@@ -33,8 +33,6 @@ def _scratch(root: Path) -> None:
         path.parent.mkdir(parents=True, exist_ok=True)
         path.write_bytes(text if isinstance(text, bytes) else text.encode())
     (root / "adir").mkdir()
-    (root / "unreadable.toml").write_text("a_mm = 4.0\n")
-    (root / "unreadable.toml").chmod(0)  # root reads it anyway
 
 
 def _snapshot(root: Path) -> dict:

@@ -83,11 +83,12 @@ def _bad(path, allowed: str):
 
 def read_table(path: str | Path = TABLE_FILE) -> Table:
     """Read a finger calibration CSV; InputError naming the file on any problem."""
+    from softhand.reduced.design import read_input_file
+
     path = Path(path)
+    data = read_input_file(path, "finger_table", "a CSV written by softhand calibrate finger")
     try:
-        text = path.read_text()
-    except (FileNotFoundError, IsADirectoryError):
-        raise _bad(path, "no such file; give a CSV written by softhand calibrate finger") from None
+        text = data.decode("utf-8")
     except UnicodeDecodeError:
         raise _bad(path, "is not a text (CSV) file") from None
     comments = [line for line in text.splitlines() if line.startswith("#")]

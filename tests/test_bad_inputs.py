@@ -10,6 +10,7 @@ from pathlib import Path
 
 import pytest
 
+from bad_input_cases import EXTRA_FILES, replay_cases
 from softhand.reduced.design import BOUNDS, HandDesign
 from softhand.studies.cli.main import main
 
@@ -251,7 +252,7 @@ def _cases():
         for k, extra in enumerate(variants):
             cases.append((f"{verb}-{k}-{' '.join(extra)[:40]}", [verb, *extra]))
     cases += [("verb-unknown", ["bnd"]), ("verb-huge", ["x" * 100_000])]
-    return cases
+    return cases + replay_cases()  # calibrate, design, material, inspect, ranges, ...
 
 
 CASES = _cases()
@@ -259,7 +260,7 @@ CASES = _cases()
 
 @pytest.fixture
 def scratch(tmp_path, monkeypatch):
-    for name, text in {**FILES, **_design_files(), **STUDIES}.items():
+    for name, text in {**FILES, **_design_files(), **STUDIES, **EXTRA_FILES}.items():
         path = tmp_path / name
         path.write_bytes(text if isinstance(text, bytes) else text.encode())
     (tmp_path / "adir").mkdir()
@@ -283,7 +284,7 @@ def test_there_are_enough_cases():
     assert len(CASES) >= 150
     assert {argv[0] for _, argv in CASES} >= {"curve", "grasp", "control", "fit", "bend", "weights",
                                               "reservoir", "study", "inspect", "verify", "reproduce",
-                                              "design"}
+                                              "calibrate", "design", "material"}
 
 
 @pytest.mark.parametrize("argv", [argv for _, argv in CASES], ids=[name for name, _ in CASES])

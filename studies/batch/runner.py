@@ -78,13 +78,18 @@ def run_study(study: Study, *, results_root: str | Path = "results", workers: in
         print(f"softhand study: {summary.corrupt} case files do not parse; recomputing them",
               file=sys.stderr)
     workers = max(1, workers or os.cpu_count() or 1)
+    dask = None
+    if scheduler and todo:
+        from softhand.studies.batch.cluster import open_cluster
+
+        dask = open_cluster(scheduler, workers)  # reached before anything is written
     bar = _progress_bar(study, summary, progress)
     claims = Claims(sdir)
     try:
         while todo:
             deferred: list[Case] = []
             mine = _claimed(sdir, todo, claims, fresh, deferred, summary, bar)
-            with closing(_outcomes(study, mine, workers, scheduler)) as outcomes:
+            with closing(_outcomes(study, mine, workers, dask)) as outcomes:
                 for case, output in outcomes:
                     commit_case(sdir, study, case, output)
                     claims.release(case.key)
@@ -101,6 +106,10 @@ def run_study(study: Study, *, results_root: str | Path = "results", workers: in
     finally:
         claims.release_all()
         bar.close()
+        if dask is not None:
+            from softhand.studies.batch.cluster import close_cluster
+
+            close_cluster(*dask)
         write_index(study, results_root)
     return summary
 
@@ -130,16 +139,17 @@ def _progress_bar(study: Study, summary: RunSummary, enabled: bool):
                 file=sys.stderr, disable=not enabled, dynamic_ncols=True)
 
 
-def _outcomes(study: Study, todo, workers: int, scheduler: str | None):
-    """Yield (case, output) as cases finish, on the chosen executor; ``todo`` is an iterator,
-    read only as workers become free (each case is claimed when read)."""
+def _outcomes(study: Study, todo, workers: int, dask):
+    """Yield (case, output) as cases finish, on the chosen executor (``dask``: an open
+    (client, cluster)); ``todo`` is an iterator, read only as workers become free (each case
+    is claimed when read)."""
     todo = iter(todo)
-    if scheduler:
+    if dask is not None:
         from softhand.studies.batch.cluster import dask_outcomes
 
         cases = list(todo)
         if cases:
-            yield from dask_outcomes(study, cases, workers, scheduler)
+            yield from dask_outcomes(study, cases, dask[0])
     elif workers == 1:
         for case in todo:
             yield case, execute_case(study.kind, case.params, case.design)

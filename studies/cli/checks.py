@@ -25,7 +25,10 @@ RENDER_SUFFIXES = (".png", ".jpg", ".jpeg")
 
 #: argument name -> kind of output, per verb where it differs from the default
 OUTPUTS = {"out": "dir", "plot": "plot", "results": "dir", "write_calibration": "file"}
-VERB_OUTPUTS = {"fit": {"out": "file"}, "inspect": {"out": "render"}}
+VERB_OUTPUTS = {"fit": {"out": "toml"}, "material": {"out": "toml"}, "inspect": {"out": "render"},
+                "calibrate": {"out": "csv"}, "reservoir": {"write_calibration": "csv"}}
+#: file suffixes an output kind must end in (a design TOML, a table)
+SUFFIXES = {"plot": PLOT_SUFFIXES, "render": RENDER_SUFFIXES, "toml": (".toml",), "csv": (".csv",)}
 #: verbs that may use the on-disk caches (meshes, grasp weights)
 CACHE_VERBS = ("bend", "weights", "grasp", "study", "reproduce", "reservoir")
 
@@ -60,7 +63,7 @@ def check_outputs(verb: str, args, parser) -> None:
 
 
 def check_writable(path, kind: str, field: str) -> None:
-    """``path`` can be written as a ``kind`` ('dir', 'file', 'plot', 'render') output."""
+    """``path`` can be written as a ``kind`` ('dir', 'file' or one of SUFFIXES) output."""
     text = str(path)
     if not text.strip() or "\0" in text:
         raise InputError(field, text, "must be a file or folder name")
@@ -72,7 +75,7 @@ def check_writable(path, kind: str, field: str) -> None:
     else:
         if p.is_dir() or text.endswith(os.sep):
             raise InputError(field, text, "is a folder; give a file name")
-        suffixes = {"plot": PLOT_SUFFIXES, "render": RENDER_SUFFIXES}.get(kind)
+        suffixes = SUFFIXES.get(kind)
         if suffixes and p.suffix.lower() not in suffixes:
             raise InputError(field, text, f"must end in one of {', '.join(suffixes)}")
         folder = p.parent

@@ -51,8 +51,17 @@ def run(args) -> int:
     from softhand.studies.calibration import finger as fc
     from softhand.studies.calibration.finger_table import write_design_with_table, write_table
 
-    if args.workers < 1:
-        raise InputError("--workers", args.workers, "must be a whole number >= 1")
+    from softhand.studies.cli.verbs.study import MAX_WORKERS
+
+    if not 1 <= args.workers <= MAX_WORKERS:
+        raise InputError("--workers", args.workers, f"must be a whole number in [1, {MAX_WORKERS}]")
+    if args.table is not None:
+        from softhand.reduced.finger_fem import read_table
+
+        try:
+            read_table(args.table)  # before any FEM
+        except InputError as exc:
+            raise exc.renamed("--table") from None
     if args.check is None and not args.out:
         raise InputError("--out", None, "give the table to write, e.g. --out finger_fem.csv")
     if args.check is not None:

@@ -128,6 +128,9 @@ def _parse_bounds(text):
     """'K=lo:hi,K2=lo:hi' -> {K: (lo, hi)}."""
     if not text:
         return None
+    import math
+
+    from softhand.reduced.design import BOUNDS
     from softhand.reduced.errors import InputError
 
     bounds = {}
@@ -137,6 +140,10 @@ def _parse_bounds(text):
             lo, hi = (float(x) for x in rng.split(":"))
         except ValueError:
             raise InputError("--bounds", item, "must be KEY=LOW:HIGH, e.g. V0_mm3=1e4:3e4") from None
+        limits = BOUNDS.get(key.strip(), (-math.inf, math.inf))
+        if not (math.isfinite(lo) and math.isfinite(hi) and limits[0] <= lo and hi <= limits[1]):
+            raise InputError(f"--bounds {key.strip()}", rng, f"must be finite and within the design "
+                             f"bounds [{limits[0]:g}, {limits[1]:g}]")
         bounds[key.strip()] = (lo, hi)
     return bounds
 

@@ -99,6 +99,11 @@ def _run(args) -> int:
     case = case_from_args(args)
     diameters = _values(args.diameter_mm, "--diameter-mm", max_cases(args, MAX_DIAMETERS, MOST_FEM_POINTS))
     check = None if args.check_mm is None else _scalar(args.check_mm, "--check-mm")
+    if check is not None and (diameters.size == 1 or args.fig8 is not None):
+        raise InputError("--check-mm", args.check_mm, "applies to several diameters "
+                         "(--diameter-mm a,b,.. or start:stop:step), not to one or to --fig8")
+    if args.out is not None and (diameters.size > 1 or args.fig8 is not None):
+        raise InputError("--out", args.out, "applies to one diameter, not to a sweep or --fig8")
     if check is not None and not diameters.min() <= check <= diameters.max():
         raise InputError("--check-mm", args.check_mm, f"must lie within the diameters "
                          f"[{diameters.min():g}, {diameters.max():g}] mm")
