@@ -88,6 +88,18 @@ def state_row(state, w, mass: float, design: HandDesign) -> dict:
             "newton_iterations": state.iterations, "factorizations": state.factorizations}
 
 
+def failed_record(case: WeightsCase, states) -> dict:
+    """result.json's fields of a grasp FEM that stopped: the case and the states it reached
+    (the last one's contact may not have converged: its penetration says by how much)."""
+    rows = [{"P_MPa": s.P, "theta_deg": math.degrees(s.theta), "hinge_deg": np.degrees(s.q).tolist(),
+             "contact_force_N": s.N.tolist(), "F_v_fem_N": s.F_v,
+             "max_penetration_mm": float(np.max(-s.gap[s.N > 0], initial=0.0))} for s in states]
+    return {"diameter_mm": case.diameter_mm, "mass_kg": case.mass_kg, "pressure_MPa": case.pressure_mpa,
+            "dP_MPa": case.dP_mpa, "mesh_size_mm": case.mesh_size_mm,
+            "last_converged_MPa": rows[-1]["P_MPa"] if rows else 0.0, "states": rows,
+            "design": case.design.to_dict()}
+
+
 def finger_options(mesh_size_mm: float):
     """The grasp FEM's finger mesh: graded (element size mesh_size_mm, half that at the ring
     edges), not refined; pinned here so that it does not follow the free-bending default."""
@@ -101,19 +113,24 @@ def compute(case: WeightsCase, out=None) -> dict:
     also the two states' fields as the VTK scene series ``grasp.pvd`` (hand, object, contact forces)."""
     from softhand.fem.hand.finger import FingerModel
     from softhand.fem.hand.grasp import GraspModel, grasp_weights
+    from softhand.fem.newton import NotConverged
 
     finger = FingerModel(case.design, finger_options(case.mesh_size_mm))
     model = GraspModel(finger, case.diameter_mm, mass=case.mass_kg, depth=case.depth_mm)
-    r = grasp_weights(model, case.pressure_mpa, case.dP_mpa)
+    try:
+        r = grasp_weights(model, case.pressure_mpa, case.dP_mpa)
+    except NotConverged as err:
+        err.case = case  # which grasp stopped (the verb saves err.states)
+        raise
     if out is not None:
-        _write_vtk(out, model, (r.state, r.state_dP))
+        write_vtk(out, model, (r.state, r.state_dP))
     return {"diameter_mm": case.diameter_mm, "mass_kg": case.mass_kg, "depth_mm": model.depth,
             "dP_MPa": case.dP_mpa, "w": r.w.tolist(), "w_sum": float(r.w.sum()),
             **state_row(r.state, r.w, case.mass_kg, case.design),
             "mesh_size_mm": case.mesh_size_mm, "ndofs": r.ndofs, "wall_seconds": r.wall_seconds}
 
 
-def _write_vtk(out, model, states) -> None:
+def write_vtk(out, model, states) -> None:
     """The contact states as the scene series grasp.pvd (see :mod:`fem.hand.scene`)."""
     from softhand.fem.io import SceneSeries
     from softhand.fem.hand.scene import grasp_scene

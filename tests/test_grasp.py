@@ -145,10 +145,10 @@ def test_weights_bad_input_is_one_line_exit_2(argv, field, capsys):
 def test_vtk_series_of_the_contact_states(grasp180, tmp_path):
     import meshio
 
-    from softhand.studies.weights import _write_vtk
+    from softhand.studies.weights import write_vtk
 
     model, a, b, _ = grasp180
-    _write_vtk(tmp_path, model, (a, b))
+    write_vtk(tmp_path, model, (a, b))
     assert (tmp_path / "grasp.pvd").read_text().count("<DataSet") == 2
     mesh = meshio.read(tmp_path / "grasp" / "grasp_0001" / "tube.vtu")
     u = mesh.point_data["displacement_mm"]
@@ -161,10 +161,10 @@ def test_scene_of_a_contact_state_holds_the_object_and_the_pad_forces(grasp180, 
     forces (normal part along the line from the centre = N of the FEM state), the links
     turned by the state's hinge angles."""
     from softhand.studies.io.render import load_scene
-    from softhand.studies.weights import _write_vtk
+    from softhand.studies.weights import write_vtk
 
     model, a, _, _ = grasp180
-    _write_vtk(tmp_path, model, (a,))
+    write_vtk(tmp_path, model, (a,))
     scene = load_scene(tmp_path / "grasp.pvd")[0]
     assert {"object", "contact_forces"} <= set(scene.keys())
     centre = np.array([0.0, model.depth, 0.0])

@@ -7,6 +7,7 @@ import sys
 import time
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from softhand.meshes import cache as mesh_cache
@@ -358,3 +359,39 @@ def test_a_real_reservoir_failure_saves_the_last_converged_state(tmp_path, monke
     r, z = points[wet, 0] + u[wet, 0], u[wet, 1]
     order = np.argsort(r)
     assert simpson(2 * np.pi * r[order] * z[order], x=r[order]) == pytest.approx(last["V_mm3"], rel=1e-6)
+
+
+@pytest.mark.slow
+def test_a_grasp_fem_that_stops_saves_the_states_it_reached(tmp_path, monkeypatch, capsys):
+    """A real grasp FEM failure: the second contact state's Newton is held to no iteration, so
+    its load path cuts back to nothing. One error line naming the cavity pressure reached;
+    result.json and grasp.pvd hold the states reached: the first converged (contact within
+    the gap tolerance, the object's forces in equilibrium with a bent finger), the second
+    where its path stopped, at the first's pressure."""
+    import dataclasses
+    import re
+
+    from softhand.fem.hand import grasp
+    from softhand.fem.newton import NewtonOptions
+
+    solve = grasp.GraspModel.solve
+
+    def second_state_fails(self, P, *, start=None):
+        if start is not None:
+            self.options = dataclasses.replace(self.options, newton=NewtonOptions(max_iter=0))
+        return solve(self, P, start=start)
+
+    monkeypatch.setattr(grasp.GraspModel, "solve", second_state_fails)
+    out = tmp_path / "w"
+    assert main(["weights", "--diameter-mm", "180", "--pressure-mpa", "0.2", "--mesh-size-mm", "10",
+                 "--no-cache", "--out", str(out)]) == 1
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "P = 0.2 MPa" in err[0] and "Traceback" not in err[0], err
+    result = json.loads((out / "result.json").read_text())
+    assert result["failed"] and result["last_converged_MPa"] == pytest.approx(0.2)
+    first, stopped = result["states"]
+    assert first["P_MPa"] == stopped["P_MPa"] == pytest.approx(0.2)
+    assert first["max_penetration_mm"] <= grasp.GraspOptions().gap_tol
+    assert sum(first["contact_force_N"]) > 0 and first["theta_deg"] > 0
+    datasets = re.findall(r"<DataSet[^>]*file=\"([^\"]+)\"", (out / "grasp.pvd").read_text())
+    assert len(datasets) == 2 and all((out / f).is_file() for f in datasets)

@@ -168,7 +168,13 @@ class GraspModel:
         its, steps = 0, self.options.steps if start is None else 1
         penalty, last = self.options.penalty if start is None else start.penalty, np.inf
         for update in range(self.options.max_updates + 1):
-            y, n = self._path(y, P0, P, lam, shares, penalty, solver, steps)
+            try:
+                y, n = self._path(y, P0, P, lam, shares, penalty, solver, steps)
+            except NotConverged as err:
+                t, x = err.last_converged or (0.0, y)
+                raise self._failure(f"Newton stopped at P = {P0 + t * (P - P0):.4g} MPa on the way "
+                                    f"to {P:.4g} MPa", err, P0 + t * (P - P0), x, lam, shares,
+                                    penalty, update, its) from err
             its, P0, steps = its + n, P, 1
             L = self.load(self.finger.constraint.q(y), lam, shares, penalty)
             g = gaps(self.pads, self.circle, self.finger.constraint.q(y)).g
@@ -181,8 +187,20 @@ class GraspModel:
             if penetration > 0.25 * last:  # slow Uzawa (near-dependent contacts): stiffen
                 penalty = min(10.0 * penalty, self.options.max_penalty)
             lam, shares, last = L.N, new_shares, penetration
-        raise NotConverged(f"contact: penetration {penetration:.3g} mm after "
-                           f"{self.options.max_updates} augmented-Lagrangian updates", [], y)
+        raise self._failure(f"contact: penetration {penetration:.3g} mm at P = {P:.4g} MPa after "
+                            f"{self.options.max_updates} augmented-Lagrangian updates",
+                            NotConverged("", [], y), P, y, lam, shares, penalty, update, its)
+
+    def _failure(self, message, err, P, y, lam, shares, penalty, updates, its) -> NotConverged:
+        """The NotConverged to raise: ``message``, and as ``.state`` the finger's last converged
+        configuration y at cavity pressure ``.pressure`` = P under the contact load it had
+        (its penetration may exceed gap_tol: Uzawa had not finished), for the caller to save."""
+        q = self.finger.constraint.q(y)
+        state = self._state(P, y, self.load(q, lam, shares, penalty), gaps(self.pads, self.circle, q).g,
+                            updates, its, penalty)
+        failure = NotConverged(message, err.history, err.x, err.last_converged)
+        failure.pressure, failure.state = float(P), state
+        return failure
 
     def _state(self, P, y, L, g, updates, its, penalty) -> GraspState:
         q = np.array(self.finger.constraint.q(y))
@@ -217,6 +235,12 @@ def grasp_weights(model: GraspModel, P: float, dP: float) -> WeightResult:
     if not P > 0 or not dP > 0:
         raise InputError("pressure_MPa", (P, dP), "P and dP must be positive")
     t0 = time.perf_counter()
-    a = model.solve(P)
-    b = model.solve(P + dP, start=a)
+    a = None
+    try:
+        a = model.solve(P)
+        b = model.solve(P + dP, start=a)
+    except NotConverged as err:  # what was reached, for the caller to save: ``.states``, ``.model``
+        err.model = model
+        err.states = tuple(s for s in (a, getattr(err, "state", None)) if s is not None)
+        raise
     return WeightResult(weight_vector(a, b), a, b, model.finger.ndofs, time.perf_counter() - t0)

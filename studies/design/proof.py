@@ -145,7 +145,7 @@ def prove(ev: Evaluation, task: Task, options: ProofOptions = ProofOptions(), *,
     from softhand.fem.hand.finger import FingerModel
     from softhand.fem.hand.grasp import GraspModel
     from softhand.fem.hand.reservoir import SheetModel, inflate
-    from softhand.studies.weights import _write_vtk, finger_options
+    from softhand.studies.weights import write_vtk, finger_options
 
     say = progress or (lambda text: None)
     design = ev.design
@@ -179,7 +179,7 @@ def prove(ev: Evaluation, task: Task, options: ProofOptions = ProofOptions(), *,
     # the sheet's path from flat to V0 passes V_grasp (steps <= R^2 t / 2): interpolated
     p_grasp = float(np.interp(V_grasp, sheet.path_volume, sheet.path_pressure))
     if out is not None:
-        _write_vtk(out, model, (best,))
+        write_vtk(out, model, (best,))
     first = g["first"]
     return {
         "P_grasp_MPa": best.P - p_grasp,

@@ -88,9 +88,27 @@ def run(args) -> int:
     try:
         return _run(args)
     except NotConverged as exc:  # the FEM's own failure: one line, exit 1
+        if getattr(exc, "states", None) and getattr(exc, "case", None) is not None:
+            return _failed(exc, Path(args.out or FAILED_OUT))
         print(f"softhand weights: error: the grasp FEM did not converge: {str(exc)[:300]}",
               file=sys.stderr)
         return 1
+
+
+#: where a failed grasp FEM without --out leaves the states it reached
+FAILED_OUT = "results/weights"
+
+
+def _failed(exc, out: Path) -> int:
+    """The grasp FEM stopped: the states it reached (result.json + grasp.pvd) and one error
+    line naming the cavity pressure reached; exit code 1."""
+    from softhand.studies.io.failure import save_last_converged
+    from softhand.studies.weights import failed_record, write_vtk
+
+    record = failed_record(exc.case, exc.states)
+    return save_last_converged(
+        out, "weights", "grasp FEM", str(exc).split(";")[0], f"P = {record['last_converged_MPa']:.4g} MPa",
+        record, write_files=lambda: write_vtk(out, exc.model, exc.states), files="grasp.pvd")
 
 
 def _run(args) -> int:
