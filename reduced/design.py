@@ -56,6 +56,17 @@ FINGER_MODELS = ("paper", "fem")
 PAPER_DESIGN_FILE = Path(__file__).resolve().parent.parent / "studies" / "designs" / "paper.toml"
 
 
+def _check_model(field: str, name: str, models, neo_hookean: bool, part: str, body: str,
+                 material, closed_form: str) -> None:
+    """A model name the registry knows; the FEM-calibrated table only for a Neo-Hookean part."""
+    if name not in models:
+        raise InputError(field, name, f"must be one of {', '.join(models)}")
+    if name == "fem" and not neo_hookean:
+        raise InputError(field, "fem", f"the FEM-calibrated {part} table holds a Neo-Hookean "
+                         f"{body}, not {material.model}; use {field} = \"{closed_form}\" with this "
+                         f"[{part}.material]")
+
+
 @dataclass(frozen=True)
 class HandDesign:
     """A hydraulic soft hand: fingers (Table I), reservoir sheet, kinematics.
@@ -117,20 +128,11 @@ class HandDesign:
                              f"must increase strictly within (0, l0 = {self.l0:g}) mm")
         for check in CONSISTENCY:
             check(self)
-        if self.reservoir_model not in RESERVOIR_MODELS:
-            raise InputError("reservoir_model", self.reservoir_model,
-                             f"must be one of {', '.join(RESERVOIR_MODELS)}")
-        if self.reservoir_model == "fem" and not self.reservoir_is_neo_hookean:
-            raise InputError("reservoir_model", "fem", "the FEM-calibrated reservoir table holds a "
-                             f"Neo-Hookean sheet, not {self.reservoir_material.model}; use "
-                             "reservoir_model = \"ellipse\" with this [reservoir.material]")
-        if self.finger_model not in FINGER_MODELS:
-            raise InputError("finger_model", self.finger_model,
-                             f"must be one of {', '.join(FINGER_MODELS)}")
-        if self.finger_model == "fem" and not self.finger_is_neo_hookean:
-            raise InputError("finger_model", "fem", "the FEM-calibrated finger table holds a "
-                             f"Neo-Hookean tube, not {self.finger_material.model}; use "
-                             "finger_model = \"paper\" with this [finger.material]")
+        _check_model("reservoir_model", self.reservoir_model, RESERVOIR_MODELS,
+                     self.reservoir_is_neo_hookean, "reservoir", "sheet", self.reservoir_material,
+                     "ellipse")
+        _check_model("finger_model", self.finger_model, FINGER_MODELS, self.finger_is_neo_hookean,
+                     "finger", "tube", self.finger_material, "paper")
 
     def check_volume(self, theta_max: float) -> None:
         """Raise if V0 cannot supply the oil the fingers take at bend ``theta_max`` [rad] (eq. (15))."""

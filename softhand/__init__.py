@@ -9,12 +9,6 @@ Sub-packages (dependencies point down; ``tests/test_layers.py`` enforces it):
 * :mod:`softhand.reduced` -- the ground floor: the design vocabulary and the paper's
   analytical virtual-work model (NumPy/SciPy only).
 """
-from importlib.metadata import PackageNotFoundError, version
-
-try:
-    __version__ = version("softhand")
-except PackageNotFoundError:  # running from a source tree that is not installed
-    __version__ = "unknown"
 
 # Run from a source tree (a checkout on PYTHONPATH, or an editable install) the sub-packages are
 # the repository's top-level folders beside this one; an installed wheel has them inside it.
@@ -24,3 +18,7 @@ _root = _Path(__file__).resolve().parent.parent
 if not (_Path(__file__).parent / "fem").is_dir() and (_root / "fem" / "__init__.py").is_file():
     __path__.append(str(_root))
 del _Path, _root
+
+from softhand.reduced.versions import package_version as _package_version  # noqa: E402
+
+__version__ = _package_version()  # "unknown" in a source tree that is not installed

@@ -24,6 +24,7 @@ from pathlib import Path
 import numpy as np
 
 from softhand.reduced.design import HandDesign
+from softhand.reduced.versions import package_version
 from softhand.studies.batch.studyfile import Study, resolve_kind
 from softhand.studies.io.files import write_json
 
@@ -50,19 +51,13 @@ def code_version() -> dict:
         for path in sorted((root / package).rglob("*.py")):
             sha.update(path.relative_to(root).as_posix().encode())
             sha.update(path.read_bytes())
-    return {"softhand": _version("softhand"), "source_sha256": sha.hexdigest()[:16]}
+    return {"softhand": package_version("softhand", "not installed"), "source_sha256": sha.hexdigest()[:16]}
 
 
 @lru_cache(maxsize=1)
 def package_versions() -> dict:
     names = ("numpy", "scipy", "scikit-fem", "gmsh", "meshio", "pyvista")
-    return {"python": sys.version.split()[0], **{n: _version(n) for n in names}}
-
-
-def _version(name: str) -> str:
-    from softhand.reduced.versions import package_version
-
-    return package_version(name, "not installed")
+    return {"python": sys.version.split()[0], **{n: package_version(n, "not installed") for n in names}}
 
 
 def case_key(kind: str, params: dict, design: HandDesign) -> str:
