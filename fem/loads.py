@@ -135,6 +135,8 @@ class CavityVolume:
         cofN = np.einsum("aKeq,Keq->aeq", kin.cofactor(F), self.f.N)
         return float(-np.einsum("aeq,ab,beq,eq->", x, self.D, cofN, self.f.W))
 
+    value = volume  #: V(u), the name of every volume functional (:func:`volume_control`)
+
     def gradient(self, u) -> np.ndarray:
         """dV/du [mm^2], shape (ndofs,)."""
         x, F = self.f.fields(u)
@@ -170,11 +172,13 @@ class CavityVolume:
         return self.f.solid.scatter.csr(self.hessian_data(u))
 
 
-def volume_control(R: np.ndarray, K: sp.spmatrix, p: float, cavity: CavityVolume, u, V_target: float):
+def volume_control(R: np.ndarray, K: sp.spmatrix | None, p: float, cavity, u, V_target: float):
     """Bordered residual and Jacobian of Pi(u) - p (V(u) - V*), unknowns (u, p).
 
-    R, K: residual and tangent of everything else at u (solid + other loads);
-    returns (R_b (ndofs+1,), K_b CSR (ndofs+1)^2, symmetric if K is):
+    R, K: residual and tangent of everything else at u (solid + other loads; K None: the
+    residual alone); cavity: its volume functional (``value``, ``gradient``, ``hessian``:
+    :class:`CavityVolume`, :class:`fem.axisym.RevolvedVolume`);
+    returns (R_b (ndofs+1,), K_b CSR (ndofs+1)^2 or None, symmetric if K is):
 
         [ R - p dV/du ]      [ K - p d2V/du2   -dV/du ]
         [ -(V - V*)   ],     [ -dV/du^T          0    ]
@@ -182,8 +186,8 @@ def volume_control(R: np.ndarray, K: sp.spmatrix, p: float, cavity: CavityVolume
     Restrict rows/columns to the free dofs plus the last (pressure) index.
     """
     g = cavity.gradient(u)
-    Kuu = K - p * cavity.hessian(u)
+    Rb = np.append(R - p * g, -(cavity.value(u) - V_target))
+    if K is None:
+        return Rb, None
     gcol = sp.csr_matrix(-g[:, None])
-    Kb = sp.bmat([[Kuu, gcol], [gcol.T, sp.csr_matrix((1, 1))]], format="csr")
-    Rb = np.append(R - p * g, -(cavity.volume(u) - V_target))
-    return Rb, Kb
+    return Rb, sp.bmat([[K - p * cavity.hessian(u), gcol], [gcol.T, sp.csr_matrix((1, 1))]], format="csr")

@@ -14,19 +14,22 @@ residual norm is a poor merit for slender bodies (a good step can raise
 :math:`\|R\|` a lot); ``merit="residual"`` keeps Armijo backtracking on it;
 ``merit="finite"`` takes full steps (the mixed (u, p) iteration of a nearly
 incompressible solid converges in ~4 full steps although its displacement residual
-jumps by 1e3 after the first: any merit on it would cut those steps). A non-finite
+jumps by 1e3 after the first: any merit on it would cut those steps); ``merit="decrease"``
+takes a solve's first step whole (from a predicted state) and halves later ones until a
+caller's merit (default :math:`\|R\|`; a bordered system weighs its blocks) decreases. A non-finite
 residual (inverted element) halves the step. The Jacobian evaluated at an accepted
 trial point is reused for the next iteration, so a full step costs one assembly.
 Given a cheaper ``residual(x) -> R`` (for the P2 solid a residual costs ~5 % of a
 residual + tangent), trial points evaluate only R and the tangent is assembled once, at
 the accepted point: a rejected trial then costs a residual, not a full assembly.
 
-Load stepping (:func:`solve_path`): t runs from 0 to 1; each step starts from the
-last converged state along a predictor direction, line-searched like a Newton
-step: the tangent (Euler) direction :math:`-K^{-1}(R + \partial_t R\,\Delta t)`
-with :math:`\partial_t R` by a forward difference in t (default: it keeps a
-prescribed boundary displacement from distorting the boundary elements alone), or
-the secant of the last two converged states, or none; a step that fails is
+Load stepping (:func:`solve_path`): t runs from 0 to 1 (or from t0 through given stops,
+e.g. volumes); each step starts from the last converged state along a predictor
+direction, line-searched like a Newton step: the tangent (Euler) direction
+:math:`-K^{-1}(R + \partial_t R\,\Delta t)` with :math:`\partial_t R` by a forward
+difference in t (default: it keeps a prescribed boundary displacement from distorting
+the boundary elements alone), or none; or Newton starts at the secant extrapolation of
+the last two converged states (``predictor="secant"``); a step that fails is
 halved (cut-back) down to ``min_dt``; easy steps let the increment grow again, and so do
 ``grow_after`` converged steps in a row after a cut-back.
 On final failure :class:`NotConverged` carries the last converged (t, x).
@@ -39,6 +42,10 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from softhand.fem.linsolve import make_solver
+from softhand.fem.newton_steps import add_pair, bfgs_direction, factored_size, line_search, predict, record
+
+
+MERITS = ("slope", "residual", "finite", "decrease")
 
 
 @dataclass(frozen=True)
@@ -50,6 +57,7 @@ class NewtonOptions:
     line_search: bool = True  #: adjust the step length (see ``merit``)
     #: "slope": R(x + s dx).dx -> 0 (energy); "residual": Armijo on ||R||; "finite": full
     #: steps, halved only where R is not finite (the mixed (u, p) iteration, see fem.solid.MixedNewton)
+    #: "decrease": the first step whole, then halving until ``newton``'s ``merit`` decreases
     merit: str = "slope"
     eta: float = 0.5  #: "slope": accept when |R(x + s dx).dx| <= eta |R(x).dx|
     max_backtracks: int = 6  #: trial steps before taking the last one
@@ -61,8 +69,8 @@ class NewtonOptions:
     memory: int = 10  #: "adaptive": secant pairs of the BFGS update kept
 
     def __post_init__(self):
-        if self.merit not in ("slope", "residual", "finite"):
-            raise ValueError(f"merit {self.merit!r} not in ('slope', 'residual', 'finite')")
+        if self.merit not in MERITS:
+            raise ValueError(f"merit {self.merit!r} not in {MERITS}")
         if self.refactor not in ("always", "adaptive"):
             raise ValueError(f"refactor {self.refactor!r} not in ('always', 'adaptive')")
         if not 0 < self.contraction < 1:
@@ -95,7 +103,7 @@ class NewtonResult:
 
 
 def newton(fun, x0, options: NewtonOptions = NewtonOptions(), *, solver=None, scale=None,
-           direction=None, on_accept=None, residual=None) -> NewtonResult:
+           direction=None, on_accept=None, residual=None, converged=None, merit=None) -> NewtonResult:
     """Solve R(x) = 0 from x0; raises NotConverged with the residual history.
 
     fun(x) -> (R, K); solver: a :mod:`fem.linsolve` solver (default auto, unsymmetric);
@@ -103,11 +111,14 @@ def newton(fun, x0, options: NewtonOptions = NewtonOptions(), *, solver=None, sc
     direction: search direction of the first iteration instead of -K^{-1} R (a load-step
     predictor, line-searched like a Newton step); on_accept(x): called with x0 and every
     accepted iterate before fun is evaluated around it (e.g. :class:`fem.solid.MixedNewton`);
-    residual(x) -> R: optional, fun's residual alone, for the line search's trial points.
+    residual(x) -> R: optional, fun's residual alone, for the line search's trial points;
+    converged(x, R, it) -> bool: optional test of the iterate x (it Newton iterations so far)
+    instead of ||R|| <= atol + rtol scale, e.g. one tolerance per block of a bordered system
+    (:mod:`fem.volume_path`); merit(x, R) -> float: the measure of ``options.merit = "decrease"``.
 
     ``options.refactor = "adaptive"`` (quasi-Newton): the direction is
     :math:`-H R` with H the limited-memory BFGS update (secant pairs of the accepted steps
-    since the last factorisation, :func:`_bfgs_direction`) of the inverse of the last
+    since the last factorisation, :func:`fem.newton_steps.bfgs_direction`) of the inverse of the last
     factorised tangent, so an iteration costs a residual and a solve with the stored factor
     instead of an assembly and a factorisation. A step that does not lower ||R|| is
     discarded and redone with the tangent at the same iterate; one that lowers it by less
@@ -120,17 +131,18 @@ def newton(fun, x0, options: NewtonOptions = NewtonOptions(), *, solver=None, sc
     x = np.array(x0, dtype=float)
     if on_accept is not None:
         on_accept(x)
-    reuse = adaptive and _factored_size(solver) == len(x)
+    reuse = adaptive and factored_size(solver) == len(x)
     R, K = (residual(x), None) if reuse and residual is not None else fun(x)
     K = None if reuse else K  # K: the tangent at x still to be factorised (None: keep the factor)
     t_asm = time.perf_counter() - t0
     norm = float(np.linalg.norm(R))
     tol = options.atol + options.rtol * (norm if scale is None else scale)
     history, steps, t_solve, factorizations, pairs = [norm], [], 0.0, 0, []
+    done = (lambda x, R, it: float(np.linalg.norm(R)) <= tol) if converged is None else converged
     for it in range(options.max_iter + 1):
         if not np.isfinite(norm):
             raise NotConverged("residual is not finite", history, x)
-        if norm <= tol:
+        if done(x, R, len(history) - 1):
             return NewtonResult(x, it, history, steps, t_asm, t_solve, factorizations)
         if it == options.max_iter:
             break
@@ -143,27 +155,28 @@ def newton(fun, x0, options: NewtonOptions = NewtonOptions(), *, solver=None, sc
                 dx, pairs = solver.solve(K, -R), []
                 factorizations += 1
             else:
-                dx, old = _bfgs_direction(R, pairs, solver.apply), True
+                dx, old = bfgs_direction(R, pairs, solver.apply), True
         except (RuntimeError, np.linalg.LinAlgError, ValueError) as err:
             raise NotConverged(f"linear solve failed ({err})", history, x) from err
         t_solve += time.perf_counter() - t1
         t1 = time.perf_counter()
         small = it > 0 and np.linalg.norm(dx) <= options.xtol * (1.0 + np.linalg.norm(x))
-        xt, Rt, Kt, normt, s = _line_search(fun, x, dx, R, norm, options, residual, tangent=not adaptive)
+        xt, Rt, Kt, normt, s = line_search(fun, x, dx, R, norm, options, residual, tangent=not adaptive,
+                                           merit=merit, first=not steps)
         rate = normt / norm
         if old and not rate < 1.0:  # the old factorisation is not good enough here: redo with K(x)
             R, K = fun(x)
             t_asm += time.perf_counter() - t1
             continue
         if adaptive:
-            _add_pair(pairs, xt - x, Rt - R, options.memory)
+            add_pair(pairs, xt - x, Rt - R, options.memory)
         x, R, K, norm = xt, Rt, Kt, normt
         history.append(norm)
         steps.append(s)
         if on_accept is not None:
             on_accept(x)
         if adaptive:
-            if rate > options.contraction or _factored_size(solver) != len(x):
+            if rate > options.contraction or factored_size(solver) != len(x):
                 R, K = (R, K) if K is not None else fun(x)
             else:
                 K = None
@@ -173,75 +186,12 @@ def newton(fun, x0, options: NewtonOptions = NewtonOptions(), *, solver=None, sc
     raise NotConverged(f"no convergence in {options.max_iter} iterations (tol {tol:.2e})", history, x)
 
 
-def _bfgs_direction(R, pairs, apply):
-    """-H R by the two-loop recursion: H the BFGS update of H0 = apply (the stored factor's
-    inverse) by the secant pairs (s, y, 1 / s.y), oldest first."""
-    q, alphas = np.array(R, dtype=float), []
-    for s, y, rho in reversed(pairs):
-        alphas.append(rho * (s @ q))
-        q -= alphas[-1] * y
-    r = apply(q)
-    for (s, y, rho), a in zip(pairs, reversed(alphas)):
-        r += (a - rho * (y @ r)) * s
-    return -r
-
-
-def _add_pair(pairs, s, y, memory):
-    """Keep the secant pair (s = dx, y = dR) when its curvature s.y is positive (BFGS stays
-    positive definite), at most ``memory`` of them."""
-    sy = float(s @ y)
-    if np.isfinite(sy) and sy > 1e-12 * np.linalg.norm(s) * np.linalg.norm(y):
-        pairs.append((s, y, 1.0 / sy))
-        del pairs[:-memory]
-
-
-def _factored_size(solver):
-    """Order of the solver's current factorisation (None: none, or a solver without one)."""
-    return getattr(solver, "factored_size", None)
-
-
-def _line_search(fun, x, dx, R0, norm0, options, residual=None, tangent=True):
-    """Step length on x + s dx; returns the accepted (x, R, K, ||R||, s); K is None when
-    ``tangent`` is false and only ``residual`` was evaluated. See the module docstring."""
-    trial = fun if residual is None else (lambda xt: (residual(xt), None))
-    g0 = float(R0 @ dx)  # slope of the energy along dx at s = 0 (< 0 for a descent direction)
-    s, lo, glo, hi, ghi = 1.0, 0.0, g0, None, None
-    for _ in range(options.max_backtracks + 1):
-        xt = x + s * dx
-        with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
-            R, K = trial(xt)
-        norm = float(np.linalg.norm(R))
-        if not options.line_search or (options.merit == "finite" and np.isfinite(norm)):
-            break
-        if not np.isfinite(norm):  # e.g. an inverted element: shorten
-            hi, ghi, s = s, None, 0.5 * (lo + s)
-            continue
-        if options.merit == "residual":
-            if norm <= (1 - options.armijo * s) * norm0:
-                break
-            phi0, phis = norm0 ** 2, norm ** 2
-            s = float(np.clip(s * s * phi0 / (phis - phi0 + 2 * s * phi0), 0.1 * s, 0.5 * s))
-            continue
-        g = float(R @ dx)
-        if g0 >= 0 or abs(g) <= options.eta * abs(g0) or (g < 0 and hi is None):
-            break  # slope small enough, or still descending at the full step
-        if g < 0:
-            lo, glo = s, g
-        else:
-            hi, ghi = s, g
-        # regula falsi for the zero of the slope in [lo, hi], kept off the ends
-        s_new = lo + (hi - lo) * glo / (glo - ghi) if ghi is not None else 0.5 * (lo + hi)
-        s = float(np.clip(s_new, lo + 0.1 * (hi - lo), hi - 0.1 * (hi - lo)))
-    # accepted, or no sufficient step in max_backtracks: the last trial (Newton may still recover)
-    if K is None and tangent:
-        with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
-            R, K = fun(xt)
-    return xt, R, K, norm, s
-
-
 @dataclass(frozen=True)
 class PathOptions:
-    steps: int = 5  #: initial number of equal load steps on t in [0, 1]
+    steps: int = 5  #: initial number of equal load steps on t in [0, 1] (the whole path)
+    #: first increment of t instead (e.g. a volume [mm^3] for :func:`fem.volume_path.follow_volume`)
+    first_step: float | None = None
+    max_step: float = np.inf  #: largest increment of t
     min_dt: float = 1e-4  #: smallest load increment before giving up
     grow: float = 1.5  #: increment growth after a step converging in <= easy_iter iterations
     easy_iter: int = 4  #: iterations counted as an easy step
@@ -250,7 +200,8 @@ class PathOptions:
     #: the mixed (u, p) iteration's 5-6, would otherwise keep the cut-back increment for good)
     grow_after: int = 2
     #: "tangent": Euler predictor every step (best with prescribed displacements);
-    #: "secant": extrapolate the last two converged states (tangent for the first step);
+    #: "secant": Newton starts at the extrapolation of the last two converged states
+    #: (tangent for the first step);
     #: "none": start each step from the last converged state (pure load control needs no more)
     predictor: str = "tangent"
     newton: NewtonOptions = field(default_factory=NewtonOptions)
@@ -258,7 +209,7 @@ class PathOptions:
 
 @dataclass
 class PathResult:
-    t: list  #: converged load factors, first 0
+    t: list  #: converged load factors, first the start (0)
     x: list  #: converged states
     iterations: list  #: Newton iterations of each converged step
     cutbacks: int  #: failed attempts that were retried with a smaller step
@@ -266,6 +217,7 @@ class PathResult:
     assembly_seconds: float = 0.0
     solve_seconds: float = 0.0
     factorizations: int = 0  #: tangents factorised, predictors and failed attempts included
+    stops: list = field(default_factory=list)  #: indices into t and x of the states at the stops
 
     @property
     def total_iterations(self) -> int:
@@ -273,72 +225,54 @@ class PathResult:
 
 
 def solve_path(fun_t, x0, options: PathOptions = PathOptions(), *, solver=None, scale_t=None,
-               callback=None, on_accept=None, residual_t=None) -> PathResult:
-    """Follow R(x, t) = 0 for t from 0 (state x0) to 1; fun_t(x, t) -> (R, K).
+               callback=None, on_accept=None, residual_t=None, converged_t=None, merit_t=None, t0=0.0,
+               stops=(1.0,)) -> PathResult:
+    """Follow R(x, t) = 0 for t from t0 (state x0) through ``stops``; fun_t(x, t) -> (R, K).
 
-    scale_t(t): optional reference residual norm for the relative tolerance at t
-    (e.g. the norm of the external load); callback(t, x) after each converged step;
-    on_accept: passed to :func:`newton` (also called before each predictor);
-    residual_t(x, t) -> R: optional, fun_t's residual alone (:func:`newton`'s ``residual``).
+    stops: the values of t the path lands on, running strictly monotonically away from t0
+    (up or down; default: t in [0, 1]); scale_t(t): optional reference residual norm for the
+    relative tolerance at t (e.g. the norm of the external load); callback(t, x) after each
+    converged step; on_accept: passed to :func:`newton` (also called before each predictor);
+    residual_t(x, t) -> R, converged_t(x, R, it, t) -> bool and merit_t(x, R, t) -> float:
+    optional, :func:`newton`'s ``residual``, ``converged`` and ``merit`` at t. On failure the :class:`NotConverged` also carries ``t``,
+    the load it failed at.
     """
     solver = solver or make_solver()
-    res = PathResult([0.0], [np.array(x0, dtype=float)], [], 0, [])
+    stops = np.asarray(stops, dtype=float)
+    sign = np.sign(stops[0] - t0)
+    if sign == 0 or np.any(sign * np.diff(stops) <= 0):
+        raise ValueError(f"path stops must run strictly monotonically away from t0 = {t0:.6g}")
+    res = PathResult([float(t0)], [np.array(x0, dtype=float)], [], 0, [])
     factorizations0 = getattr(solver, "n_factorizations", 0)
     reuse = options.newton.refactor == "adaptive"
-    dt, streak = 1.0 / options.steps, None  # streak: converged steps since the last cut-back
-    while res.t[-1] < 1.0 - 1e-12:
-        t = min(1.0, res.t[-1] + dt)
-        if on_accept is not None:
-            on_accept(res.x[-1])
-        step = _predict(res, t, fun_t, solver, options.predictor, residual_t, reuse)
-        try:
-            r = newton(lambda x: fun_t(x, t), res.x[-1], options.newton, solver=solver,
-                       scale=None if scale_t is None else scale_t(t), direction=step, on_accept=on_accept,
-                       residual=None if residual_t is None else (lambda x: residual_t(x, t)))
-        except NotConverged as err:
-            res.cutbacks += 1
-            dt, streak = 0.5 * dt, 0
-            if dt < options.min_dt:
-                raise NotConverged(f"load step cut back below {options.min_dt} at t = {t:.4g}",
-                                   err.history, err.x, (res.t[-1], res.x[-1])) from err
-            continue
-        res.t.append(t)
-        res.x.append(r.x)
-        res.iterations.append(r.iterations)
-        res.histories.append(r.history)
-        res.assembly_seconds += r.assembly_seconds
-        res.solve_seconds += r.solve_seconds
-        if callback is not None:
-            callback(t, r.x)
-        streak = None if streak is None else streak + 1
-        if r.iterations <= options.easy_iter or (reuse and r.factorizations <= 1):
-            dt *= options.grow  # easy: few iterations, or (quasi-Newton) at most one factorisation
-        elif streak is not None and streak >= options.grow_after:
-            dt, streak = dt * options.grow, 0  # steady progress since the cut-back
+    span = abs(stops[-1] - t0)
+    dt = span / options.steps if options.first_step is None else options.first_step
+    dt, streak = min(dt, options.max_step), None  # streak: converged steps since the last cut-back
+    for stop in stops:
+        while sign * (stop - res.t[-1]) > 1e-12 * span:
+            t = float(stop if dt >= sign * (stop - res.t[-1]) else res.t[-1] + sign * dt)
+            if on_accept is not None:
+                on_accept(res.x[-1])
+            x_start, step = predict(res, t, fun_t, solver, options.predictor, residual_t, reuse)
+            try:
+                r = newton(lambda x: fun_t(x, t), x_start, options.newton, solver=solver,
+                           scale=None if scale_t is None else scale_t(t), direction=step,
+                           on_accept=on_accept,
+                           converged=None if converged_t is None else (lambda x, R, it: converged_t(x, R, it, t)),
+                           merit=None if merit_t is None else (lambda x, R: merit_t(x, R, t)),
+                           residual=None if residual_t is None else (lambda x: residual_t(x, t)))
+            except NotConverged as err:
+                res.cutbacks += 1
+                dt, streak = 0.5 * dt, 0
+                if dt < options.min_dt:
+                    failed = NotConverged(f"load step cut back below {options.min_dt} at t = {t:.4g}",
+                                          err.history, err.x, (res.t[-1], res.x[-1]))
+                    failed.t = t
+                    raise failed from err
+                continue
+            dt, streak = record(res, t, r, options, dt, streak, reuse)
+            if callback is not None:
+                callback(t, r.x)
+        res.stops.append(len(res.t) - 1)
     res.factorizations = getattr(solver, "n_factorizations", 0) - factorizations0
     return res
-
-
-def _predict(res: PathResult, t: float, fun_t, solver, kind: str, residual_t=None, reuse=False):
-    """Predictor step from the last converged state to t (None: none, or a singular tangent).
-
-    ``residual_t``: the residual at t0 + eps costs no tangent; with ``reuse`` (quasi-Newton)
-    and a factorisation of this size in ``solver`` the tangent predictor solves with that
-    factorisation (the last iterate's tangent) instead of factorising K(x0)."""
-    if kind not in ("tangent", "secant", "none"):
-        raise ValueError(f"predictor {kind!r} not in ('tangent', 'secant', 'none')")
-    if kind == "none":
-        return None
-    if kind == "tangent" or len(res.t) < 2:
-        t0, x0 = res.t[-1], res.x[-1]
-        eps = 1e-7 * max(t - t0, 1e-3)
-        old = reuse and residual_t is not None and _factored_size(solver) == len(x0)
-        R0, K0 = (residual_t(x0, t0), None) if old else fun_t(x0, t0)
-        R1 = residual_t(x0, t0 + eps) if residual_t is not None else fun_t(x0, t0 + eps)[0]
-        try:
-            rhs = R0 + (R1 - R0) * ((t - t0) / eps)
-            return -(solver.apply(rhs) if old else solver.solve(K0, rhs))
-        except (RuntimeError, np.linalg.LinAlgError, ValueError):
-            return None
-    t1, t2 = res.t[-2], res.t[-1]
-    return (t - t2) / (t2 - t1) * (res.x[-1] - res.x[-2])

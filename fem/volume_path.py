@@ -1,4 +1,4 @@
-r"""Volume-controlled path following for an axisymmetric cavity (pressure = Lagrange multiplier).
+r"""Volume-controlled path following for a cavity (pressure = Lagrange multiplier).
 
 Oil is incompressible, so the reservoir and the balloon are driven by their enclosed
 volume V*, not by pressure: a rubber membrane's p(V) has a maximum past which pressure
@@ -6,53 +6,55 @@ control has no solution. The equilibrium states are the stationary points of
 
 .. math:: L(u, p) = Π(u) - p\,(V(u) - V^*),
 
-solved by Newton on the bordered (symmetric, indefinite) system
+the bordered (symmetric, indefinite) system of :func:`fem.loads.volume_control` on the free
+DOFs and p, which stays regular at and past the pressure maximum, where :math:`K - pH_V`
+itself is singular. Along the path :math:`dΠ/dV^* = p`, so :math:`\int p\,dV = Π` is an
+independent check of the residual, the tangent-free parts and the volume functional
+(``tests/test_reservoir.py``).
 
-.. math:: \begin{pmatrix} K - p\,H_V & -g_V \\ -g_V^T & 0 \end{pmatrix}
-          \begin{pmatrix} Δu \\ Δp \end{pmatrix}
-          = -\begin{pmatrix} Π'(u) - p\,g_V \\ V^* - V(u) \end{pmatrix},
-
-with :math:`g_V = V'(u)` and :math:`H_V = V''(u)` (the load stiffness of the follower
-pressure). The bordered matrix stays regular at and past the pressure maximum, where
-:math:`K - pH_V` itself is singular. Along the path :math:`dΠ/dV^* = p`, so
-:math:`\int p\,dV = Π` is an independent check of the residual, the tangent-free parts
-and the volume functional (``tests/test_reservoir.py``).
-
-Steps: a secant predictor from the last two converged states, Newton with a backtracking
-line search on the residual norm, and load-step cut-back (halve ΔV*) when Newton fails;
-the step grows again after easy steps. Raises :class:`VolumeNotConverged` (a
-:class:`fem.newton.NotConverged`, the one failure type of the FEM solvers) with the
-residual history and the last converged state.
+The path is the load path of :func:`fem.newton.solve_path` with the load t = V* [mm^3]:
+the same Newton iteration, line search, cut-back and step growth as every other FEM
+path, set up by :func:`volume_path_options`: Newton starts at the secant extrapolation
+of the last two states, takes its first step whole and halves later ones until the merit
+|R_u| / f + |R_V| / v decreases (f the largest force scale |p g_V|, |Π'| met in the solve,
+v the volume scale); increments in mm^3 from a first step up to a largest one. Only the
+measures are the border's own: the merit, and the convergence test -- the force residual
+relative to the pressure load |p g_V| (or |Π'|), the volume residual relative to the
+volume scale, or the merit below a round-off floor and no longer halving (the bordered
+matrix's condition grows with κ/μ and the mesh). Raises :class:`VolumeNotConverged` (a
+:class:`fem.newton.NotConverged`, the one failure type of the FEM solvers) with the residual
+history and the last converged state.
 """
 from __future__ import annotations
 
 from dataclasses import dataclass, field
 
 import numpy as np
-import scipy.sparse as sp
 
+from softhand.fem.assembly import Restriction
 from softhand.fem.linsolve import make_solver
-from softhand.fem.newton import NotConverged
+from softhand.fem.loads import volume_control
+from softhand.fem.newton import NewtonOptions, NotConverged, PathOptions, solve_path
 
-__all__ = ["PathOptions", "PathState", "NotConverged", "VolumeNotConverged", "follow_volume"]
+__all__ = ["PathOptions", "PathState", "NotConverged", "VolumeNotConverged", "follow_volume",
+           "volume_path_options"]
+
+VTOL = 1e-10  #: volume residual, relative to max(V*, volume_scale)
+#: merit below which Newton that stops converging quadratically has reached round-off
+FLOOR = 1e-5
 
 
-@dataclass(frozen=True)
-class PathOptions:
-    """Step control and tolerances of :func:`follow_volume`."""
-
-    first_step: float = 1.0  #: first volume increment [mm^3]
-    max_step: float = 200.0  #: largest volume increment [mm^3]
-    rtol: float = 1e-9  #: force residual, relative to the pressure load |p g_V| (or |Π'|)
-    atol: float = 0.0  #: force residual floor [N]: round-off of the stiff volumetric terms
-    #: merit below which Newton that stops converging quadratically has reached round-off
-    #: (the bordered matrix's condition grows with κ/μ and the mesh)
-    floor: float = 1e-5
-    vtol: float = 1e-10  #: volume residual, relative to max(V*, volume_scale)
-    max_iter: int = 12  #: Newton iterations per step before cut-back
-    min_step: float = 1e-6  #: smallest volume increment before giving up [mm^3]
-    grow: float = 1.5  #: step growth after a step that took <= 5 iterations
-    solver: str = "auto"  #: :func:`fem.linsolve.make_solver` method for the bordered system
+def volume_path_options(*, first_step: float = 1.0, max_step: float = 200.0, atol: float = 0.0,
+                        min_step: float = 1e-6, max_iter: int = 12) -> PathOptions:
+    """:class:`fem.newton.PathOptions` of a volume path: increments [mm^3] from ``first_step``
+    up to ``max_step``, grown 1.5x after a step of at most 5 iterations, halved down to
+    ``min_step``; ``max_iter`` Newton iterations a step, from the secant predictor; ``atol``:
+    force residual floor [N] (round-off of the stiff volumetric terms); the force residual
+    relative to the pressure load is held to 1e-9 (see the module docstring)."""
+    return PathOptions(first_step=first_step, max_step=max_step, min_dt=min_step, easy_iter=5,
+                       predictor="secant",
+                       newton=NewtonOptions(rtol=1e-9, atol=atol, xtol=0.0, max_iter=max_iter,
+                                            merit="decrease", max_backtracks=4))
 
 
 @dataclass(frozen=True)
@@ -75,113 +77,89 @@ class VolumeNotConverged(NotConverged):
         self.last = last
 
 
-class _Problem:
-    """Residual and tangent of L(u, p) on the free DOFs."""
+class _Bordered:
+    """L(u, p)'s residual and Jacobian on x = (free DOFs, p), and the border's convergence test."""
 
-    def __init__(self, solid, volume, free, volume_scale, solver):
-        self.solid, self.volume, self.free = solid, volume, free
-        self.volume_scale = volume_scale
-        self.solver = solver
+    def __init__(self, solid, volume, free, volume_scale, newton: NewtonOptions):
+        n = solid.ndofs
+        self.solid, self.volume, self.volume_scale, self.newton = solid, volume, volume_scale, newton
+        self.free, self.red = free, Restriction(n + 1, np.append(free, n))
+        self.merits, self.fnorm = [], 1.0  # the merits and the largest force scale of this solve
+        self.forces = (None, 0.0)  # (x, max(|p g_V|, |Π'|)) of the last call
 
-    def full(self, uf):
-        u = np.zeros(self.solid.ndofs)
-        u[self.free] = uf
-        return u
+    def split(self, x):
+        """(u [mm] (ndofs,), p [MPa]) of x."""
+        y = self.red.expand(x)
+        return y[:-1], y[-1]
 
-    def residual(self, uf, p, target):
-        u = self.full(uf)
-        f, g = self.solid.residual(u)[self.free], self.volume.gradient(u)[self.free]
-        return f - p * g, target - self.volume.value(u), max(np.linalg.norm(p * g), np.linalg.norm(f))
+    def join(self, u, p):
+        return self.red.vector(np.append(u, p))
 
-    def newton_step(self, uf, p, ru, rv):
-        u = self.full(uf)
-        K = self.solid.tangent(u) - p * self.volume.hessian(u)
-        g = self.volume.gradient(u)[self.free][:, None]
-        A = sp.bmat([[K[self.free][:, self.free], sp.csr_matrix(-g)], [sp.csr_matrix(-g.T), None]],
-                    format="csr")
-        x = self.solver.solve(A, -np.append(ru, rv))
-        return x[:-1], x[-1]
+    def __call__(self, x, V, tangent=True):
+        u, p = self.split(x)
+        f = self.solid.residual(u)
+        Rb, Kb = volume_control(f, self.solid.tangent(u) if tangent else None, p, self.volume, u, V)
+        Rb, f = self.red.vector(Rb), f[self.free]
+        self.forces = (x, max(np.linalg.norm(f - Rb[:-1]), np.linalg.norm(f)))  # |p g_V|, |Π'|
+        return Rb, None if Kb is None else self.red.restrict(Kb)
 
+    def force_scale(self, x, V) -> float:
+        """max(|p g_V|, |Π'|) [N] at x."""
+        if not (self.forces[0] is x or np.array_equal(self.forces[0], x)):
+            self(x, V, tangent=False)
+        return self.forces[1]
 
-def _newton(prob, uf, p, target, opt: PathOptions):
-    """Newton with backtracking line search; returns ((uf, p, iterations) or None, history).
+    def merit(self, x, R, V) -> float:
+        """|R_u| / f + |R_V| / v: f the largest force scale of the solve (x's included)."""
+        f = max(self.fnorm, self.force_scale(x, V))
+        return float(np.linalg.norm(R[:-1]) / f + abs(R[-1]) / max(abs(V), self.volume_scale))
 
-    The first step (from the predictor) is taken whole; later steps backtrack on the merit
-    |R_u| / f + |R_V| / v, f the largest force scale (|p g_V|, |Π'|, atol) met in this
-    solve, v the volume scale. Converged: both residuals within tolerance, or the merit
-    below ``floor`` and no longer halving (round-off).
-    """
-    history = []
-    vscale = max(abs(target), prob.volume_scale)
-    ru, rv, fscale = prob.residual(uf, p, target)
-    fnorm = max(fscale, opt.atol, 1e-300)
-    for it in range(opt.max_iter + 1):
-        merit = np.linalg.norm(ru) / fnorm + abs(rv) / vscale
-        history.append(merit)
-        if np.linalg.norm(ru) <= opt.rtol * fscale + opt.atol and abs(rv) <= opt.vtol * vscale:
-            return (uf, p, it), history
-        if it >= 2 and merit < opt.floor and merit > 0.5 * history[-2]:
-            return (uf, p, it), history  # stagnating at the round-off floor of the solve
-        if it == opt.max_iter or not np.isfinite(merit):
-            break
-        du, dp = prob.newton_step(uf, p, ru, rv)
-        for alpha in (1.0, 0.5, 0.25, 0.125, 0.0625):
-            with np.errstate(invalid="ignore", divide="ignore", over="ignore"):  # J < 0 trials
-                trial = prob.residual(uf + alpha * du, p + alpha * dp, target)
-            new = np.linalg.norm(trial[0]) / max(fnorm, trial[2]) + abs(trial[1]) / vscale
-            if it == 0 or (np.isfinite(new) and new < merit):
-                break
-        uf, p = uf + alpha * du, p + alpha * dp
-        ru, rv, fscale = trial
-        fnorm = max(fnorm, fscale)
-    return None, history
+    def converged(self, x, R, it, V) -> bool:
+        """Force residual within rtol |p g_V| + atol and volume residual within VTOL, or the
+        merit below FLOOR and no longer halving (round-off)."""
+        fscale = self.force_scale(x, V)
+        self.fnorm = max(fscale, self.newton.atol, 1e-300) if it == 0 else max(self.fnorm, fscale)
+        self.merits = ([] if it == 0 else self.merits) + [self.merit(x, R, V)]
+        if (np.linalg.norm(R[:-1]) <= self.newton.rtol * fscale + self.newton.atol
+                and abs(R[-1]) <= VTOL * max(abs(V), self.volume_scale)):
+            return True
+        return it >= 2 and FLOOR > self.merits[-1] > 0.5 * self.merits[-2]
 
 
-def follow_volume(solid, volume, fixed_dofs, targets, *, options=PathOptions(),
-                  volume_scale=1.0, progress=None,
-                  start: PathState | None = None) -> tuple[list[PathState], list[PathState]]:
+def follow_volume(solid, volume, fixed_dofs, targets, *, options: PathOptions | None = None,
+                  volume_scale=1.0, progress=None, start: PathState | None = None,
+                  solver=None) -> tuple[list[PathState], list[PathState]]:
     """Follow the equilibrium path from ``start`` (default u = 0) through the volumes ``targets``.
 
+    ``volume``: the cavity's functional (``value``, ``gradient``, ``hessian`` of V(u));
     ``targets`` [mm^3] must run strictly monotonically away from the start volume, up
-    (inflating) or down (oil leaving). Returns (states at the targets, every converged state
-    from the start on).
+    (inflating) or down (oil leaving); ``options``: default :func:`volume_path_options`;
+    ``solver``: a :mod:`fem.linsolve` solver (default: auto, symmetric). Returns (states at
+    the targets, every converged state from the start on).
     """
-    targets = np.asarray(targets, dtype=float)
+    options = options or volume_path_options()
     free = np.setdiff1d(np.arange(solid.ndofs), fixed_dofs)
-    prob = _Problem(solid, volume, free, volume_scale, make_solver(options.solver, symmetric=True))
+    prob = _Bordered(solid, volume, free, volume_scale, options.newton)
     if start is None:
         start = PathState(volume.value(np.zeros(solid.ndofs)), 0.0, 0.0, np.zeros(solid.ndofs))
-    sign = np.sign(targets[0] - start.volume)
+    sign = np.sign(np.asarray(targets, dtype=float)[0] - start.volume)
     if sign == 0 or np.any(sign * np.diff(targets) <= 0):
         raise ValueError(f"volume targets must run strictly monotonically away from "
                          f"{start.volume:.6g} mm^3")
-    path, step, hits = [start], options.first_step, []
-    for target in targets:
-        while sign * (target - path[-1].volume) > 0:
-            nxt = path[-1].volume + sign * min(step, sign * (target - path[-1].volume))
-            result, history = _newton(prob, *_predict(path, free, nxt), nxt, options)
-            if result is None:
-                step /= 2
-                if step < options.min_step:
-                    raise VolumeNotConverged(f"no equilibrium at V = {nxt:.6g} mm^3", history, path[-1])
-                continue
-            uf, p, its = result
-            u = prob.full(uf)
-            path.append(PathState(nxt, p, solid.energy(u), u, its))
-            if progress is not None:
-                progress(nxt)
-            if its <= 5:
-                step = min(step * options.grow, options.max_step)
-        hits.append(path[-1])
-    return hits, path
+    try:
+        res = solve_path(prob, prob.join(start.u, start.pressure), options,
+                         solver=solver or make_solver(symmetric=True), t0=start.volume, stops=targets,
+                         residual_t=lambda x, V: prob(x, V, tangent=False)[0],
+                         converged_t=prob.converged, merit_t=prob.merit,
+                         callback=None if progress is None else (lambda V, x: progress(V)))
+    except NotConverged as err:
+        V, x = err.last_converged
+        raise VolumeNotConverged(f"no equilibrium at V = {err.t:.6g} mm^3", err.history,
+                                 _state(prob, V, x)) from err
+    path = [start] + [_state(prob, V, x, its) for V, x, its in zip(res.t[1:], res.x[1:], res.iterations)]
+    return [path[k] for k in res.stops], path
 
 
-def _predict(path, free, volume):
-    """(u_free, p) at ``volume``: secant through the last two converged states, else the last."""
-    last = path[-1]
-    if len(path) < 2:
-        return last.u[free], last.pressure
-    before = path[-2]
-    s = (volume - last.volume) / (last.volume - before.volume)
-    return (last.u[free] + s * (last.u[free] - before.u[free]),
-            last.pressure + s * (last.pressure - before.pressure))
+def _state(prob: _Bordered, V, x, iterations=0) -> PathState:
+    u, p = prob.split(x)
+    return PathState(float(V), float(p), prob.solid.energy(u), u, iterations)

@@ -11,7 +11,8 @@ from softhand.fem.assembly import Restriction
 from softhand.fem.linsolve import make_solver
 from softhand.fem.loads import FollowerPressure
 from softhand.fem.materials import NeoHookean
-from softhand.fem.newton import NewtonOptions, PathOptions, _add_pair, _bfgs_direction, solve_path
+from softhand.fem.newton import NewtonOptions, PathOptions, solve_path
+from softhand.fem.newton_steps import add_pair, bfgs_direction
 from softhand.fem.solid import Solid
 
 
@@ -58,14 +59,14 @@ def test_bfgs_direction_satisfies_the_secant_condition():
     pairs = []
     for _ in range(3):
         s = rng.standard_normal(n)
-        _add_pair(pairs, s, K @ s, memory=10)
+        add_pair(pairs, s, K @ s, memory=10)
     apply = lambda r: np.linalg.solve(K0, r)
     s, y, _ = pairs[-1]
-    assert np.allclose(-_bfgs_direction(y, pairs, apply), s, rtol=1e-10)  # H y_k = s_k
-    _add_pair(pairs, np.ones(n), -np.ones(n), memory=10)  # negative curvature: not kept
+    assert np.allclose(-bfgs_direction(y, pairs, apply), s, rtol=1e-10)  # H y_k = s_k
+    add_pair(pairs, np.ones(n), -np.ones(n), memory=10)  # negative curvature: not kept
     assert len(pairs) == 3
     for _ in range(10):
-        _add_pair(pairs, rng.standard_normal(n), rng.standard_normal(n) + 100.0, memory=4)
+        add_pair(pairs, rng.standard_normal(n), rng.standard_normal(n) + 100.0, memory=4)
     assert len(pairs) == 4
 
 

@@ -194,3 +194,38 @@ def test_one_failure_type_for_load_and_volume_paths():
     assert err.value.last_converged == (100.0, last.u) and err.value.history == [1.0, 0.5]
     assert "residual history" in str(err.value)
 
+
+
+def test_decrease_merit_takes_the_first_step_whole_then_halves_until_the_merit_drops():
+    """arctan(x) = 0 from 1.5: the full Newton step overshoots to |x| = 1.69 > 1.5 (taken whole:
+    the first step), the next full step would overshoot further, so it is halved; the caller's
+    merit (here |x|, the distance to the root) decides, not ||R||."""
+    calls = []
+
+    def merit(x, R):
+        calls.append(float(x[0]))
+        return abs(float(x[0]))
+
+    r = newton(ATAN, [1.5], NewtonOptions(merit="decrease"), merit=merit)
+    assert abs(r.x[0]) < 1e-8 and r.steps[0] == 1.0 and min(r.steps[1:]) < 1.0
+    x1 = 1.5 - np.arctan(1.5) * (1 + 1.5**2)  # the first, whole Newton step
+    assert abs(x1) > 1.5 and calls[1] == pytest.approx(x1, rel=1e-12)
+
+
+def test_path_lands_on_its_stops_up_and_down_within_the_largest_step():
+    """x^3 + x = t through t = 2, 5, 10 from 0, then back down through 5, 1 from 10: every stop
+    is a converged state (closed form: the real root of x^3 + x - t), steps <= max_step."""
+    fun_t = lambda x, t: (np.array([x[0] ** 3 + x[0] - t]), sp.csr_matrix([[3 * x[0] ** 2 + 1]]))  # noqa: E731
+    root = lambda t: float(np.real(np.roots([1, 0, 1, -t])[np.isreal(np.roots([1, 0, 1, -t]))][0]))  # noqa: E731
+    opts = PathOptions(first_step=0.1, max_step=1.5, predictor="secant",
+                       newton=NewtonOptions(rtol=0.0, atol=1e-12))
+    up = solve_path(fun_t, [0.0], opts, stops=(2.0, 5.0, 10.0))
+    assert [up.t[k] for k in up.stops] == [2.0, 5.0, 10.0]
+    assert np.all(np.diff(up.t) > 0) and np.max(np.diff(up.t)) <= 1.5 + 1e-12 and up.t[1] == 0.1
+    for k, t in zip(up.stops, (2.0, 5.0, 10.0)):
+        assert up.x[k][0] == pytest.approx(root(t), abs=1e-11)
+    down = solve_path(fun_t, up.x[-1], opts, t0=10.0, stops=(5.0, 1.0))
+    assert [down.t[k] for k in down.stops] == [5.0, 1.0] and np.all(np.diff(down.t) < 0)
+    assert down.x[down.stops[-1]][0] == pytest.approx(root(1.0), abs=1e-11)
+    with pytest.raises(ValueError, match="monotonically"):
+        solve_path(fun_t, [0.0], opts, stops=(2.0, 1.0))

@@ -333,9 +333,10 @@ def test_a_real_reservoir_failure_saves_the_last_converged_state(tmp_path, monke
     import functools
 
     import softhand.fem.hand.reservoir as fr
-    from softhand.fem.volume_path import PathOptions
+    from softhand.fem.volume_path import volume_path_options
 
-    monkeypatch.setattr(fr, "PathOptions", functools.partial(PathOptions, max_iter=4, min_step=500.0))
+    monkeypatch.setattr(fr, "volume_path_options", functools.partial(volume_path_options, max_iter=4,
+                                                                     min_step=500.0))
     out = tmp_path / "sheet"
     argv = ["reservoir", "--n-radial", "4", "--n-thick", "1", "--volume-mm3", "20000", "--out", str(out)]
     assert main(argv) == 1

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from softhand.fem.hand.reservoir import SheetModel, inflate
-from softhand.fem.volume_path import PathOptions, PathState, follow_volume
+from softhand.fem.volume_path import PathState, follow_volume, volume_path_options
 from softhand.reduced import hand, reservoir
 from softhand.reduced import reservoir_fem
 from softhand.reduced.design import HandDesign
@@ -87,7 +87,7 @@ def test_thin_sheet_membrane_limit_is_hencky():
     w0_hat, V_hat = _hencky(0.5)
     q = (0.1 / w0_hat) ** 3 * E * m.t / a  # w0 = 0.1 a
     V = V_hat * a**3 * (q * a / (E * m.t)) ** (1 / 3)
-    opts = PathOptions(first_step=0.05, max_step=2 * a**2 * m.t, atol=1e-12 * 1e3 * m.mu * a * m.t)
+    opts = volume_path_options(first_step=0.05, max_step=2 * a**2 * m.t, atol=1e-12 * 1e3 * m.mu * a * m.t)
     s = inflate(m, [V], options=opts).states[0]
     assert s.pressure == pytest.approx(q, rel=0.02)
     assert s.apex == pytest.approx(0.1 * a, rel=0.02)
@@ -173,7 +173,7 @@ def test_oil_leaving_retraces_the_inflation_path(study):
     solid, volume, fixed = model.build()
     top = study.states[2]  # V0 + 2000
     start = PathState(top.volume, top.pressure, top.energy, top.u)
-    options = PathOptions(max_step=0.5 * model.R**2 * model.t,
+    options = volume_path_options(max_step=0.5 * model.R**2 * model.t,
                           atol=1e-12 * model.kappa_ratio * model.mu * model.R * model.t)
     down, _ = follow_volume(solid, volume, fixed, (DESIGN.V0, DESIGN.V0 - STROKE), start=start,
                             options=options, volume_scale=model.R**2 * model.t)

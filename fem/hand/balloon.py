@@ -24,7 +24,7 @@ import numpy as np
 from softhand.fem.axisym import AxisymSolid, RevolvedVolume
 from softhand.fem.hyperelastic import rubber_law
 from softhand.fem.materials import NeoHookean
-from softhand.fem.volume_path import PathOptions, follow_volume
+from softhand.fem.volume_path import follow_volume, volume_path_options
 from softhand.meshes.shell import shell_mesh
 
 __all__ = ["ThickSphere", "closed_form_pressure", "inflate_sphere"]
@@ -88,7 +88,7 @@ def inflate_sphere(sphere: ThickSphere, lambda_a):
     fixed = np.concatenate([b.get_dofs("axis").all("u^1"), b.get_dofs("equator").all("u^2")])
     V_ref = cavity.value(np.zeros(solid.ndofs))
     targets = V_ref * np.asarray(lambda_a, dtype=float) ** 3
-    opts = PathOptions(first_step=0.01 * V_ref, max_step=0.3 * V_ref,
+    opts = volume_path_options(first_step=0.01 * V_ref, max_step=0.3 * V_ref,
                        atol=1e-12 * sphere.kappa_ratio * mu * sphere.B**2)
     hits, path = follow_volume(solid, cavity, fixed, targets, options=opts, volume_scale=V_ref)
     return np.array([s.pressure for s in hits]), path

@@ -30,7 +30,7 @@ import numpy as np
 from softhand.fem.axisym import AxisymSolid, RevolvedVolume
 from softhand.fem.hyperelastic import rubber_law
 from softhand.reduced.rubber import NeoHookean, Rubber
-from softhand.fem.volume_path import PathOptions, follow_volume
+from softhand.fem.volume_path import PathOptions, follow_volume, volume_path_options
 from softhand.meshes.reservoir import sheet_mesh
 
 __all__ = ["SheetModel", "SheetState", "ReservoirResult", "inflate", "pressure_maximum", "sheet_vtk"]
@@ -161,7 +161,7 @@ def inflate(model: SheetModel, volumes, *, options: PathOptions | None = None,
     solid, volume, fixed = model.build()
     # round-off floor of the internal forces: the volumetric stresses are O(κ) and cancel
     atol = 1e-12 * model.kappa_ratio * model.mu * model.R * model.t
-    options = options or PathOptions(max_step=0.5 * model.R**2 * model.t, atol=atol)
+    options = options or volume_path_options(max_step=0.5 * model.R**2 * model.t, atol=atol)
     hits, path = follow_volume(solid, volume, fixed, targets, options=options,
                                volume_scale=model.R**2 * model.t, progress=progress)
     states = [_state(model, solid, s) for s in hits]
