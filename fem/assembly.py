@@ -17,6 +17,35 @@ import numpy as np
 import scipy.sparse as sp
 
 
+class DofScatter:
+    """Scatter element vectors and matrices over any element DOF numbering into a CSR pattern
+    built once (duplicates summed); the scatter of the axisymmetric kernel and its volume.
+
+    ``dofs``: (nloc, nel) global DOF of each element's local DOF; ``n``: the system's size.
+    """
+
+    def __init__(self, dofs: np.ndarray, n: int):
+        self.dofs, self.n = np.asarray(dofs), n
+        nloc, nel = self.dofs.shape
+        rows = np.broadcast_to(self.dofs[:, None, :], (nloc, nloc, nel)).ravel().astype(np.int64)
+        cols = np.broadcast_to(self.dofs[None, :, :], (nloc, nloc, nel)).ravel().astype(np.int64)
+        pattern = sp.csr_matrix((np.ones(rows.size), (rows, cols)), shape=(n, n))
+        pattern.sum_duplicates()
+        pattern.sort_indices()
+        keys = np.repeat(np.arange(n, dtype=np.int64), np.diff(pattern.indptr)) * n + pattern.indices
+        self.pattern = pattern
+        self.slots = np.searchsorted(keys, rows * n + cols)  # per (a, b, e): its slot in the CSR data
+
+    def vector(self, fe: np.ndarray) -> np.ndarray:
+        """Sum of the element vectors fe (nloc, nel) as a full vector (n,)."""
+        return np.bincount(self.dofs.ravel(), weights=fe.ravel(), minlength=self.n)
+
+    def matrix(self, Ke: np.ndarray) -> sp.csr_matrix:
+        """Sum of the element matrices Ke (nloc, nloc, nel) as CSR in the pattern."""
+        data = np.bincount(self.slots, weights=Ke.ravel(), minlength=self.pattern.nnz)
+        return sp.csr_matrix((data, self.pattern.indices, self.pattern.indptr), shape=self.pattern.shape)
+
+
 class ElementScatter:
     """Scatter element vectors/matrices of a 3-component field into a fixed CSR pattern.
 

@@ -30,7 +30,7 @@ represents exactly with one. Both parts of ψ come from the 3D material of
 :mod:`fem.materials` through its ``split()``.
 
 Assembly: the 18 × 18 element matrices of all elements come from one ``einsum`` over
-quadrature points and are scattered with ``np.bincount`` into a CSR pattern built once.
+quadrature points and are scattered into a CSR pattern built once (:class:`fem.assembly.DofScatter`).
 
 :class:`RevolvedVolume` is the volume enclosed between a boundary curve of the mesh,
 revolved about the axis, and the plane z = 0: the oil volume of a reservoir sheet measured
@@ -39,28 +39,12 @@ from its clamp plane, or the cavity of a balloon modelled with a z = 0 symmetry 
 from __future__ import annotations
 
 import numpy as np
-import scipy.sparse as sp
 from skfem import Basis, ElementQuad2, ElementVector
 
 from softhand.fem import kinematics as kin
+from softhand.fem.assembly import DofScatter
 
-__all__ = ["AxisymSolid", "RevolvedVolume", "scatter_pattern"]
-
-
-def scatter_pattern(rows, cols, shape):
-    """CSR pattern of the (rows, cols) pairs and, per pair, its slot in the CSR data array."""
-    pattern = sp.csr_matrix((np.ones(rows.size), (rows, cols)), shape=shape)
-    pattern.sum_duplicates()
-    pattern.sort_indices()
-    row_of = np.repeat(np.arange(shape[0]), np.diff(pattern.indptr))
-    keys = row_of.astype(np.int64) * shape[1] + pattern.indices
-    slots = np.searchsorted(keys, rows.astype(np.int64) * shape[1] + cols)
-    return pattern, slots
-
-
-def _scatter(pattern, slots, values):
-    data = np.bincount(slots, weights=values.ravel(), minlength=pattern.nnz)
-    return sp.csr_matrix((data, pattern.indices, pattern.indptr), shape=pattern.shape)
+__all__ = ["AxisymSolid", "RevolvedVolume"]
 
 
 class AxisymSolid:
@@ -84,10 +68,7 @@ class AxisymSolid:
         self.G = self._gradient_operators()  # (18, 3, 3, nel, nqp)
         self.G5 = self.G[:, _I5, _J5]  # (18, 5, nel, nqp): its non-zero components
         self.dofs = self.basis.element_dofs  # (18, nel)
-        n, nel = self.dofs.shape
-        rows = np.broadcast_to(self.dofs[:, None, :], (n, n, nel)).ravel()
-        cols = np.broadcast_to(self.dofs[None, :, :], (n, n, nel)).ravel()
-        self.pattern, self.slots = scatter_pattern(rows, cols, (self.basis.N,) * 2)
+        self.scatter = DofScatter(self.dofs, self.basis.N)
 
     @property
     def ndofs(self) -> int:
@@ -129,7 +110,7 @@ class AxisymSolid:
         _, p = self._pressure(F)
         S = self.iso.stress(F) + p * kin.cofactor(F)
         fe = np.einsum("ijeq,aijeq,eq->ae", S, self.G, self.wdV)
-        return np.bincount(self.dofs.ravel(), weights=fe.ravel(), minlength=self.ndofs)
+        return self.scatter.vector(fe)
 
     def tangent(self, u):
         """Tangent stiffness d²Π/du² (CSR, pattern reused) [N/mm].
@@ -150,7 +131,7 @@ class AxisymSolid:
         dtheta = np.einsum("eqk,aek->aeq", self.proj, J * np.einsum("Ieq,aIeq->aeq", FiT, self.G5))
         Ke += np.einsum("aeq,beq,eq->abe", dtheta, dtheta, self.vol.ddU(theta) * self.wdV,
                         optimize=True)
-        return _scatter(self.pattern, self.slots, Ke)
+        return self.scatter.matrix(Ke)
 
     def stretches(self, u):
         """Principal stretches at quadrature points: (in-plane max, in-plane min, hoop), each (nel, nqp)."""
@@ -210,11 +191,7 @@ class RevolvedVolume:
         self.z_dofs = np.array([nd[1, v0], fd[1, facets], nd[1, v1]])
         self.X = np.array([basis.doflocs[0, self.r_dofs], basis.doflocs[1, self.z_dofs]])  # (2, 3, nf)
         self.ndofs = basis.N
-        rows = np.concatenate([self.r_dofs, self.z_dofs])  # (6, nf)
-        n, nf = rows.shape
-        self.pattern, self.slots = scatter_pattern(
-            np.broadcast_to(rows[:, None], (n, n, nf)).ravel(),
-            np.broadcast_to(rows[None, :], (n, n, nf)).ravel(), (self.ndofs,) * 2)
+        self.scatter = DofScatter(np.concatenate([self.r_dofs, self.z_dofs]), self.ndofs)  # (6, nf)
 
     def _geometry(self, u):
         r = self.X[0] + u[self.r_dofs]
@@ -229,8 +206,7 @@ class RevolvedVolume:
         r, dz = self._geometry(u)
         g_r = -2 * np.pi * np.einsum("q,iq,qf->if", _W, _N, r * dz)
         g_z = -np.pi * np.einsum("q,iq,qf->if", _W, _DN, r**2)
-        g = np.bincount(self.r_dofs.ravel(), weights=g_r.ravel(), minlength=self.ndofs)
-        return g + np.bincount(self.z_dofs.ravel(), weights=g_z.ravel(), minlength=self.ndofs)
+        return self.scatter.vector(np.concatenate([g_r, g_z]))
 
     def hessian(self, u):
         r, dz = self._geometry(u)
@@ -239,4 +215,4 @@ class RevolvedVolume:
         H[:3, :3] = -2 * np.pi * np.einsum("q,iq,jq,qf->ijf", _W, _N, _N, dz)
         H[:3, 3:] = -2 * np.pi * np.einsum("q,iq,jq,qf->ijf", _W, _N, _DN, r)
         H[3:, :3] = np.swapaxes(H[:3, 3:], 0, 1)
-        return _scatter(self.pattern, self.slots, H)
+        return self.scatter.matrix(H)
