@@ -45,14 +45,15 @@ by one.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
 import scipy.sparse as sp
 from skfem import Basis, ElementTetP2
 
 from softhand.fem import kinematics as kin
 from softhand.fem.assembly import ElementScatter, Restriction
+from softhand.fem.mixed import MixedNewton, PressureAnchor
+
+__all__ = ["FORMULATIONS", "Solid", "MixedNewton", "PressureAnchor", "element_matrices"]
 
 FORMULATIONS = ("mean_dilatation", "displacement")
 
@@ -263,47 +264,6 @@ class Solid:
             cb = (self._vol.ddU(Jbar) / Ve)[:, None, None] * b
             Ke += cb[:, :, :, None, None] * b.transpose(0, 2, 1)[:, None, None, :, :]
         return re
-
-
-@dataclass(frozen=True)
-class PressureAnchor:
-    r"""Element pressures linearised at an iterate u0 (the P0 pressure of the mixed iteration):
-    :math:`p_e(u) = U'(\bar J_e) + U''(\bar J_e)/V_e\; b_e\cdot(u - u_0)_e`."""
-
-    u0: np.ndarray  #: the iterate [mm], (ndofs,)
-    p0: np.ndarray  #: U'(Jbar_e(u0)) [MPa], (nel,)
-    c0: np.ndarray  #: U''(Jbar_e(u0)) / V_e [MPa/mm^3], (nel,)
-    b: np.ndarray  #: b_e = int cof F : grad phi [mm^2], (nel, 3 nloc)
-
-    def pressure(self, u, elements, vdofs) -> np.ndarray:
-        """p_e(u) of the given elements (vdofs: their vector dofs, (ne, 3 nloc))."""
-        du = (u - self.u0)[vdofs]
-        return self.p0[elements] + self.c0[elements] * np.einsum("ei,ei->e", self.b[elements], du)
-
-
-class MixedNewton:
-    """Glue for :func:`fem.newton.newton`: ``on_accept`` re-anchors the element pressures.
-
-    ``expand(x)`` must return the **full** displacement at the unknowns x, prescribed values
-    included: the pressures are linearised at that state, and an anchor taken at a state
-    with the prescribed displacements missing (zeros) makes Newton converge only linearly.
-    A :class:`fem.assembly.Restriction` built with ``values=`` expands that way. Usage::
-
-        red = Restriction(solid.ndofs, free, values=u_prescribed)
-        mixed = MixedNewton(solid, red.expand)
-        fun = lambda x: ... solid.residual_tangent(red.expand(x), anchor=mixed.anchor) ...
-        newton(fun, x0, on_accept=mixed.accept)   # or solve_path(..., on_accept=mixed.accept)
-
-    For prescribed values that grow with the load factor t, pass an ``expand`` that applies
-    the current t (see ``studies/verification/solid.py``).
-    """
-
-    def __init__(self, solid: Solid, expand):
-        self.solid, self.expand, self.anchor = solid, expand, None
-
-    def accept(self, x) -> None:
-        """Called by Newton with every accepted iterate."""
-        self.anchor = self.solid.anchor(self.expand(x))
 
 
 def element_matrices(A: np.ndarray, G: np.ndarray, GW: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
