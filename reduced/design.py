@@ -40,13 +40,18 @@ import dataclasses
 import hashlib
 import json
 import math
-import tomllib
 import warnings
 from dataclasses import dataclass
 from pathlib import Path
 
 from . import rubber
+from .design_rules import BOUNDS, CONSISTENCY, _check_model, _in_bounds, _is_number
 from .errors import InputError
+from .inputfiles import MAX_FILE_BYTES, read_input_file, read_toml
+
+__all__ = ["RESERVOIR_MODELS", "FINGER_MODELS", "PAPER_DESIGN_FILE", "HandDesign", "PUBLIC_KEYS",
+           "PARTS", "BOUNDS", "CONSISTENCY", "design_from_dict", "MAX_FILE_BYTES", "read_input_file",
+           "read_toml", "load_design"]
 
 #: Reservoir models the reduced layer knows; extended when a new one is added.
 RESERVOIR_MODELS = ("ellipse", "fem")
@@ -54,17 +59,6 @@ RESERVOIR_MODELS = ("ellipse", "fem")
 FINGER_MODELS = ("paper", "fem")
 
 PAPER_DESIGN_FILE = Path(__file__).resolve().parent.parent / "studies" / "designs" / "paper.toml"
-
-
-def _check_model(field: str, name: str, models, neo_hookean: bool, part: str, body: str,
-                 material, closed_form: str) -> None:
-    """A model name the registry knows; the FEM-calibrated table only for a Neo-Hookean part."""
-    if name not in models:
-        raise InputError(field, name, f"must be one of {', '.join(models)}")
-    if name == "fem" and not neo_hookean:
-        raise InputError(field, "fem", f"the FEM-calibrated {part} table holds a Neo-Hookean "
-                         f"{body}, not {material.model}; use {field} = \"{closed_form}\" with this "
-                         f"[{part}.material]")
 
 
 @dataclass(frozen=True)
@@ -247,58 +241,6 @@ def _material_changes(part: str, table, source: str, values: dict) -> dict:
     return {f"{part}_material": material, name: material.mu0}
 
 
-#: public key -> (lowest, highest) allowed value, both included, in the key's unit. Every
-#: number of a design is checked against this one table (the hinge positions hinge_s_mm lie
-#: strictly inside (0, l0_mm));
-#: a new numeric design key adds one line here. The limits are physical: a rubber tube of
-#: a hand-sized soft finger, a rubber reservoir sheet, Earth-like gravity.
-BOUNDS: dict[str, tuple[float, float]] = {
-    "theta0_deg": (0.0, 89.0),        # base link inclination
-    "l0_mm": (10.0, 1000.0),          # finger tube length
-    "a_mm": (0.1, 50.0),              # tube inner radius
-    "b_mm": (0.1, 50.0),              # tube wall thickness
-    "d_mm": (0.2, 200.0),             # tube axis to hinge plate (also > a + b)
-    "R_mm": (1.0, 500.0),             # reservoir sheet radius
-    "t_mm": (0.01, 50.0),             # reservoir sheet thickness (also < R)
-    "V0_mm3": (1.0, 1.0e8),           # initial oil volume
-    "n": (1, 12),                     # fingers
-    "n_s": (1, 20),                   # hinges per finger
-    "mu_sf_MPa": (1.0e-3, 100.0),     # rubber shear modulus, finger tube
-    "mu_sr_MPa": (1.0e-3, 100.0),     # rubber shear modulus, reservoir sheet
-    "base_offset_mm": (-1000.0, 1000.0),
-    "g_N_per_kg": (0.01, 100.0),
-    "tie_width_mm": (0.1, 1000.0),    # the links' tied rings (also shorter than every link)
-}
-
-
-def _in_bounds(key: str, value) -> None:
-    lo, hi = BOUNDS[key]
-    if not _is_number(value) or not math.isfinite(value) or not lo <= value <= hi:
-        raise InputError(key, value, f"must be a number in [{lo:g}, {hi:g}]")
-
-
-def _tube_fits(design: "HandDesign") -> None:
-    if not design.a + design.b < design.d:
-        raise InputError("d_mm", design.d, f"must exceed the tube's outer radius a_mm + b_mm = "
-                         f"{design.a + design.b:g} (the tube lies between its axis and the hinge plate)")
-
-
-def _sheet_thinner_than_radius(design: "HandDesign") -> None:
-    if not design.t < design.R:
-        raise InputError("t_mm", design.t, f"must be smaller than the sheet radius R_mm = {design.R:g}")
-
-
-#: checks between fields, run after the bounds; each raises InputError naming one field
-def _ties_fit_links(design: "HandDesign") -> None:
-    shortest = min(design.link_lengths)
-    if design.tie_width >= shortest:
-        raise InputError("tie_width_mm", design.tie_width,
-                         f"must be shorter than every link (shortest {shortest:g} mm)")
-
-
-CONSISTENCY = (_tube_fits, _sheet_thinner_than_radius, _ties_fit_links)
-
-
 def _to_public(name: str, value):
     if name == "theta0":
         return math.degrees(value)
@@ -328,10 +270,6 @@ def _from_public(key: str, value):
     return math.radians(value) if name == "theta0" else float(value)
 
 
-def _is_number(value) -> bool:
-    return isinstance(value, (int, float)) and not isinstance(value, bool)
-
-
 def design_from_dict(values: dict, base: HandDesign | None = None, *, source: str = "design") -> HandDesign:
     """A design from public keys (as in TOML), over ``base`` (default: the paper's)."""
     base = base if base is not None else HandDesign()
@@ -348,39 +286,6 @@ def design_from_dict(values: dict, base: HandDesign | None = None, *, source: st
         if part in values:
             changes.update(_material_changes(part, values[part], source, values))
     return dataclasses.replace(base, **changes)
-
-
-#: largest design / study / data file read [bytes]; a bigger one (or /dev/zero) is refused
-MAX_FILE_BYTES = 1_000_000
-
-
-def read_input_file(path: str | Path, field: str, what: str) -> bytes:
-    """The bytes of a small regular input file; InputError (one line) for anything else."""
-    path = Path(path)
-    try:
-        with open(path, "rb") as f:
-            if not path.is_file():
-                raise InputError(field, str(path), f"is not a regular file; give {what}")
-            data = f.read(MAX_FILE_BYTES + 1)
-    except FileNotFoundError:
-        raise InputError(field, str(path), f"no such file; give {what}") from None
-    except IsADirectoryError:
-        raise InputError(field, str(path), f"is a directory; give {what}") from None
-    except OSError as exc:
-        raise InputError(field, str(path), f"cannot be read ({exc.strerror or exc}); "
-                         f"give {what}") from None
-    if len(data) > MAX_FILE_BYTES:
-        raise InputError(field, str(path), f"is larger than {MAX_FILE_BYTES} bytes; give {what}")
-    return data
-
-
-def read_toml(path: str | Path, field: str, what: str) -> dict:
-    """A small TOML file as a dict; InputError (one line) if unreadable or not TOML."""
-    data = read_input_file(path, field, what)
-    try:
-        return tomllib.loads(data.decode("utf-8"))
-    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
-        raise InputError(field, str(path), f"is not valid TOML ({exc})") from None
 
 
 def load_design(path: str | Path | None = None) -> HandDesign:

@@ -14,7 +14,7 @@ NH, Mooney-Rivlin and Yeoh are linear in their parameters: solved directly. Gent
 Ogden are fitted by :func:`scipy.optimize.least_squares` from several starts (Ogden:
 exponents on a grid, the moduli for each by linear least squares; Gent: locking
 parameters on a grid) and refined. Standard errors and correlations come from the
-Jacobian at the optimum as in :func:`reduced.fit.diagnose`: Cov = S/(N - k) (J^T J)^{-1}.
+Jacobian at the optimum as in :func:`reduced.lsq.diagnose`: Cov = S/(N - k) (J^T J)^{-1}.
 Ogden's terms are reported in ascending alpha_p (W does not depend on their order). A
 standard error never drops below :data:`PRECISION` of its parameter's scale: with
 data without scatter the statistical error is round-off, the solver's precision is not.
@@ -36,7 +36,7 @@ from scipy.optimize import least_squares
 from . import rubber
 from .csvdata import _read_rows
 from .errors import InputError
-from .fit import FitOptions, diagnose, jacobian
+from .lsq import FitOptions, diagnose, jacobian
 
 #: ``--model`` -> (rubber model, Ogden terms)
 FIT_MODELS = {"neo-hookean": ("neo-hookean", 0), "mooney-rivlin": ("mooney-rivlin", 0),
