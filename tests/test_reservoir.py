@@ -194,3 +194,17 @@ def test_cli_reports_newton_failure_in_one_line(monkeypatch, capsys, tmp_path):
     assert main(["reservoir", "--volume-mm3", "17800"]) == 1
     err = capsys.readouterr().err.strip().splitlines()[-1]
     assert "V = 123 mm^3" in err and "last converged state (V = 100 mm^3, p = 0.01 MPa)" in err
+
+
+def test_volume_steps_follow_the_path_options():
+    """The volume path is fem.newton.solve_path with t = V*: its first increment, its largest
+    one and the stops it lands on are those of the one PathOptions (coarse 6 x 1 sheet)."""
+    model = SheetModel(n_radial=6, n_thick=1)
+    solid, volume, fixed = model.build()
+    options = volume_path_options(first_step=2.0, max_step=50.0,
+                                  atol=1e-12 * model.kappa_ratio * model.mu * model.R * model.t)
+    hits, path = follow_volume(solid, volume, fixed, (120.0, 300.0), options=options,
+                               volume_scale=model.R**2 * model.t)
+    dV = np.diff([s.volume for s in path])
+    assert dV[0] == 2.0 and dV.max() <= 50.0 and [h.volume for h in hits] == [120.0, 300.0]
+    assert all(0 < s.iterations <= 12 for s in path[1:]) and path[-1] is hits[-1]
