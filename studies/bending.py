@@ -23,6 +23,7 @@ import math
 import time
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -32,6 +33,9 @@ from softhand.reduced import finger as reduced_finger
 from softhand.reduced import hand
 from softhand.reduced.design import HandDesign
 from softhand.reduced.errors import InputError
+
+if TYPE_CHECKING:
+    from softhand.studies.compare import WholeHandResult
 
 
 @dataclass(frozen=True)
@@ -61,7 +65,7 @@ class BendingResult:
     build_seconds: float        #: meshing (cached) and setting up the model
     model: FingerModel = field(repr=False)
     states: list[FingerState] = field(repr=False)
-    hand: dict | None = None    #: the whole hand (:func:`studies.compare.whole_hand`), or None
+    hand: WholeHandResult | None = None  #: the whole hand (:func:`studies.compare.whole_hand`), or None
 
     def summary(self) -> dict:
         """Numbers and provenance for result.json."""
@@ -70,7 +74,7 @@ class BendingResult:
                "stats": asdict(self.stats), "options": {**asdict(self.model.options),  # the ring width in effect
                                  "tie_width": ring_width(self.model.design, self.model.options)},
                "design": self.model.design.to_dict(), "design_hash": self.model.design.hash()}
-        return out if self.hand is None else {**out, "hand": self.hand}
+        return out if self.hand is None else {**out, "hand": self.hand.summary()}
 
     def write(self, out) -> list[str]:
         """result.json (:meth:`summary`), table.csv (the rows) and, with the hand, hand.csv
@@ -78,18 +82,16 @@ class BendingResult:
         from softhand.studies.io.files import write_csv, write_json
 
         out = Path(out)
-        names = ["result.json", "table.csv"] + (["hand.csv"] if self.hand else [])
-        if self.hand:
-            write_csv(out / "hand.csv", self.hand["rows"])
+        names = self.hand.write(out) if self.hand else []
         write_json(out / "result.json", self.summary())
         write_csv(out / "table.csv", self.rows)
-        return names
+        return ["result.json", "table.csv", *names]
 
     def plot(self, path, **labels) -> None:
         """Fig. 7 with FEM points (:func:`studies.io.bend_plot.plot_bending`)."""
         from softhand.studies.io.bend_plot import plot_bending
 
-        plot_bending(path, self.rows, self.model.design, self.hand, **labels)
+        plot_bending(path, self.rows, self.model.design, self.hand and self.hand.rows, **labels)
 
 
 def row(state: FingerState, design: HandDesign) -> dict:

@@ -9,23 +9,54 @@ Delta Q(theta) its cavity volume change. Here both come from the finger FEM (a b
 sweep's (P, theta, dQ) rows), p_r from the reservoir-sheet FEM (:mod:`fem.hand.reservoir`) at
 the oil volumes left; the reduced counterpart is eq. (27) (eq. (28) + the ellipse model with
 eq. (2)'s volume). The reservoir's pressure offset p_r(V0) is what the paper reads off
-Fig. 7 as "0.1 MPa lower pressure".
+Fig. 7 as "0.1 MPa lower pressure". The result summarises and writes itself; the bending
+study (:mod:`studies.bending`) runs it with ``hand=True``.
 """
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 
 from softhand.fem.hand.reservoir import SheetModel, inflate
-from softhand.reduced import hand
+from softhand.reduced import hand, paper
 from softhand.reduced import reservoir as ellipse
 from softhand.reduced.design import HandDesign
 
 
-def whole_hand(rows: list[dict], design: HandDesign, **sheet_mesh) -> dict:
+@dataclass(frozen=True)
+class WholeHandResult:
+    """The hand's pump pressure from both FEMs against eq. (27), per bending row."""
+
+    rows: list                  #: theta, P_finger_fem, V, p_reservoir_fem, P_hand_fem, eqs. (27), (28)
+    offset_fem_MPa: float       #: p_r(V0), reservoir-sheet FEM
+    offset_ellipse_MPa: float   #: p_r(V0), the ellipse model
+    reservoir_ndofs: int
+    reservoir_seconds: float
+
+    def summary(self) -> dict:
+        """The rows, the offsets (with the paper's) and the sheet FEM's size and time."""
+        return {"rows": self.rows, "offset_fem_MPa": self.offset_fem_MPa,
+                "offset_ellipse_MPa": self.offset_ellipse_MPa, "offset_paper_MPa": paper.RESERVOIR_OFFSET_MPA,
+                "reservoir_ndofs": self.reservoir_ndofs, "reservoir_seconds": self.reservoir_seconds}
+
+    def write(self, out) -> list[str]:
+        """hand.csv (the rows) into the folder ``out``; the names written."""
+        from softhand.studies.io.files import write_csv
+
+        write_csv(Path(out) / "hand.csv", self.rows)
+        return ["hand.csv"]
+
+    def max_abs_difference_MPa(self) -> float:
+        """Largest |P_hand,FEM - P_eq.(27)| over the rows [MPa]."""
+        return float(max(abs(r["P_hand_fem_MPa"] - r["P_hand_eq27_MPa"]) for r in self.rows))
+
+
+def whole_hand(rows: list[dict], design: HandDesign, **sheet_mesh) -> WholeHandResult:
     """Per bending row (P_MPa, theta_deg, dQ_mm3): the hand's pump pressure from the FEM
-    finger + FEM reservoir, and eq. (27) at the same theta. Returns rows and the offset."""
+    finger + FEM reservoir, and eq. (27) at the same theta."""
     dQ = np.array([r["dQ_mm3"] for r in rows])
     V = design.V0 - design.n * dQ
     sheet = inflate(SheetModel.from_design(design, **sheet_mesh), np.append(V, design.V0))
@@ -42,11 +73,5 @@ def whole_hand(rows: list[dict], design: HandDesign, **sheet_mesh) -> dict:
             "P_hand_eq27_MPa": float(hand.pressure(theta, design, reservoir=True)),
             "P_finger_eq28_MPa": float(hand.pressure(theta, design, reservoir=False)),
         })
-    return {
-        "rows": out,
-        "offset_fem_MPa": float(p_res[-1]),
-        "offset_ellipse_MPa": float(ellipse.pressure(design.V0, design)),
-        "offset_paper_MPa": 0.1,
-        "reservoir_ndofs": int(sheet.ndofs),
-        "reservoir_seconds": sheet.wall_time,
-    }
+    return WholeHandResult(out, float(p_res[-1]), float(ellipse.pressure(design.V0, design)),
+                           int(sheet.ndofs), sheet.wall_time)

@@ -3,10 +3,13 @@
 * :func:`weights` -- one grasp case (diameter, mass, cavity pressure, mesh) through the FEM
   (:mod:`fem.hand.grasp`), cached on disk by its inputs: w, theta, hinge angles, contact forces,
   F_v from the FEM and from eq. (25) with this w at the same P, theta, m.
+  :func:`run_case` wraps it in a :class:`CaseResult` that summarises and writes itself.
 * :func:`run` (:class:`WeightsStudy`) -- w(D) over diameters, and w at an unseen diameter
-  by interpolation checked against the FEM there.
-* :func:`fig8` -- the Fig. 8 analogue: F_v against theta at several pressures (theta varied
-  by the object's depth), FEM points and reduced-model values.
+  by interpolation checked against the FEM there (:class:`WeightsResult`: summary, plot, write).
+* The Fig. 8 analogue (F_v against theta at several pressures) is :mod:`studies.fig8`.
+
+``softhand weights``, ``softhand grasp --diameter-mm``, the batch kind ``weights`` and the
+``weights_fem`` section of ``softhand reproduce`` only choose the inputs.
 
 Pressures: P is the finger's cavity pressure. Eq. (25) is evaluated without the reservoir
 term at P, which equals eq. (25) with the reservoir at the pump pressure P - p_r(V(theta))
@@ -23,7 +26,7 @@ from pathlib import Path
 
 import numpy as np
 
-from softhand.reduced import grasp, paper
+from softhand.reduced import grasp
 from softhand.reduced.design import HandDesign
 from softhand.reduced.errors import InputError
 from softhand.studies.io.files import jsonable, write_json
@@ -159,6 +162,38 @@ def weights(case: WeightsCase, *, cache: bool = True, out=None) -> dict:
     return {**result, "cached": False}
 
 
+@dataclass(frozen=True)
+class CaseResult:
+    """One grasp case: its flat numbers (:func:`weights`) and the files computing it wrote."""
+
+    case: WeightsCase
+    record: dict               #: :func:`compute`'s result, with ``cached``
+    files: tuple = ()          #: written into the ``out`` folder while computing (grasp.pvd)
+
+    def summary(self) -> dict:
+        """The flat numbers (``softhand weights --json`` for one diameter; result.json)."""
+        return self.record
+
+    def write(self, out) -> list[str]:
+        """result.json into the folder ``out``; the names there (with the VTK series)."""
+        write_json(Path(out) / "result.json", self.record)
+        return ["result.json", *self.files]
+
+    def batch_record(self) -> dict:
+        """The numbers a batch case keeps: w, theta, F_v, the mesh and the solver's cost."""
+        r = self.record
+        keep = ("w", "w_sum", "theta_deg", "hinge_deg", "F_v_fem_N", "F_v_reduced_N", "contact_force_N")
+        return {**{k: r[k] for k in keep if r.get(k) is not None},
+                "mesh": {"mesh_size_mm": r["mesh_size_mm"], "dofs": r["ndofs"]},
+                "solver": {"newton_iterations": r["newton_iterations"], "factorizations": r["factorizations"],
+                           "wall_time_s": r["wall_seconds"]}}
+
+
+def run_case(case: WeightsCase, *, cache: bool = True, out=None) -> CaseResult:
+    """:func:`weights` as a :class:`CaseResult`; ``out``: a folder for grasp.pvd (computes)."""
+    return CaseResult(case, weights(case, cache=cache, out=out), () if out is None else ("grasp.pvd",))
+
+
 #: keys and types every cached result has
 _SCHEMA = {"w": list, "w_sum": float, "theta_deg": float, "F_v_fem_N": float,
            "diameter_mm": float, "mesh_size_mm": float, "ndofs": int}
@@ -222,6 +257,24 @@ class WeightsResult:
     rows: list        #: one :func:`weights` result per diameter
     check: dict | None  #: diameter, w_interpolated, w_fem, max_abs_difference
 
+    def summary(self) -> dict:
+        """The w(D) table and the interpolation check (``softhand weights --json``)."""
+        return {"rows": self.rows, "check": self.check}
+
+    def write(self, out) -> list[str]:
+        """result.json (:meth:`summary`) and table.csv (the rows) into the folder ``out``."""
+        from softhand.studies.io.files import write_csv
+
+        write_json(Path(out) / "result.json", self.summary())
+        write_csv(Path(out) / "table.csv", self.rows)
+        return ["result.json", "table.csv"]
+
+    def plot(self, path) -> None:
+        """w_i against D (:func:`studies.io.weights_plot.plot_weights`)."""
+        from softhand.studies.io.weights_plot import plot_weights
+
+        plot_weights(path, self)
+
 
 def run(study: WeightsStudy, *, cache: bool = True, progress=None) -> WeightsResult:
     """The FEM at every diameter (cached), then the interpolation check."""
@@ -237,44 +290,3 @@ def run(study: WeightsStudy, *, cache: bool = True, progress=None) -> WeightsRes
         check = {"diameter_mm": study.check_mm, "w_interpolated": w_int.tolist(), "w_fem": fem["w"],
                  "max_abs_difference": float(np.max(np.abs(w_int - np.array(fem["w"]))))}
     return WeightsResult(rows, check)
-
-
-def fig8(case: WeightsCase, pressures_mpa, depth_offsets_mm=(0.0, 10.0, 20.0)) -> list[dict]:
-    """The Fig. 8 analogue for one object: at each depth (default depth + offset) the
-    pressures in turn; each point a FEM contact state with its own w (P, P + dP)."""
-    from softhand.fem.hand.finger import FingerModel
-    from softhand.fem.hand.grasp import GraspModel, weight_vector
-
-    finger = FingerModel(case.design, finger_options(case.mesh_size_mm))
-    base = GraspModel(finger, case.diameter_mm, mass=case.mass_kg).depth
-    rows = []
-    for offset in depth_offsets_mm:
-        model = GraspModel(finger, case.diameter_mm, mass=case.mass_kg, depth=base + offset)
-        state = None
-        for P in sorted(pressures_mpa):
-            state = model.solve(P, start=state)
-            upper = model.solve(P + case.dP_mpa, start=state)
-            w = weight_vector(state, upper)
-            rows.append({"depth_mm": model.depth, "w": w.tolist(),
-                         **state_row(state, w, case.mass_kg, case.design),
-                         "F_v_reduced_paper_w_N": paper_w_F_v(state.P, state.theta, case)})
-    return rows
-
-
-def paper_w_F_v(P: float, theta: float, case: WeightsCase) -> float | None:
-    """Eq. (25) -> (29) with the paper's w for this diameter, normalised (None if it has none)."""
-    w = paper.WEIGHTS.get(float(case.diameter_mm))
-    if w is None:
-        return None
-    return reduced_F_v(P, theta, case.mass_kg, np.array(w) / np.sum(w), case.design)
-
-
-def fig8_errors(rows: list[dict]) -> dict:
-    """RMS and largest |F_v(eq. 25) - F_v_fem| [kgf] over the points of :func:`fig8`, with the
-    FEM's own w at each point and (``paper_w_*``) with the paper's w when it has one."""
-    out = {}
-    for prefix, key in (("", "F_v_reduced_N"), ("paper_w_", "F_v_reduced_paper_w_N")):
-        e = np.array([(r[key] - r["F_v_fem_N"]) / grasp.KGF for r in rows if r.get(key) is not None])
-        out[f"{prefix}rms_error_kgf"] = float(np.sqrt(np.mean(e ** 2))) if e.size else None
-        out[f"{prefix}max_abs_error_kgf"] = float(np.abs(e).max()) if e.size else None
-    return out

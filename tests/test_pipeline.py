@@ -58,7 +58,7 @@ def bent(tmp_path_factory):
 def test_the_whole_hand_is_both_fems_against_eq27(bent):
     result, *_ = bent
     d = HandDesign()
-    h = result.hand
+    h = result.hand.summary()
     for r, row in zip(result.rows, h["rows"]):
         assert row["theta_deg"] == r["theta_deg"]
         assert math.isclose(row["V_mm3"], d.V0 - d.n * r["dQ_mm3"])
@@ -78,7 +78,7 @@ def test_the_result_writes_what_it_computed(bent):
     assert names == ["result.json", "table.csv", "hand.csv"]
     assert seen == [0.0, 0.3]
     saved = json.loads((out / "result.json").read_text())
-    assert saved["hand"]["rows"] == json.loads(json.dumps(result.hand["rows"]))
+    assert saved["hand"]["rows"] == json.loads(json.dumps(result.hand.rows))
     assert [float(r["theta_deg"]) for r in csv.DictReader(open(out / "table.csv"))] == \
         pytest.approx([r["theta_deg"] for r in result.rows], rel=1e-12)
     assert len(list(csv.DictReader(open(out / "hand.csv")))) == 2

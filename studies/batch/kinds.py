@@ -51,17 +51,14 @@ def grasp(params: dict, design: HandDesign, outdir: Path) -> dict:
 
 
 def control(params: dict, design: HandDesign, outdir: Path) -> dict:
-    """The flexibility experiment (Table II) at one setting: angle control, push, pressure control."""
-    from softhand.reduced.control import flexibility, ramp
-    from softhand.reduced.grasp import PAPER_WEIGHTS
+    """The flexibility experiment (Table II) at one setting (:mod:`studies.control`)."""
+    from softhand.studies.control import ControlStudy, run
 
-    push_n, push_at = params.get("push_n", 5.0), params.get("push_at_s", 5.0)
-    result = flexibility(design, math.radians(params.get("theta_ref_deg", 50.0)),
-                         params.get("mass_kg", 2.0),
-                         PAPER_WEIGHTS[params.get("diameter_mm", 180.0)],
-                         ramp(push_n, push_at),
-                         t_end=params.get("t_end_s", 10.0))
-    s = result.angle_summary
+    result = run(ControlStudy(design=design, theta_ref=math.radians(params.get("theta_ref_deg", 50.0)),
+                              mass_kg=params.get("mass_kg", 2.0), diameter_mm=params.get("diameter_mm", 180.0),
+                              push_n=params.get("push_n", 5.0), push_at_s=params.get("push_at_s", 5.0),
+                              t_end_s=params.get("t_end_s", 10.0)))
+    s = result.flex.angle_summary
     out = {"settling_time_s": s.settling_time, "P_before_MPa": s.P_before,
            "P_during_MPa": s.P_during, "theta_during_deg": math.degrees(s.theta_during)}
     out |= {f"F_v_{r['state']}_kgf": r["F_v_estimated_kgf"] for r in result.rows}
@@ -96,15 +93,8 @@ def reservoir(params: dict, design: HandDesign, outdir: Path) -> dict:
 
 
 def weights(params: dict, design: HandDesign, outdir: Path) -> dict:
-    """One grasp by FEM (:func:`studies.weights.weights`): w, theta, F_v by FEM and eq. (25)."""
-    from softhand.studies.weights import WeightsCase, weights as grasp_weights
+    """One grasp by FEM (:func:`studies.weights.run_case`): w, theta, F_v by FEM and eq. (25)."""
+    from softhand.studies.weights import WeightsCase, run_case
 
-    names = {"diameter_mm": "diameter_mm", "mass_kg": "mass_kg", "pressure_mpa": "pressure_mpa",
-             "dP_mpa": "dP_mpa", "mesh_size_mm": "mesh_size_mm"}
-    case = WeightsCase(design=design, **{names[k]: float(v) for k, v in params.items()})
-    r = grasp_weights(case, out=outdir)  # the VTK series; the runner writes result.json
-    keep = ("w", "w_sum", "theta_deg", "hinge_deg", "F_v_fem_N", "F_v_reduced_N", "contact_force_N")
-    return {**{k: r[k] for k in keep if r.get(k) is not None},
-            "mesh": {"mesh_size_mm": r["mesh_size_mm"], "dofs": r["ndofs"]},
-            "solver": {"newton_iterations": r["newton_iterations"], "factorizations": r["factorizations"],
-                       "wall_time_s": r["wall_seconds"]}}
+    case = WeightsCase(design=design, **{k: float(v) for k, v in params.items()})
+    return run_case(case, out=outdir).batch_record()  # the VTK series; the runner writes result.json

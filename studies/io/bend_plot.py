@@ -7,10 +7,10 @@ from softhand.reduced import hand
 from softhand.studies.io.files import figure, save_figure
 
 
-def plot_bending(path, rows: list[dict], design, hand_result: dict | None = None, *,
+def plot_bending(path, rows: list[dict], design, hand_rows: list[dict] | None = None, *,
                  title: str | None = None) -> None:
     """theta vs P: the free finger's FEM points (``rows`` of a bending study) and eq. (28);
-    with ``hand_result`` (:func:`studies.compare.whole_hand`) the whole hand's FEM points
+    with ``hand_rows`` (of :func:`studies.compare.whole_hand`) the whole hand's FEM points
     (finger FEM + reservoir-sheet FEM) and eq. (27)."""
     theta_max = max(max(r["theta_deg"] for r in rows), 1.0)
     theta_deg = np.linspace(0.0, theta_max, 101)
@@ -20,11 +20,11 @@ def plot_bending(path, rows: list[dict], design, hand_result: dict | None = None
             label="eq. (28), no reservoir")
     ax.plot([r["P_MPa"] for r in rows], [r["theta_deg"] for r in rows], "o",
             label="finger FEM (no reservoir)")
-    if hand_result is not None:
+    if hand_rows:
         ax.plot(hand.pressure(theta, design, reservoir=True), theta_deg, "k-",
                 label="eq. (27), with reservoir")
-        ax.plot([r["P_hand_fem_MPa"] for r in hand_result["rows"]],
-                [r["theta_deg"] for r in hand_result["rows"]], "s", mfc="none",
+        ax.plot([r["P_hand_fem_MPa"] for r in hand_rows],
+                [r["theta_deg"] for r in hand_rows], "s", mfc="none",
                 label="finger FEM + reservoir FEM")
     ax.set(xlabel="pump pressure P [MPa]", ylabel="bend angle θ [deg]", title=title)
     ax.legend(fontsize=8)

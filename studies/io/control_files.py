@@ -1,9 +1,64 @@
-"""The control study's time series and Fig. 10: angle control against pressure control."""
+"""The control study's files: the push profile read from CSV, the time series, and Fig. 10.
+
+Disturbance file: CSV, header ``t_s,force_N``, then rows of time [s] (increasing, >= 0) and
+push force [N]; ``#`` lines are comments. Between rows the force is interpolated linearly;
+before the first row it is 0, after the last row it keeps the last value.
+"""
 from __future__ import annotations
+
+import csv
+import math
+from pathlib import Path
 
 import numpy as np
 
+from softhand.reduced.errors import InputError
 from softhand.studies.io.files import save_figure
+
+DISTURBANCE_HEADER = ("t_s", "force_N")
+#: allowed push force [N], of ``--push-N`` and of a disturbance file's rows
+PUSH_LIMITS_N = (-1000.0, 1000.0)
+
+
+def read_disturbance(path: str | Path):
+    """The push profile of a ``t_s,force_N`` CSV file as a function of t [s]; InputError on bad files."""
+    path = Path(path)
+    from softhand.reduced.design import read_input_file
+
+    data = read_input_file(path, "--disturbance", "a CSV file t_s,force_N")
+    try:
+        text = data.decode("utf-8-sig")
+    except UnicodeDecodeError:
+        raise InputError("--disturbance", str(path), "is not a text (CSV) file") from None
+    rows = [(number, cells) for number, cells in enumerate(csv.reader(text.splitlines()), start=1)
+            if cells and "".join(cells).strip() and not cells[0].lstrip().startswith("#")]
+    if not rows or tuple(c.strip() for c in rows[0][1]) != DISTURBANCE_HEADER:
+        raise InputError("--disturbance", str(path), f"must start with the header {','.join(DISTURBANCE_HEADER)}")
+    if len(rows) < 2:
+        raise InputError("--disturbance", str(path), "has no data rows")
+    values = np.array([_row(path, number, cells) for number, cells in rows[1:]])
+    t, force = values[:, 0], values[:, 1]
+    if np.any(t < 0) or np.any(np.diff(t) <= 0):
+        bad = int(np.flatnonzero(np.concatenate([[t[0] < 0], np.diff(t) <= 0]))[0])
+        raise InputError(f"--disturbance {path.name}: line {rows[bad + 1][0]}", float(t[bad]),
+                         "times must be >= 0 and strictly increasing")
+    return lambda x: np.interp(x, t, force, left=0.0, right=force[-1])
+
+
+def _row(path: Path, number: int, cells: list[str]) -> tuple[float, float]:
+    where = f"--disturbance {path.name}: line {number}"
+    if len(cells) != 2:
+        raise InputError(where, ",".join(cells), "must be two numbers: t_s,force_N")
+    try:
+        t, force = float(cells[0]), float(cells[1])
+    except ValueError:
+        raise InputError(where, ",".join(cells), "must be two numbers: t_s,force_N") from None
+    if not (math.isfinite(t) and math.isfinite(force)):
+        raise InputError(where, ",".join(cells), "must be finite numbers")
+    lo, hi = PUSH_LIMITS_N
+    if not (t <= 600 and lo <= force <= hi):
+        raise InputError(where, ",".join(cells), f"t_s must be at most 600 s and force_N in [{lo:g}, {hi:g}]")
+    return t, force
 
 
 def series_rows(sim, every: int) -> list[dict]:

@@ -1,12 +1,9 @@
 """Plots of the grasp FEM studies: w(D) and the Fig. 8 analogue (matplotlib, Agg)."""
 from __future__ import annotations
 
-import math
-
 import numpy as np
 
 from softhand.reduced.grasp import KGF
-from softhand.studies.weights import reduced_F_v
 
 
 def _pyplot():
@@ -38,29 +35,27 @@ def plot_weights(path, result) -> None:
     save_figure(fig, path)
 
 
-def plot_fig8(path, case, rows: list[dict]) -> None:
-    """F_v [kgf] vs theta [deg]: FEM points, eq. (25) lines with each pressure's mean FEM w."""
+def plot_fig8(path, result) -> None:
+    """F_v [kgf] vs theta [deg] of a :class:`studies.fig8.Fig8Result`: FEM points, eq. (25) lines."""
     from softhand.studies.io.files import save_figure
 
     plt = _pyplot()
     fig, ax = plt.subplots(figsize=(6, 4))
-    draw_fig8(ax, case, rows)
+    draw_fig8(ax, result)
+    case = result.case
     ax.set_title(f"D = {case.diameter_mm:g} mm, m = {case.mass_kg:g} kg (cavity pressure)")
     save_figure(fig, path)
 
 
-def draw_fig8(ax, case, rows: list[dict]) -> None:
-    """The Fig. 8 analogue of :func:`studies.weights.fig8`'s ``rows`` on the axes ``ax``."""
-    for k, P in enumerate(sorted({r["P_MPa"] for r in rows})):
-        pts = [r for r in rows if r["P_MPa"] == P]
+def draw_fig8(ax, result) -> None:
+    """The Fig. 8 analogue of a :class:`studies.fig8.Fig8Result` on the axes ``ax``: per
+    pressure the FEM points and eq. (25) with that pressure's mean FEM w."""
+    for k, (P, theta_deg, F_v_kgf) in enumerate(result.model_lines()):
+        pts = [r for r in result.rows if r["P_MPa"] == P]
         color = f"C{k}"
         ax.plot([r["theta_deg"] for r in pts], [r["F_v_fem_N"] / KGF for r in pts], "o",
                 color=color, label=f"FEM {P:g} MPa")
-        w = np.mean([r["w"] for r in pts], axis=0)
-        th = np.linspace(min(r["theta_deg"] for r in pts) - 5, max(r["theta_deg"] for r in pts) + 5, 50)
-        F = [reduced_F_v(P, math.radians(t), case.mass_kg, w, case.design) for t in th]
-        ax.plot(th, [np.nan if f is None else f / KGF for f in F], "-", color=color,
-                label=f"eq. (25) {P:g} MPa")
+        ax.plot(theta_deg, F_v_kgf, "-", color=color, label=f"eq. (25) {P:g} MPa")
     ax.set_xlabel("bend angle theta [deg]")
     ax.set_ylabel("F_v [kgf]")
     ax.grid(alpha=0.3)

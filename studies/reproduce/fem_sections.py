@@ -63,14 +63,13 @@ def fig7_fem(ctx: Context, outdir: Path):
                      on_state=vtk_writer(folder / "finger.pvd", then=lambda model, state: bar.update(1)))
     result.write(folder)
     result.plot(outdir / "fig7_fem.png", title="Fig. 7 with FEM points")
-    rows = [{**r, **h} for r, h in zip(result.rows, result.hand["rows"])]
-    hand_error = [r["P_hand_fem_MPa"] - r["P_hand_eq27_MPa"] for r in rows]
+    rows = [{**r, **h} for r, h in zip(result.rows, result.hand.rows)]
     numbers = {"theta_fem_at_max_P_deg": rows[-1]["theta_deg"],
                "theta_eq28_at_max_P_deg": rows[-1]["theta_reduced_deg"],
                "max_abs_theta_difference_deg": float(np.max(np.abs(
                    [r["theta_deg"] - r["theta_reduced_deg"] for r in rows]))),
-               "max_abs_hand_pressure_difference_MPa": float(np.max(np.abs(hand_error))),
-               "reservoir_offset_fem_MPa": result.hand["offset_fem_MPa"],
+               "max_abs_hand_pressure_difference_MPa": result.hand.max_abs_difference_MPa(),
+               "reservoir_offset_fem_MPa": result.hand.offset_fem_MPa,
                "max_radial_stretch": float(max(r["radial_stretch_max"] for r in rows)),
                "dofs": result.ndofs, "newton_iterations": result.stats.newton_iterations,
                "fem_wall_time_s": result.stats.wall_seconds}
@@ -79,12 +78,12 @@ def fig7_fem(ctx: Context, outdir: Path):
     text = f"""The finger FEM (half model, rigid links on hinges, {result.ndofs} unknowns,
 {'CI mesh 6 mm' if ctx.quick else 'default mesh'}) at {len(rows)} pressures, against eq. (28)
 at the same pressure; the whole hand P = p_finger − p_r(V0 − n ΔQ_FEM) with the
-reservoir-sheet FEM ({result.hand['reservoir_ndofs']} DOFs), against eq. (27) at the FEM angle
+reservoir-sheet FEM ({result.hand.reservoir_ndofs} DOFs), against eq. (27) at the FEM angle
 ([bend/table.csv](bend/table.csv), [bend/hand.csv](bend/hand.csv), VTK series
 [bend/finger.pvd](bend/finger.pvd)). Largest |θ_FEM − θ_eq.(28)| =
 {numbers['max_abs_theta_difference_deg']:.2f}°; largest |P_hand,FEM − P_eq.(27)| =
 {numbers['max_abs_hand_pressure_difference_MPa']:.4f} MPa; reservoir offset p_r(V0) by FEM
-{result.hand['offset_fem_MPa']:.4f} MPa (paper: about {paper.RESERVOIR_OFFSET_MPA} MPa); largest
+{result.hand.offset_fem_MPa:.4f} MPa (paper: about {paper.RESERVOIR_OFFSET_MPA} MPa); largest
 radial stretch {numbers['max_radial_stretch']:.4f} (the model assumes 1).
 
 {md_table(rows, columns)}
@@ -147,12 +146,12 @@ VTK of the deformed sheet (ParaView, `softhand inspect`): {", ".join(f"[{n}](res
 # ---------------------------------------------------------------------- w and Fig. 8 by grasp FEM
 def weights_fem(ctx: Context, outdir: Path):
     """w for the 180 mm / 2 kg and 240 mm / 6 kg objects by grasp FEM, against the paper's."""
-    from softhand.studies.weights import WeightsCase, weights
+    from softhand.studies.weights import WeightsCase, run_case
 
     rows, numbers = [], {}
     for D, mass, _, P, _ in paper.FIG8:
-        r = weights(WeightsCase(design=ctx.design, diameter_mm=D, mass_kg=mass, pressure_mpa=P),
-                    out=outdir / f"D{D:.0f}")
+        r = run_case(WeightsCase(design=ctx.design, diameter_mm=D, mass_kg=mass, pressure_mpa=P),
+                     out=outdir / f"D{D:.0f}").summary()
         w_paper = np.asarray(paper.WEIGHTS[D])
         rows.append({"diameter_mm": D, "mass_kg": mass, "P_MPa": r["P_MPa"],
                      "theta_deg": r["theta_deg"], "w_fem": r["w"],
@@ -176,8 +175,8 @@ are shown normalised (its 180 mm vector sums to 1.40 as printed).
 
 def fig8_fem(ctx: Context, outdir: Path):
     """Fig. 8 analogue with FEM points: F_v by grasp FEM and by eq. (25) at the same (P, θ)."""
-    from softhand.studies.io.weights_plot import draw_fig8
-    from softhand.studies.weights import WeightsCase, fig8, fig8_errors
+    from softhand.studies.fig8 import Fig8Study, run
+    from softhand.studies.weights import WeightsCase
 
     fig, axes = figure(2)
     summary, numbers = [], {}
@@ -185,13 +184,13 @@ def fig8_fem(ctx: Context, outdir: Path):
         chosen = (pressures[0], pressures[-1]) if ctx.quick else pressures
         offsets = (0.0,) if ctx.quick else (0.0, 10.0, 20.0)
         case = WeightsCase(design=ctx.design, diameter_mm=D, mass_kg=mass)
-        rows = fig8(case, chosen, offsets)
-        write_csv(outdir / f"fig8_fem_{D:.0f}mm.csv", rows)
-        errors = fig8_errors(rows)
-        summary.append({"diameter_mm": D, "mass_kg": mass, "points": len(rows), **errors,
+        result = run(Fig8Study(case, chosen, offsets))
+        result.write(outdir)
+        errors = result.errors()
+        summary.append({"diameter_mm": D, "mass_kg": mass, "points": len(result.rows), **errors,
                         "paper_error_vs_measurement_kgf": paper_error})
         numbers |= {f"{k}_{D:.0f}mm": v for k, v in errors.items() if v is not None}
-        draw_fig8(ax, case, rows)
+        result.draw(ax)
         ax.set_title(f"{mass:g} kg, {D:g} mm")
     save_figure(fig, outdir / "fig8_fem.png")
     text = f"""Grasp FEM at the paper's grasp pressures ({'two pressures, one object depth' if ctx.quick
@@ -222,9 +221,9 @@ SECTIONS: list[Section] = [
             ("softhand.studies.reservoir:run", "softhand.studies.io.reservoir_files:write_sheet_vtk"),
             reservoir_fem),
     Section("weights_fem", "w for the 180 mm and 240 mm objects by grasp FEM",
-            ("softhand.studies.weights:weights", "softhand.studies.weights:WeightsCase"), weights_fem),
+            ("softhand.studies.weights:run_case", "softhand.studies.weights:WeightsCase"), weights_fem),
     Section("fig8_fem", "Fig. 8 analogue with grasp-FEM points",
-            ("softhand.studies.weights:fig8", "softhand.studies.weights:fig8_errors"), fig8_fem),
+            ("softhand.studies.fig8:run", "softhand.studies.fig8:Fig8Study"), fig8_fem),
     Section("verify", "FEM verification against closed forms",
             ("softhand.studies.verification.registry:run_case", "softhand.studies.verification.registry:REGISTRY"), verify, in_quick=False),
 ]

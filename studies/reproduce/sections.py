@@ -8,6 +8,7 @@ compare with come from :mod:`reduced.paper`.
 """
 from __future__ import annotations
 
+import functools
 import math
 import warnings
 from pathlib import Path
@@ -192,19 +193,19 @@ which F_v falls to 0 (the finger just stops pressing) at each pressure:
 
 
 # ---------------------------------------------------------------------- Table II and Fig. 10, controller
-PUSH_N, PUSH_AT_S, T_END_S = 5.0, 5.0, 10.0  #: the push of `softhand control` (the paper gives no magnitude)
-
-
+@functools.lru_cache(maxsize=4)
 def _flexibility(ctx: Context):
-    """Angle control to 50 deg holding 2 kg, a push at 5 s; then pressure control (Table II)."""
-    from softhand.reduced.control import flexibility, ramp
-    return flexibility(ctx.design, math.radians(50.0), 2.0, paper.WEIGHTS[180.0],
-                       ramp(PUSH_N, PUSH_AT_S), t_end=T_END_S)
+    """Angle control to 50 deg holding 2 kg, a 5 N push at 5 s; then pressure control (Table II).
+    Both sections take the one simulation of a context."""
+    from softhand.studies.control import ControlStudy, run
+
+    return run(ControlStudy(design=ctx.design))
 
 
 def table2_control(ctx: Context, outdir: Path):
     """Table II by simulation: the three states of the flexibility experiment."""
     result = _flexibility(ctx)
+    study = result.study
     columns = ["state", "P_MPa", "theta_deg", "F_v_estimated_kgf", "F_v_actual_mean_N",
                "paper_P_MPa", "paper_theta_deg", "paper_F_v_kgf"]
     write_csv(outdir / "table2_control.csv", result.rows)
@@ -214,7 +215,7 @@ def table2_control(ctx: Context, outdir: Path):
     verdict = "holds" if F["c_push_angle_control"] < F["b_push_pressure_control"] else "does not hold"
     text = f"""The simulated hand (reduced-model statics, pump and finger lags; the paper's
 design and 180 mm w) holds a 2 kg object under angle control at θ_ref = 50° (eqs. (30),
-(31)); a {PUSH_N:g} N horizontal push ramps up from {PUSH_AT_S:g} s in 0.5 s. Pressure control then holds
+(31)); a {study.push_n:g} N horizontal push ramps up from {study.push_at_s:g} s in {study.push_rise_s:g} s. Pressure control then holds
 the pressure angle control had before the push. Each state's F_v is estimated as the
 paper does, by eq. (25) from the window-mean P and θ; the plant's actual mean pad force is
 next to it ([table2_control.csv](table2_control.csv)).
@@ -231,20 +232,17 @@ F_v(c) = {F['c_push_angle_control']:.3f} kgf, F_v(b) = {F['b_push_pressure_contr
 
 def fig10_control(ctx: Context, outdir: Path):
     """Fig. 10 analogue: finger angles and pressure against time, angle vs pressure control."""
-    from softhand.studies.io.control_files import plot_fig10, series_rows
-
     result = _flexibility(ctx)
-    sim = result.angle
-    plot_fig10(outdir / "fig10_control.png", result, "angle", 50.0)
-    every = max(1, int(round(0.01 / (sim.t[1] - sim.t[0]))))  # the CSV at 100 Hz
-    write_csv(outdir / "fig10_control.csv", series_rows(sim, every))
-    s = result.angle_summary
+    study = result.study
+    result.plot(outdir / "fig10_control.png", "angle")
+    write_csv(outdir / "fig10_control.csv", result.series("angle"))  # at the sensor rate, 100 Hz
+    s = result.flex.angle_summary
     numbers = {"settling_time_s": s.settling_time, "theta_error_deg": math.degrees(s.theta_error),
                "P_before_MPa": s.P_before, "P_during_MPa": s.P_during,
                "theta_before_deg": math.degrees(s.theta_before),
                "theta_during_deg": math.degrees(s.theta_during)}
-    text = f"""Angle control to θ_ref = 50° with a 2 kg object; a {PUSH_N:g} N push from
-{PUSH_AT_S:g} s ([fig10_control.csv](fig10_control.csv), angle control, 100 Hz).
+    text = f"""Angle control to θ_ref = 50° with a 2 kg object; a {study.push_n:g} N push from
+{study.push_at_s:g} s ([fig10_control.csv](fig10_control.csv), angle control, 100 Hz).
 Settling time {s.settling_time:.2f} s (±1°), steady error {math.degrees(s.theta_error):.3f}°;
 pressure {s.P_before:.3f} MPa before and {s.P_during:.3f} MPa during the push; mean angle
 {math.degrees(s.theta_before):.2f}° before and {math.degrees(s.theta_during):.2f}° during it.
@@ -263,7 +261,7 @@ REDUCED_SECTIONS: list[Section] = [
     Section("fig8_reduced", "Fig. 8 analogue: grasping force against bend angle",
             ("softhand.reduced.grasp:angle_at",), fig8_reduced),
     Section("table2_control", "Table II: angle control vs pressure control, simulated",
-            ("softhand.reduced.control:flexibility", "softhand.reduced.control:ramp"), table2_control),
+            ("softhand.studies.control:run", "softhand.studies.control:ControlStudy"), table2_control),
     Section("fig10_control", "Fig. 10 analogue: angle control under a push",
-            ("softhand.reduced.control:flexibility", "softhand.reduced.control:ramp"), fig10_control),
+            ("softhand.studies.control:run", "softhand.studies.control:ControlStudy"), fig10_control),
 ]

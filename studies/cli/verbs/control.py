@@ -5,33 +5,24 @@ at ``--push-at-s``, or a force profile from ``--disturbance FILE``), and pressur
 holding the pressure angle control had just before the push. Prints the summary of the
 ``--mode`` run (settling time, steady error, P and mean angle before/during the push) and
 the grasping force in the three states of Table II next to the paper's numbers. The plant
-and its parameters: reduced/plant.py and docs/control.md.
-
-Disturbance file: CSV, header ``t_s,force_N``, then rows of time [s] (increasing, >= 0) and
-push force [N]; ``#`` lines are comments. Between rows the force is interpolated linearly;
-before the first row it is 0, after the last row it keeps the last value.
+and its parameters: reduced/plant.py and docs/control.md. The study itself is
+:mod:`studies.control`; the disturbance file's format: :mod:`studies.io.control_files`.
 """
 from __future__ import annotations
 
-import csv
 import math
 import sys
-import warnings
 from pathlib import Path
 
-import numpy as np
-
 from softhand.reduced import grasp
-from softhand.reduced.control import Gains, default_gains, flexibility, ramp
 from softhand.reduced.errors import InputError
-from softhand.reduced.plant import HandTables, PlantParams, Push
+from softhand.reduced.plant import PlantParams, Push
 from softhand.studies.cli.args import add_design_option, add_json_option, check_range, design_from_args, \
     print_json, print_table
-from softhand.studies.io.control_files import plot_fig10, series_rows
-from softhand.studies.io.files import kept_if_unwritable, write_csv, write_json
+from softhand.studies.io.control_files import PUSH_LIMITS_N
+from softhand.studies.io.files import kept_if_unwritable
 
 HELP = "simulate angle control (eqs. 30, 31) vs pressure control under a push (Table II, Fig. 10)"
-DISTURBANCE_HEADER = ("t_s", "force_N")
 
 
 def configure(parser) -> None:
@@ -79,47 +70,6 @@ def _plant_options(parser) -> None:
     parser.add_argument("--seed", type=int, default=0, help="of the sensor noise")
 
 
-def read_disturbance(path: str | Path):
-    """The push profile of a ``t_s,force_N`` CSV file as a function of t [s]; InputError on bad files."""
-    path = Path(path)
-    from softhand.reduced.design import read_input_file
-
-    data = read_input_file(path, "--disturbance", "a CSV file t_s,force_N")
-    try:
-        text = data.decode("utf-8-sig")
-    except UnicodeDecodeError:
-        raise InputError("--disturbance", str(path), "is not a text (CSV) file") from None
-    rows = [(number, cells) for number, cells in enumerate(csv.reader(text.splitlines()), start=1)
-            if cells and "".join(cells).strip() and not cells[0].lstrip().startswith("#")]
-    if not rows or tuple(c.strip() for c in rows[0][1]) != DISTURBANCE_HEADER:
-        raise InputError("--disturbance", str(path), f"must start with the header {','.join(DISTURBANCE_HEADER)}")
-    if len(rows) < 2:
-        raise InputError("--disturbance", str(path), "has no data rows")
-    values = np.array([_row(path, number, cells) for number, cells in rows[1:]])
-    t, force = values[:, 0], values[:, 1]
-    if np.any(t < 0) or np.any(np.diff(t) <= 0):
-        bad = int(np.flatnonzero(np.concatenate([[t[0] < 0], np.diff(t) <= 0]))[0])
-        raise InputError(f"--disturbance {path.name}: line {rows[bad + 1][0]}", float(t[bad]),
-                         "times must be >= 0 and strictly increasing")
-    return lambda x: np.interp(x, t, force, left=0.0, right=force[-1])
-
-
-def _row(path: Path, number: int, cells: list[str]) -> tuple[float, float]:
-    where = f"--disturbance {path.name}: line {number}"
-    if len(cells) != 2:
-        raise InputError(where, ",".join(cells), "must be two numbers: t_s,force_N")
-    try:
-        t, force = float(cells[0]), float(cells[1])
-    except ValueError:
-        raise InputError(where, ",".join(cells), "must be two numbers: t_s,force_N") from None
-    if not (math.isfinite(t) and math.isfinite(force)):
-        raise InputError(where, ",".join(cells), "must be finite numbers")
-    lo, hi = LIMITS["--push-N"]
-    if not (t <= 600 and lo <= force <= hi):
-        raise InputError(where, ",".join(cells), f"t_s must be at most 600 s and force_N in [{lo:g}, {hi:g}]")
-    return t, force
-
-
 def _check_inputs(args) -> None:
     checks = [("--theta-ref-deg", args.theta_ref_deg, -30 < args.theta_ref_deg < 120, "in (-30, 120) deg"),
               ("--mass-kg", args.mass_kg, args.mass_kg >= 0, ">= 0"),
@@ -142,7 +92,7 @@ def _check_inputs(args) -> None:
 
 
 #: option -> (lowest, highest) allowed, beyond the checks above
-LIMITS = {"--push-N": (-1000.0, 1000.0), "--push-rise-s": (0.0, 600.0),
+LIMITS = {"--push-N": PUSH_LIMITS_N, "--push-rise-s": (0.0, 600.0),
           "--push-azimuth-deg": (-360.0, 360.0), "--push-elevation-deg": (-90.0, 90.0),
           "--kp": (0.0, 100.0), "--ki": (0.0, 1000.0), "--plant-mu-scale": (0.01, 100.0),
           "--tau-f-s": (1e-3, 100.0), "--tau-m-s": (1e-3, 100.0), "--q-max-mm3-s": (1.0, 1e7),
@@ -150,68 +100,42 @@ LIMITS = {"--push-N": (-1000.0, 1000.0), "--push-rise-s": (0.0, 600.0),
           "--noise-mpa": (0.0, 1.0), "--seed": (0, 2**32 - 1), "--mass-kg": (0.0, 100.0)}
 
 
-def _setup(args):
-    """(design, plant design, plant params, w, push, force profile, gains) from the arguments."""
+def study_from_args(args):
+    """The :class:`studies.control.ControlStudy` the arguments ask for (checked)."""
+    from softhand.studies.control import ControlStudy
+
+    _check_inputs(args)
     design = design_from_args(args)
-    plant_design = design.replace(mu_sf=args.plant_mu_scale * design.mu_sf,
-                                  mu_sr=args.plant_mu_scale * design.mu_sr)
     plant = PlantParams(tau_f=args.tau_f_s, tau_m=args.tau_m_s, q_max=args.q_max_mm3_s,
                         P_max=args.p_max_mpa, sample_hz=args.sample_hz,
                         noise_theta=math.radians(args.noise_deg), noise_P=args.noise_mpa, seed=args.seed)
-    with warnings.catch_warnings():  # the paper's 180 mm w sums to 1.40; reported in the output
-        warnings.simplefilter("ignore", grasp.WeightSumWarning)
-        w = grasp.weights_for_diameter(args.diameter_mm, design)
-    push = Push(math.radians(args.push_azimuth_deg), math.radians(args.push_elevation_deg))
-    force = read_disturbance(args.disturbance) if args.disturbance else \
-        ramp(args.push_N, args.push_at_s, args.push_rise_s)
-    gains = default_gains(HandTables(design, w), plant)
-    if args.kp is not None or args.ki is not None:
-        per_rad = 180.0 / math.pi  # MPa/deg -> MPa/rad
-        gains = Gains(kp=gains.kp if args.kp is None else args.kp * per_rad,
-                      ki=gains.ki if args.ki is None else args.ki * per_rad)
-    gains = Gains(gains.kp, gains.ki, anti_windup=not args.no_anti_windup)
-    return design, plant_design, plant, w, push, force, gains
-
-
-def _summary_dict(s) -> dict:
-    """The summary in edge units; nan (not applicable, e.g. no push) becomes None (JSON null)."""
-    deg = math.degrees
-    return {key: None if isinstance(value, float) and math.isnan(value) else value for key, value in {"mode": s.mode, "settling_time_s": s.settling_time, "theta_error_deg": deg(s.theta_error),
-            "P_error_MPa": s.P_error, "P_before_MPa": s.P_before, "theta_before_deg": deg(s.theta_before),
-            "P_during_MPa": s.P_during, "theta_during_deg": deg(s.theta_during),
-            "fingers_during_deg": [deg(x) for x in s.fingers_during],
-            "push_start_s": s.push_start, "push_end_s": s.push_end}.items()}
+    per_rad = 180.0 / math.pi  # MPa/deg -> MPa/rad
+    return ControlStudy(
+        design=design, theta_ref=math.radians(args.theta_ref_deg), mass_kg=args.mass_kg,
+        diameter_mm=args.diameter_mm, push_n=args.push_N, push_at_s=args.push_at_s,
+        push_rise_s=args.push_rise_s, disturbance=args.disturbance,
+        push=Push(math.radians(args.push_azimuth_deg), math.radians(args.push_elevation_deg)),
+        kp=None if args.kp is None else args.kp * per_rad, ki=None if args.ki is None else args.ki * per_rad,
+        anti_windup=not args.no_anti_windup, plant=plant, plant_mu_scale=args.plant_mu_scale,
+        t_end_s=args.t_end_s)
 
 
 def run(args) -> int:
-    _check_inputs(args)
-    design, plant_design, plant, w, push, force, gains = _setup(args)
-    theta_ref = math.radians(args.theta_ref_deg)
-    result = flexibility(design, theta_ref, args.mass_kg, w, force, push=push, gains=gains, plant=plant,
-                         plant_design=plant_design, t_end=args.t_end_s)
-    chosen, other = (result.angle_summary, result.pressure_summary) if args.mode == "angle" \
-        else (result.pressure_summary, result.angle_summary)
-    report = {"mode": args.mode, "summary": _summary_dict(chosen), "other_mode": _summary_dict(other),
-              "table2": result.rows,
-              "gains": {"kp_MPa_per_deg": math.radians(gains.kp), "ki_MPa_per_deg_s": math.radians(gains.ki),
-                        "anti_windup": gains.anti_windup},
-              "plant": {k: getattr(plant, k) for k in PlantParams.__dataclass_fields__},
-              "push": {"azimuth_deg": args.push_azimuth_deg, "elevation_deg": args.push_elevation_deg,
-                       "source": args.disturbance or f"{args.push_N:g} N at {args.push_at_s:g} s, "
-                                                      f"rise {args.push_rise_s:g} s"},
-              "w": [float(x) for x in w], "design": design.to_dict()}
+    from softhand.studies.control import run as run_study
+
+    study = study_from_args(args)
+    result = run_study(study)
     if args.out:
-        out = Path(args.out)
-        with kept_if_unwritable(out, "control"):
-            write_csv(out / "control_angle.csv", series_rows(result.angle, plant.steps_per_sample))
-            write_csv(out / "control_pressure.csv", series_rows(result.pressure, plant.steps_per_sample))
-            write_json(out / "summary.json", report)
+        with kept_if_unwritable(Path(args.out), "control"):
+            result.write(args.out, args.mode)
     if args.plot:
         with kept_if_unwritable(args.plot, "control"):
-            plot_fig10(args.plot, result, args.mode, args.theta_ref_deg)
-    if result.angle_summary.P_before >= plant.P_max - 1e-3:
-        print(f"softhand control: warning: angle control saturates the pump at P_max = {plant.P_max:g} MPa "
+            result.plot(args.plot, args.mode)
+    P_max = study.plant.P_max
+    if result.flex.angle_summary.P_before >= P_max - 1e-3:
+        print(f"softhand control: warning: angle control saturates the pump at P_max = {P_max:g} MPa "
               f"before the push; theta_ref is not reached", file=sys.stderr)
+    report = result.summary(args.mode)
     if args.json:
         print_json(report)
     else:

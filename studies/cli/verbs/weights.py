@@ -136,17 +136,15 @@ def _run(args) -> int:
 
 
 def _one(case, args) -> dict:
-    from softhand.studies.weights import weights
+    from softhand.studies.weights import run_case
 
     if not args.no_cache:
         print("softhand weights: running the grasp FEM (or reading the cache)...", file=sys.stderr)
-    result = weights(case, cache=not args.no_cache, out=args.out)
+    result = run_case(case, cache=not args.no_cache, out=args.out)
     if args.out:
-        from softhand.studies.io.files import write_json
-
         with kept_if_unwritable(Path(args.out) / "result.json", "weights"):
-            write_json(Path(args.out) / "result.json", result)
-    return result
+            result.write(args.out)
+    return result.summary()
 
 
 def _print_one(result: dict) -> None:
@@ -171,12 +169,10 @@ def _sweep(args, case, diameters) -> int:
     with tqdm(total=len(diameters), desc="weights", unit="D", file=sys.stderr) as bar:
         result = run_study(study, cache=not args.no_cache, progress=lambda row: bar.update())
     if args.plot:
-        from softhand.studies.io.weights_plot import plot_weights
-
         with kept_if_unwritable(args.plot, "weights"):
-            plot_weights(args.plot, result)
+            result.plot(args.plot)
     if args.json:
-        print_json({"rows": result.rows, "check": result.check})
+        print_json(result.summary())
     else:
         print_table(result.rows, COLUMNS, digits=3)
         if result.check:
@@ -185,19 +181,17 @@ def _sweep(args, case, diameters) -> int:
 
 
 def _fig8(args, case, pressures) -> int:
-    from softhand.studies.weights import fig8, fig8_errors
+    from softhand.studies.fig8 import Fig8Study, run as run_fig8
 
-    rows = fig8(case, pressures)
+    result = run_fig8(Fig8Study(case, tuple(float(P) for P in pressures)))
     if args.plot:
-        from softhand.studies.io.weights_plot import plot_fig8
-
         with kept_if_unwritable(args.plot, "weights"):
-            plot_fig8(args.plot, case, rows)
-    summary = fig8_errors(rows)
+            result.plot(args.plot)
+    summary = result.summary()
     if args.json:
-        print_json({"rows": rows, **summary})
+        print_json(summary)
     else:
-        print_table(rows, ["depth_mm", "P_MPa", "theta_deg", "F_v_fem_N", "F_v_reduced_N",
+        print_table(result.rows, ["depth_mm", "P_MPa", "theta_deg", "F_v_fem_N", "F_v_reduced_N",
                            "F_v_error_kgf", "w"], digits=3)
         for prefix, what in (("", "the FEM's w"), ("paper_w_", "the paper's w, normalised")):
             if summary[f"{prefix}rms_error_kgf"] is not None:
