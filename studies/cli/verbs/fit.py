@@ -12,7 +12,6 @@ the calibrated design as a TOML file that every verb reads with ``--design``.
 from __future__ import annotations
 
 import sys
-import warnings
 
 from softhand.studies.cli.args import add_design_option, add_json_option, design_from_args, parse_values, print_json
 
@@ -48,40 +47,30 @@ def configure(parser) -> None:
 
 def run(args) -> int:
     from softhand.reduced.csvdata import read_measurements
-    from softhand.reduced.fit import check_params, fit, make_predictor
+    from softhand.reduced.fit import check_params
+    from softhand.studies.fit import FitStudy, run as run_study
+    from softhand.studies.io.files import kept_if_unwritable
 
     design = design_from_args(args)
     data = read_measurements(args.data)
     keys = check_params(args.params, len(data))
     design = _start_from_shore_a(design, keys, args.shore_a)
-
-    def predictor_for(points):
-        return make_predictor(points, args.model, reservoir=not args.no_reservoir,
-                              weights=weights, normalise=args.normalise, design=design)
-
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always")
-        weights = _weights(args, design)
-        predictor = predictor_for(data)
-        result = fit(data, keys, predictor, design, bounds=_parse_bounds(args.bounds))
-    notes = [str(w.message) for w in caught] + list(result.warnings)
+    w = _weights(args, design)
+    study = FitStudy(data, keys, design, model=args.model, reservoir=not args.no_reservoir,
+                     weights=None if w is None else tuple(float(x) for x in w), normalise=args.normalise,
+                     bounds=_parse_bounds(args.bounds), data_name=args.data)
+    result = run_study(study)
     if args.out:
-        from softhand.studies.io.files import kept_if_unwritable, write_atomic
-
         with kept_if_unwritable(args.out, "fit"):
-            write_atomic(args.out, _design_toml(result, data, args))
+            result.write(args.out)
     if args.plot:
-        from softhand.studies.io.fit_plot import plot_fit
-        from softhand.studies.io.files import kept_if_unwritable
-
         with kept_if_unwritable(args.plot, "fit"):
-            plot_fit(result, data, predictor_for, args.plot)
+            result.plot(args.plot)
     if args.json:
-        print_json({**result.to_dict(), "data": args.data, "model": args.model,
-                    "reservoir": not args.no_reservoir, "notes": notes})
+        print_json(result.summary())
     else:
-        _print_report(result, data, args)
-    for note in notes:
+        _print_report(result.fit, data, args)
+    for note in result.notes:
         print(f"softhand fit: warning: {note}", file=sys.stderr)
     return 0
 
@@ -146,15 +135,6 @@ def _parse_bounds(text):
                              f"bounds [{limits[0]:g}, {limits[1]:g}]")
         bounds[key.strip()] = (lo, hi)
     return bounds
-
-
-def _design_toml(result, data, args) -> str:
-    fitted = ", ".join(f"{k} = {v:.6g} +- {se:.2g}"
-                       for k, v, se in zip(result.params, result.values, result.stderr))
-    head = (f"# calibrated by softhand fit from {args.data} ({len(data)} points, model "
-            f"{args.model}{', no reservoir' if args.no_reservoir else ''})\n"
-            f"# fitted: {fitted}; RMSE {result.rmse:.4g} {data.unit}\n")
-    return head + result.design.to_toml()
 
 
 def _print_report(result, data, args) -> None:
