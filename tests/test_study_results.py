@@ -196,3 +196,16 @@ def test_weights_fig8_verb_prints_the_results_summary(monkeypatch, tmp_path):
     assert printed == json.loads(json.dumps(_fig8_result().summary()))
     assert seen[0].pressures_mpa == (0.9, 0.6) and seen[0].case.diameter_mm == 180.0
     assert (tmp_path / "fig8.png").stat().st_size > 10_000
+
+
+# ---------------------------------------------------------------- grasp forces at one state
+def test_grasp_kind_keeps_the_verbs_forces(tmp_path):
+    from softhand.studies.batch.kinds import grasp as grasp_kind
+
+    printed = verb_json(["grasp", "--pressure-mpa", "1.2", "--theta-deg", "40", "--mass-kg", "2",
+                         "--weights", "0.1,0.2,0.2,0.25,0.25"])
+    record = grasp_kind({"pressure_mpa": 1.2, "theta_deg": 40.0, "mass_kg": 2.0,
+                         "weights": [0.1, 0.2, 0.2, 0.25, 0.25]}, HandDesign(), tmp_path)
+    assert record == {k: printed[k] for k in ("F_x_N", "F_y_N", "F_v_N", "F_v_kgf", "w")}
+    # F_v in kgf is F_v in N over g (kgf = 9.80665 N)
+    assert record["F_v_kgf"] == pytest.approx(record["F_v_N"] / 9.80665, rel=1e-12)

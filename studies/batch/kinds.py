@@ -35,19 +35,19 @@ def curve(params: dict, design: HandDesign, outdir: Path) -> dict:
 
 
 def grasp(params: dict, design: HandDesign, outdir: Path) -> dict:
-    """Eqs. (24), (25), (29) at one state: F_x, F_y, F_v for (P, theta, m) and w.
+    """Eqs. (24), (25), (29) at one state (:func:`studies.grasp.state`): F_x, F_y, F_v for (P, theta, m) and w.
 
     ``weights`` (n_s numbers) or ``diameter_mm`` (the paper's presets, 180 or 240).
     """
-    from softhand.reduced.grasp import KGF, check_weights, grasp_forces, weights_for_diameter
+    from softhand.reduced.grasp import check_weights, weights_for_diameter
+    from softhand.studies.grasp import state
 
     if "weights" in params:
         w = check_weights(params["weights"], design)
     else:
         w = weights_for_diameter(params.get("diameter_mm", 180.0), design)
-    F = grasp_forces(params["pressure_mpa"], math.radians(params["theta_deg"]),
-                     params.get("mass_kg", 0.0), w, design)
-    return {"F_x_N": F.F_x, "F_y_N": F.F_y, "F_v_N": F.F_v, "F_v_kgf": F.F_v / KGF, "w": w}
+    s = state(params["pressure_mpa"], params["theta_deg"], params.get("mass_kg", 0.0), w, design)
+    return {k: s[k] for k in ("F_x_N", "F_y_N", "F_v_N", "F_v_kgf", "w")}
 
 
 def control(params: dict, design: HandDesign, outdir: Path) -> dict:

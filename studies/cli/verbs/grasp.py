@@ -10,20 +10,21 @@ docs/conventions.md (F_v > 0: the finger squeezes).
 ``--model fem`` (with ``--diameter-mm D``) replaces eq. (25) by the FEM-informed estimate of
 :mod:`reduced.grasp_fem`: the calibrated finger in equilibrium hinge by hinge against the
 object, touching where the geometry says; P is converted to the cavity pressure with the
-reservoir at theta, and the object's depth is the one that gives theta.
+reservoir at theta, and the object's depth is the one that gives theta. Both are computed
+by :mod:`studies.grasp`; this verb reads the options and prints.
 """
 from __future__ import annotations
 
-import math
 import sys
 import warnings
 
 import numpy as np
 
-from softhand.reduced import grasp, hand
+from softhand.reduced import grasp
 from softhand.reduced.errors import InputError
 from softhand.studies.cli.args import add_design_option, add_json_option, design_from_args, parse_values, \
     print_json
+from softhand.studies.grasp import state, state_fem
 
 #: the paper's weight vectors by name (--weights paper180)
 PAPER_NAMES = {f"paper{D:g}": D for D in grasp.PAPER_WEIGHTS}
@@ -93,33 +94,6 @@ def _weights(args, design, mass: float) -> tuple[np.ndarray, str, list[str]]:
     return w, source, [str(warning.message) for warning in caught]
 
 
-def evaluate(P: float, theta_deg: float, mass: float, w, design) -> dict:
-    """One grasp state -> the flat result (forces in N and kgf, the w used, the free pressure)."""
-    theta = math.radians(theta_deg)
-    F = grasp.grasp_forces(P, theta, mass, w, design)
-    return {"P_MPa": P, "theta_deg": theta_deg, "mass_kg": mass,
-            "F_x_N": float(F.F_x), "F_y_N": float(F.F_y), "F_v_N": float(F.F_v),
-            "F_v_kgf": float(F.F_v) / grasp.KGF,
-            "w": [float(x) for x in w], "w_sum": float(np.sum(w)),
-            "P_free_MPa": float(hand.pressure(theta, design))}
-
-
-def evaluate_fem(P: float, theta_deg: float, mass: float, diameter: float, design) -> dict:
-    """One grasp state by the FEM-informed model at pump pressure P [MPa] -> the flat result."""
-    from softhand.reduced import grasp_fem
-
-    theta = math.radians(theta_deg)
-    fem = grasp_fem.fem_finger(design)
-    P_cavity = P + float(hand.pressure(theta, fem, reservoir=False) - hand.pressure(theta, fem))
-    s = grasp_fem.grasp_state_at_angle(design, diameter, P_cavity, theta, mass)
-    return {"P_MPa": P, "theta_deg": theta_deg, "mass_kg": mass,
-            "F_x_N": float(s.F[0]), "F_y_N": float(s.F[1]), "F_v_N": s.F_v, "F_v_kgf": s.F_v / grasp.KGF,
-            "model": "fem", "diameter_mm": diameter, "P_cavity_MPa": P_cavity,
-            "contact_link": s.link, "contact_force_N": s.N, "contact_point_mm": s.point.tolist() if s.link >= 0 else None,
-            "depth_mm": s.depth, "hinge_deg": np.degrees(s.q).tolist(),
-            "P_free_MPa": float(hand.pressure(theta, fem))}
-
-
 def _model(args) -> str:
     model = args.model.strip()
     if model not in MODELS:
@@ -137,7 +111,7 @@ def run(args) -> int:
     mass = _scalar(args.mass_kg, "--mass-kg")
     if _model(args) == "fem":
         diameter = _scalar(args.diameter_mm, "--diameter-mm")
-        return _print(args, evaluate_fem(P, theta_deg, mass, diameter, design))
+        return _print(args, state_fem(P, theta_deg, mass, diameter, design))
     if args.weights is not None and args.weights.strip() not in PAPER_NAMES:
         try:
             with warnings.catch_warnings():
@@ -146,7 +120,7 @@ def run(args) -> int:
         except InputError as exc:
             raise exc.renamed("--weights") from None
     w, source, notes = _weights(args, design, mass)
-    result = evaluate(P, theta_deg, mass, w, design) | {"model": "paper", "w_source": source}
+    result = state(P, theta_deg, mass, w, design) | {"model": "paper", "w_source": source}
     for note in notes:  # only once the inputs are known to be good
         print(f"softhand grasp: warning: {note}", file=sys.stderr)
     return _print(args, result)

@@ -1,0 +1,42 @@
+"""Grasping forces at one state of the hand: eqs. (24), (25), (29), or the FEM-informed model.
+
+:func:`state` -- pump pressure, bend angle, mass and a weight vector w -> F_x (25), F_y (24),
+F_v (29) in N and kgf, with the free finger's pressure at that angle; :func:`state_fem` -- the
+same state by the calibrated finger in equilibrium against the object (:mod:`reduced.grasp_fem`).
+``softhand grasp`` and the batch kind ``grasp`` only choose the inputs. Axes and signs:
+docs/conventions.md (F_v > 0: the finger squeezes).
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from softhand.reduced import grasp, hand
+
+
+def state(P: float, theta_deg: float, mass: float, w, design) -> dict:
+    """One grasp state -> the flat result (forces in N and kgf, the w used, the free pressure)."""
+    theta = math.radians(theta_deg)
+    F = grasp.grasp_forces(P, theta, mass, w, design)
+    return {"P_MPa": P, "theta_deg": theta_deg, "mass_kg": mass,
+            "F_x_N": float(F.F_x), "F_y_N": float(F.F_y), "F_v_N": float(F.F_v),
+            "F_v_kgf": float(F.F_v) / grasp.KGF,
+            "w": [float(x) for x in w], "w_sum": float(np.sum(w)),
+            "P_free_MPa": float(hand.pressure(theta, design))}
+
+
+def state_fem(P: float, theta_deg: float, mass: float, diameter: float, design) -> dict:
+    """One grasp state by the FEM-informed model at pump pressure P [MPa] -> the flat result."""
+    from softhand.reduced import grasp_fem
+
+    theta = math.radians(theta_deg)
+    fem = grasp_fem.fem_finger(design)
+    P_cavity = P + float(hand.pressure(theta, fem, reservoir=False) - hand.pressure(theta, fem))
+    s = grasp_fem.grasp_state_at_angle(design, diameter, P_cavity, theta, mass)
+    return {"P_MPa": P, "theta_deg": theta_deg, "mass_kg": mass,
+            "F_x_N": float(s.F[0]), "F_y_N": float(s.F[1]), "F_v_N": s.F_v, "F_v_kgf": s.F_v / grasp.KGF,
+            "model": "fem", "diameter_mm": diameter, "P_cavity_MPa": P_cavity,
+            "contact_link": s.link, "contact_force_N": s.N, "contact_point_mm": s.point.tolist() if s.link >= 0 else None,
+            "depth_mm": s.depth, "hinge_deg": np.degrees(s.q).tolist(),
+            "P_free_MPa": float(hand.pressure(theta, fem))}
