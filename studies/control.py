@@ -16,7 +16,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from softhand.reduced import grasp
-from softhand.reduced.control import FlexibilityResult, Gains, default_gains, flexibility, ramp
+from softhand.reduced.control import FlexibilityResult, flexibility, ramp
+from softhand.reduced.controllers import Gains, default_gains
 from softhand.reduced.design import HandDesign
 from softhand.reduced.plant import HandTables, PlantParams, Push
 
