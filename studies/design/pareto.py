@@ -54,7 +54,7 @@ def front(task: Task, optimum: design_opt.Optimum, options: design_opt.Optimiser
 
 def _row(task: Task, x, ev: design_opt.Evaluation) -> dict:
     return {"stretch_limit": task.max_stretch, "max_principal_stretch": ev.rubber_stretch,
-            "P_grasp_MPa": ev.P_grasp, "margin_N": ev.F_v_at_limit - ev.F_v,
+            "P_grasp_MPa": ev.P_grasp, "margin_N": ev.predicted()["margin_N"],
             "objective": design_opt.objective(ev, task),
             "free": {k: float(v) for (k, _, _), v in zip(task.free, x)}}
 

@@ -1,0 +1,258 @@
+r"""A design judged on the reduced model for a task: grasp angle, pressures, forces, constraints.
+
+For a design the task's object is placed as in the grasp FEM (:func:`reduced.contact.object_depth`),
+the finger closes with equal hinge angles until a pad touches (the **grasp angle** theta_g,
+:func:`reduced.contact.contact_angle`), and the virtual displacement w is the rolling motion
+that keeps that pad on the object (:func:`reduced.contact.rolling_weights`). Then
+:func:`grasp_relation`, the one place where a design's F_v is computed, gives
+
+* ``P_grasp``: the pump pressure at which each finger presses with the required F_v;
+* ``P_contact``: the free hand's pump pressure at theta_g (eq. (27)), where the fingers touch;
+* ``F_v`` at the pump limit, and the margin over the requirement;
+
+for ``finger_model = "fem"`` by the FEM-informed grasp (:mod:`reduced.grasp_hold`: the
+calibrated finger in equilibrium hinge by hinge against the object, the reservoir's pressure
+at the oil taken), for the paper's finger model by eqs. (25), (29) at theta_g with the
+rolling w. The tube's peak principal stretch is eq. (8), 1 + (d + a + b) theta / l0 (the outer
+fibre on the far side of the hinge plate), at the bend that holds the object.
+
+Constraints (each ``(name, value, limit, sense)``, normalised slack >= 0 when met): the tube
+fits its links (a + b < d), walls (b >= min wall, t > 0), the reservoir keeps oil at the grasp
+and sits below the first pressure maximum of its model p_r(V) (limit point), peak stretch,
+pump pressure, the open hand passes the object, and the finger model's calibrated range
+when it has one. The whole model's P(theta) and theta(P) are those of
+``design.finger_model``/``design.reservoir_model`` through :mod:`reduced.hand`, so another
+finger model changes the answer by a design key alone.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from functools import lru_cache
+from typing import NamedTuple
+
+import numpy as np
+
+from softhand.reduced import contact, finger, grasp, grasp_hold, hand, reservoir
+from softhand.reduced.design import HandDesign, design_from_dict
+from softhand.reduced.errors import InputError
+from softhand.studies.design.task import Task
+
+
+@dataclass(frozen=True)
+class Constraint:
+    name: str
+    value: float
+    limit: float
+    sense: str  #: "<=" or ">="
+    scale: float | None = None  #: of the normalised slack; None: |limit|
+
+    @property
+    def slack(self) -> float:
+        """Normalised distance to the limit, >= 0 when met."""
+        if not math.isfinite(self.value):
+            return -1e3
+        if not math.isfinite(self.limit):  # no limit (e.g. no limit point): met, by far
+            return 1e3
+        gap = self.limit - self.value if self.sense == "<=" else self.value - self.limit
+        scale = self.scale if self.scale is not None else abs(self.limit)
+        return min(gap / max(scale, 1e-9), 1e3)
+
+    @property
+    def satisfied(self) -> bool:
+        return self.slack >= -1e-9
+
+    def as_dict(self) -> dict:
+        return {"name": self.name, "value": self.value, "limit": self.limit, "sense": self.sense,
+                "satisfied": self.satisfied}
+
+
+@dataclass(frozen=True)
+class Evaluation:
+    """The reduced model's answer for one design (mm, N, MPa, rad)."""
+
+    design: HandDesign
+    depth: float               #: object centre below the palm [mm]
+    theta_grasp: float         #: grasp angle theta_g [rad]
+    link: int                  #: the pad that touches (0 = base link)
+    w: np.ndarray              #: rolling weight vector at theta_g
+    P_grasp: float             #: pump pressure holding the object with the required F_v [MPa]
+    P_contact: float           #: free hand's pump pressure at theta_g (27) [MPa]
+    F_v: float                 #: required normal force per finger [N]
+    F_v_at_limit: float        #: F_v at the pump limit [N]
+    stretch: float             #: the tube's peak principal stretch, eq. (8), at theta_hold
+    sheet_stretch: float       #: the reservoir sheet's stretch at V0, eq. (16)
+    constraints: tuple[Constraint, ...]
+    theta_hold: float = math.nan  #: the finger's bend when it presses with the required F_v [rad]
+
+    @property
+    def rubber_stretch(self) -> float:
+        """The larger of the tube's and the sheet's stretch (the Pareto front's axis)."""
+        return max(self.stretch, self.sheet_stretch)
+
+    @property
+    def feasible(self) -> bool:
+        return all(c.satisfied for c in self.constraints)
+
+    def predicted(self) -> dict:
+        return {"P_grasp_MPa": self.P_grasp, "P_contact_MPa": self.P_contact,
+                "theta_grasp_deg": math.degrees(self.theta_hold), "F_v_N": self.F_v,
+                "theta_contact_deg": math.degrees(self.theta_grasp),
+                "F_v_at_pump_limit_N": _number(self.F_v_at_limit),
+                "margin_N": _number(self.F_v_at_limit - self.F_v),
+                "w": self.w.tolist(), "touching_link": self.link, "depth_mm": self.depth,
+                "max_principal_stretch": self.stretch, "sheet_stretch": self.sheet_stretch,
+                **self.contact_parts()}
+
+    def contact_parts(self) -> dict:
+        """P_contact's two parts: the finger's pressure (28) and the reservoir's p_r at theta_g [MPa]."""
+        try:
+            P_finger = float(hand.pressure(self.theta_grasp, self.design, reservoir=False))
+        except InputError:
+            return {}
+        return {"P_finger_at_contact_MPa": P_finger,
+                "reservoir_pressure_at_contact_MPa": P_finger - self.P_contact}
+
+
+def _number(x: float) -> float | None:
+    """x, or None where it was not computed (nan)."""
+    return None if math.isnan(x) else x
+
+
+def design_at(task: Task, x) -> HandDesign:
+    """The base design with the free keys set to x (public units); l0 scales the hinges."""
+    base, values = task.base, {}
+    for (key, _, _), v in zip(task.free, np.asarray(x, dtype=float)):
+        values[key] = float(v)
+        if key == "l0_mm":
+            values["hinge_s_mm"] = [s * float(v) / base.l0 for s in base.hinge_s]
+    return design_from_dict(values, base, source="free")
+
+
+#: tube lengths on which the kinematics are tabulated while the optimiser varies l0 [mm]
+L0_STEP = 0.5
+
+
+def grasp_geometry(design: HandDesign, task: Task, *, exact: bool = True) -> contact.Geometry:
+    """The task's kinematics for this design (cached). ``exact=False``: linear in l0 between
+    the neighbours on the L0_STEP grid (hinges scaled with l0; w and the link of the nearer)."""
+    if exact:
+        return contact.grasp_geometry(task.diameter, task.opening_mm, design)
+    lo = math.floor(design.l0 / L0_STEP) * L0_STEP
+    t = (design.l0 - lo) / L0_STEP
+    ends = [contact.grasp_geometry(task.diameter, task.opening_mm, design.replace(
+        l0=l0, hinge_s=tuple(s * l0 / design.l0 for s in design.hinge_s))) for l0 in (lo, lo + L0_STEP)]
+    near = ends[int(t >= 0.5)]
+    lerp = lambda i: (1 - t) * ends[0][i] + t * ends[1][i]  # noqa: E731
+    return contact.Geometry(lerp(0), lerp(1), near.link, near.w, lerp(4))
+
+
+def peak_stretch(theta, design: HandDesign) -> float:
+    """Eq. (8) at the tube's outer fibre (r = b, phi = pi/2): 1 + (d + a + b) theta / l0."""
+    return 1.0 + (design.d + design.a + design.b) * theta / design.l0
+
+
+@lru_cache(maxsize=4096)
+def limit_point_volume(design: HandDesign) -> float:
+    """Oil volume [mm^3] of the first pressure maximum of p_r(V) up to 4 V0 (inf: none)."""
+    V = np.linspace(0.01, 4.0, 201) * design.V0
+    p = reservoir.pressure(V, design)
+    falls = np.flatnonzero(np.diff(p) <= 0.0)
+    return float(V[falls[0]]) if falls.size else math.inf
+
+
+def evaluate(design: HandDesign, task: Task, *, exact: bool = True) -> Evaluation:
+    """Grasp angle, pressures, forces, stretch and every constraint of ``design`` for ``task``
+    (``exact=False``: the kinematics interpolated in l0, see :func:`grasp_geometry`)."""
+    depth, theta, link, w, theta_open = grasp_geometry(design, task, exact=exact)
+    F_req = task.required_F_v()
+    try:
+        P_grasp, P_contact, P_open, F_lim, theta_hold = grasp_relation(design, task, theta, w, theta_open)
+    except InputError:  # e.g. V0 too small for the oil, a design outside the calibrated range
+        P_grasp, P_contact, P_open, F_lim, theta_hold = math.inf, math.inf, -math.inf, -math.inf, theta
+    theta_hold = max(theta, theta_hold)
+    try:  # the oil of the design's finger model; outside its calibrated range: none (see below)
+        oil = design.n * float(finger.oil_taken(theta_hold, design))
+    except InputError:
+        oil = math.inf
+    stretch = peak_stretch(theta_hold, design)
+    sheet = float(reservoir.stretch(design.V0, design))
+    cons = [
+        Constraint("tube_fits_links (a + b < d) [mm]", design.a + design.b, design.d, "<="),
+        Constraint("tube_wall b [mm]", design.b, task.min_wall, ">="),
+        Constraint("sheet_thickness t [mm]", design.t, 0.0, ">=", 1.0),
+        Constraint("reservoir_oil the fingers take at the grasp [mm^3]", oil, design.V0, "<="),
+        Constraint("reservoir_below_limit_point V0 [mm^3]", design.V0, limit_point_volume(design), "<="),
+        Constraint("max_principal_stretch", stretch, task.max_stretch, "<="),
+        Constraint("sheet_stretch at V0, eq. (16)", sheet, task.max_stretch, "<="),
+        Constraint("pump_pressure at the grasp [MPa]", P_grasp, task.max_pressure, "<="),
+        *([] if math.isnan(F_lim) else [Constraint("F_v at the pump limit [N]", F_lim, F_req, ">=")]),
+        Constraint("opening: P(theta_open), the free hand's pump pressure where the tips "
+                   f"span {task.opening_mm:g} mm [MPa]", P_open, 0.0, ">=", task.max_pressure),
+        *calibrated_range(design),
+    ]
+    return Evaluation(design, depth, theta, link, w, P_grasp, P_contact, F_req, F_lim, stretch, sheet,
+                      tuple(cons), theta_hold)
+
+
+class GraspRelation(NamedTuple):
+    P_grasp: float     #: pump pressure at which each finger presses with the required F_v [MPa]
+    P_contact: float   #: free hand's pump pressure at the grasp angle (27) [MPa]
+    P_open: float      #: free hand's pump pressure where the tips span the opening [MPa]; -inf: never
+    F_at_limit: float  #: F_v at the pump limit [N]; nan: not asked (see grasp_relation)
+    theta_hold: float  #: the finger's bend when it presses with the required F_v [rad]
+
+
+def grasp_relation(design: HandDesign, task: Task, theta: float, w, theta_open: float) -> GraspRelation:
+    """The design's pump pressure <-> normal force F_v at the grasp angle theta [rad]: for
+    ``finger_model = "fem"`` the FEM-informed grasp (:mod:`reduced.grasp_hold`), else eqs. (25),
+    (29) with the rolling w. The one place where the design's F_v is computed."""
+    if design.finger_model == "fem":
+        return _fem_relation(design, task, theta, theta_open)
+    F_req = task.required_F_v()
+    # eq. (25) is linear in F_v: one call for F_v = 0, 1 N, F_req and the free hand (27)
+    P0, P1, P_grasp, P_contact, P_open = (float(p) for p in grasp.pressure_to_hold(
+        np.array([task.mass, task.mass, task.mass, 0.0, 0.0]),
+        np.array([theta] * 4 + [theta_open if math.isfinite(theta_open) else 0.0]), w, design,
+        F_v=np.array([0.0, 1.0, F_req, 0.0, 0.0])))
+    F_lim = (task.max_pressure - P0) / (P1 - P0)  # [N]: F_v at P0 is 0, at P1 1 N
+    return GraspRelation(P_grasp, P_contact, P_open if math.isfinite(theta_open) else -math.inf, F_lim,
+                         theta)
+
+
+def _fem_relation(design: HandDesign, task: Task, theta: float, theta_open: float) -> GraspRelation:
+    """The FEM-informed grasp: P_grasp from the equilibrium with F_v = F_req; F_v at the pump
+    limit only for the "margin" objective (for "pressure" the pump-pressure constraint on
+    P_grasp is the same condition, F_v growing with the pump pressure: nan)."""
+    P_contact = float(hand.pressure(theta, design))
+    P_open = float(hand.pressure(theta_open, design)) if math.isfinite(theta_open) else -math.inf
+    held = grasp_hold.hold(design, task.diameter, task.mass, "F_v", task.required_F_v())
+    F_lim = math.nan
+    if task.objective == "margin":
+        F_lim = 0.0 if task.max_pressure <= P_contact else \
+            grasp_hold.hold(design, task.diameter, task.mass, "P_pump", task.max_pressure).F_v
+    return GraspRelation(held.P_pump, P_contact, P_open, F_lim, held.theta)
+
+
+def calibrated_range(design: HandDesign) -> list[Constraint]:
+    """The FEM-calibrated finger model's space (its table's group ranges) as constraints;
+    none for the paper's model."""
+    if getattr(design, "finger_model", "paper") == "paper":
+        return []
+    from softhand.reduced import finger_fem
+
+    table = _finger_table(design.finger_table or str(finger_fem.TABLE_FILE))
+    groups = finger_fem.groups_of(design)
+    out = []
+    for g in finger_fem.GROUPS:
+        lo, hi = table.ranges[g]
+        label = f"calibrated range of {finger_fem.LABELS[g]}"
+        out += [Constraint(label, groups[g], lo, ">="), Constraint(label, groups[g], hi, "<=")]
+    return out
+
+
+@lru_cache(maxsize=4)
+def _finger_table(path: str):
+    from softhand.reduced import finger_fem
+
+    return finger_fem.read_table(path)

@@ -1,0 +1,77 @@
+"""softhand.reduced.grasp_hold: the one-solve grasp (F_v or pump pressure given) against the
+bracketing root finder on grasp_fem.grasp_state, and the state it finds is grasp_state's."""
+import math
+
+import numpy as np
+import pytest
+
+from softhand.reduced import grasp_fem, grasp_hold, hand
+from softhand.reduced.design import HandDesign
+
+PAPER = grasp_fem.fem_finger(HandDesign(reservoir_model="fem"))
+#: (design, diameter, mass, F_v [N], pump pressure [MPa]): pad 2 (the paper's task), pad 3 after a
+#: long close (small object, long finger, short lever), the tip link (large object, thick wall);
+#: the task's 2 m g / n and a pump pressure near it, where one pad touches
+CASES = [
+    (PAPER, 180.0, 2.0, 9.80665, 0.6),
+    (PAPER.replace(a=4.5, b=4.5, d=12.0, V0=16226.0, l0=185.7,
+                   hinge_s=tuple(s * 185.7 / PAPER.l0 for s in PAPER.hinge_s)), 140.0, 0.5, 2.4516625, 1.39),
+    (PAPER.replace(a=4.5, b=5.69, d=18.0, R=29.3, V0=30000.0), 240.0, 3.0, 14.709975, 1.0),
+]
+
+@pytest.mark.parametrize("design, diameter, mass, F_v, P_pump", CASES)
+@pytest.mark.parametrize("target", ["F_v", "P_pump"])
+def test_fast_path_equals_the_slow_path(design, diameter, mass, F_v, P_pump, target):
+    value = F_v if target == "F_v" else P_pump
+    fast = grasp_hold.fast_hold(design, diameter, mass, target, value)
+    slow = grasp_hold.slow_hold(design, diameter, mass, target, value)
+    assert fast is not None and fast.fast and not slow.fast
+    assert fast.link == slow.link
+    # both solve the same equations: Newton to 1e-13 of the unknowns, brentq to 1e-13 MPa
+    for a, b in zip(fast[:4], slow[:4]):
+        assert a == pytest.approx(b, rel=1e-10, abs=1e-12)
+
+
+@pytest.mark.parametrize("design, diameter, mass, F_v, P_pump", CASES)
+def test_the_fast_state_is_grasp_states_at_its_pressure(design, diameter, mass, F_v, P_pump):
+    h = grasp_hold.fast_hold(design, diameter, mass, "F_v", 0.8 * F_v)
+    s = grasp_fem.grasp_state(design, diameter, h.P_cavity, mass)
+    assert s.link == h.link
+    assert s.F_v == pytest.approx(0.8 * F_v, rel=1e-9)
+    assert s.theta == pytest.approx(h.theta, rel=1e-9)
+    # the pump pressure: the cavity's less the reservoir's at the bend (eq. (27) less eq. (28))
+    p_r = float(hand.pressure(h.theta, design, reservoir=False) - hand.pressure(h.theta, design))
+    assert h.P_pump == pytest.approx(h.P_cavity - p_r, rel=1e-12)
+
+
+def test_pump_pressure_and_force_are_inverse():
+    """F_v at the pump pressure that holds F_v is that F_v; without reservoir P_pump = P_cavity."""
+    held = grasp_hold.hold(PAPER, 180.0, 2.0, "F_v", 7.5)
+    back = grasp_hold.hold(PAPER, 180.0, 2.0, "P_pump", held.P_pump)
+    assert back.F_v == pytest.approx(7.5, rel=1e-10)
+    bare = grasp_hold.hold(PAPER, 180.0, 2.0, "F_v", 7.5, reservoir=False)
+    assert bare.P_pump == bare.P_cavity == pytest.approx(held.P_cavity, rel=1e-10)
+
+
+def test_hold_falls_back_to_the_slow_path(monkeypatch):
+    expected = grasp_hold.fast_hold(PAPER, 180.0, 2.0, "F_v", 9.80665)
+    monkeypatch.setattr(grasp_hold, "fast_hold", lambda *a, **k: None)
+    h = grasp_hold.hold(PAPER, 180.0, 2.0, "F_v", 9.80665)
+    assert not h.fast and h.P_pump == pytest.approx(expected.P_pump, rel=1e-10)
+
+
+def test_the_equations_at_a_batch_are_those_of_each_state():
+    """_residuals vectorised over states: a batch gives, row by row, the single states' values."""
+    depth = 104.14135964771822
+    Z = np.array([[0.02, 0.03, 0.04, 5.0, 0.7], [0.03, 0.02, 0.05, 8.0, 0.9]])
+    args = (2, depth, 90.0, 2.0 * PAPER.g / PAPER.n, "F_v", 9.0, PAPER, True)
+    batch, F = grasp_hold._residuals(Z, *args)
+    for i in range(2):
+        one, F1 = grasp_hold._residuals(Z[i:i + 1], *args)
+        np.testing.assert_allclose(batch[i], one[0], rtol=1e-14)
+    # the moment of hinge 1 against grasp_fem's own hinge moment and lever (pad 2 at its closest point)
+    q = np.array([0.02, 0.03, 0.04, 0.04, 0.04])
+    _, grad, Tq, *_ = grasp_fem._load(q, (0.0, depth), 2, 2.0 * PAPER.g / PAPER.n, PAPER)
+    M = grasp_fem.hinge_moments(q, 0.7, PAPER)
+    assert batch[0, 0] == pytest.approx(M[0] - 5.0 * grad[0] - Tq[0], rel=1e-12)
+    assert math.isfinite(F[0])
