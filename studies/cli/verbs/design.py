@@ -29,12 +29,14 @@ def configure(parser) -> None:
     parser.add_argument("--plot", metavar="FILE.png", help="the Pareto plot (default DIR/pareto.png)")
     parser.add_argument("--no-fem", action="store_true", help="skip the FEM proof (reduced model only)")
     parser.add_argument("--mesh-size-mm", type=float, metavar="H",
-                        help="finger element size of the FEM proof [mm] (default: the task's, 6)")
+                        help="finger element size of the FEM proof [mm] (default: the task's, 6; "
+                             "at most 6 for walls b > 5 mm)")
     add_json_option(parser)
 
 
 def run(args) -> int:
     from softhand.studies.design import optimise as design_opt
+    from softhand.studies.design.proof import fem_report
     from softhand.studies.design.task import load_task
     from softhand.studies.io.files import write_atomic, write_json
 
@@ -65,19 +67,22 @@ def run(args) -> int:
         result["report"] = design_opt.infeasible_report(task, opt)
     elif not args.no_fem:
         result["fem"] = _prove(ev, task, args, out, say)
+        report = fem_report(result["fem"], ev)
+        if report:
+            result["fem_report"] = report
     write_json(out / "result.json", result)
     if args.json:
         print_json(result)
     else:
         _print(result, task, opt)
-    return 0 if ev.feasible else 1
+    return 0 if ev.feasible and "fem_report" not in result else 1
 
 
 def _prove(ev, task, args, out, say) -> dict:
     from softhand.fem.newton import NotConverged
-    from softhand.studies.design.proof import ProofOptions, prove
+    from softhand.studies.design.proof import ProofOptions, proof_mesh, prove
 
-    h = args.mesh_size_mm if args.mesh_size_mm is not None else task.mesh_size
+    h = proof_mesh(ev.design, args.mesh_size_mm if args.mesh_size_mm is not None else task.mesh_size)
     try:
         options = ProofOptions(mesh_size_mm=h, dP_mpa=task.dP, edge_ratio=task.edge_ratio)
         return prove(ev, task, options, out=out, progress=say)
@@ -114,8 +119,9 @@ def _print(result: dict, task, opt) -> None:
     for key, lo, hi in task.clipped:
         print(f"# free {key} = [{lo:g}, {hi:g}] clipped to {result['free_bounds'][key]}: the space "
               f"finger_model \"fem\" is calibrated on")
-    if "report" in result:
-        print(result["report"])
+    for key in ("report", "fem_report"):
+        if key in result:
+            print(result[key])
     rows = [{"constraint": c["name"], "value": c["value"], "sense": c["sense"], "limit": c["limit"],
              "satisfied": c["satisfied"]} for c in result["constraints"]]
     print_table(rows)
@@ -126,6 +132,8 @@ def _print(result: dict, task, opt) -> None:
               "FEM": fem.get(k), "FEM / predicted - 1": _rel(fem.get(k), result["predicted"].get(k))}
              for k in keys]
     print_table(table)
+    if fem.get("constraints"):
+        print_table(fem["constraints"])
     if fem.get("wall_seconds"):
         print(f"# FEM proof: finger {fem['finger_ndofs']} unknowns (mesh {fem['mesh_size_mm']:g} mm), "
               f"sheet {fem['sheet_ndofs']}, {fem['wall_seconds']:.0f} s; F_v at the FEM's P_grasp "
