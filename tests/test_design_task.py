@@ -303,3 +303,28 @@ def test_the_proof_mesh_follows_the_wall():
     assert proof_mesh(task.base.replace(b=5.0), 10.0) == 10.0
     assert proof_mesh(task.base.replace(b=5.69), 10.0) == 6.0   # the 10 mm mesh fails at b = 5.5
     assert proof_mesh(task.base.replace(b=5.69), 4.0) == 4.0    # a finer mesh is kept
+
+
+def test_a_failed_proof_mesh_is_retried_on_the_thick_walls_mesh(monkeypatch):
+    from types import SimpleNamespace
+
+    from softhand.studies.cli.verbs import design as verb
+    from softhand.studies.design import proof
+
+    tried = []
+
+    def prove(ev, task, options, out=None, progress=None):
+        tried.append(options.mesh_size_mm)
+        if options.mesh_size_mm > 6.0:
+            raise RuntimeError("free-bend FEM: Newton failed")
+        return {"P_grasp_MPa": 0.5}
+
+    monkeypatch.setattr(proof, "prove", prove)
+    task = task_from_dict({**CI_TASK, "fem": {"mesh_size_mm": 10.0}})
+    ev = design_opt.evaluate(task.base, task)
+    fem = verb._prove(ev, task, SimpleNamespace(mesh_size_mm=None), None, lambda text: None)
+    assert tried == [10.0, 6.0] and fem["P_grasp_MPa"] == 0.5
+    assert fem["failed_meshes"][0]["mesh_size_mm"] == 10.0
+    tried.clear()
+    fem = verb._prove(ev, task, SimpleNamespace(mesh_size_mm=6.0), None, lambda text: None)
+    assert tried == [6.0] and "failed_meshes" not in fem

@@ -80,15 +80,19 @@ def run(args) -> int:
 
 def _prove(ev, task, args, out, say) -> dict:
     from softhand.fem.newton import NotConverged
-    from softhand.studies.design.proof import ProofOptions, proof_mesh, prove
+    from softhand.studies.design.proof import PROOF_MESH_THICK_WALL, ProofOptions, proof_mesh, prove
 
     h = proof_mesh(ev.design, args.mesh_size_mm if args.mesh_size_mm is not None else task.mesh_size)
-    try:
-        options = ProofOptions(mesh_size_mm=h, dP_mpa=task.dP, edge_ratio=task.edge_ratio)
-        return prove(ev, task, options, out=out, progress=say)
-    except (NotConverged, RuntimeError) as exc:
-        say(f"the FEM proof failed: {str(exc)[:300]}")
-        return {"error": str(exc)[:300]}
+    failed = []
+    for size in (h, PROOF_MESH_THICK_WALL) if h > PROOF_MESH_THICK_WALL else (h,):
+        try:  # a coarse finger mesh that fails is retried once on the thick walls' mesh
+            options = ProofOptions(mesh_size_mm=size, dP_mpa=task.dP, edge_ratio=task.edge_ratio)
+            fem = prove(ev, task, options, out=out, progress=say)
+            return {**fem, "failed_meshes": failed} if failed else fem
+        except (NotConverged, RuntimeError) as exc:
+            say(f"the FEM proof on the {size:g} mm finger mesh failed: {str(exc)[:300]}")
+            failed.append({"mesh_size_mm": size, "error": str(exc)[:300]})
+    return {"error": failed[-1]["error"], "failed_meshes": failed}
 
 
 def _result(task, opt, base, design_file, seed: int) -> dict:
