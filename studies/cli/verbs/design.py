@@ -111,7 +111,7 @@ def _result(task, opt, base, design_file, seed: int) -> dict:
         "design_file": str(design_file),
         "optimiser": {"method": "differential_evolution + SLSQP polish", "seed": seed,
                       "evaluations": opt.evaluations, "generations": opt.generations,
-                      "seconds": opt.seconds, "message": opt.message},
+                      "seconds": opt.seconds, "cpu_seconds": opt.cpu_seconds, "message": opt.message},
     }
 
 
@@ -119,7 +119,8 @@ def _print(result: dict, task, opt) -> None:
     free = ", ".join(f"{k} = {v:.5g}" for k, v in result["free"].items())
     print(f"task {task.name}: {task.diameter:g} mm, {task.mass:g} kg, F_v >= {task.required_F_v():.4g} N "
           f"per finger, pump <= {task.max_pressure:g} MPa; objective: {task.objective}")
-    print(f"optimum: {free}  ({opt.evaluations} model evaluations, {opt.seconds:.1f} s)")
+    print(f"optimum: {free}  ({opt.evaluations} model evaluations, {opt.seconds:.1f} s wall, "
+          f"{opt.cpu_seconds:.1f} s CPU)")
     for key, lo, hi in task.clipped:
         print(f"# free {key} = [{lo:g}, {hi:g}] clipped to {result['free_bounds'][key]}: the space "
               f"finger_model \"fem\" is calibrated on")
