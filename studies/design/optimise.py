@@ -74,9 +74,9 @@ class Optimum:
     evaluation: Evaluation
     evaluations: int
     seconds: float
-    cpu_seconds: float = 0.0  #: the process's CPU time (the wall time of a loaded machine is a multiple)
     generations: int
     message: str
+    cpu_seconds: float = 0.0  #: the process's CPU time (the wall time of a loaded machine is a multiple)
 
 
 def optimise(task: Task, options: OptimiserOptions = OptimiserOptions()) -> Optimum:
