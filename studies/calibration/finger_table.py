@@ -109,11 +109,16 @@ def write_table(path, space: DesignSpace, results: list[tuple[HandDesign, dict]]
     notes = provenance_lines(command, pairs, records)
     if space.mesh_pair is not None:  # scale the coarse mesh's points to the default mesh
         dy, rq = mesh_correction(results[n][1]["numbers"], results[n + 1][1]["numbers"])
+        coarse = {i for i, (_, record) in enumerate(results[:n])
+                  if "axial_size_mm" in record["provenance"]["inputs"]}
         for row in rows:
-            row["p_tilde"] *= math.exp(dy)
-            row["q_tilde"] *= rq
+            if row["design"] in coarse:
+                row["p_tilde"] *= math.exp(dy)
+                row["q_tilde"] *= rq
         notes.append(f"mesh correction to the default mesh (the mesh_pair design on both meshes, at "
-                     f"equal bend): P x {math.exp(dy):.5f}, dQ x {rq:.5f}, applied to every row")
+                     f"equal bend): P x {math.exp(dy):.5f}, dQ x {rq:.5f}, applied to the {len(coarse)} "
+                     f"designs on the longer slices; {n - len(coarse)} designs (untied gap shorter than "
+                     "3 slices) ran on the default mesh")
     ranges = space_ranges(space.box)
     varying = sum(ranges[g][1] > ranges[g][0] * (1 + 1e-9) for g in GROUPS)
     degrees = fit_degrees(len(pairs), varying)
