@@ -18,6 +18,7 @@ import importlib
 import os
 import signal
 import sys
+import warnings
 
 from softhand.reduced.errors import InputError, short
 from softhand.reduced.versions import package_version
@@ -80,6 +81,9 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(rest)
     previous = _sigterm_as_interrupt()
     float_errors = _quiet_float_warnings()
+    show = warnings.showwarning
+    warnings.showwarning = lambda message, *rest, **kw: print(f"softhand {verb}: warning: {message}",
+                                                              file=sys.stderr)
     try:
         _check(verb, args, parser)
         code = int(module.run(args) or 0)
@@ -95,6 +99,7 @@ def main(argv: list[str] | None = None) -> int:
         _silence_stdout()
         return 141
     finally:
+        warnings.showwarning = show
         _restore_float_warnings(float_errors)
         if previous is not None:
             signal.signal(signal.SIGTERM, previous)
