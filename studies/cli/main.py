@@ -81,9 +81,8 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(rest)
     previous = _sigterm_as_interrupt()
     float_errors = _quiet_float_warnings()
-    show = warnings.showwarning
-    warnings.showwarning = lambda message, *rest, **kw: print(f"softhand {verb}: warning: {message}",
-                                                              file=sys.stderr)
+    form = warnings.formatwarning  # every warning shown is one line (which are shown: the filters)
+    warnings.formatwarning = lambda message, *rest, **kw: f"softhand {verb}: warning: {message}\n"
     try:
         _check(verb, args, parser)
         code = int(module.run(args) or 0)
@@ -99,7 +98,7 @@ def main(argv: list[str] | None = None) -> int:
         _silence_stdout()
         return 141
     finally:
-        warnings.showwarning = show
+        warnings.formatwarning = form
         _restore_float_warnings(float_errors)
         if previous is not None:
             signal.signal(signal.SIGTERM, previous)
