@@ -40,10 +40,8 @@ from __future__ import annotations
 
 import math
 import warnings
-from dataclasses import dataclass
 from functools import lru_cache
 from itertools import combinations_with_replacement
-from pathlib import Path
 from typing import NamedTuple
 
 import numpy as np
@@ -52,16 +50,10 @@ from . import finger
 from .finger_curves import Curves, energy_curves
 from .design import HandDesign
 from .errors import InputError
+from .finger_fem_table import COLUMNS, GROUPS, LABELS, PRIORS, TABLE_FILE, Table, _bad, read_table
 
-__all__ = ["TABLE_FILE", "GROUPS", "Table", "read_table", "groups_of", "curves", "FEM"]
+__all__ = ["TABLE_FILE", "GROUPS", "COLUMNS", "PRIORS", "Table", "read_table", "groups_of", "curves", "FEM"]
 
-TABLE_FILE = Path(__file__).resolve().parent / "data" / "finger_fem.csv"
-#: the nondimensional groups, in table column order
-GROUPS = ("b_a", "d_a", "link_a", "tie_link")
-LABELS = {"b_a": "b/a", "d_a": "d/a", "link_a": "link/a", "tie_link": "tie/link"}
-COLUMNS = ("design", *GROUPS, "theta", "p_tilde", "q_tilde")
-#: the physics a table's residual is taken against (see :func:`prior_pressure`)
-PRIORS = ("paper", "rings")
 N_LINKS = 6
 #: the shipped table's designs with an untied gap (link - tie) under this [mm] were computed with
 #: one or two 5 mm slices across the gap, which lock: for such designs the model bends less than
@@ -71,80 +63,6 @@ SHORT_GAP_MM = 10.0
 
 class ShortGapWarning(UserWarning):
     """A design in the part of the space where the shipped table is known to be too stiff."""
-
-
-@dataclass(frozen=True)
-class Table:
-    """A calibration table: FEM rows, the calibrated ranges and the fit's degrees."""
-
-    source: str  #: file name, for messages
-    rows: dict  #: column -> array
-    ranges: dict  #: group -> (min, max)
-    design_degree: int  #: total degree of the polynomial in the groups
-    theta_degree: int  #: degree in theta
-    prior: str = "paper"  #: the physics the residual is taken against, one of PRIORS
-    header: tuple[str, ...] = ()  #: the provenance comment lines
-
-
-def _bad(path, allowed: str):
-    return InputError("finger_table", str(path), allowed)
-
-
-def read_table(path: str | Path = TABLE_FILE) -> Table:
-    """Read a finger calibration CSV; InputError naming the file on any problem."""
-    from softhand.reduced.design import read_input_file
-
-    path = Path(path)
-    data = read_input_file(path, "finger_table", "a CSV written by softhand calibrate finger")
-    try:
-        text = data.decode("utf-8")
-    except UnicodeDecodeError:
-        raise _bad(path, "is not a text (CSV) file") from None
-    comments = [line for line in text.splitlines() if line.startswith("#")]
-    lines = [line for line in text.splitlines() if line.strip() and not line.startswith("#")]
-    if not lines or tuple(c.strip() for c in lines[0].split(",")) != COLUMNS:
-        raise _bad(path, f"needs the header {','.join(COLUMNS)}")
-    try:
-        values = np.array([[float(x) for x in line.split(",")] for line in lines[1:]], ndmin=2)
-    except ValueError:
-        raise _bad(path, "has a cell that is not a number") from None
-    if values.shape[0] == 0 or values.shape[1] != len(COLUMNS) or not np.all(np.isfinite(values)):
-        raise _bad(path, f"needs rows of {len(COLUMNS)} finite numbers")
-    rows = {c: values[:, i] for i, c in enumerate(COLUMNS)}
-    if np.any(rows["theta"] <= 0) or np.any(rows["p_tilde"] <= 0) or np.any(rows["q_tilde"] <= 0):
-        raise _bad(path, "theta, p_tilde and q_tilde must be positive (the P = 0 state is implied)")
-    ranges, degrees, prior = _header(comments, path)
-    for g in GROUPS:
-        lo, hi = ranges[g]
-        if np.any(rows[g] < lo * (1 - 1e-9)) or np.any(rows[g] > hi * (1 + 1e-9)):
-            raise _bad(path, f"has {LABELS[g]} outside its '# range:' [{lo:g}, {hi:g}]")
-    return Table(path.name, rows, ranges, *degrees, prior=prior, header=tuple(comments))
-
-
-def _header(comments: list[str], path) -> tuple[dict, tuple[int, int], str]:
-    """The '# range: g=lo:hi, ...' and '# fit: design_degree=D, theta_degree=T[, prior=P]' lines."""
-    spec = {}
-    for line in comments:
-        body = line.lstrip("#").strip()
-        for tag in ("range:", "fit:"):
-            if body.startswith(tag):
-                for item in body[len(tag):].split(","):
-                    key, _, value = item.strip().partition("=")
-                    spec[key.strip()] = value.strip()
-    try:
-        ranges = {g: tuple(float(v) for v in spec[g].split(":")) for g in GROUPS}
-        degrees = (int(spec["design_degree"]), int(spec["theta_degree"]))
-    except (KeyError, ValueError):
-        raise _bad(path, "needs the lines '# range: b_a=lo:hi, d_a=..., link_a=..., tie_link=...' "
-                         "and '# fit: design_degree=D, theta_degree=T'") from None
-    if any(len(r) != 2 or not 0 < r[0] <= r[1] for r in ranges.values()) or min(degrees) < 0:
-        raise _bad(path, "has a range lo:hi with not 0 < lo <= hi, or a negative degree")
-    prior = spec.get("prior", "paper")
-    if prior not in PRIORS:
-        raise _bad(path, f"has prior={prior}; allowed: {', '.join(PRIORS)}")
-    if ranges["tie_link"][1] >= 1.0:
-        raise _bad(path, "has tie/link >= 1: a ring cannot be wider than its link")
-    return ranges, degrees, prior
 
 
 # ---------------------------------------------------------------------- groups and the fit

@@ -5,7 +5,7 @@ import pytest
 
 from softhand.reduced import hand
 from softhand.studies.cli.main import main
-from softhand.studies.calibration.finger import load_space
+from softhand.studies.calibration.space import finger_design, load_space
 
 SPACE = """
 name = "{name}"
@@ -79,7 +79,7 @@ def test_mesh_correction_scales_only_the_designs_on_longer_slices(tmp_path):
     import math
 
     from softhand.reduced.finger_fem import read_table
-    from softhand.studies.calibration.finger import as_study, design_cases, finger_design
+    from softhand.studies.calibration.finger import as_study, design_cases
     from softhand.studies.calibration.finger_table import write_table
 
     path = tmp_path / "gaps.toml"

@@ -8,7 +8,7 @@ from scipy.integrate import quad
 from softhand.reduced import finger, finger_fem, hand, reservoir
 from softhand.reduced.design import HandDesign
 from softhand.reduced.errors import InputError
-from softhand.studies.calibration.finger import finger_design
+from softhand.studies.calibration.space import finger_design
 from softhand.studies.calibration.finger_table import table_csv
 
 BOX = {"a_mm": (3.0, 6.0), "b_mm": (3.0, 7.0), "d_mm": (10.0, 20.0), "l0_mm": (120.0, 200.0),

@@ -1,7 +1,7 @@
 """The table of the reduced finger model ``"fem"`` from finished FEM cases, and its check.
 
 :func:`write_table` turns the ``finger_bend`` cases of a design space
-(:mod:`studies.finger_calibration`) into the nondimensional CSV of
+(:mod:`softhand.studies.calibration.finger`) into the nondimensional CSV of
 :mod:`reduced.finger_fem` with its provenance (code version, mesh, date, command);
 :func:`heldout_rows` compares the calibrated model with FEM cases it was not built from.
 """
@@ -17,7 +17,7 @@ from scipy.interpolate import PchipInterpolator
 from softhand.reduced import finger, hand
 from softhand.reduced.design import HandDesign
 from softhand.reduced.finger_fem import COLUMNS, GROUPS, groups_of
-from softhand.studies.calibration.finger import DesignSpace, VARIABLES, finger_design
+from softhand.studies.calibration.space import DesignSpace, VARIABLES, finger_design
 from softhand.studies.io.files import write_atomic
 
 

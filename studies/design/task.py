@@ -203,7 +203,7 @@ def _calibrated(free, base: HandDesign):
     """(free bounds clipped to the packaged finger table's box, the bounds that were clipped)."""
     if base.finger_model != "fem" or base.finger_table:
         return free, ()
-    from softhand.studies.calibration.finger import load_space
+    from softhand.studies.calibration.space import load_space
 
     box = load_space(CALIBRATED_SPACE).box
     out, clipped = [], []

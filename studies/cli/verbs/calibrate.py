@@ -48,7 +48,7 @@ def configure(parser) -> None:
 
 def run(args) -> int:
     from softhand.reduced.errors import InputError
-    from softhand.studies.calibration import finger as fc
+    from softhand.studies.calibration import space as fc
     from softhand.studies.calibration.finger_table import write_design_with_table, write_table
 
     from softhand.studies.cli.verbs.study import MAX_WORKERS
