@@ -55,19 +55,26 @@ def test_table_from_two_ties_predicts_the_middle_one(tmp_path, capsys):
     assert spread > 1.1
 
 
+def _gap_space(tmp_path, extra=""):
+    """A space on 5 mm slices with two designs of l0 = 120 mm: rings of 5 mm (a 15 mm gap) and of
+    15 mm (a 5 mm gap); ``extra``: more TOML (e.g. a mesh pair)."""
+    path = tmp_path / "gaps.toml"
+    path.write_text(SPACE.format(name="gaps").replace("mesh_size_mm = 6.0", "axial_size_mm = 5.0")
+                    .replace("l0_mm = [180.0, 180.0]", "l0_mm = [120.0, 120.0]")
+                    .replace("[6.0, 14.0]", "[5.0, 15.0]")
+                    + DESIGN.format(tie=5.0).replace("180.0", "120.0")
+                    + DESIGN.format(tie=15.0).replace("180.0", "120.0")
+                    + extra)
+    return path
+
+
 def test_longer_slices_only_where_they_resolve_the_gap(tmp_path):
     """A space's longer slices put at least 3 slices across every untied gap: a 15 mm gap (l0 =
     120, 5 mm rings) keeps them; a 5 mm gap (15 mm rings) runs on the default mesh instead (one
     5 mm slice there bends 26 % less than the default mesh: a locked element, not a correction)."""
     from softhand.studies.calibration.finger import design_cases, resolves_gap
 
-    path = tmp_path / "gaps.toml"
-    path.write_text(SPACE.format(name="gaps").replace("mesh_size_mm = 6.0", "axial_size_mm = 5.0")
-                    .replace("l0_mm = [180.0, 180.0]", "l0_mm = [120.0, 120.0]")
-                    .replace("[6.0, 14.0]", "[5.0, 15.0]")
-                    + DESIGN.format(tie=5.0).replace("180.0", "120.0")
-                    + DESIGN.format(tie=15.0).replace("180.0", "120.0"))
-    (p5, d5), (p15, d15) = design_cases(load_space(path))
+    (p5, d5), (p15, d15) = design_cases(load_space(_gap_space(tmp_path)))
     assert (d5.tie_width, d15.tie_width) == (5.0, 15.0)
     assert p5["axial_size_mm"] == 5.0 and "axial_size_mm" not in p15
     assert resolves_gap(d15, 2.49) and not resolves_gap(d15, 2.5)  # 3 slices of 5 mm need < 2.5
@@ -82,15 +89,8 @@ def test_mesh_correction_scales_only_the_designs_on_longer_slices(tmp_path):
     from softhand.studies.calibration.finger import as_study, design_cases
     from softhand.studies.calibration.finger_table import write_table
 
-    path = tmp_path / "gaps.toml"
-    path.write_text(SPACE.format(name="gaps").replace("mesh_size_mm = 6.0", "axial_size_mm = 5.0")
-                    .replace("l0_mm = [180.0, 180.0]", "l0_mm = [120.0, 120.0]")
-                    .replace("[6.0, 14.0]", "[5.0, 15.0]")
-                    + DESIGN.format(tie=5.0).replace("180.0", "120.0")
-                    + DESIGN.format(tie=15.0).replace("180.0", "120.0")
-                    + "[mesh_pair]\na_mm = 4.0\nb_mm = 5.0\nd_mm = 15.0\nl0_mm = 180.0\n"
-                      "tie_width_mm = 10.0\npressures_mpa = [0.4, 0.8]\n")
-    space = load_space(path)
+    space = load_space(_gap_space(tmp_path, "[mesh_pair]\na_mm = 4.0\nb_mm = 5.0\nd_mm = 15.0\n"
+                                              "l0_mm = 180.0\ntie_width_mm = 10.0\npressures_mpa = [0.4, 0.8]\n"))
     numbers = {"P_MPa": [0.4, 0.8], "theta_deg": [10.0, 20.0], "dQ_mm3": [100.0, 200.0]}
     fine = {"P_MPa": [0.4, 0.8], "theta_deg": [11.0, 22.0], "dQ_mm3": [110.0, 220.0]}
     cases = as_study(space).cases()
@@ -102,5 +102,7 @@ def test_mesh_correction_scales_only_the_designs_on_longer_slices(tmp_path):
     P = table.rows["p_tilde"] * cases[0][1].mu_sf
     # the pair: the fine mesh bends 10 % more at equal P, so at equal bend it needs less P
     assert P[0] < 0.4 * (1 - 1e-3) and P[1] < 0.8 * (1 - 1e-3)  # design 0: corrected
+    # closed form: the pair is linear in theta, so at equal bend P_fine / P_coarse = 10 / 11 exactly
+    assert P[:2] == pytest.approx([0.4 * 10 / 11, 0.8 * 10 / 11], rel=1e-9)
     assert P[2:] == pytest.approx([0.4, 0.8], rel=1e-9)  # design 1 (5 mm gap): as computed (CSV: 10 digits)
     assert math.isclose(table.rows["q_tilde"][2] * 4.0**3, 100.0, rel_tol=1e-9)

@@ -17,6 +17,7 @@ from scipy.interpolate import PchipInterpolator
 from softhand.reduced import finger, hand
 from softhand.reduced.design import HandDesign
 from softhand.reduced.finger_fem import COLUMNS, GROUPS, groups_of
+from softhand.studies.calibration.finger import MIN_GAP_SLICES
 from softhand.studies.calibration.space import DesignSpace, VARIABLES, finger_design
 from softhand.studies.io.files import write_atomic
 
@@ -118,7 +119,7 @@ def write_table(path, space: DesignSpace, results: list[tuple[HandDesign, dict]]
         notes.append(f"mesh correction to the default mesh (the mesh_pair design on both meshes, at "
                      f"equal bend): P x {math.exp(dy):.5f}, dQ x {rq:.5f}, applied to the {len(coarse)} "
                      f"designs on the longer slices; {n - len(coarse)} designs (untied gap shorter than "
-                     "3 slices) ran on the default mesh")
+                     f"{MIN_GAP_SLICES} slices) ran on the default mesh")
     ranges = space_ranges(space.box)
     varying = sum(ranges[g][1] > ranges[g][0] * (1 + 1e-9) for g in GROUPS)
     degrees = fit_degrees(len(pairs), varying)
