@@ -41,7 +41,6 @@ from __future__ import annotations
 import math
 import warnings
 from functools import lru_cache
-from itertools import combinations_with_replacement
 from typing import NamedTuple
 
 import numpy as np
@@ -50,6 +49,7 @@ from . import finger
 from .finger_curves import Curves, energy_curves
 from .design import HandDesign
 from .errors import InputError
+from .finger_fem_terms import term_matrix
 from .finger_fem_table import COLUMNS, GROUPS, LABELS, PRIORS, TABLE_FILE, Table, _bad, read_table
 
 __all__ = ["TABLE_FILE", "GROUPS", "COLUMNS", "PRIORS", "Table", "read_table", "groups_of", "curves", "FEM"]
@@ -78,43 +78,15 @@ def groups_of(design: HandDesign) -> dict:
             "tie_link": design.tie_width / L}
 
 
-def _scaled(value, lo: float, hi: float):
-    return 2 * (np.asarray(value, float) - lo) / (hi - lo) - 1
-
-
-def _x(groups: dict, table: Table, kind: str) -> np.ndarray:
-    """The design features of y (kind "p") or ln kappa (kind "q"), scaled to [-1, 1] over the
-    table's ranges, only those the table varies; (..., k)."""
-    r = table.ranges
-    varies = {g: r[g][1] > r[g][0] * (1 + 1e-9) for g in GROUPS}
-    cols = []
-    if kind == "p":
-        if varies["b_a"] or varies["link_a"] or varies["tie_link"]:
-            shape2 = lambda b, link, tie: (b / (link * (1.0 - tie)))**2  # noqa: E731
-            lo = shape2(r["b_a"][0], r["link_a"][1], r["tie_link"][0])
-            hi = shape2(r["b_a"][1], r["link_a"][0], r["tie_link"][1])
-            cols.append(_scaled(shape2(*(np.asarray(groups[g], float) for g in ("b_a", "link_a", "tie_link"))),
-                                lo, hi))
-        names = ("b_a", "d_a")
-    else:
-        names = GROUPS
-    for g in names:
-        if varies[g]:
-            f = (lambda v: -np.log1p(-v)) if g == "tie_link" else np.log
-            cols.append(_scaled(f(np.asarray(groups[g], float)), f(r[g][0]), f(r[g][1])))
-    return np.stack(cols, axis=-1) if cols else np.zeros(np.shape(groups[GROUPS[0]]) + (0,))
-
-
-def _features(x: np.ndarray, theta, table: Table) -> np.ndarray:
-    """Monomials of x (total degree <= design_degree), then theta^k (1 <= k <= theta_degree); (..., m)."""
-    k = x.shape[-1]
-    monos = [np.ones(x.shape[:-1])]
-    for degree in range(1, table.design_degree + 1):
-        for combo in combinations_with_replacement(range(k), degree):
-            monos.append(np.prod(x[..., list(combo)], axis=-1))
-    theta = np.asarray(theta, float)
-    return np.stack(monos + [np.broadcast_to(theta**j, monos[0].shape)
-                             for j in range(1, table.theta_degree + 1)], axis=-1)
+def lstsq_terms(groups: dict, theta, target, terms) -> np.ndarray:
+    """Least-squares coefficients of ``target`` in [1, terms] (columns scaled to unit norm for
+    the conditioning, the coefficients returned for the unscaled columns); None if the
+    columns are dependent (too few designs for the terms)."""
+    A = term_matrix(groups, theta, terms)
+    norm = np.linalg.norm(A, axis=0)
+    if np.linalg.matrix_rank(A / norm) < A.shape[1]:
+        return None
+    return np.linalg.lstsq(A / norm, target, rcond=None)[0] / norm
 
 
 class _Tube(NamedTuple):
@@ -148,28 +120,34 @@ def prior_pressure(theta, groups: dict, prior: str):
     return P
 
 
+def fit_targets(rows: dict, prior: str, path="table") -> tuple[np.ndarray, np.ndarray]:
+    """The residuals a table's rows give the fit: y = ln(P / P_prior) and ln kappa."""
+    y = np.empty(rows["theta"].size)
+    for i in np.unique(rows["design"]):  # the prior per design, all its angles at once
+        at = rows["design"] == i
+        g = {k: float(rows[k][at][0]) for k in GROUPS}
+        y[at] = np.log(rows["p_tilde"][at] / prior_pressure(rows["theta"][at], g, prior))
+    dilation = rows["q_tilde"] - math.pi * rows["d_a"] * rows["theta"]
+    if np.any(dilation <= 0):
+        raise _bad(path, "has dQ/a^3 <= pi (d/a) theta in a row: below the tube's kinematic "
+                         "oil volume of eq. (2)")
+    return y, np.log(dilation / rows["p_tilde"])
+
+
 @lru_cache(maxsize=8)
 def _fit(path: str) -> tuple[Table, np.ndarray, np.ndarray, float]:
     """(table, beta_y, beta_k, theta_max): least-squares coefficients of y and ln kappa."""
     table = read_table(path)
     r = table.rows
     ids = np.unique(r["design"])
-    y = np.empty(r["theta"].size)
-    for i in ids:  # the prior per design, all its angles at once
-        at = r["design"] == i
-        g = {k: float(r[k][at][0]) for k in GROUPS}
-        y[at] = np.log(r["p_tilde"][at] / prior_pressure(r["theta"][at], g, table.prior))
-    dilation = r["q_tilde"] - math.pi * r["d_a"] * r["theta"]
-    if np.any(dilation <= 0):
-        raise _bad(path, "has dQ/a^3 <= pi (d/a) theta in a row: below the tube's kinematic "
-                         "oil volume of eq. (2)")
+    y, ln_kappa = fit_targets(r, table.prior, path)
     betas = []
-    for kind, target in (("p", y), ("q", np.log(dilation / r["p_tilde"]))):
-        A = _features(_x(r, table, kind), r["theta"], table)
-        if np.linalg.matrix_rank(A) < A.shape[1]:
-            raise _bad(path, f"has too few designs ({ids.size}) for the fit's degrees "
-                             f"({table.design_degree}, {table.theta_degree}); lower them in '# fit:'")
-        betas.append(np.linalg.lstsq(A, target, rcond=None)[0])
+    for terms, target in ((table.p_terms, y), (table.q_terms, ln_kappa)):
+        beta = lstsq_terms(r, r["theta"], target, terms)
+        if beta is None:
+            raise _bad(path, f"has too few designs ({ids.size}) for the fit's terms "
+                             f"({' '.join(terms)}); use fewer in '# fit:'")
+        betas.append(beta)
     return table, betas[0], betas[1], float(r["theta"].max())
 
 
@@ -192,11 +170,8 @@ def residuals(theta, design: HandDesign) -> tuple[np.ndarray, np.ndarray]:
     table, beta_y, beta_k, theta_max = _fit(_table_path(design))
     groups = check_space(design, table)
     t = np.clip(np.asarray(theta, float), -theta_max, theta_max)
-    out = []
-    for kind, beta in (("p", beta_y), ("q", beta_k)):
-        x = _x(groups, table, kind)
-        out.append(_features(np.broadcast_to(x, t.shape + x.shape), t, table) @ beta)
-    return out[0], out[1]
+    return (term_matrix(groups, t, table.p_terms) @ beta_y,
+            term_matrix(groups, t, table.q_terms) @ beta_k)
 
 
 def _table_path(design: HandDesign) -> str:

@@ -3,7 +3,9 @@
 ``reduced/data/finger_fem.csv`` (or a table of one design made by ``softhand calibrate finger
 --design``) holds the finger FEM's (theta, P/mu_sf, Delta Q/a^3) at sampled designs, after
 comment lines with its provenance, the groups' calibrated ranges (``# range:``) and the fit's
-degrees and prior (``# fit:``); :mod:`softhand.reduced.finger_fem` fits and uses it.
+prior and terms (``# fit: prior=rings, p_terms=s2 lb th, q_terms=lt th``, or, in older tables,
+polynomial degrees ``design_degree=D, theta_degree=T``); :mod:`softhand.reduced.finger_fem` fits
+and uses it.
 """
 from __future__ import annotations
 
@@ -13,6 +15,7 @@ from pathlib import Path
 import numpy as np
 
 from .errors import InputError
+from .finger_fem_terms import check_terms, legacy_terms
 
 TABLE_FILE = Path(__file__).resolve().parent / "data" / "finger_fem.csv"
 #: the nondimensional groups, in table column order
@@ -30,8 +33,8 @@ class Table:
     source: str  #: file name, for messages
     rows: dict  #: column -> array
     ranges: dict  #: group -> (min, max)
-    design_degree: int  #: total degree of the polynomial in the groups
-    theta_degree: int  #: degree in theta
+    p_terms: tuple[str, ...]  #: the terms of y = ln(P / P_prior) (finger_fem_terms)
+    q_terms: tuple[str, ...]  #: the terms of ln kappa
     prior: str = "paper"  #: the physics the residual is taken against, one of PRIORS
     header: tuple[str, ...] = ()  #: the provenance comment lines
 
@@ -63,16 +66,36 @@ def read_table(path: str | Path = TABLE_FILE) -> Table:
     rows = {c: values[:, i] for i, c in enumerate(COLUMNS)}
     if np.any(rows["theta"] <= 0) or np.any(rows["p_tilde"] <= 0) or np.any(rows["q_tilde"] <= 0):
         raise _bad(path, "theta, p_tilde and q_tilde must be positive (the P = 0 state is implied)")
-    ranges, degrees, prior = _header(comments, path)
+    ranges, spec, prior = _header(comments, path)
     for g in GROUPS:
         lo, hi = ranges[g]
         if np.any(rows[g] < lo * (1 - 1e-9)) or np.any(rows[g] > hi * (1 + 1e-9)):
             raise _bad(path, f"has {LABELS[g]} outside its '# range:' [{lo:g}, {hi:g}]")
-    return Table(path.name, rows, ranges, *degrees, prior=prior, header=tuple(comments))
+    terms = _terms(spec, ranges, path)
+    return Table(path.name, rows, ranges, *terms, prior=prior, header=tuple(comments))
 
 
-def _header(comments: list[str], path) -> tuple[dict, tuple[int, int], str]:
-    """The '# range: g=lo:hi, ...' and '# fit: design_degree=D, theta_degree=T[, prior=P]' lines."""
+def _terms(spec: dict, ranges: dict, path) -> tuple[tuple[str, ...], tuple[str, ...]]:
+    """(p_terms, q_terms) named by the '# fit:' line, or made from its degrees (older tables)."""
+    if "p_terms" in spec or "q_terms" in spec:
+        try:
+            return tuple(check_terms(spec.get(k, "").split()) for k in ("p_terms", "q_terms"))
+        except ValueError as error:
+            raise _bad(path, f"has a '# fit:' {error}") from None
+    try:
+        degrees = (int(spec["design_degree"]), int(spec["theta_degree"]))
+    except (KeyError, ValueError):
+        raise _bad(path, "needs the lines '# range: b_a=lo:hi, d_a=..., link_a=..., tie_link=...' "
+                         "and '# fit: p_terms=..., q_terms=...' (or design_degree=D, "
+                         "theta_degree=T)") from None
+    if min(degrees) < 0:
+        raise _bad(path, "has a negative degree in '# fit:'")
+    varying = {g: ranges[g][1] > ranges[g][0] * (1 + 1e-9) for g in GROUPS}
+    return tuple(legacy_terms(kind, varying, *degrees) for kind in ("p", "q"))
+
+
+def _header(comments: list[str], path) -> tuple[dict, dict, str]:
+    """The '# range: g=lo:hi, ...' line's ranges, the '# fit: key=value, ...' line, its prior."""
     spec = {}
     for line in comments:
         body = line.lstrip("#").strip()
@@ -83,15 +106,15 @@ def _header(comments: list[str], path) -> tuple[dict, tuple[int, int], str]:
                     spec[key.strip()] = value.strip()
     try:
         ranges = {g: tuple(float(v) for v in spec[g].split(":")) for g in GROUPS}
-        degrees = (int(spec["design_degree"]), int(spec["theta_degree"]))
     except (KeyError, ValueError):
         raise _bad(path, "needs the lines '# range: b_a=lo:hi, d_a=..., link_a=..., tie_link=...' "
-                         "and '# fit: design_degree=D, theta_degree=T'") from None
-    if any(len(r) != 2 or not 0 < r[0] <= r[1] for r in ranges.values()) or min(degrees) < 0:
-        raise _bad(path, "has a range lo:hi with not 0 < lo <= hi, or a negative degree")
+                         "and '# fit: p_terms=..., q_terms=...' (or design_degree=D, "
+                         "theta_degree=T)") from None
+    if any(len(r) != 2 or not 0 < r[0] <= r[1] for r in ranges.values()):
+        raise _bad(path, "has a range lo:hi with not 0 < lo <= hi")
     prior = spec.get("prior", "paper")
     if prior not in PRIORS:
         raise _bad(path, f"has prior={prior}; allowed: {', '.join(PRIORS)}")
     if ranges["tie_link"][1] >= 1.0:
         raise _bad(path, "has tie/link >= 1: a ring cannot be wider than its link")
-    return ranges, degrees, prior
+    return ranges, spec, prior

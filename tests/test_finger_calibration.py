@@ -39,7 +39,7 @@ def test_table_from_two_ties_predicts_the_middle_one(tmp_path, capsys):
     assert main(["calibrate", "finger", "--space", str(space), "--out", str(table),
                  "--results", results, "--no-progress"]) == 0
     text = table.read_text()
-    assert "# fit: design_degree=1, theta_degree=1" in text and "mesher gmsh" in text
+    assert "p_terms=s2 th, q_terms=lt th" in text and "mesher gmsh" in text
     held = _space(tmp_path / "held.toml", "held", (10.0,))
     capsys.readouterr()
     assert main(["calibrate", "finger", "--check", str(held), "--table", str(table),

@@ -49,7 +49,7 @@ def _synthetic_table(tmp_path, ties=(5.0, 10.0, 15.0)):
     ranges = {k: (v, v) for k, v in groups[0].items()}
     ranges["tie_link"] = (groups[0]["tie_link"], groups[-1]["tie_link"])
     path = tmp_path / "synthetic.csv"
-    path.write_text(table_csv(rows, ranges, ["synthetic test table"], (1, 1)))
+    path.write_text(table_csv(rows, ranges, ["synthetic test table"], (("s2", "th"), ("lt", "th"))))
     return path, designs, ties
 
 
@@ -121,7 +121,8 @@ def test_package_table_covers_its_space_and_names_the_group_outside():
 @pytest.mark.parametrize("edit, message", [
     (lambda t: t.replace("design,b_a", "design,b"), "needs the header"),
     (lambda t: t.replace("# range:", "# ranges:"), "needs the lines '# range"),
-    (lambda t: t.replace("# fit: design_degree=1", "# fit: design_degree=x"), "needs the lines"),
+    (lambda t: t.replace("# fit:", "# fits:"), "needs the lines"),
+    (lambda t: t.replace("p_terms=s2 th", "p_terms=s2 th*b"), "term 'th\\*b': allowed are products of lb"),
     (lambda t: t.rstrip("\n") + "\n9,1,2,3,0.1,0.5,0.2,oops\n", "not a number"),
     (lambda t: t.rstrip("\n") + "\n9,1,2,3,0.1,-0.5,0.2,3\n", "must be positive"),
     (lambda t: t.rstrip("\n") + "\n9,1.25,3.75,7.5,0.9,0.5,0.2,3\n", "tie/link outside"),
@@ -138,7 +139,7 @@ def test_missing_table_and_too_few_designs(tmp_path):
     with pytest.raises(InputError, match="no such file"):
         finger_fem.read_table(tmp_path / "none.csv")
     path, designs, _ = _synthetic_table(tmp_path, ties=(5.0, 15.0))
-    path.write_text(path.read_text().replace("design_degree=1", "design_degree=2"))
+    path.write_text(path.read_text().replace("p_terms=s2 th", "p_terms=s2 lt th"))
     d = designs[0].replace(finger_model="fem", finger_table=str(path))
     with pytest.raises(InputError, match="too few designs"):
         hand.pressure(0.5, d)

@@ -46,24 +46,46 @@ def table_rows(results: list[tuple[HandDesign, dict]]) -> list[dict]:
     return rows
 
 
-def fit_degrees(n_designs: int, n_varying: int) -> tuple[int, int]:
-    """(design_degree, theta_degree) of the fit for a table of n_designs over n_varying groups:
-    quadratic in the groups with 2 designs per coefficient, else linear (n_varying + 1 designs
-    at least), else constant; linear in theta."""
-    quadratic = 1 + n_varying + n_varying * (n_varying + 1) // 2
-    if n_varying and n_designs >= 2 * quadratic:
-        return 2, 1
-    return (1, 1) if n_varying and n_designs >= n_varying + 1 else (0, 1)
+#: designs a table needs before its terms are chosen by leave-one-design-out error
+SELECT_MIN_DESIGNS = 6
 
 
-def table_csv(rows: list[dict], ranges: dict, provenance: list[str], degrees: tuple[int, int],
+def choose_terms(rows: list[dict], ranges: dict, prior: str) -> tuple[tuple, tuple, list[str]]:
+    """(p_terms, q_terms, notes) of the fit of ``rows``: chosen by forward selection on the
+    leave-one-design-out error (:mod:`.fit_terms`) when the table has SELECT_MIN_DESIGNS
+    designs or more; else a polynomial of the varying groups, linear if it has a design more
+    than groups, and linear in theta."""
+    from softhand.reduced.finger_fem import fit_targets
+    from softhand.reduced.finger_fem_terms import legacy_terms
+    from softhand.studies.calibration.fit_terms import group_rows, select_terms
+
+    columns = group_rows(rows)
+    n_designs = np.unique(columns["design"]).size
+    varying = {g: ranges[g][1] > ranges[g][0] * (1 + 1e-9) for g in GROUPS}
+    if n_designs < SELECT_MIN_DESIGNS:
+        degree = 1 if any(varying.values()) and n_designs >= sum(varying.values()) + 1 else 0
+        return (legacy_terms("p", varying, degree, 1), legacy_terms("q", varying, degree, 1),
+                [f"fit: {n_designs} designs, too few to choose terms by leave-one-out; linear in the groups"])
+    columns["p_tilde"] = np.array([r["p_tilde"] for r in rows])
+    columns["q_tilde"] = np.array([r["q_tilde"] for r in rows])
+    targets = fit_targets(columns, prior)
+    chosen, notes = [], []
+    for name, target in zip(("y = ln(P/P_prior)", "ln kappa"), targets):
+        terms, rms, _ = select_terms(columns, target)
+        chosen.append(terms)
+        notes.append(f"fit of {name}: terms chosen by leave-one-design-out error, rms {rms:.4f} "
+                     f"over {n_designs} designs")
+    return chosen[0], chosen[1], notes
+
+
+def table_csv(rows: list[dict], ranges: dict, provenance: list[str], terms: tuple[tuple, tuple],
               prior: str = "paper") -> str:
     """The calibration CSV of :mod:`reduced.finger_fem`: provenance, range and fit lines, rows."""
     lines = [f"# {line}" for line in provenance]
     lines.append("# groups: b_a = b/a, d_a = d/a, link_a = (l0/6)/a, tie_link = tie width/(l0/6); "
                  "theta [rad]; p_tilde = P/mu_sf; q_tilde = dQ/a^3 (one finger)")
     lines.append("# range: " + ", ".join(f"{g}={ranges[g][0]:.10g}:{ranges[g][1]:.10g}" for g in GROUPS))
-    lines.append(f"# fit: design_degree={degrees[0]}, theta_degree={degrees[1]}, prior={prior}")
+    lines.append(f"# fit: prior={prior}, p_terms={' '.join(terms[0])}, q_terms={' '.join(terms[1])}")
     lines.append(",".join(COLUMNS))
     for r in rows:
         lines.append(",".join(str(int(r[c])) if c == "design" else f"{r[c]:.10g}" for c in COLUMNS))
@@ -121,9 +143,8 @@ def write_table(path, space: DesignSpace, results: list[tuple[HandDesign, dict]]
                      f"designs on the longer slices; {n - len(coarse)} designs (untied gap shorter than "
                      f"{MIN_GAP_SLICES} slices) ran on the default mesh")
     ranges = space_ranges(space.box)
-    varying = sum(ranges[g][1] > ranges[g][0] * (1 + 1e-9) for g in GROUPS)
-    degrees = fit_degrees(len(pairs), varying)
-    text = table_csv(rows, ranges, notes, degrees, prior=space.prior)
+    p_terms, q_terms, fit_notes = choose_terms(rows, ranges, space.prior)
+    text = table_csv(rows, ranges, notes + fit_notes, (p_terms, q_terms), prior=space.prior)
     return write_atomic(path, text)
 
 

@@ -1,0 +1,83 @@
+"""The terms the finger model ``"fem"`` fits its residuals with: named functions of the groups.
+
+A fit is linear in a constant and a list of *terms*; a term is one base feature or a product
+of base features joined by ``*`` (``lb*th``, ``lt*lt``). The base features are those a free
+tube segment's physics names:
+
+=====  ==========================================================================
+``lb``  ln(b/a): the wall's thickness
+``ld``  ln(d/a): the lever arm of the plate
+``lL``  ln(L/a): the link length (hinge spacing, L = l0 / 6)
+``lt``  -ln(1 - w/L): the tied share of a link (w the tie width)
+``lg``  ln((L - w)/a): the untied gap between two ties
+``s2``  (b / (L - w))^2: the squared shape factor of the untied segment (a short segment
+        bonded at both ends cannot contract, so it stiffens as this square)
+``th``  theta [rad], the finger's bend
+=====  ==========================================================================
+
+A table names its terms in its ``# fit:`` line (``p_terms=s2 lb ld th``); older tables give
+polynomial degrees instead, which :func:`legacy_terms` turns into the same list.
+"""
+from __future__ import annotations
+
+from itertools import combinations_with_replacement
+
+import numpy as np
+
+__all__ = ["BASE", "DESIGN_BASE", "legacy_terms", "check_terms", "term_matrix"]
+
+
+def _gap(g):
+    return np.asarray(g["link_a"], float) * (1.0 - np.asarray(g["tie_link"], float))
+
+
+#: base feature -> function of (groups, theta); groups' values may be arrays
+BASE = {
+    "lb": lambda g, th: np.log(np.asarray(g["b_a"], float)),
+    "ld": lambda g, th: np.log(np.asarray(g["d_a"], float)),
+    "lL": lambda g, th: np.log(np.asarray(g["link_a"], float)),
+    "lt": lambda g, th: -np.log1p(-np.asarray(g["tie_link"], float)),
+    "lg": lambda g, th: np.log(_gap(g)),
+    "s2": lambda g, th: (np.asarray(g["b_a"], float) / _gap(g))**2,
+    "th": lambda g, th: np.asarray(th, float),
+}
+DESIGN_BASE = tuple(k for k in BASE if k != "th")
+
+
+def check_terms(terms) -> tuple[str, ...]:
+    """The terms as a tuple; ValueError naming the first one that is not a product of BASE."""
+    terms = tuple(terms)
+    for term in terms:
+        if not term or any(f not in BASE for f in term.split("*")):
+            raise ValueError(f"term {term!r}: allowed are products of {', '.join(BASE)} joined by '*'")
+    return terms
+
+
+def term_matrix(groups: dict, theta, terms) -> np.ndarray:
+    """[1, term_1, ..., term_k] at the groups and theta (broadcast together); (..., k + 1)."""
+    base = {}
+    columns = []
+    for term in terms:
+        value = 1.0
+        for f in term.split("*"):
+            if f not in base:
+                base[f] = BASE[f](groups, theta)
+            value = value * base[f]
+        columns.append(value)
+    shape = np.broadcast_shapes(np.shape(theta), *(np.shape(c) for c in columns))
+    return np.stack([np.ones(shape)] + [np.broadcast_to(c, shape) for c in columns], axis=-1)
+
+
+def legacy_terms(kind: str, varying: dict, design_degree: int, theta_degree: int) -> tuple[str, ...]:
+    """The terms of a table that gives polynomial degrees: for y (kind "p") s2 (if b/a, L/a or
+    w/L varies), lb, ld; for ln kappa (kind "q") lb, ld, lL, lt; only the groups the table
+    varies, their monomials up to design_degree, then th, th*th, ... up to theta_degree."""
+    if kind == "p":
+        names = (["s2"] if varying["b_a"] or varying["link_a"] or varying["tie_link"] else []) + \
+                [n for n, g in (("lb", "b_a"), ("ld", "d_a")) if varying[g]]
+    else:
+        names = [n for n, g in (("lb", "b_a"), ("ld", "d_a"), ("lL", "link_a"), ("lt", "tie_link"))
+                 if varying[g]]
+    terms = ["*".join(c) for degree in range(1, design_degree + 1)
+             for c in combinations_with_replacement(names, degree)]
+    return tuple(terms + ["*".join(["th"] * k) for k in range(1, theta_degree + 1)])
