@@ -328,3 +328,50 @@ def test_a_failed_proof_mesh_is_retried_on_the_thick_walls_mesh(monkeypatch):
     tried.clear()
     fem = verb._prove(ev, task, SimpleNamespace(mesh_size_mm=6.0), None, lambda text: None)
     assert tried == [6.0] and "failed_meshes" not in fem
+
+
+def test_a_fem_stretch_above_the_limit_reoptimises_with_the_fems_factor(tmp_path, monkeypatch, capsys):
+    """The proof's peak stretch 1.41 breaks the limit 1.4: the verb optimises again with eq. (8)'s
+    strain scaled by (1.41 - 1) / (lambda_pred - 1), proves that design (here: the FEM stand-in
+    gives its scaled prediction), keeps the first under "rejected" and exits 0. At 1.45 no design
+    meets the scaled limit if l0 is fixed: one paragraph naming it and the nearest design, exit 1."""
+    from softhand.studies.cli.main import main
+    from softhand.studies.design import proof
+    from softhand.studies.design import evaluate
+    from softhand.studies.design.proof import fem_constraints
+
+    seen = []
+
+    def prove(ev, task, options, out=None, progress=None):
+        seen.append((ev, task))
+        stretch = first if len(seen) == 1 else 1 + 0.999 * (ev.stretch - 1)  # the second: as the factor says
+        fem = {"max_principal_stretch": stretch, "P_grasp_MPa": ev.P_grasp, "F_v_N": ev.F_v}
+        return {**fem, "constraints": fem_constraints(fem, task)}
+
+    monkeypatch.setattr(proof, "prove", prove)
+    task = _write(tmp_path, CI_TASK_TOML + "l0_mm = [150.0, 200.0]\n")  # a longer finger stretches less
+    first = 1.41
+    assert main(["design", "--task", str(task), "--json", "--out", str(tmp_path / "out"), "--seed", "3"]) == 0
+    result = json.loads(capsys.readouterr().out)
+    (ev1, task1), (ev2, task2) = seen
+    factor = 0.41 / (ev1.stretch - 1.0)
+    assert task1.stretch_factor == 1.0 and task2.stretch_factor == pytest.approx(factor, rel=1e-12)
+    assert result["stretch_factor"] == pytest.approx(factor, rel=1e-12)
+    # the new optimum's predicted stretch is eq. (8) x the factor, and within the limit
+    eq8 = evaluate.peak_stretch(ev2.theta_hold, ev2.design)
+    assert ev2.stretch == pytest.approx(1 + factor * (eq8 - 1), rel=1e-12) and ev2.stretch <= 1.4 + 1e-9
+    assert ev2.design != ev1.design  # it moved: the first would be 1.41
+    assert result["rejected"]["fem"]["max_principal_stretch"] == 1.41 and "fem_report" not in result
+    assert load_design(result["design_file"]).to_dict() == result["design"] == ev2.design.to_dict()
+    assert load_design(result["rejected"]["design_file"]).to_dict() == ev1.design.to_dict()
+    seen.clear()  # with l0 fixed the bend at the grasp, so eq. (8), hardly moves: 1.45 cannot be met
+    first, fixed_l0 = 1.45, _write(tmp_path, CI_TASK_TOML, "fixed_l0.toml")
+    assert main(["design", "--task", str(fixed_l0), "--json", "--out", str(tmp_path / "o1"), "--seed", "3"]) == 1
+    result = json.loads(capsys.readouterr().out)
+    assert len(seen) == 1 and result["report"].startswith("The task cannot be met")
+    assert "binding constraint is max_principal_stretch" in result["report"] and "nearest design" in result["report"]
+    # --no-correct keeps the first optimum and its exit code 1
+    seen.clear()
+    assert main(["design", "--task", str(task), "--json", "--out", str(tmp_path / "o2"), "--seed", "3",
+                 "--no-correct"]) == 1
+    assert len(seen) == 1 and "rejected" not in json.loads(capsys.readouterr().out)

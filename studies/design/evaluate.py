@@ -14,7 +14,9 @@ for ``finger_model = "fem"`` by the FEM-informed grasp (:mod:`reduced.grasp_hold
 calibrated finger in equilibrium hinge by hinge against the object, the reservoir's pressure
 at the oil taken), for the paper's finger model by eqs. (25), (29) at theta_g with the
 rolling w. The tube's peak principal stretch is eq. (8), 1 + (d + a + b) theta / l0 (the outer
-fibre on the far side of the hinge plate), at the bend that holds the object.
+fibre on the far side of the hinge plate), at the bend that holds the object, with its strain
+lambda - 1 scaled by the task's ``stretch_factor`` once an FEM proof has measured how far the
+FEM's peak (at the tied rings and the end cap) lies above it.
 
 Constraints (each ``(name, value, limit, sense)``, normalised slack >= 0 when met): the tube
 fits its links (a + b < d), walls (b >= min wall, t > 0), the reservoir keeps oil at the grasp
@@ -80,7 +82,7 @@ class Evaluation:
     P_contact: float           #: free hand's pump pressure at theta_g (27) [MPa]
     F_v: float                 #: required normal force per finger [N]
     F_v_at_limit: float        #: F_v at the pump limit [N]
-    stretch: float             #: the tube's peak principal stretch, eq. (8), at theta_hold
+    stretch: float             #: the tube's peak principal stretch, eq. (8) x stretch_factor, at theta_hold
     sheet_stretch: float       #: the reservoir sheet's stretch at V0, eq. (16)
     constraints: tuple[Constraint, ...]
     theta_hold: float = math.nan  #: the finger's bend when it presses with the required F_v [rad]
@@ -175,7 +177,7 @@ def evaluate(design: HandDesign, task: Task, *, exact: bool = True) -> Evaluatio
         oil = design.n * float(finger.oil_taken(theta_hold, design))
     except InputError:
         oil = math.inf
-    stretch = peak_stretch(theta_hold, design)
+    stretch = 1.0 + task.stretch_factor * (peak_stretch(theta_hold, design) - 1.0)
     sheet = float(reservoir.stretch(design.V0, design))
     cons = [
         Constraint("tube_fits_links (a + b < d) [mm]", design.a + design.b, design.d, "<="),

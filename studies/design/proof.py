@@ -172,6 +172,18 @@ def fem_report(fem: dict, ev: Evaluation) -> str | None:
             f"at the tied rings and the end cap, which the reduced model does not see.")
 
 
+def corrected_task(task: Task, ev: Evaluation, fem: dict) -> Task | None:
+    """The task with eq. (8)'s strain scaled to the FEM's, if the FEM's peak stretch at the
+    verified grasp broke the task's limit (None otherwise): stretch_factor x (lambda_FEM - 1) /
+    (lambda_predicted - 1), so that the reduced model predicts this design's FEM peak and a new
+    optimum keeps its FEM stretch near the limit. The FEM's peak grows with the bend as eq. (8)
+    does (both are the wall's strain at the hinge), so one factor carries to nearby designs."""
+    stretch = fem.get("max_principal_stretch")
+    if stretch is None or stretch <= task.max_stretch or not ev.stretch > 1.0:
+        return None
+    return replace(task, stretch_factor=task.stretch_factor * (stretch - 1.0) / (ev.stretch - 1.0))
+
+
 def prove(ev: Evaluation, task: Task, options: ProofOptions = ProofOptions(), *, out=None,
           progress=None) -> dict:
     """Run the three FEM models for the evaluated design; the FEM's numbers (see module doc)."""

@@ -81,6 +81,8 @@ class Task:
     objective: str = "pressure"            #: one of OBJECTIVES
     opening: float | None = None           #: open tip span to pass [mm]; None: the diameter
     max_stretch: float = 1.5               #: peak principal stretch of the tube
+    #: the FEM's peak stretch over eq. (8)'s, in (lambda - 1): 1 until a proof has measured it
+    stretch_factor: float = 1.0
     min_wall: float = 1.0                  #: least tube wall and sheet thickness [mm]
     mesh_size: float = 6.0                 #: FEM proof: finger element size [mm]
     edge_ratio: float = 0.5                #: FEM proof: element size at the ring edges / mesh_size
