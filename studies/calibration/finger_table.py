@@ -51,10 +51,11 @@ SELECT_MIN_DESIGNS = 6
 
 
 def choose_terms(rows: list[dict], ranges: dict, prior: str) -> tuple[tuple, tuple, list[str]]:
-    """(p_terms, q_terms, notes) of the fit of ``rows``: chosen by forward selection on the
-    leave-one-design-out error (:mod:`.fit_terms`) when the table has SELECT_MIN_DESIGNS
-    designs or more; else a polynomial of the varying groups, linear if it has a design more
-    than groups, and linear in theta."""
+    """(p_terms, q_terms, notes) of the fit of ``rows``: the physics' linear terms (for y the
+    untied segment's s^2, ln b/a, ln d/a; for ln kappa the four groups' logarithms; and theta),
+    to which forward selection on the leave-one-design-out error (:mod:`.fit_terms`) adds
+    terms when the table has SELECT_MIN_DESIGNS designs or more; with fewer, linear terms if
+    the table has a design more than groups, else theta only."""
     from softhand.reduced.finger_fem import fit_targets
     from softhand.reduced.finger_fem_terms import legacy_terms
     from softhand.studies.calibration.fit_terms import group_rows, select_terms
@@ -70,11 +71,11 @@ def choose_terms(rows: list[dict], ranges: dict, prior: str) -> tuple[tuple, tup
     columns["q_tilde"] = np.array([r["q_tilde"] for r in rows])
     targets = fit_targets(columns, prior)
     chosen, notes = [], []
-    for name, target in zip(("y = ln(P/P_prior)", "ln kappa"), targets):
-        terms, rms, _ = select_terms(columns, target)
+    for kind, name, target in zip("pq", ("y = ln(P/P_prior)", "ln kappa"), targets):
+        terms, rms, _ = select_terms(columns, target, start=legacy_terms(kind, varying, 1, 1))
         chosen.append(terms)
-        notes.append(f"fit of {name}: terms chosen by leave-one-design-out error, rms {rms:.4f} "
-                     f"over {n_designs} designs")
+        notes.append(f"fit of {name}: linear terms and those forward selection added by "
+                     f"leave-one-design-out error, rms {rms:.4f} over {n_designs} designs")
     return chosen[0], chosen[1], notes
 
 
@@ -184,11 +185,12 @@ def heldout_rows(results: list[tuple[HandDesign, dict]], table: str | None = Non
     return rows, worst
 
 
-def leave_one_out(path: str | Path | None = None) -> list[dict]:
+def leave_one_out(path: str | Path | None = None, reselect: bool = False) -> list[dict]:
     """Each design of a table predicted by the table without it (its rows removed, the fit
     redone, the ranges kept): per FEM row, theta at the FEM's pressure and dQ at the FEM's
     theta, errors [%]. A check of the fit that runs no FEM (the designs are at a = 4 mm, which
-    the groups do not see)."""
+    the groups do not see). ``reselect``: the terms too are chosen again without the design
+    (:func:`choose_terms`), so that the left-out design has had no say in the fit at all."""
     import tempfile
 
     from softhand.reduced.finger_fem import TABLE_FILE, read_table
@@ -202,6 +204,10 @@ def leave_one_out(path: str | Path | None = None) -> list[dict]:
             at = r["design"] == i
             rest = [{c: r[c][k] for c in COLUMNS} for k in np.flatnonzero(~at)]
             lines = [line.lstrip("#").strip() for line in header]
+            if reselect:
+                p_terms, q_terms, _ = choose_terms(rest, table.ranges, table.prior)
+                lines = [line for line in lines if not line.startswith("fit:")] + [
+                    f"fit: prior={table.prior}, p_terms={' '.join(p_terms)}, q_terms={' '.join(q_terms)}"]
             text = "\n".join(f"# {line}" for line in lines) + "\n" + ",".join(COLUMNS) + "\n"
             text += "".join(",".join(f"{row[c]:.10g}" for c in COLUMNS) + "\n" for row in rest)
             held = Path(tmp) / f"without_{int(i)}.csv"

@@ -2,7 +2,8 @@
 
 The table's residuals (y = ln(P_FEM / P_prior) and ln kappa, :func:`reduced.finger_fem.fit_targets`)
 are fitted linearly in a constant and terms of :mod:`reduced.finger_fem_terms`. Which terms is
-not fixed beforehand: starting from theta alone, each step adds the candidate (a varying base
+not wholly fixed beforehand: starting from given terms (the calibration starts from the
+physics' linear terms, a test from theta alone), each step adds the candidate (a varying base
 feature, a product of two, or a base feature times theta) that most lowers the rms error of
 predicting every design from the table without it (all of that design's rows left out, the fit
 redone), and stops when no candidate lowers it by ``min_gain`` (relative), when it is zero to
@@ -51,14 +52,14 @@ def loo_rms(rows: dict, target: np.ndarray, terms) -> float:
     return float(np.sqrt(np.mean(errors**2)))
 
 
-def select_terms(rows: dict, target: np.ndarray, min_gain: float = 0.02,
-                 designs_per_term: int = 2) -> tuple[tuple[str, ...], float, list[tuple[str, float]]]:
+def select_terms(rows: dict, target: np.ndarray, min_gain: float = 0.02, designs_per_term: int = 2,
+                 start=("th",)) -> tuple[tuple[str, ...], float, list[tuple[str, float]]]:
     """(terms, their leave-one-design-out rms, the path [(term added, rms after)]) for ``target``
-    over the table ``rows`` (GROUPS, theta and design columns)."""
+    over the table ``rows`` (GROUPS, theta and design columns), adding to the terms ``start``."""
     n_designs = np.unique(rows["design"]).size
-    terms = ["th"]
+    terms = list(start)
     best = loo_rms(rows, target, terms)
-    path = [("th", best)]
+    path = [(" ".join(terms), best)]
     pool = [c for c in candidates(rows) if c not in terms]
     while pool and best > 1e-12 and (len(terms) + 2) * designs_per_term <= n_designs:
         scores = [loo_rms(rows, target, terms + [c]) for c in pool]
