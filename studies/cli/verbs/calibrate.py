@@ -117,9 +117,11 @@ def _finished_only(space, results):
 
     n = len(space.points)
     keep = [i for i in range(n) if results[i][1] is not None]
-    if not keep or any(record is None for _, record in results[n:]):
-        raise InputError("--finished", "results", "need one finished design and the finished "
-                                                  "mesh_pair cases; run without --finished")
+    pair_pending = any(record is None for _, record in results[n:])
+    if not keep or pair_pending:
+        found = f"{len(keep)} finished designs" + (", mesh_pair pending" if pair_pending else "")
+        raise InputError("--finished", found, "needs one finished design and the finished "
+                                              "mesh_pair cases; run without --finished")
     return (dataclasses.replace(space, points=tuple(space.points[i] for i in keep)),
             [results[i] for i in keep] + results[n:])
 
