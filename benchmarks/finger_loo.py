@@ -2,9 +2,7 @@
 table without it (fit redone, ranges kept), no FEM run. Prints theta and dQ errors per
 design (worst over its FEM points) and the rms / worst over all points.
 
-Run: ``python benchmarks/finger_loo.py [TABLE.csv] [--reselect]`` (default: the shipped table;
-``--reselect``: the fit's terms are chosen again without each design, the honest estimate of a
-new design's error, since the terms were chosen by this very error).
+Run: ``python benchmarks/finger_loo.py [TABLE.csv]`` (default: the shipped table).
 """
 from __future__ import annotations
 
@@ -16,8 +14,7 @@ from softhand.studies.calibration.finger_table import leave_one_out
 
 
 def main() -> None:
-    args = [a for a in sys.argv[1:] if a != "--reselect"]
-    rows = leave_one_out(args[0] if args else None, reselect="--reselect" in sys.argv[1:])
+    rows = leave_one_out(sys.argv[1] if len(sys.argv) > 1 else None)
     print("design  b/a    d/a    link/a  tie/link  |theta err| max [%]  |dQ err| max [%]")
     for i in sorted({r["design"] for r in rows}):
         mine = [r for r in rows if r["design"] == i]

@@ -49,7 +49,7 @@ from . import finger
 from .finger_curves import Curves, energy_curves
 from .design import HandDesign
 from .errors import InputError
-from .finger_fem_terms import term_matrix
+from .finger_fem_terms import KernelFit, term_matrix
 from .finger_fem_table import COLUMNS, GROUPS, LABELS, PRIORS, TABLE_FILE, Table, _bad, read_table
 
 __all__ = ["TABLE_FILE", "GROUPS", "COLUMNS", "PRIORS", "Table", "read_table", "groups_of", "curves", "FEM"]
@@ -134,21 +134,36 @@ def fit_targets(rows: dict, prior: str, path="table") -> tuple[np.ndarray, np.nd
     return y, np.log(dilation / rows["p_tilde"])
 
 
+class _TermsFit:
+    """y and ln kappa by least squares in the table's terms."""
+
+    def __init__(self, table: Table, y, ln_kappa, path):
+        r = table.rows
+        self.terms, self.betas = (table.p_terms, table.q_terms), []
+        for terms, target in zip(self.terms, (y, ln_kappa)):
+            beta = lstsq_terms(r, r["theta"], target, terms)
+            if beta is None:
+                raise _bad(path, f"has too few designs ({np.unique(r['design']).size}) for the "
+                                 f"fit's terms ({' '.join(terms)}); use fewer in '# fit:'")
+            self.betas.append(beta)
+
+    def __call__(self, groups: dict, theta):
+        return tuple(term_matrix(groups, theta, terms) @ beta for terms, beta in zip(self.terms, self.betas))
+
+
 @lru_cache(maxsize=8)
-def _fit(path: str) -> tuple[Table, np.ndarray, np.ndarray, float]:
-    """(table, beta_y, beta_k, theta_max): least-squares coefficients of y and ln kappa."""
+def _fit(path: str) -> tuple[Table, object, float]:
+    """(table, fit, theta_max): fit(groups, theta) -> (y, ln kappa)."""
     table = read_table(path)
-    r = table.rows
-    ids = np.unique(r["design"])
-    y, ln_kappa = fit_targets(r, table.prior, path)
-    betas = []
-    for terms, target in ((table.p_terms, y), (table.q_terms, ln_kappa)):
-        beta = lstsq_terms(r, r["theta"], target, terms)
-        if beta is None:
-            raise _bad(path, f"has too few designs ({ids.size}) for the fit's terms "
-                             f"({' '.join(terms)}); use fewer in '# fit:'")
-        betas.append(beta)
-    return table, betas[0], betas[1], float(r["theta"].max())
+    y, ln_kappa = fit_targets(table.rows, table.prior, path)
+    if table.kernel is None:
+        fit = _TermsFit(table, y, ln_kappa, path)
+    else:
+        try:
+            fit = KernelFit(table.rows, y, ln_kappa, table.kernel, table.features)
+        except ValueError as error:
+            raise _bad(path, f"has {error}") from None
+    return table, fit, float(table.rows["theta"].max())
 
 
 def check_space(design: HandDesign, table: Table) -> dict:
@@ -167,11 +182,9 @@ def check_space(design: HandDesign, table: Table) -> dict:
 def residuals(theta, design: HandDesign) -> tuple[np.ndarray, np.ndarray]:
     """(y, ln kappa) of the fit at theta [rad] for this design:
     P = P_prior e^y, Delta Q = a^2 pi d theta + a^3 kappa P / mu_sf."""
-    table, beta_y, beta_k, theta_max = _fit(_table_path(design))
+    table, fit, theta_max = _fit(_table_path(design))
     groups = check_space(design, table)
-    t = np.clip(np.asarray(theta, float), -theta_max, theta_max)
-    return (term_matrix(groups, t, table.p_terms) @ beta_y,
-            term_matrix(groups, t, table.q_terms) @ beta_k)
+    return fit(groups, np.clip(np.asarray(theta, float), -theta_max, theta_max))
 
 
 def _table_path(design: HandDesign) -> str:

@@ -2,9 +2,10 @@
 
 ``reduced/data/finger_fem.csv`` (or a table of one design made by ``softhand calibrate finger
 --design``) holds the finger FEM's (theta, P/mu_sf, Delta Q/a^3) at sampled designs, after
-comment lines with its provenance, the groups' calibrated ranges (``# range:``) and the fit's
-prior and terms (``# fit: prior=rings, p_terms=s2 lb th, q_terms=lt th``, or, in older tables,
-polynomial degrees ``design_degree=D, theta_degree=T``); :mod:`softhand.reduced.finger_fem` fits
+comment lines with its provenance, the groups' calibrated ranges (``# range:``) and the fit
+(``# fit: prior=rings, kernel=thin_plate_spline, features=lb ld lL lt s2`` for an interpolant
+over many designs; ``# fit: prior=rings, p_terms=s2 lb th, q_terms=lt th`` for least squares
+in named terms; in older tables polynomial degrees ``design_degree=D, theta_degree=T``); :mod:`softhand.reduced.finger_fem` fits
 and uses it.
 """
 from __future__ import annotations
@@ -24,6 +25,8 @@ LABELS = {"b_a": "b/a", "d_a": "d/a", "link_a": "link/a", "tie_link": "tie/link"
 COLUMNS = ("design", *GROUPS, "theta", "p_tilde", "q_tilde")
 #: the physics a table's residual is taken against (see :func:`prior_pressure`)
 PRIORS = ("paper", "rings")
+#: the radial basis functions a kernel fit may use (scipy.interpolate.RBFInterpolator's)
+KERNELS = ("thin_plate_spline", "cubic", "linear", "quintic")
 
 
 @dataclass(frozen=True)
@@ -33,10 +36,12 @@ class Table:
     source: str  #: file name, for messages
     rows: dict  #: column -> array
     ranges: dict  #: group -> (min, max)
-    p_terms: tuple[str, ...]  #: the terms of y = ln(P / P_prior) (finger_fem_terms)
-    q_terms: tuple[str, ...]  #: the terms of ln kappa
+    p_terms: tuple[str, ...]  #: the terms of y = ln(P / P_prior) (finger_fem_terms), or ()
+    q_terms: tuple[str, ...]  #: the terms of ln kappa, or ()
     prior: str = "paper"  #: the physics the residual is taken against, one of PRIORS
     header: tuple[str, ...] = ()  #: the provenance comment lines
+    kernel: str | None = None  #: a kernel fit's radial basis function (instead of the terms)
+    features: tuple[str, ...] = ()  #: the features a kernel fit interpolates in
 
 
 def _bad(path, allowed: str):
@@ -71,6 +76,15 @@ def read_table(path: str | Path = TABLE_FILE) -> Table:
         lo, hi = ranges[g]
         if np.any(rows[g] < lo * (1 - 1e-9)) or np.any(rows[g] > hi * (1 + 1e-9)):
             raise _bad(path, f"has {LABELS[g]} outside its '# range:' [{lo:g}, {hi:g}]")
+    if "kernel" in spec:
+        if spec["kernel"] not in KERNELS:
+            raise _bad(path, f"has kernel={spec['kernel']}; allowed: {', '.join(KERNELS)}")
+        try:
+            features = check_terms(spec.get("features", "").split())
+        except ValueError as error:
+            raise _bad(path, f"has '# fit:' features: {error}") from None
+        return Table(path.name, rows, ranges, (), (), prior=prior, header=tuple(comments),
+                     kernel=spec["kernel"], features=features)
     terms = _terms(spec, ranges, path)
     return Table(path.name, rows, ranges, *terms, prior=prior, header=tuple(comments))
 

@@ -81,3 +81,40 @@ def legacy_terms(kind: str, varying: dict, design_degree: int, theta_degree: int
     terms = ["*".join(c) for degree in range(1, design_degree + 1)
              for c in combinations_with_replacement(names, degree)]
     return tuple(terms + ["*".join(["th"] * k) for k in range(1, theta_degree + 1)])
+
+
+#: the features a kernel fit interpolates in (the groups' logarithms and the shape factor)
+KERNEL_FEATURES = ("lb", "ld", "lL", "lt", "s2")
+
+
+class KernelFit:
+    """y and ln kappa as a radial-basis interpolant over the designs: per design, each
+    residual's least-squares line in theta (a + b theta); a, b interpolated over the design
+    features (scaled to [0, 1] over the table's designs) by SciPy's RBFInterpolator with a
+    linear polynomial, exact at every design of the table."""
+
+    def __init__(self, rows: dict, y: np.ndarray, ln_kappa: np.ndarray, kernel: str, features):
+        from scipy.interpolate import RBFInterpolator
+
+        ids = np.unique(rows["design"])
+        coef, X = [], []
+        for i in ids:
+            at = rows["design"] == i
+            th = rows["theta"][at]
+            line = [np.polyfit(th, v[at], 1) if np.ptp(th) > 0 else (0.0, v[at].mean()) for v in (y, ln_kappa)]
+            coef.append([line[0][1], line[0][0], line[1][1], line[1][0]])
+            g = {k: rows[k][at][0] for k in ("b_a", "d_a", "link_a", "tie_link")}
+            X.append([float(BASE[f](g, 0.0)) for f in features])
+        X = np.array(X)
+        self.features = tuple(features)
+        self.lo, self.span = X.min(axis=0), np.ptp(X, axis=0)
+        if np.any(self.span <= 1e-12 * np.maximum(np.abs(self.lo), 1.0)) or ids.size < len(features) + 2:
+            raise ValueError(f"{ids.size} designs: a kernel fit in {' '.join(features)} needs at least "
+                             f"{len(features) + 2} designs over which every feature varies")
+        self.rbf = RBFInterpolator((X - self.lo) / self.span, np.array(coef), kernel=kernel, degree=1)
+
+    def __call__(self, groups: dict, theta) -> tuple[np.ndarray, np.ndarray]:
+        x = np.array([float(BASE[f](groups, 0.0)) for f in self.features])
+        a_y, b_y, a_k, b_k = self.rbf(((x - self.lo) / self.span)[None, :])[0]
+        theta = np.asarray(theta, float)
+        return a_y + b_y * theta, a_k + b_k * theta

@@ -49,7 +49,7 @@ def _synthetic_table(tmp_path, ties=(5.0, 10.0, 15.0)):
     ranges = {k: (v, v) for k, v in groups[0].items()}
     ranges["tie_link"] = (groups[0]["tie_link"], groups[-1]["tie_link"])
     path = tmp_path / "synthetic.csv"
-    path.write_text(table_csv(rows, ranges, ["synthetic test table"], (("s2", "th"), ("lt", "th"))))
+    path.write_text(table_csv(rows, ranges, ["synthetic test table"], "p_terms=s2 th, q_terms=lt th"))
     return path, designs, ties
 
 
@@ -208,3 +208,58 @@ def test_a_short_untied_gap_is_announced_in_one_line(tmp_path):
     err = run.stderr.strip().splitlines()
     assert run.returncode == 0 and len(err) == 1, run.stderr
     assert err[0].startswith('softhand curve: warning: finger_model "fem": untied gap')
+
+
+def _kernel_table(tmp_path, truth, name, n=14, seed=4):
+    """A table of n random designs in the box whose rows follow truth(groups, theta) -> (y, ln kappa)
+    over the rings prior, with the kernel fit's '# fit:' line."""
+    from softhand.reduced.finger_fem_terms import KERNEL_FEATURES
+
+    rng = np.random.default_rng(seed)
+    rows = []
+    for i in range(n):
+        g = {"b_a": rng.uniform(0.5, 2.3), "d_a": rng.uniform(1.7, 6.6), "link_a": rng.uniform(3.4, 11.0),
+             "tie_link": rng.uniform(0.15, 0.75)}
+        for theta in (0.2, 0.6, 1.0):
+            y, ln_kappa = truth(g, theta)
+            p = finger_fem.prior_pressure(theta, g, "rings") * math.exp(y)
+            rows.append({"design": i, **g, "theta": theta, "p_tilde": float(p),
+                         "q_tilde": math.pi * g["d_a"] * theta + math.exp(ln_kappa) * float(p)})
+    ranges = {"b_a": (0.5, 2.333333333), "d_a": (1.666666667, 6.666666667),
+              "link_a": (3.333333333, 11.11111111), "tie_link": (0.15, 0.75)}
+    path = tmp_path / f"{name}.csv"  # one name per table: fits are cached by path
+    path.write_text(table_csv(rows, ranges, ["kernel test table"],
+                              f"kernel=thin_plate_spline, features={' '.join(KERNEL_FEATURES)}", prior="rings"))
+    return path, rows
+
+
+def test_kernel_fit_is_exact_at_its_designs_and_for_linear_residuals(tmp_path):
+    """The thin-plate-spline fit carries a linear polynomial, so a residual linear in the
+    features (and theta) is reproduced at any design, not only the table's; a nonlinear one
+    is reproduced at the table's designs (an interpolant) and only approximated between."""
+    from softhand.reduced.finger_fem_terms import BASE
+
+    def linear(g, th):
+        return (0.1 - 0.05 * BASE["lb"](g, th) + 0.02 * BASE["s2"](g, th) + 0.03 * th,
+                1.5 + 0.2 * BASE["lt"](g, th) - 0.1 * BASE["lL"](g, th) - 0.05 * th)
+
+    path, _ = _kernel_table(tmp_path, linear, "linear")
+    new = finger_design({"a_mm": 4.0, "b_mm": 5.0, "d_mm": 15.0, "l0_mm": 180.0, "tie_width_mm": 10.0})
+    model = new.replace(finger_model="fem", finger_table=str(path))
+    y, k = finger_fem.residuals(np.array([0.3, 0.8]), model)
+    want = [linear(finger_fem.groups_of(new), t) for t in (0.3, 0.8)]
+    assert np.allclose(y, [w[0] for w in want], atol=1e-9) and np.allclose(k, [w[1] for w in want], atol=1e-9)
+
+    def curved(g, th):
+        return 0.2 * math.sin(3 * BASE["lb"](g, th)) + 0.01 * th, 1.0 + BASE["lt"](g, th)**2
+
+    path, rows = _kernel_table(tmp_path, curved, "curved")
+    first = rows[0]
+    d = finger_design({"a_mm": 2.0, "b_mm": 2.0 * first["b_a"], "d_mm": 2.0 * first["d_a"],
+                       "l0_mm": 12.0 * first["link_a"], "tie_width_mm": 2.0 * first["link_a"] * first["tie_link"]})
+    y, k = finger_fem.residuals(np.array([0.2, 1.0]), d.replace(finger_model="fem", finger_table=str(path)))
+    want = [curved(first, t) for t in (0.2, 1.0)]
+    assert np.allclose(y, [w[0] for w in want], atol=1e-6) and np.allclose(k, [w[1] for w in want], atol=1e-6)
+    path, _ = _kernel_table(tmp_path, curved, "few", n=6)
+    with pytest.raises(InputError, match="6 designs: a kernel fit in lb ld lL lt s2 needs at least 7"):
+        finger_fem.residuals(0.5, d.replace(finger_model="fem", finger_table=str(path)))
