@@ -17,12 +17,14 @@ holds the FEM's (theta, P/mu, Delta Q/a^3) at the sampled designs; this model fi
 .. math:: y = \ln\frac{P_{FEM}}{P_{prior}}, \qquad
           \ln\kappa = \ln\frac{\Delta Q_{FEM}/a^3 - \pi (d/a)\,\theta}{P_{FEM}/\mu_{sf}}
 
-by least squares, each as a polynomial (total degree from the table's ``# fit:`` line) in its
-design features scaled to [-1, 1] over the table's range, plus theta, ..., theta^T. The
-features are those a free tube segment's physics names. For y: s^2, s = b / (L - w) the
-wall over the untied gap (a short bonded segment cannot contract, so it stiffens as the
-square of its shape factor), ln(b/a) and ln(d/a). For ln kappa: the four groups' logarithms
-(with -ln(1 - w/L) for the tie, the tied share of the length). So P(theta) = P_prior(theta)
+over the features a free tube segment's physics names (ln b/a, ln d/a, ln L/a, the tied share
+-ln(1 - w/L) and the untied gap's shape factor s = b / (L - w) squared: a short segment
+bonded at both ends cannot contract, so it stiffens as s^2; :mod:`.finger_fem_terms`), as
+the table's ``# fit:`` line says. A table of the design space (12 designs or more) is
+interpolated by a thin-plate spline with a linear polynomial, per design a line in theta
+(:class:`~.finger_fem_terms.KernelFit`, exact at the table's designs; chosen over polynomial
+least squares by leave-one-design-out error); a table of a few designs is fitted by least
+squares in linear terms (older tables: polynomial degrees). So P(theta) = P_prior(theta)
 e^{y} and Delta Q = a^2 pi d theta + a^3 kappa P(theta) / mu_sf. Beyond the table's largest
 angle theta_max (and below -theta_max) y and ln kappa are held at their end values.
 
