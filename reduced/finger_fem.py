@@ -41,7 +41,6 @@ makes a table for such a design. Units: mm, MPa, N mm, rad.
 from __future__ import annotations
 
 import math
-import warnings
 from functools import lru_cache
 from typing import NamedTuple
 
@@ -57,16 +56,6 @@ from .finger_fem_table import COLUMNS, GROUPS, LABELS, PRIORS, TABLE_FILE, Table
 __all__ = ["TABLE_FILE", "GROUPS", "COLUMNS", "PRIORS", "Table", "read_table", "groups_of", "curves", "FEM"]
 
 N_LINKS = 6
-#: the shipped table's designs with an untied gap (link - tie) under this [mm] were computed with
-#: one or two 5 mm slices across the gap, which lock: for such designs the model bends less than
-#: the finger FEM (measured -6 % and -16 % at two 5 mm gaps, docs/finger.md)
-SHORT_GAP_MM = 10.0
-
-
-class ShortGapWarning(UserWarning):
-    """A design in the part of the space where the shipped table is known to be too stiff."""
-
-
 # ---------------------------------------------------------------------- groups and the fit
 def groups_of(design: HandDesign) -> dict:
     """The design's groups b/a, d/a, link/a, tie/link (5 equal hinges required)."""
@@ -198,12 +187,6 @@ def curves(design: HandDesign) -> Curves:
     """The calibrated curves of ``design`` (cached per design)."""
     table = _fit(_table_path(design))[0]
     groups = check_space(design, table)
-    gap = design.l0 / N_LINKS - design.tie_width
-    if not design.finger_table and gap < SHORT_GAP_MM:
-        warnings.warn(f'finger_model "fem": untied gap {gap:.3g} mm (link - tie) is under '
-                      f"{SHORT_GAP_MM:g} mm, where the shipped table is too stiff (it bends 6-16 % "
-                      "less than the finger FEM there); calibrate this design with softhand "
-                      "calibrate finger --design FILE --out FILE.csv", ShortGapWarning, stacklevel=2)
 
     def pressure(t):
         return design.mu_sf * prior_pressure(t, groups, table.prior) * np.exp(residuals(t, design)[0])

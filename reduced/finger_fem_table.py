@@ -26,7 +26,7 @@ COLUMNS = ("design", *GROUPS, "theta", "p_tilde", "q_tilde")
 #: the physics a table's residual is taken against (see :func:`prior_pressure`)
 PRIORS = ("paper", "rings")
 #: the radial basis functions a kernel fit may use (scipy.interpolate.RBFInterpolator's)
-KERNELS = ("thin_plate_spline", "cubic", "linear", "quintic")
+KERNELS = ("thin_plate_spline", "cubic", "linear")
 
 
 @dataclass(frozen=True)

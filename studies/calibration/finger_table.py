@@ -55,21 +55,22 @@ def choose_fit(rows: list[dict], ranges: dict, prior: str) -> tuple[str, list[st
     """The '# fit:' line's items after the prior for ``rows``, and a provenance note. With
     KERNEL_MIN_DESIGNS designs or more: the thin-plate-spline interpolant over the five
     features of :data:`KERNEL_FEATURES` (per design a line in theta; exact at the designs).
-    It was chosen over least squares in polynomial terms (linear, or forward-selected products)
-    by leave-one-design-out error on the 31-design table: y 0.018 against 0.03-0.10 rms,
-    ln kappa 0.020 against 0.04-0.07 (docs/finger.md). With fewer designs: least squares in
-    the varying groups' linear terms and theta (theta only if the designs are too few)."""
+    It was chosen over least squares by leave-one-design-out error on the 31-design table
+    (rms of y / ln kappa): 0.017 / 0.018, against 0.036 / 0.059 for terms linear in the
+    features and 0.105 / 0.040 for quadratic ones (cubic radial functions: 0.017 / 0.018,
+    linear ones 0.020 / 0.022). With fewer designs: least squares in the varying groups' linear
+    terms and theta (theta only if the designs are too few)."""
     from softhand.reduced.finger_fem_terms import KERNEL_FEATURES, legacy_terms
 
     n_designs = len({r["design"] for r in rows})
     if n_designs >= KERNEL_MIN_DESIGNS:
         return (f"kernel={KERNEL}, features={' '.join(KERNEL_FEATURES)}",
-                [f"fit: {KERNEL} interpolant over {n_designs} designs in {', '.join(KERNEL_FEATURES)}"])
+                [f"fitted by the {KERNEL} interpolant over {n_designs} designs in {', '.join(KERNEL_FEATURES)}"])
     varying = {g: ranges[g][1] > ranges[g][0] * (1 + 1e-9) for g in GROUPS}
     degree = 1 if any(varying.values()) and n_designs >= sum(varying.values()) + 1 else 0
     terms = [" ".join(legacy_terms(kind, varying, degree, 1)) for kind in "pq"]
     return (f"p_terms={terms[0]}, q_terms={terms[1]}",
-            [f"fit: least squares, {'linear in the groups and ' if degree else ''}linear in theta "
+            [f"fitted by least squares, {'linear in the groups and ' if degree else ''}linear in theta "
              f"({n_designs} designs)"])
 
 
