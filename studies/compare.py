@@ -15,6 +15,7 @@ study (:mod:`studies.bending`) runs it with ``hand=True``.
 from __future__ import annotations
 
 import math
+import warnings
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -51,7 +52,7 @@ class WholeHandResult:
 
     def max_abs_difference_MPa(self) -> float:
         """Largest |P_hand,FEM - P_eq.(27)| over the rows [MPa]."""
-        return float(max(abs(r["P_hand_fem_MPa"] - r["P_hand_eq27_MPa"]) for r in self.rows))
+        return float(np.nanmax([abs(r["P_hand_fem_MPa"] - r["P_hand_eq27_MPa"]) for r in self.rows]))
 
 
 def whole_hand(rows: list[dict], design: HandDesign, **sheet_mesh) -> WholeHandResult:
@@ -59,10 +60,15 @@ def whole_hand(rows: list[dict], design: HandDesign, **sheet_mesh) -> WholeHandR
     finger + FEM reservoir, and eq. (27) at the same theta."""
     dQ = np.array([r["dQ_mm3"] for r in rows])
     V = design.V0 - design.n * dQ
-    sheet = inflate(SheetModel.from_design(design, **sheet_mesh), np.append(V, design.V0))
-    p_res = np.array([s.pressure for s in sheet.states])
+    wet = V > 0  # beyond, the fingers would take more oil than the reservoir holds: no hand
+    if not wet.all():
+        warnings.warn(f"the {design.n} FEM fingers take more oil than V0 = {design.V0:g} mm^3 from "
+                      f"{rows[int(np.argmin(wet))]['theta_deg']:.4g} deg on: no whole-hand pressure there")
+    sheet = inflate(SheetModel.from_design(design, **sheet_mesh), np.append(V[wet], design.V0))
+    p_res = np.full(V.size, math.nan)
+    p_res[wet] = [s.pressure for s in sheet.states[:-1]]
     out = []
-    for r, v, pr in zip(rows, V, p_res[:-1]):
+    for r, v, pr in zip(rows, V, p_res):
         theta = math.radians(r["theta_deg"])
         out.append({
             "theta_deg": r["theta_deg"],
@@ -70,8 +76,8 @@ def whole_hand(rows: list[dict], design: HandDesign, **sheet_mesh) -> WholeHandR
             "V_mm3": float(v),
             "p_reservoir_fem_MPa": float(pr),
             "P_hand_fem_MPa": r["P_MPa"] - float(pr),
-            "P_hand_eq27_MPa": float(hand.pressure(theta, design, reservoir=True)),
+            "P_hand_eq27_MPa": float(hand.pressure(theta, design, reservoir=True)) if v > 0 else math.nan,
             "P_finger_eq28_MPa": float(hand.pressure(theta, design, reservoir=False)),
         })
-    return WholeHandResult(out, float(p_res[-1]), float(ellipse.pressure(design.V0, design)),
+    return WholeHandResult(out, float(sheet.states[-1].pressure), float(ellipse.pressure(design.V0, design)),
                            int(sheet.ndofs), sheet.wall_time)

@@ -86,3 +86,18 @@ def test_the_result_writes_what_it_computed(bent):
     assert steps == 2 and "tube" in scene.keys()
     assert (out / "fig7.png").stat().st_size > 10_000
     assert np.isfinite(saved["rows"][-1]["theta_deg"]) and saved["rows"][-1]["theta_deg"] > 0
+
+
+def test_the_whole_hand_stops_where_the_reservoir_runs_dry():
+    """Rows whose oil n dQ exceeds V0 have no reservoir pressure (nan) and are announced in one
+    warning; the rows before keep the sheet FEM's answer of a run without them."""
+    from softhand.studies.compare import whole_hand
+
+    d = HandDesign()
+    dry = d.V0 / d.n * 1.01
+    rows = [{"P_MPa": 0.2, "theta_deg": 8.0, "dQ_mm3": 500.0}, {"P_MPa": 0.9, "theta_deg": 90.0, "dQ_mm3": dry}]
+    with pytest.warns(UserWarning, match=r"take more oil than V0 = 17800 mm\^3 from 90 deg on"):
+        h = whole_hand(rows, d)
+    assert math.isnan(h.rows[1]["P_hand_fem_MPa"]) and math.isnan(h.rows[1]["P_hand_eq27_MPa"])
+    alone = whole_hand(rows[:1], d)
+    assert h.rows[0] == alone.rows[0] and h.max_abs_difference_MPa() == alone.max_abs_difference_MPa()
