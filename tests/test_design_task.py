@@ -375,3 +375,32 @@ def test_a_fem_stretch_above_the_limit_reoptimises_with_the_fems_factor(tmp_path
     assert main(["design", "--task", str(task), "--json", "--out", str(tmp_path / "o2"), "--seed", "3",
                  "--no-correct"]) == 1
     assert len(seen) == 1 and "rejected" not in json.loads(capsys.readouterr().out)
+
+
+def test_the_pareto_knee_goes_through_the_fem_too(tmp_path, monkeypatch, capsys):
+    """With --pareto the proof runs for the optimum and for the front's knee (its design file in
+    knee/, its prediction at the knee's stretch limit beside the FEM's answer)."""
+    from softhand.studies.cli.main import main
+    from softhand.studies.design import proof
+    from softhand.studies.design.proof import fem_constraints
+
+    seen = []
+
+    def prove(ev, task, options, out=None, progress=None):
+        seen.append((ev, out))
+        fem = {"max_principal_stretch": ev.stretch, "P_grasp_MPa": ev.P_grasp, "F_v_N": ev.F_v}
+        return {**fem, "constraints": fem_constraints(fem, task)}
+
+    monkeypatch.setattr(proof, "prove", prove)
+    task = _write(tmp_path, CI_TASK_TOML + "l0_mm = [150.0, 200.0]\n")
+    out = tmp_path / "out"
+    assert main(["design", "--task", str(task), "--json", "--pareto", "--out", str(out), "--seed", "3"]) == 0
+    pareto = json.loads(capsys.readouterr().out)["pareto"]
+    knee = pareto["rows"][pareto["knee"]]
+    assert pareto["knee"] > 0 and len(seen) == 2 and seen[1][1] == out / "knee"
+    proof_of_knee = pareto["knee_proof"]
+    predicted = proof_of_knee["predicted"]  # the front's axis: the larger of the tube's and the sheet's
+    assert max(predicted["max_principal_stretch"], predicted["sheet_stretch"]) == \
+        pytest.approx(knee["max_principal_stretch"], rel=1e-9)
+    assert proof_of_knee["fem"]["P_grasp_MPa"] == pytest.approx(knee["P_grasp_MPa"], rel=1e-9)
+    assert load_design(proof_of_knee["design_file"]).to_dict() == seen[1][0].design.to_dict()

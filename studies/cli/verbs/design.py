@@ -4,15 +4,18 @@ The task file (see ``studies/designs/tasks/``) names the object, the grasp requi
 pump, the limits and the free design keys with their bounds. The optimum of the reduced
 model (differential evolution, seeded) goes through the FEM -- free bend with the reservoir
 and the grasp at the task's object -- unless ``--no-fem``. Written to ``--out DIR``: the
-design TOML (usable by every verb), ``result.json``, with ``--pareto`` the front's plot, and
-the VTK of the verified grasp (``grasp.pvd``). A task that cannot be met: one paragraph
+design TOML (usable by every verb), ``result.json``, with ``--pareto`` the front's plot and the
+FEM proof of its knee (``knee/``), and the VTK of the verified grasp (``grasp.pvd``). A task that cannot be met: one paragraph
 naming the binding constraint and the nearest design, exit code 1.
 """
 from __future__ import annotations
 
 import math
 import sys
+from dataclasses import replace
 from pathlib import Path
+
+import numpy as np
 
 from softhand.reduced.errors import InputError
 from softhand.studies.cli.args import add_json_option, print_json, print_table
@@ -70,6 +73,8 @@ def run(args) -> int:
         result["report"] = design_opt.infeasible_report(task, opt)
     elif not args.no_fem:
         result = _prove_and_correct(result, task, opt, base, args, out, say, options)
+        if args.pareto:
+            result["pareto"]["knee_proof"] = _prove_knee(result["pareto"], task, args, out, say)
     write_json(out / "result.json", result)
     if args.json:
         print_json(result)
@@ -110,6 +115,24 @@ def _prove_and_correct(result, task, opt, base, args, out, say, options) -> dict
     if report:
         new["fem_report"] = report
     return new
+
+
+def _prove_knee(pareto: dict, task, args, out, say) -> dict | None:
+    """The FEM proof of the Pareto front's knee (None if the knee is the optimum): its design
+    (knee/design.toml), prediction and FEM, the VTK in knee/."""
+    from softhand.studies.design import optimise as design_opt
+    from softhand.studies.io.files import write_atomic
+
+    row = pareto["rows"][pareto["knee"]]
+    if pareto["knee"] == 0:
+        return None
+    sub = replace(task, max_stretch=row["stretch_limit"])
+    ev = design_opt.Problem(sub).evaluation(np.array([row["free"][k] for k, _, _ in task.free]))
+    (out / "knee").mkdir(exist_ok=True)
+    say(f"FEM proof of the Pareto knee (stretch {row['max_principal_stretch']:.4g})")
+    return {"design_file": str(write_atomic(out / "knee" / "design.toml", ev.design.to_toml())),
+            "stretch_limit": row["stretch_limit"], "predicted": ev.predicted(),
+            "fem": _prove(ev, sub, args, out / "knee", say)}
 
 
 def _prove(ev, task, args, out, say) -> dict:
@@ -185,6 +208,11 @@ def _print(result: dict, task, opt) -> None:
         k = result["pareto"]["knee"]
         print(f"Pareto front: {len(result['pareto']['rows'])} points, knee at stretch "
               f"{result['pareto']['rows'][k]['max_principal_stretch']:.4g}; plot {result['pareto']['plot']}")
+        knee = result["pareto"].get("knee_proof")
+        if knee and "P_grasp_MPa" in knee["fem"]:
+            print(f"knee: P_grasp {knee['predicted']['P_grasp_MPa']:.4g} MPa predicted, "
+                  f"{knee['fem']['P_grasp_MPa']:.4g} MPa FEM; F_v {knee['predicted']['F_v_N']:.4g} N "
+                  f"predicted, {knee['fem']['F_v_N']:.4g} N FEM; design {knee['design_file']}")
     print(f"design: {result['design_file']}")
 
 
