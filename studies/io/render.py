@@ -1,6 +1,7 @@
 """Render a VTK result (a ``.vtm`` scene, a ``.vtu``, or one step of a ``.pvd``) with pyvista.
 
-This is the one module of the project that imports pyvista (and imageio, for animations).
+This module and :mod:`.scene_read` (reading the files) are the only ones that import pyvista
+(and this one imageio, for animations).
 Rendering is off-screen by default (no display needed). The picture shows the *body* (the
 finger's ``tube``, the reservoir's ``sheet``, or a plain file's mesh) deformed by its
 ``displacement_mm`` (true scale) and coloured by a field, with a colour bar labelled with
@@ -15,10 +16,7 @@ preferred to cell data of the same name.
 """
 from __future__ import annotations
 
-import contextlib
 import importlib.util
-import logging
-import re
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -27,10 +25,10 @@ import pyvista as pv
 
 from softhand.meshes.atomic import atomic_path
 from softhand.reduced.errors import InputError
+from softhand.studies.io.scene_read import field_names, field_values, load_scene
 from softhand.studies.io.render_style import (VIEWS, body_name, camera, clim_of, colour_label, default_field,
-                                   default_png, has_display, step_index, title_of)
+                                   default_png, has_display, title_of)
 
-SUFFIXES = (".vtu", ".vtm", ".pvd", ".vtk")
 ANIMATIONS = (".gif", ".mp4")
 
 
@@ -45,73 +43,6 @@ class FieldSummary:
     maximum: float
     peak_at: tuple[float, float, float]  #: reference position of the maximum [mm]
     png: str | None  #: picture (or animation) written, or None (interactive only)
-
-
-def load_scene(path: str | Path, step: int | None = None) -> tuple[pv.MultiBlock, int, int]:
-    """(named blocks, step index, number of steps) of a VTK file; a single dataset is one
-    block named after the file."""
-    path = Path(path)
-    if path.suffix not in SUFFIXES or not path.is_file():
-        raise InputError("file", str(path), f"must be an existing {'/'.join(SUFFIXES)} file")
-    _sniff(path)
-    with pv.vtk_verbosity("off"), _quiet_logging():
-        try:
-            reader = pv.get_reader(str(path))
-            n = len(reader.time_values) if path.suffix == ".pvd" else 1
-            index = step_index(step, n)
-            if path.suffix == ".pvd":
-                reader.set_active_time_point(index)
-            data = reader.read()
-        except InputError:
-            raise
-        except Exception as exc:  # VTK reports bad files through many exception types
-            raise InputError("file", str(path), f"must be a readable VTK file: {_first_line(exc)}") from None
-    scene = _flatten(data, path.stem)
-    if not any(b.n_points for b in scene):
-        raise InputError("file", str(path), "must be a VTK file with a mesh (found no points)")
-    return scene, index, n
-
-
-def _flatten(data, name: str) -> pv.MultiBlock:
-    """Nested multiblocks (a .pvd step of a .vtm) -> one level of named non-empty datasets."""
-    out = pv.MultiBlock()
-    if not isinstance(data, pv.MultiBlock):
-        out[name] = data
-        return out
-    for key, block in zip(data.keys(), data):
-        if isinstance(block, pv.MultiBlock):
-            inner = _flatten(block, key)
-            for k, b in zip(inner.keys(), inner):
-                out[k] = b
-        elif block is not None and block.n_points:  # a .vtu in a .pvd: named after the file
-            out[name if re.fullmatch(r"Block-\d+", key or "Block-0") else key] = block
-    return out
-
-
-def field_values(mesh: pv.DataSet, name: str) -> tuple[np.ndarray, str]:
-    """(scalar values, "point"|"cell") of field ``name`` or ``name[i]`` on ``mesh``."""
-    match = re.fullmatch(r"(.+?)(?:\[(\d+)\])?", name)
-    base, component = match.group(1), match.group(2)
-    for location, data in (("point", mesh.point_data), ("cell", mesh.cell_data)):
-        if base in data:
-            values = np.asarray(data[base], dtype=float)
-            break
-    else:
-        raise InputError("field", name, f"allowed: {', '.join(field_names(mesh))}")
-    if values.ndim == 1:
-        if component not in (None, "0"):
-            raise InputError("field", name, f"{base} is a scalar; use it without [i]")
-        return values, location
-    if component is None:
-        return np.linalg.norm(values, axis=1), location
-    if int(component) >= values.shape[1]:
-        raise InputError("field", name, f"{base} has components [0]..[{values.shape[1] - 1}]")
-    return values[:, int(component)], location
-
-
-def field_names(mesh: pv.DataSet) -> list[str]:
-    """The names of the point and cell arrays, each once."""
-    return list(dict.fromkeys([*mesh.point_data.keys(), *mesh.cell_data.keys()]))
 
 
 def describe(path: str | Path, step: int | None = None) -> list[dict]:
@@ -277,30 +208,6 @@ def _deformed(mesh):
 def _surface(mesh):
     """The outer surface (quadratic cells tessellated), for fast, smooth drawing."""
     return mesh.extract_surface(nonlinear_subdivision=2, algorithm="dataset_surface") if isinstance(mesh, pv.UnstructuredGrid) else mesh
-
-
-def _sniff(path: Path) -> None:
-    """A VTK file starts with its XML header or the legacy '# vtk DataFile' line."""
-    with path.open("rb") as f:
-        head = f.read(256).lstrip()
-    if not (head.startswith(b"<?xml") or head.startswith(b"<VTKFile")
-            or head.startswith(b"# vtk DataFile")):
-        raise InputError("file", str(path), "must be a VTK file (XML .vtu/.vtm/.pvd or legacy .vtk)")
-
-
-@contextlib.contextmanager
-def _quiet_logging():
-    """pyvista forwards VTK errors to the logging module; the CLI reports one line instead."""
-    logging.disable(logging.CRITICAL)
-    try:
-        yield
-    finally:
-        logging.disable(logging.NOTSET)
-
-
-def _first_line(exc: Exception) -> str:
-    return next((line.strip() for line in str(exc).splitlines() if line.strip()),
-                type(exc).__name__)
 
 
 __all__ = ["FieldSummary", "VIEWS", "animate", "describe", "field_names", "field_values",

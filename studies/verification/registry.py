@@ -18,7 +18,7 @@ REGISTRY: dict[str, str] = {
     "locking": "softhand.studies.verification.solid:tube_locking",
     "fiber_tube": "softhand.studies.verification.solid:fiber_tube",
     "convergence": "softhand.studies.verification.solid:tube_convergence",
-    "newton": "softhand.studies.verification.solid:tangent_and_newton",
+    "newton": "softhand.studies.verification.newton_checks:tangent_and_newton",
     "balloon": "softhand.studies.verification.balloon:balloon",
     "modes": "softhand.studies.verification.materials:homogeneous_modes",
     "balloon_models": "softhand.studies.verification.materials:balloon_models",

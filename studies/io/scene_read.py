@@ -1,0 +1,112 @@
+"""Read a VTK result (a ``.vtm`` scene, a ``.vtu``, or one step of a ``.pvd``) into named
+pyvista blocks, and pick a field from them; a file that is not one is one InputError.
+
+:mod:`.render` draws what this reads.
+"""
+from __future__ import annotations
+
+import contextlib
+import logging
+import re
+from pathlib import Path
+
+import numpy as np
+import pyvista as pv
+
+from softhand.reduced.errors import InputError
+from softhand.studies.io.render_style import step_index
+
+__all__ = ["SUFFIXES", "field_names", "field_values", "load_scene"]
+
+SUFFIXES = (".vtu", ".vtm", ".pvd", ".vtk")
+
+
+def load_scene(path: str | Path, step: int | None = None) -> tuple[pv.MultiBlock, int, int]:
+    """(named blocks, step index, number of steps) of a VTK file; a single dataset is one
+    block named after the file."""
+    path = Path(path)
+    if path.suffix not in SUFFIXES or not path.is_file():
+        raise InputError("file", str(path), f"must be an existing {'/'.join(SUFFIXES)} file")
+    _sniff(path)
+    with pv.vtk_verbosity("off"), _quiet_logging():
+        try:
+            reader = pv.get_reader(str(path))
+            n = len(reader.time_values) if path.suffix == ".pvd" else 1
+            index = step_index(step, n)
+            if path.suffix == ".pvd":
+                reader.set_active_time_point(index)
+            data = reader.read()
+        except InputError:
+            raise
+        except Exception as exc:  # VTK reports bad files through many exception types
+            raise InputError("file", str(path), f"must be a readable VTK file: {_first_line(exc)}") from None
+    scene = _flatten(data, path.stem)
+    if not any(b.n_points for b in scene):
+        raise InputError("file", str(path), "must be a VTK file with a mesh (found no points)")
+    return scene, index, n
+
+
+def _flatten(data, name: str) -> pv.MultiBlock:
+    """Nested multiblocks (a .pvd step of a .vtm) -> one level of named non-empty datasets."""
+    out = pv.MultiBlock()
+    if not isinstance(data, pv.MultiBlock):
+        out[name] = data
+        return out
+    for key, block in zip(data.keys(), data):
+        if isinstance(block, pv.MultiBlock):
+            inner = _flatten(block, key)
+            for k, b in zip(inner.keys(), inner):
+                out[k] = b
+        elif block is not None and block.n_points:  # a .vtu in a .pvd: named after the file
+            out[name if re.fullmatch(r"Block-\d+", key or "Block-0") else key] = block
+    return out
+
+
+def field_values(mesh: pv.DataSet, name: str) -> tuple[np.ndarray, str]:
+    """(scalar values, "point"|"cell") of field ``name`` or ``name[i]`` on ``mesh``."""
+    match = re.fullmatch(r"(.+?)(?:\[(\d+)\])?", name)
+    base, component = match.group(1), match.group(2)
+    for location, data in (("point", mesh.point_data), ("cell", mesh.cell_data)):
+        if base in data:
+            values = np.asarray(data[base], dtype=float)
+            break
+    else:
+        raise InputError("field", name, f"allowed: {', '.join(field_names(mesh))}")
+    if values.ndim == 1:
+        if component not in (None, "0"):
+            raise InputError("field", name, f"{base} is a scalar; use it without [i]")
+        return values, location
+    if component is None:
+        return np.linalg.norm(values, axis=1), location
+    if int(component) >= values.shape[1]:
+        raise InputError("field", name, f"{base} has components [0]..[{values.shape[1] - 1}]")
+    return values[:, int(component)], location
+
+
+def field_names(mesh: pv.DataSet) -> list[str]:
+    """The names of the point and cell arrays, each once."""
+    return list(dict.fromkeys([*mesh.point_data.keys(), *mesh.cell_data.keys()]))
+
+
+def _sniff(path: Path) -> None:
+    """A VTK file starts with its XML header or the legacy '# vtk DataFile' line."""
+    with path.open("rb") as f:
+        head = f.read(256).lstrip()
+    if not (head.startswith(b"<?xml") or head.startswith(b"<VTKFile")
+            or head.startswith(b"# vtk DataFile")):
+        raise InputError("file", str(path), "must be a VTK file (XML .vtu/.vtm/.pvd or legacy .vtk)")
+
+
+@contextlib.contextmanager
+def _quiet_logging():
+    """pyvista forwards VTK errors to the logging module; the CLI reports one line instead."""
+    logging.disable(logging.CRITICAL)
+    try:
+        yield
+    finally:
+        logging.disable(logging.NOTSET)
+
+
+def _first_line(exc: Exception) -> str:
+    return next((line.strip() for line in str(exc).splitlines() if line.strip()),
+                type(exc).__name__)
