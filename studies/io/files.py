@@ -82,3 +82,14 @@ def kept_if_unwritable(what, verb: str):
     except OSError as exc:
         print(f"softhand {verb}: warning: {what} not written ({exc.strerror or exc}); "
               f"the results are printed on stdout", file=sys.stderr)
+
+
+def write_outputs(result, verb: str, out=None, plot=None) -> None:
+    """A study result's ``write(out)`` and ``plot(plot)``, each where asked, each kept going
+    (a warning) if the disk refuses it: the verb prints the results in any case."""
+    if out:
+        with kept_if_unwritable(out, verb):
+            result.write(out)
+    if plot:
+        with kept_if_unwritable(plot, verb):
+            result.plot(plot)

@@ -49,7 +49,7 @@ def run(args) -> int:
     from softhand.reduced.csvdata import read_measurements
     from softhand.reduced.fit import check_params
     from softhand.studies.fit import FitStudy, run as run_study
-    from softhand.studies.io.files import kept_if_unwritable
+    from softhand.studies.io.files import write_outputs
 
     design = design_from_args(args)
     data = read_measurements(args.data)
@@ -60,12 +60,7 @@ def run(args) -> int:
                      weights=None if w is None else tuple(float(x) for x in w), normalise=args.normalise,
                      bounds=_parse_bounds(args.bounds), data_name=args.data)
     result = run_study(study)
-    if args.out:
-        with kept_if_unwritable(args.out, "fit"):
-            result.write(args.out)
-    if args.plot:
-        with kept_if_unwritable(args.plot, "fit"):
-            result.plot(args.plot)
+    write_outputs(result, "fit", args.out, args.plot)
     if args.json:
         print_json(result.summary())
     else:

@@ -11,13 +11,12 @@ volume (r–z and revolved to 3D); see :class:`studies.reservoir.ReservoirStudyR
 from __future__ import annotations
 
 import subprocess
-import sys
 from pathlib import Path
 
 from softhand.reduced.errors import InputError
 from softhand.studies.cli.args import MAX_FEM_POINTS, MOST_FEM_POINTS, add_design_option, add_json_option, \
     add_max_cases_option, design_from_args, max_cases, parse_values, print_json, print_table
-from softhand.studies.io.files import kept_if_unwritable
+from softhand.studies.io.files import write_outputs
 
 HELP = "inflate the reservoir sheet (FEM) and measure the ellipse assumption (eqs. 11-18)"
 
@@ -72,12 +71,7 @@ def run(args) -> int:
     except NotConverged as exc:
         return _failed(exc, study, Path(args.out or FAILED_OUT))
     summary = result.summary()
-    if args.out:
-        with kept_if_unwritable(args.out, "reservoir"):
-            result.write(args.out)
-    if args.plot:
-        with kept_if_unwritable(args.plot, "reservoir"):
-            result.plot(args.plot)
+    write_outputs(result, "reservoir", args.out, args.plot)
     if args.json:
         print_json({"rows": result.rows, **summary})
     else:
