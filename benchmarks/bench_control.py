@@ -1,4 +1,4 @@
-"""Control simulation speed (issue 7): 10 s of simulated time at 1 kHz, target < 1 s.
+"""Control simulation speed: 10 s of simulated time at 1 kHz, target < 1 s.
 
 Angle control to 50 deg holding 2 kg on the paper's design, a 5 N push at 5 s; the
 controller runs at 100 Hz (default) and at 1 kHz (every step). Prints the best of

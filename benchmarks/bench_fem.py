@@ -1,4 +1,4 @@
-"""FEM speed benchmark (issue 3): a compressible Neo-Hookean tube under dead loads.
+"""FEM speed benchmark: a compressible Neo-Hookean tube under dead loads.
 
 Tube inner radius 4 mm, outer 9 mm, length 60 mm, clamped at z = 0; dead internal
 pressure 0.3 MPa on the inner surface, dead traction (0.05, 0, 0) MPa on the end face;

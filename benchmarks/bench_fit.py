@@ -1,4 +1,4 @@
-"""Calibration speed (issue 8): ``softhand fit`` on the shipped synthetic examples.
+"""Calibration speed: ``softhand fit`` on the shipped synthetic examples.
 
 Prints the best wall / CPU time of the least-squares fit itself (reading, fitting, the
 Jacobian and its SVD; no plotting) for the bending example (36 points) with one and two

@@ -1,4 +1,4 @@
-"""Grasp FEM speed (issue 6): one ``softhand weights`` case (two contact states), by mesh.
+"""Grasp FEM speed: one ``softhand weights`` case (two contact states), by mesh.
 
 180 mm object, m = 0 (or ``--mass-kg``), P = 0.8 + 0.05 MPa, default placement. Prints, per
 element size, the unknowns, wall and CPU time of building the finger model and of the two
