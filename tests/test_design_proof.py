@@ -137,3 +137,20 @@ def test_the_pareto_knee_goes_through_the_fem_too(tmp_path, monkeypatch, capsys)
         pytest.approx(knee["max_principal_stretch"], rel=1e-9)
     assert proof_of_knee["fem"]["P_grasp_MPa"] == pytest.approx(knee["P_grasp_MPa"], rel=1e-9)
     assert load_design(proof_of_knee["design_file"]).to_dict() == seen[1][0].design.to_dict()
+
+
+def test_a_proof_that_fails_on_every_mesh_is_not_a_proven_design(tmp_path, monkeypatch, capsys):
+    """The FEM failing on the task's mesh and on the retry mesh: one paragraph saying the
+    design is not proven, the meshes tried, exit 1 (not a silent success without FEM)."""
+    from softhand.studies.cli.main import main
+    from softhand.studies.design import proof
+
+    def prove(ev, task, options, out=None, progress=None):
+        raise RuntimeError("free-bend FEM: Newton failed at 0.2 MPa")
+
+    monkeypatch.setattr(proof, "prove", prove)
+    task = _write(tmp_path, CI_TASK_TOML.replace("[free]", "[fem]\nmesh_size_mm = 10.0\n[free]"))
+    assert main(["design", "--task", str(task), "--json", "--out", str(tmp_path / "out"), "--seed", "3"]) == 1
+    result = json.loads(capsys.readouterr().out)
+    assert result["fem_report"].startswith("The FEM proof could not be completed (finger mesh 10 mm")
+    assert "Newton failed at 0.2 MPa" in result["fem_report"] and "rejected" not in result
