@@ -252,3 +252,21 @@ def test_kernel_fit_is_exact_at_its_designs_and_for_linear_residuals(tmp_path):
     path, _ = _kernel_table(tmp_path, curved, "few", n=6)
     with pytest.raises(InputError, match="6 designs: a kernel fit in lb ld lL lt s2 needs at least 7"):
         finger_fem.residuals(0.5, d.replace(finger_model="fem", finger_table=str(path)))
+
+
+def test_the_held_out_whole_hand_error_is_the_fingers_for_the_models_own_reservoir():
+    """FEM points made from the calibrated finger itself, with the cavity pressure raised by
+    1 %: the reservoir parts cancel (the shipped sheet table reproduces the sheet FEM at the
+    paper's sheet, measured to 1e-8 MPa), so the whole hand's error is the finger's alone,
+    -0.01 P; a point where the fingers would take more oil than V0 is nan."""
+    from softhand.studies.calibration.finger_table import _whole_hand_errors
+
+    d = HandDesign(tie_width=10.0)
+    model = d.replace(finger_model="fem")
+    theta = np.radians([5.0, 12.0, 20.0])
+    P = hand.pressure(theta, model, reservoir=False)
+    dQ = finger.oil_taken(theta, model)
+    numbers = {"P_MPa": [*(1.01 * P), 3.0], "theta_deg": [*np.degrees(theta), 150.0],
+               "dQ_mm3": [*dQ, d.V0 / d.n * 1.1]}
+    err = _whole_hand_errors(d, numbers, None)
+    assert err[:3] == pytest.approx(-0.01 * P, abs=1e-6) and np.isnan(err[3])

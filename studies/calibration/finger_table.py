@@ -154,10 +154,14 @@ def write_design_with_table(design: HandDesign, table: Path) -> Path:
 
 def heldout_rows(results: list[tuple[HandDesign, dict]], table: str | None = None):
     """Per FEM point of each design: theta and dQ by FEM and by the calibrated model, errors
-    [%]; per design with an FEM bend >= 60 deg, the model's bend at the FEM's pressure of 60 deg
+    [%], and the whole hand's pump pressure at the FEM's theta by the models "fem" (finger and
+    reservoir) against finger FEM + reservoir-sheet FEM (:func:`studies.compare.whole_hand`,
+    the design's reservoir), error [MPa] (nan where the fingers take more oil than V0); per
+    design with an FEM bend >= 60 deg, the model's bend at the FEM's pressure of 60 deg
     (monotone cubic interpolation of the FEM points). Returns (rows, worst |error| per column)."""
     rows = []
     for design, record in results:
+        hand_err = _whole_hand_errors(design, record["numbers"], table)
         model = design.replace(finger_model="fem", finger_table=str(table or ""))
         n = record["numbers"]
         P, th, dQ = (np.array(n[k], float) for k in ("P_MPa", "theta_deg", "dQ_mm3"))
@@ -169,15 +173,40 @@ def heldout_rows(results: list[tuple[HandDesign, dict]], table: str | None = Non
         for k in range(P.size):
             rows.append({"design": point, "P_MPa": P[k], "theta_fem_deg": th[k], "theta_model_deg": th_m[k],
                          "theta_err_pct": 100 * (th_m[k] / th[k] - 1), "dQ_fem_mm3": dQ[k],
-                         "dQ_model_mm3": dQ_m[k], "dQ_err_pct": 100 * (dQ_m[k] / dQ[k] - 1)})
+                         "dQ_model_mm3": dQ_m[k], "dQ_err_pct": 100 * (dQ_m[k] / dQ[k] - 1),
+                         "P_hand_err_MPa": hand_err[k]})
         if th.max() >= 60.0:
             P60 = float(PchipInterpolator(np.r_[0.0, th], np.r_[0.0, P])(60.0))
             t60 = float(np.degrees(hand.bend_angle(P60, model, reservoir=False)))
             rows.append({"design": point, "P_MPa": P60, "theta_fem_deg": 60.0, "theta_model_deg": t60,
                          "theta_err_pct": 100 * (t60 / 60.0 - 1), "dQ_fem_mm3": math.nan,
-                         "dQ_model_mm3": math.nan, "dQ_err_pct": math.nan})
-    worst = {k: float(np.nanmax([abs(r[k]) for r in rows])) for k in ("theta_err_pct", "dQ_err_pct")}
+                         "dQ_model_mm3": math.nan, "dQ_err_pct": math.nan, "P_hand_err_MPa": math.nan})
+    worst = {k: float(np.nanmax([abs(r[k]) for r in rows]))
+             for k in ("theta_err_pct", "dQ_err_pct", "P_hand_err_MPa")}
     return rows, worst
+
+
+def _whole_hand_errors(design: HandDesign, numbers: dict, table) -> np.ndarray:
+    """P_hand of the models "fem" minus finger FEM + sheet FEM [MPa], per FEM point with P > 0."""
+    import warnings
+
+    from softhand.reduced.errors import InputError
+    from softhand.studies.compare import whole_hand
+
+    fem = [{"P_MPa": P, "theta_deg": t, "dQ_mm3": q}
+           for P, t, q in zip(numbers["P_MPa"], numbers["theta_deg"], numbers["dQ_mm3"]) if P > 0]
+    with warnings.catch_warnings():  # a dry reservoir is a nan here, reported in the table
+        warnings.simplefilter("ignore")
+        rows = whole_hand(fem, design).rows
+    model = design.replace(finger_model="fem", reservoir_model="fem", finger_table=str(table or ""))
+    out = np.full(len(rows), math.nan)
+    for k, r in enumerate(rows):
+        if r["V_mm3"] > 0:
+            try:
+                out[k] = float(hand.pressure(math.radians(r["theta_deg"]), model, reservoir=True)) - r["P_hand_fem_MPa"]
+            except InputError:  # the model's fingers take more oil than V0 there
+                pass
+    return out
 
 
 def leave_one_out(path: str | Path | None = None) -> list[dict]:

@@ -15,7 +15,6 @@ from __future__ import annotations
 
 import shlex
 import sys
-from pathlib import Path
 
 from softhand.studies.cli.args import add_json_option, print_json, print_table
 
@@ -138,5 +137,6 @@ def _check(space, args) -> int:
         print_json({"rows": rows, "worst": worst})
     else:
         print_table(rows)
-        print("# worst |error|: " + ", ".join(f"{k} {v:.2f} %" for k, v in worst.items()))
+        print("# worst |error|: " + ", ".join(f"{k} {v:.2f} %" if k.endswith("pct") else f"{k} {v:.4f} MPa"
+                                             for k, v in worst.items()))
     return 0
