@@ -70,16 +70,18 @@ class Curves:
         return self.W_knots[i] + span * (self.energy_rate(tau) @ _GAUSS_W)
 
 
-def _with_slopes(fn) -> Hermite:
-    """Hermite interpolant of fn at the knots, slopes by central differences (h = 1e-6 rad)."""
+def _with_slopes(fn) -> tuple[Hermite, ...]:
+    """Hermite interpolants of each output of fn at the knots (fn evaluated three times), slopes
+    by central differences (h = 1e-6 rad)."""
     h = 1e-6
-    return Hermite(fn(_KNOTS), (fn(_KNOTS + h) - fn(_KNOTS - h)) / (2 * h))
+    at, up, down = fn(_KNOTS), fn(_KNOTS + h), fn(_KNOTS - h)
+    return tuple(Hermite(f, (u - d) / (2 * h)) for f, u, d in zip(at, up, down))
 
 
-def energy_curves(pressure, oil, Q0: float) -> Curves:
-    """Curves of pressure(theta) [MPa] and oil(theta) = Delta Q [mm^3] (vectorised callables),
+def energy_curves(pressure_and_oil, Q0: float) -> Curves:
+    """Curves of (P [MPa], Delta Q [mm^3]) = pressure_and_oil(theta) (a vectorised callable),
     W_f(0) = 0; Q0 = Q(0) [mm^3]."""
-    P, dQ = _with_slopes(pressure), _with_slopes(oil)
+    P, dQ = _with_slopes(pressure_and_oil)
     pieces = np.empty(_KNOTS.size)
     pieces[0] = 0.0
     tau = _KNOTS[:-1, None] + (_KNOTS[1] - _KNOTS[0]) * _GAUSS_X

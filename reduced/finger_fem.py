@@ -188,12 +188,12 @@ def curves(design: HandDesign) -> Curves:
     table = _fit(_table_path(design))[0]
     groups = check_space(design, table)
 
-    def pressure(t):
-        return design.mu_sf * prior_pressure(t, groups, table.prior) * np.exp(residuals(t, design)[0])
+    def pressure_and_oil(t):
+        y, ln_kappa = residuals(t, design)
+        P = design.mu_sf * prior_pressure(t, groups, table.prior) * np.exp(y)
+        return P, design.a**2 * math.pi * design.d * t + design.a**3 * np.exp(ln_kappa) * P / design.mu_sf
 
-    return energy_curves(pressure, lambda t: design.a**2 * math.pi * design.d * t
-                         + design.a**3 * np.exp(residuals(t, design)[1]) * pressure(t) / design.mu_sf,
-                         design.a**2 * math.pi * design.l0)
+    return energy_curves(pressure_and_oil, design.a**2 * math.pi * design.l0)
 
 
 def _energy(theta, design):

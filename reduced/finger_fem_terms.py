@@ -9,14 +9,14 @@ tube segment's physics names:
 ``ld``  ln(d/a): the lever arm of the plate
 ``lL``  ln(L/a): the link length (hinge spacing, L = l0 / 6)
 ``lt``  -ln(1 - w/L): the tied share of a link (w the tie width)
-``lg``  ln((L - w)/a): the untied gap between two ties
 ``s2``  (b / (L - w))^2: the squared shape factor of the untied segment (a short segment
         bonded at both ends cannot contract, so it stiffens as this square)
 ``th``  theta [rad], the finger's bend
 =====  ==========================================================================
 
 A table names its terms in its ``# fit:`` line (``p_terms=s2 lb ld th``); older tables give
-polynomial degrees instead, which :func:`legacy_terms` turns into the same list.
+polynomial degrees instead, which :func:`legacy_terms` turns into the same list. A table of
+the design space is instead interpolated over :data:`KERNEL_FEATURES` (:class:`KernelFit`).
 """
 from __future__ import annotations
 
@@ -24,7 +24,7 @@ from itertools import combinations_with_replacement
 
 import numpy as np
 
-__all__ = ["BASE", "DESIGN_BASE", "legacy_terms", "check_terms", "term_matrix"]
+__all__ = ["BASE", "KERNEL_FEATURES", "KernelFit", "legacy_terms", "check_terms", "term_matrix"]
 
 
 def _gap(g):
@@ -37,11 +37,9 @@ BASE = {
     "ld": lambda g, th: np.log(np.asarray(g["d_a"], float)),
     "lL": lambda g, th: np.log(np.asarray(g["link_a"], float)),
     "lt": lambda g, th: -np.log1p(-np.asarray(g["tie_link"], float)),
-    "lg": lambda g, th: np.log(_gap(g)),
     "s2": lambda g, th: (np.asarray(g["b_a"], float) / _gap(g))**2,
     "th": lambda g, th: np.asarray(th, float),
 }
-DESIGN_BASE = tuple(k for k in BASE if k != "th")
 
 
 def check_terms(terms) -> tuple[str, ...]:

@@ -162,7 +162,12 @@ def fem_constraints(fem: dict, task: Task) -> list[dict]:
 
 
 def fem_report(fem: dict, ev: Evaluation) -> str | None:
-    """One paragraph if the FEM's grasp breaks a limit of the task, else None."""
+    """One paragraph if the FEM proof failed (``fem["error"]``, on every mesh it tried) or its
+    grasp breaks a limit of the task, else None."""
+    if "error" in fem:
+        meshes = ", ".join(f"{m['mesh_size_mm']:g} mm" for m in fem.get("failed_meshes", ()))
+        return (f"The FEM proof could not be completed (finger mesh {meshes}): {fem['error']}. "
+                "The design is not proven; try --mesh-size-mm with a finer mesh.")
     broken = [c for c in fem.get("constraints", ()) if not c["satisfied"]]
     if not broken:
         return None

@@ -87,12 +87,12 @@ def _prove_and_correct(result, task, opt, base, args, out, say, options) -> dict
     re-optimisation with eq. (8)'s strain scaled to the FEM's and the proof of that design
     (the first optimum is kept under ``rejected``)."""
     from softhand.studies.design import optimise as design_opt
-    from softhand.studies.design.proof import corrected_task
+    from softhand.studies.design.proof import corrected_task, fem_report
     from softhand.studies.io.files import write_atomic
 
     ev = opt.evaluation
     result["fem"] = _prove(ev, task, args, out, say)
-    report = _report(result["fem"], ev)
+    report = fem_report(result["fem"], ev)
     if not report:
         return result
     result["fem_report"] = report
@@ -110,21 +110,10 @@ def _prove_and_correct(result, task, opt, base, args, out, say, options) -> dict
         new["report"] = design_opt.infeasible_report(corrected, opt)
         return new
     new["fem"] = _prove(opt.evaluation, corrected, args, out, say)
-    report = _report(new["fem"], opt.evaluation)
+    report = fem_report(new["fem"], opt.evaluation)
     if report:
         new["fem_report"] = report
     return new
-
-
-def _report(fem: dict, ev) -> str | None:
-    """One paragraph if the FEM proof failed or does not confirm the design, else None."""
-    from softhand.studies.design.proof import fem_report
-
-    if "error" in fem:
-        meshes = ", ".join(f"{m['mesh_size_mm']:g} mm" for m in fem.get("failed_meshes", ()))
-        return (f"The FEM proof could not be completed (finger mesh {meshes}): {fem['error']}. "
-                "The design is not proven; try --mesh-size-mm with a finer mesh.")
-    return fem_report(fem, ev)
 
 
 def _prove_knee(pareto: dict, task, args, out, say) -> dict | None:
