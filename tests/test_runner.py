@@ -162,3 +162,30 @@ def test_a_killed_worker_loses_nothing_and_its_cases_are_rerun(tmp_path, monkeyp
     assert (tmp_path / "died").exists()  # a worker did die
     assert summary.ok and summary.computed == 8
     assert sorted(v["y"] for v in results_by_key(tmp_path / "res", study).values()) == list(range(1, 9))
+
+
+THREADS_KIND = '''
+def case(params, design, outdir):
+    from threadpoolctl import threadpool_info
+    return {"threads": max(pool["num_threads"] for pool in threadpool_info())}
+'''
+
+
+def test_pool_workers_share_the_cores_threads(tmp_path, monkeypatch):
+    """Two workers on two cores run one thread each in every numerical library (MKL, OpenBLAS,
+    OpenMP), also in those loaded before the worker started (a forked worker inherits them)."""
+    import numpy  # noqa: F401  OpenBLAS loaded in this process, so inherited by forked workers
+    from threadpoolctl import threadpool_info
+
+    from softhand.studies.batch import pool
+
+    if max(p["num_threads"] for p in threadpool_info()) < 2:
+        pytest.skip("the numerical libraries run one thread here already")
+
+    kind = install_kind(tmp_path, "threads_kind", THREADS_KIND)
+    monkeypatch.syspath_prepend(str(tmp_path))
+    monkeypatch.setattr(os, "cpu_count", lambda: 2)
+    assert [pool.thread_share(n) for n in (1, 2, 3)] == [2, 1, 1]
+    study = load_study(write_study(tmp_path, f'name = "t"\nkind = "{kind}"\n[sweep]\nx = [1, 2, 3, 4]\n'))
+    assert run_study(study, results_root=tmp_path / "r", workers=2, progress=False).ok
+    assert {n["threads"] for n in results_by_key(tmp_path / "r", study).values()} == {1}

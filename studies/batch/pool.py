@@ -1,4 +1,10 @@
-"""The local process pool of the batch runner; its workers die with the parent process."""
+"""The local process pool of the batch runner; its workers die with the parent process.
+
+Each worker gets an equal share of the cores for its own threads (MKL PARDISO, OpenBLAS,
+OpenMP): N workers on C cores run ``max(1, C // N)`` threads each. Left alone, every
+worker's PARDISO would start a thread per core, and two workers on two cores would run four
+busy threads, which spin-wait on each other (see ``benchmarks/bench_batch.py``).
+"""
 from __future__ import annotations
 
 import itertools
@@ -33,7 +39,8 @@ def _one_pool(study: Study, todo, workers: int, lost: list[Case]):
     first = next(todo, None)
     if first is None:
         return
-    pool = ProcessPoolExecutor(max_workers=workers, initializer=_worker_init, initargs=(os.getpid(),))
+    pool = ProcessPoolExecutor(max_workers=workers, initializer=_worker_init,
+                               initargs=(os.getpid(), thread_share(workers)))
     futures, broken = {}, False
 
     def submit(case):
@@ -66,8 +73,25 @@ def _one_pool(study: Study, todo, workers: int, lost: list[Case]):
         pool.shutdown(wait=True, cancel_futures=True)
 
 
-def _worker_init(parent: int) -> None:
-    """In each pool worker: die with the parent (Linux: PR_SET_PDEATHSIG), default SIGTERM."""
+def thread_share(workers: int) -> int:
+    """Threads of each of ``workers`` processes: an equal share of the cores, at least one."""
+    return max(1, (os.cpu_count() or 1) // workers)
+
+
+def limit_threads(threads: int) -> None:
+    """At most ``threads`` threads in this process's numerical libraries: those loaded later
+    read the environment, those already loaded (a forked worker inherits them) are told."""
+    for name in ("OMP_NUM_THREADS", "MKL_NUM_THREADS", "OPENBLAS_NUM_THREADS"):
+        os.environ[name] = str(threads)
+    from threadpoolctl import threadpool_limits
+
+    threadpool_limits(limits=threads)
+
+
+def _worker_init(parent: int, threads: int) -> None:
+    """In each pool worker: its share of the cores' threads; die with the parent (Linux:
+    PR_SET_PDEATHSIG); default SIGTERM."""
+    limit_threads(threads)
     signal.signal(signal.SIGTERM, signal.SIG_DFL)
     try:
         import ctypes
