@@ -126,6 +126,11 @@ class GraspModel:
             raise InputError("depth_mm", self.depth, "the object overlaps the open finger")
         self.circle = Circle(tuple(to_finger_frame([0.0, self.depth], design)), 0.5 * diameter)
         self.weight = self.mass * design.g / design.n  #: the weight share, eq. (24) [N]
+        # one solver for every state of this model: the symbolic analysis is done once. Double
+        # precision, as for the free finger (fem.hand.finger_sweep): the single-precision factor
+        # of this tangent refines too slowly and fell back after one wasted factorisation.
+        # Unsymmetric under a weight: the tangential load is a follower
+        self.solver = make_solver(symmetric=self.weight == 0.0, precision="double")
 
     def load(self, q, multipliers, shares, penalty: float | None = None):
         """Physical contact load at hinge angles q (:class:`fem.contact.ContactLoad`)."""
@@ -164,7 +169,7 @@ class GraspModel:
         else:
             y, P0, lam = start.y, start.P, start.N
             shares = start.N / start.N.sum() if start.N.sum() > 0 else np.zeros(n_links)
-        solver = make_solver(symmetric=self.weight == 0.0)  # the tangential load is a follower
+        solver, factorizations = self.solver, self.solver.n_factorizations
         its, steps = 0, self.options.steps if start is None else 1
         penalty, last = self.options.penalty if start is None else start.penalty, np.inf
         for update in range(self.options.max_updates + 1):
@@ -183,7 +188,7 @@ class GraspModel:
             if penetration <= self.options.gap_tol and \
                     np.max(np.abs(new_shares - shares)) <= self.options.share_tol:
                 return replace(self._state(P, y, L, g, update, its, penalty),
-                               factorizations=solver.n_factorizations)
+                               factorizations=solver.n_factorizations - factorizations)
             if penetration > 0.25 * last:  # slow Uzawa (near-dependent contacts): stiffen
                 penalty = min(10.0 * penalty, self.options.max_penalty)
             lam, shares, last = L.N, new_shares, penetration
