@@ -2,8 +2,8 @@
 
 Each worker gets an equal share of the cores for its own threads (MKL PARDISO, OpenBLAS,
 OpenMP): N workers on C cores run ``max(1, C // N)`` threads each. Left alone, every
-worker's PARDISO would start a thread per core, and two workers on two cores would run four
-busy threads, which spin-wait on each other (see ``benchmarks/bench_batch.py``).
+worker's PARDISO starts a thread per core, so two workers on two cores ran four threads each
+(``benchmarks/bench_batch.py`` measures the speed-up of 2 workers over 1).
 """
 from __future__ import annotations
 
