@@ -3,7 +3,7 @@
 ``reduced/data/finger_fem.csv`` (or a table of one design made by ``softhand calibrate finger
 --design``) holds the finger FEM's (theta, P/mu_sf, Delta Q/a^3) at sampled designs, after
 comment lines with its provenance, the groups' calibrated ranges (``# range:``) and the fit
-(``# fit: prior=rings, kernel=thin_plate_spline, features=lb ld lL lt s2`` for an interpolant
+(``# fit: prior=rings, kernel=cubic, features=lb ld lL lt s2`` for an interpolant
 over many designs; ``# fit: prior=rings, p_terms=s2 lb th, q_terms=lt th`` for least squares
 in named terms; in older tables polynomial degrees ``design_degree=D, theta_degree=T``); :mod:`softhand.reduced.finger_fem` fits
 and uses it.

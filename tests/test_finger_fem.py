@@ -171,18 +171,18 @@ def test_a_design_file_names_its_own_table_relative_to_itself(tmp_path):
 
 
 def test_each_design_of_the_package_table_is_predicted_without_it():
-    """Leave-one-out over the shipped table's 31 FEM designs (the interpolant rebuilt without the
-    design): measured theta 1.90 % rms, 7.6 % at worst (the corner b/a 0.5, d/a 1.67, link/a 3.33,
-    tie/link 0.75: extrapolation), dQ 0.85 % rms, 2.6 % at worst. The least-squares fit linear in
-    the same features, the same way: y (ln P) 0.036 rms against the interpolant's 0.017."""
+    """Leave-one-out over the shipped table's 41 FEM designs (the interpolant rebuilt without the
+    design): measured theta 1.33 % rms, 6.4 % at worst (the corner b/a 0.5, d/a 1.67, link/a 3.33,
+    tie/link 0.75: extrapolation), dQ 0.87 % rms, 4.5 % at worst. The least-squares fit linear in
+    the features had twice the interpolant's leave-one-out error in y on the earlier 31-design table."""
     from softhand.studies.calibration.finger_table import leave_one_out
 
     rows = leave_one_out()
     theta = np.array([r["theta_err_pct"] for r in rows])
     dQ = np.array([r["dQ_err_pct"] for r in rows])
-    assert len({r["design"] for r in rows}) == 31
-    assert np.sqrt(np.mean(theta**2)) < 2.2 and np.abs(theta).max() < 8.0
-    assert np.sqrt(np.mean(dQ**2)) < 1.0 and np.abs(dQ).max() < 3.0
+    assert len({r["design"] for r in rows}) == 41
+    assert np.sqrt(np.mean(theta**2)) < 1.5 and np.abs(theta).max() < 7.0
+    assert np.sqrt(np.mean(dQ**2)) < 1.0 and np.abs(dQ).max() < 5.0
 
 
 def test_a_cli_warning_is_one_line():

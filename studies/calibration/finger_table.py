@@ -48,18 +48,19 @@ def table_rows(results: list[tuple[HandDesign, dict]]) -> list[dict]:
 
 #: designs a table needs for the kernel fit (else least squares in linear terms)
 KERNEL_MIN_DESIGNS = 12
-KERNEL = "thin_plate_spline"
+KERNEL = "cubic"
 
 
 def choose_fit(rows: list[dict], ranges: dict, prior: str) -> tuple[str, list[str]]:
     """The '# fit:' line's items after the prior for ``rows``, and a provenance note. With
-    KERNEL_MIN_DESIGNS designs or more: the thin-plate-spline interpolant over the five
+    KERNEL_MIN_DESIGNS designs or more: the cubic radial-basis interpolant over the five
     features of :data:`KERNEL_FEATURES` (per design a line in theta; exact at the designs).
-    It was chosen over least squares by leave-one-design-out error on the 31-design table
-    (rms of y / ln kappa): 0.017 / 0.018, against 0.036 / 0.059 for terms linear in the
-    features and 0.105 / 0.040 for quadratic ones (cubic radial functions: 0.017 / 0.018,
-    linear ones 0.020 / 0.022). With fewer designs: least squares in the varying groups' linear
-    terms and theta (theta only if the designs are too few)."""
+    It was chosen by leave-one-design-out error of theta on the 41-design table (rms / worst,
+    ``benchmarks/finger_loo.py``): cubic 1.33 / 6.4 %, thin-plate spline 1.62 / 9.0 %, linear
+    2.02 / 12.9 % (dQ: 0.87 / 4.5, 0.75 / 2.3, 0.80 / 2.7 %); on the earlier 31-design table,
+    least squares in terms linear in the features had twice the spline's error in y and 3x
+    in ln kappa, quadratic terms 6x. With fewer designs: least squares in the varying groups'
+    linear terms and theta (theta only if the designs are too few)."""
     from softhand.reduced.finger_fem_terms import KERNEL_FEATURES, legacy_terms
 
     n_designs = len({r["design"] for r in rows})
