@@ -158,8 +158,9 @@ def heldout_rows(results: list[tuple[HandDesign, dict]], table: str | None = Non
     [%], and the whole hand's pump pressure at the FEM's theta by the models "fem" (finger and
     reservoir) against finger FEM + reservoir-sheet FEM (:func:`studies.compare.whole_hand`,
     the design's reservoir), error [MPa] (nan where the fingers take more oil than V0); per
-    design with an FEM bend >= 60 deg, the model's bend at the FEM's pressure of 60 deg
-    (monotone cubic interpolation of the FEM points). Returns (rows, worst |error| per column)."""
+    design with an FEM bend >= 60 deg, the model's bend at the FEM's pressure of 60 deg and the
+    whole hand's error there (the FEM's pressure and oil at 60 deg by monotone cubic
+    interpolation of its points). Returns (rows, worst |error| per column)."""
     rows = []
     for design, record in results:
         hand_err = _whole_hand_errors(design, record["numbers"], table)
@@ -177,11 +178,12 @@ def heldout_rows(results: list[tuple[HandDesign, dict]], table: str | None = Non
                          "dQ_model_mm3": dQ_m[k], "dQ_err_pct": 100 * (dQ_m[k] / dQ[k] - 1),
                          "P_hand_err_MPa": hand_err[k]})
         if th.max() >= 60.0:
-            P60 = float(PchipInterpolator(np.r_[0.0, th], np.r_[0.0, P])(60.0))
+            P60, dQ60 = (float(PchipInterpolator(np.r_[0.0, th], np.r_[0.0, v])(60.0)) for v in (P, dQ))
             t60 = float(np.degrees(hand.bend_angle(P60, model, reservoir=False)))
+            hand60 = _whole_hand_errors(design, {"P_MPa": [P60], "theta_deg": [60.0], "dQ_mm3": [dQ60]}, table)
             rows.append({"design": point, "P_MPa": P60, "theta_fem_deg": 60.0, "theta_model_deg": t60,
                          "theta_err_pct": 100 * (t60 / 60.0 - 1), "dQ_fem_mm3": math.nan,
-                         "dQ_model_mm3": math.nan, "dQ_err_pct": math.nan, "P_hand_err_MPa": math.nan})
+                         "dQ_model_mm3": math.nan, "dQ_err_pct": math.nan, "P_hand_err_MPa": hand60[0]})
     worst = {k: float(np.nanmax([abs(r[k]) for r in rows]))
              for k in ("theta_err_pct", "dQ_err_pct", "P_hand_err_MPa")}
     return rows, worst
