@@ -172,8 +172,8 @@ def test_a_design_file_names_its_own_table_relative_to_itself(tmp_path):
 
 def test_each_design_of_the_package_table_is_predicted_without_it():
     """Leave-one-out over the shipped table's 41 FEM designs (the interpolant rebuilt without the
-    design): measured theta 1.33 % rms, 6.4 % at worst (the corner b/a 0.5, d/a 1.67, link/a 3.33,
-    tie/link 0.75: extrapolation), dQ 0.87 % rms, 4.5 % at worst. The least-squares fit linear in
+    design): measured theta 1.33 % rms, 6.4 % at worst (the corner b/a 0.5, d/a 3.33, link/a 3.33,
+    tie/link 0.75: extrapolation), dQ 0.87 % rms, 4.5 % at worst (b/a 1.17 at that link and tie). The least-squares fit linear in
     the features had twice the interpolant's leave-one-out error in y on the earlier 31-design table."""
     from softhand.studies.calibration.finger_table import leave_one_out
 
