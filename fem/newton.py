@@ -111,7 +111,9 @@ def newton(fun, x0, options: NewtonOptions = NewtonOptions(), *, solver=None, sc
     direction: search direction of the first iteration instead of -K^{-1} R (a load-step
     predictor, line-searched like a Newton step); on_accept(x): called with x0 and every
     accepted iterate before fun is evaluated around it (e.g. :class:`fem.solid.MixedNewton`);
-    residual(x) -> R: optional, fun's residual alone, for the line search's trial points;
+    residual(x) -> R: optional, fun's residual alone, for the line search's trial points and
+    (Newton) the iterates, whose tangent is then evaluated only when a step needs it (not at a
+    start that takes ``direction``, nor at the converged iterate);
     converged(x, R, it) -> bool: optional test of the iterate x (it Newton iterations so far)
     instead of ||R|| <= atol + rtol scale, e.g. one tolerance per block of a bordered system
     (:mod:`fem.volume_path`); merit(x, R) -> float: the measure of ``options.merit = "decrease"``.
@@ -132,8 +134,12 @@ def newton(fun, x0, options: NewtonOptions = NewtonOptions(), *, solver=None, sc
     if on_accept is not None:
         on_accept(x)
     reuse = adaptive and factored_size(solver) == len(x)
-    R, K = (residual(x), None) if reuse and residual is not None else fun(x)
-    K = None if reuse else K  # K: the tangent at x still to be factorised (None: keep the factor)
+    # Newton with a residual function evaluates the tangent only where a step needs it: not at
+    # a start whose first step is the predictor's direction, nor at the converged iterate
+    lazy = residual is not None and not adaptive
+    R, K = (residual(x), None) if residual is not None and (reuse or lazy) else fun(x)
+    K = None if reuse else K  # K: the tangent at x still to be factorised (None: keep the factor,
+    # or, lazy, not evaluated yet)
     t_asm = time.perf_counter() - t0
     norm = float(np.linalg.norm(R))
     tol = options.atol + options.rtol * (norm if scale is None else scale)
@@ -146,6 +152,10 @@ def newton(fun, x0, options: NewtonOptions = NewtonOptions(), *, solver=None, sc
             return NewtonResult(x, it, history, steps, t_asm, t_solve, factorizations)
         if it == options.max_iter:
             break
+        if lazy and K is None and not (it == 0 and direction is not None):
+            t1 = time.perf_counter()
+            R, K = fun(x)
+            t_asm += time.perf_counter() - t1
         t1 = time.perf_counter()
         old = False  # the step uses a factorisation of another iterate's tangent
         try:
@@ -161,7 +171,7 @@ def newton(fun, x0, options: NewtonOptions = NewtonOptions(), *, solver=None, sc
         t_solve += time.perf_counter() - t1
         t1 = time.perf_counter()
         small = it > 0 and np.linalg.norm(dx) <= options.xtol * (1.0 + np.linalg.norm(x))
-        xt, Rt, Kt, normt, s = line_search(fun, x, dx, R, norm, options, residual, tangent=not adaptive,
+        xt, Rt, Kt, normt, s = line_search(fun, x, dx, R, norm, options, residual, tangent=not (adaptive or lazy),
                                            merit=merit, first=not steps)
         rate = normt / norm
         if old and not rate < 1.0:  # the old factorisation is not good enough here: redo with K(x)

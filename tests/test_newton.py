@@ -44,8 +44,12 @@ def test_residual_only_trials_give_the_same_iterates_with_one_tangent_per_iterat
     plain = newton(ATAN, [2.0])
     r = newton(fun, [2.0], residual=residual)
     assert r.history == plain.history and r.steps == plain.steps and min(r.steps) < 1.0
-    assert calls["fun"] == r.iterations + 1  # x0, then once per accepted iterate
+    # a tangent per step taken (at x0 and each accepted iterate but the converged one)
+    assert calls["fun"] == r.iterations == r.factorizations
     assert calls["residual"] > r.iterations  # rejected trials cost residuals only
+    calls["fun"] = 0
+    given = newton(fun, [2.0], residual=residual, direction=[-1.0])  # e.g. a load-step predictor
+    assert calls["fun"] == given.iterations - 1 == given.factorizations  # none at x0 either
 
 
 def test_cut_back_and_last_converged_state():
