@@ -271,7 +271,9 @@ def _from_public(key: str, value):
 
 
 def design_from_dict(values: dict, base: HandDesign | None = None, *, source: str = "design") -> HandDesign:
-    """A design from public keys (as in TOML), over ``base`` (default: the paper's)."""
+    """A design from public keys (as in TOML), over ``base`` (default: the paper's). Without
+    ``hinge_s_mm``, a new ``l0_mm`` scales the base's hinge positions with it and a new ``n_s``
+    spaces the hinges equally."""
     base = base if base is not None else HandDesign()
     changes = {}
     for key, value in values.items():
@@ -282,6 +284,12 @@ def design_from_dict(values: dict, base: HandDesign | None = None, *, source: st
                              f"unknown key; allowed: {', '.join(PUBLIC_KEYS)}, "
                              "[finger.material], [reservoir.material]")
         changes[_FIELD_OF[key]] = _from_public(key, value)
+    if "hinge_s" not in changes and ("l0" in changes or "n_s" in changes):
+        # the hinges follow the tube: scaled with l0 (equal links stay equal), or equal links
+        # when the number of hinges changes
+        l0, n_s = changes.get("l0", base.l0), changes.get("n_s", base.n_s)
+        changes["hinge_s"] = (tuple(s * l0 / base.l0 for s in base.hinge_s) if n_s == base.n_s
+                              else tuple(l0 * k / (n_s + 1) for k in range(1, n_s + 1)))
     for part in PARTS:
         if part in values:
             changes.update(_material_changes(part, values[part], source, values))

@@ -30,7 +30,7 @@ def test_toml_round_trip(tmp_path):
     ({"bogus": 1}, "bogus"),
     ({"n": 2.5}, "n"),
     ({"l0_mm": "long"}, "l0_mm"),
-    ({"n_s": 4}, "hinge_s_mm"),
+    ({"n_s": 4, "hinge_s_mm": [30, 60, 90, 120, 150]}, "hinge_s_mm"),
     ({"hinge_s_mm": [30, 20, 90, 120, 150]}, "hinge_s_mm"),
     ({"theta0_deg": 95}, "theta0_deg"),
     ({"reservoir_model": "balloon"}, "reservoir_model"),
@@ -54,3 +54,14 @@ def test_bad_files(tmp_path):
     bad.write_text("a_mm = = 3")
     with pytest.raises(InputError, match="not valid TOML"):
         load_design(bad)
+
+
+def test_hinges_follow_a_new_tube_length_or_hinge_count_unless_given():
+    """Equal links stay equal: l0 without hinge_s_mm scales the hinges, n_s spaces them equally."""
+    assert design_from_dict({"l0_mm": 160.0}).hinge_s == pytest.approx([160.0 * k / 6 for k in range(1, 6)])
+    assert design_from_dict({"n_s": 3}).hinge_s == pytest.approx([45.0, 90.0, 135.0])
+    given = design_from_dict({"l0_mm": 200.0, "hinge_s_mm": [30.0, 60.0, 90.0, 120.0, 150.0]})
+    assert given.hinge_s == (30.0, 60.0, 90.0, 120.0, 150.0)
+    uneven = HandDesign(hinge_s=(20.0, 60.0, 90.0, 120.0, 150.0))
+    assert design_from_dict({"l0_mm": 135.0}, uneven).hinge_s == pytest.approx([15.0, 45.0, 67.5, 90.0, 112.5])
+    assert design_from_dict({"a_mm": 4.5}).hinge_s == HandDesign().hinge_s

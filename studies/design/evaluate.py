@@ -122,13 +122,10 @@ def _number(x: float) -> float | None:
 
 
 def design_at(task: Task, x) -> HandDesign:
-    """The base design with the free keys set to x (public units); l0 scales the hinges."""
-    base, values = task.base, {}
-    for (key, _, _), v in zip(task.free, np.asarray(x, dtype=float)):
-        values[key] = float(v)
-        if key == "l0_mm":
-            values["hinge_s_mm"] = [s * float(v) / base.l0 for s in base.hinge_s]
-    return design_from_dict(values, base, source="free")
+    """The base design with the free keys set to x (public units); l0 scales the hinges
+    (:func:`reduced.design.design_from_dict`)."""
+    values = {key: float(v) for (key, _, _), v in zip(task.free, np.asarray(x, dtype=float))}
+    return design_from_dict(values, task.base, source="free")
 
 
 #: tube lengths on which the kinematics are tabulated while the optimiser varies l0 [mm]
