@@ -25,10 +25,12 @@ from __future__ import annotations
 import argparse
 import resource
 import time
+from dataclasses import replace
 
 import numpy as np
 
 from softhand.fem.assembly import Restriction
+from softhand.fem.hand.finger_sweep import SWEEP_NEWTON
 from softhand.fem.linsolve import make_solver
 from softhand.fem.loads import dead_load
 from softhand.fem.materials import CompressibleNeoHookean
@@ -78,8 +80,9 @@ def run_ours(mesh, steps: int, solver_name: str, intorder: int, predictor: str, 
         return red.vector(solid.residual(red.expand(x))) - t * f_free
 
     scale = np.linalg.norm(red.vector(f_ext))
-    opts = PathOptions(steps=steps, grow=1.0, predictor=predictor, newton=NewtonOptions(
-        rtol=1e-10, atol=0.0, refactor=refactor, contraction=0.5, memory=20, max_iter=40 if refactor == "adaptive" else 25))
+    newton = NewtonOptions(rtol=1e-10, atol=0.0) if refactor == "always" else \
+        replace(SWEEP_NEWTON, rtol=1e-10, atol=0.0)  # the finger sweep's quasi-Newton
+    opts = PathOptions(steps=steps, grow=1.0, predictor=predictor, newton=newton)
     res = solve_path(fun_t, np.zeros(len(red.keep)), opts, solver=solver, scale_t=lambda t: t * scale,
                      residual_t=residual_t)
     total = time.perf_counter() - t0

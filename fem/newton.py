@@ -171,8 +171,8 @@ def newton(fun, x0, options: NewtonOptions = NewtonOptions(), *, solver=None, sc
         t_solve += time.perf_counter() - t1
         t1 = time.perf_counter()
         small = it > 0 and np.linalg.norm(dx) <= options.xtol * (1.0 + np.linalg.norm(x))
-        xt, Rt, Kt, normt, s = line_search(fun, x, dx, R, norm, options, residual, tangent=not (adaptive or lazy),
-                                           merit=merit, first=not steps)
+        xt, Rt, Kt, normt, s = line_search(fun, x, dx, R, norm, options, residual, merit=merit,
+                                           first=not steps)
         rate = normt / norm
         if old and not rate < 1.0:  # the old factorisation is not good enough here: redo with K(x)
             R, K = fun(x)

@@ -28,9 +28,9 @@ def add_pair(pairs, s, y, memory):
         del pairs[:-memory]
 
 
-def line_search(fun, x, dx, R0, norm0, options, residual=None, tangent=True, merit=None, first=False):
+def line_search(fun, x, dx, R0, norm0, options, residual=None, merit=None, first=False):
     """Step length on x + s dx; returns the accepted (x, R, K, ||R||, s); K is None when
-    ``tangent`` is false and only ``residual`` was evaluated. See :mod:`fem.newton`'s docstring.
+    only ``residual`` was evaluated (the caller evaluates a tangent where a step needs one). See :mod:`fem.newton`'s docstring.
 
     merit(x, R) -> float: the measure "decrease" compares (default ||R||); first: the solve's
     first step ("decrease" takes it whole)."""
@@ -72,9 +72,6 @@ def line_search(fun, x, dx, R0, norm0, options, residual=None, tangent=True, mer
         s_new = lo + (hi - lo) * glo / (glo - ghi) if ghi is not None else 0.5 * (lo + hi)
         s = float(np.clip(s_new, lo + 0.1 * (hi - lo), hi - 0.1 * (hi - lo)))
     # accepted, or no sufficient step in max_backtracks: the last trial (Newton may still recover)
-    if K is None and tangent:
-        with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
-            R, K = fun(xt)
     return xt, R, K, norm, s
 
 

@@ -50,8 +50,8 @@ from .errors import InputError
 from .inputfiles import MAX_FILE_BYTES, read_input_file, read_toml
 
 __all__ = ["RESERVOIR_MODELS", "FINGER_MODELS", "PAPER_DESIGN_FILE", "HandDesign", "PUBLIC_KEYS",
-           "PARTS", "BOUNDS", "CONSISTENCY", "design_from_dict", "MAX_FILE_BYTES", "read_input_file",
-           "read_toml", "load_design"]
+           "PARTS", "BOUNDS", "CONSISTENCY", "design_from_dict", "hinges_for", "MAX_FILE_BYTES",
+           "read_input_file", "read_toml", "load_design"]
 
 #: Reservoir models the reduced layer knows; extended when a new one is added.
 RESERVOIR_MODELS = ("ellipse", "fem")
@@ -270,6 +270,14 @@ def _from_public(key: str, value):
     return math.radians(value) if name == "theta0" else float(value)
 
 
+def hinges_for(base: HandDesign, l0: float, n_s: int) -> tuple[float, ...]:
+    """Hinge positions [mm] for a tube of length l0 with n_s hinges: the base's scaled with l0
+    (equal links stay equal), or equal links when the number of hinges changes."""
+    if n_s == base.n_s:
+        return tuple(s * l0 / base.l0 for s in base.hinge_s)
+    return tuple(l0 * k / (n_s + 1) for k in range(1, n_s + 1))
+
+
 def design_from_dict(values: dict, base: HandDesign | None = None, *, source: str = "design") -> HandDesign:
     """A design from public keys (as in TOML), over ``base`` (default: the paper's). Without
     ``hinge_s_mm``, a new ``l0_mm`` scales the base's hinge positions with it and a new ``n_s``
@@ -285,11 +293,7 @@ def design_from_dict(values: dict, base: HandDesign | None = None, *, source: st
                              "[finger.material], [reservoir.material]")
         changes[_FIELD_OF[key]] = _from_public(key, value)
     if "hinge_s" not in changes and ("l0" in changes or "n_s" in changes):
-        # the hinges follow the tube: scaled with l0 (equal links stay equal), or equal links
-        # when the number of hinges changes
-        l0, n_s = changes.get("l0", base.l0), changes.get("n_s", base.n_s)
-        changes["hinge_s"] = (tuple(s * l0 / base.l0 for s in base.hinge_s) if n_s == base.n_s
-                              else tuple(l0 * k / (n_s + 1) for k in range(1, n_s + 1)))
+        changes["hinge_s"] = hinges_for(base, changes.get("l0", base.l0), changes.get("n_s", base.n_s))
     for part in PARTS:
         if part in values:
             changes.update(_material_changes(part, values[part], source, values))

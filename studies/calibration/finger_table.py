@@ -163,12 +163,18 @@ def heldout_rows(results: list[tuple[HandDesign, dict]], table: str | None = Non
     interpolation of its points). Returns (rows, worst |error| per column)."""
     rows = []
     for design, record in results:
-        hand_err = _whole_hand_errors(design, record["numbers"], table)
         model = design.replace(finger_model="fem", finger_table=str(table or ""))
         n = record["numbers"]
         P, th, dQ = (np.array(n[k], float) for k in ("P_MPa", "theta_deg", "dQ_mm3"))
         keep = P > 0
         P, th, dQ = P[keep], th[keep], dQ[keep]
+        at60 = th.max() >= 60.0
+        if at60:
+            P60, dQ60 = (float(PchipInterpolator(np.r_[0.0, th], np.r_[0.0, v])(60.0)) for v in (P, dQ))
+        # one sheet FEM per design: the FEM points and the 60 deg point together
+        hand_err = _whole_hand_errors(design, {"P_MPa": [*P, P60] if at60 else P,
+                                               "theta_deg": [*th, 60.0] if at60 else th,
+                                               "dQ_mm3": [*dQ, dQ60] if at60 else dQ}, table)
         th_m = np.degrees(hand.bend_angle(P, model, reservoir=False))
         dQ_m = finger.oil_taken(np.radians(th), model)
         point = " ".join(f"{design.to_dict()[k]:g}" for k in VARIABLES)
@@ -177,13 +183,11 @@ def heldout_rows(results: list[tuple[HandDesign, dict]], table: str | None = Non
                          "theta_err_pct": 100 * (th_m[k] / th[k] - 1), "dQ_fem_mm3": dQ[k],
                          "dQ_model_mm3": dQ_m[k], "dQ_err_pct": 100 * (dQ_m[k] / dQ[k] - 1),
                          "P_hand_err_MPa": hand_err[k]})
-        if th.max() >= 60.0:
-            P60, dQ60 = (float(PchipInterpolator(np.r_[0.0, th], np.r_[0.0, v])(60.0)) for v in (P, dQ))
+        if at60:
             t60 = float(np.degrees(hand.bend_angle(P60, model, reservoir=False)))
-            hand60 = _whole_hand_errors(design, {"P_MPa": [P60], "theta_deg": [60.0], "dQ_mm3": [dQ60]}, table)
             rows.append({"design": point, "P_MPa": P60, "theta_fem_deg": 60.0, "theta_model_deg": t60,
                          "theta_err_pct": 100 * (t60 / 60.0 - 1), "dQ_fem_mm3": math.nan,
-                         "dQ_model_mm3": math.nan, "dQ_err_pct": math.nan, "P_hand_err_MPa": hand60[0]})
+                         "dQ_model_mm3": math.nan, "dQ_err_pct": math.nan, "P_hand_err_MPa": hand_err[-1]})
     worst = {k: float(np.nanmax([abs(r[k]) for r in rows]))
              for k in ("theta_err_pct", "dQ_err_pct", "P_hand_err_MPa")}
     return rows, worst

@@ -36,7 +36,7 @@ from typing import NamedTuple
 import numpy as np
 
 from softhand.reduced import contact, finger, grasp, grasp_hold, hand, reservoir
-from softhand.reduced.design import HandDesign, design_from_dict
+from softhand.reduced.design import HandDesign, design_from_dict, hinges_for
 from softhand.reduced.errors import InputError
 from softhand.studies.design.task import Task
 
@@ -140,7 +140,7 @@ def grasp_geometry(design: HandDesign, task: Task, *, exact: bool = True) -> con
     lo = math.floor(design.l0 / L0_STEP) * L0_STEP
     t = (design.l0 - lo) / L0_STEP
     ends = [contact.grasp_geometry(task.diameter, task.opening_mm, design.replace(
-        l0=l0, hinge_s=tuple(s * l0 / design.l0 for s in design.hinge_s))) for l0 in (lo, lo + L0_STEP)]
+        l0=l0, hinge_s=hinges_for(design, l0, design.n_s))) for l0 in (lo, lo + L0_STEP)]
     near = ends[int(t >= 0.5)]
     lerp = lambda i: (1 - t) * ends[0][i] + t * ends[1][i]  # noqa: E731
     return contact.Geometry(lerp(0), lerp(1), near.link, near.w, lerp(4))
