@@ -212,9 +212,10 @@ class ChainConstraint:
         vals = np.concatenate((np.ones(n_f), J[moving].ravel()))
         return sp.csr_matrix((vals, (rows, cols)), shape=(self.n_dofs, self.n_reduced))
 
-    def reduce(self, y, R, K=None, K_qq=None):
+    def reduce(self, y, R, K=None, K_qq=None, *, symmetric: bool = False):
         """Reduced residual T'^T R and, with K (CSR), tangent T'^T K T' + sum_n R_n . T''_n
-        (+ K_qq, an (n_s, n_s) term of loads on the hinge angles).
+        (+ K_qq, an (n_s, n_s) term of loads on the hinge angles); ``symmetric``: K is
+        symmetric, so K^T J_m is K J_m and is not formed a second time.
 
         With T' = [S_f | J_m] (S_f selects the free entries; J_m, nonzero on the x, y rows of
         the moving nodes, is dx/dq): K_ff is a gather of K.data, K_fq = (K J_m)_f and
@@ -235,7 +236,7 @@ class ChainConstraint:
         K = K.tocsr()  # K.data below must be in CSR order
         pat = self._reduced_pattern(K, rows_m)
         KJ = pat["cols"](K.data) @ Jm                  # (n_dofs, n_s) = K J_m
-        KtJ = pat["rows"](K.data).T @ Jm               # (n_dofs, n_s) = K^T J_m
+        KtJ = KJ if symmetric else pat["rows"](K.data).T @ Jm  # (n_dofs, n_s) = K^T J_m
         Kqq = Jm.T @ KJ[rows_m] + self.chain.force_hessian(self.q(y), self.links, x, R[self.nodes[:, :2]])
         if K_qq is not None:
             Kqq = Kqq + K_qq

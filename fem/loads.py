@@ -56,6 +56,7 @@ class _Facets:
         self.G = np.stack([fb.basis[i][0].grad for i in range(nloc)]).transpose(2, 3, 0, 1).copy()
         self.X = np.asarray(fb.global_coordinates())  # (3, nf, nq)
         self.vdofs = solid.scatter.vector_dofs(self.elements)  # (nf, 3 nloc)
+        self._positions = None  # see add_matrix_data
 
     def fields(self, u):
         """x (3, nf, nq) and F (3, 3, nf, nq) at the facet quadrature points."""
@@ -73,9 +74,18 @@ class _Facets:
     def matrix_data(self, Ke):
         """Scatter (nf, nloc, 3, nloc, 3) matrices into CSR data in the solid's pattern."""
         data = np.zeros(self.solid.scatter.nnz)
-        n = Ke.shape[1] * 3
-        self.solid.scatter.add_matrix(data, Ke.reshape(len(self.elements), n, n), self.elements)
+        self.add_matrix_data(data, Ke)
         return data
+
+    def add_matrix_data(self, data, Ke, factor: float = 1.0) -> None:
+        """data += factor * the scatter of (nf, nloc, 3, nloc, 3) matrices, touching only the
+        positions these facets' elements reach (a few % of the solid's pattern: no pass over
+        all of data, which costs more than the facet terms themselves)."""
+        if self._positions is None:  # (the distinct CSR positions, each entry's index among them)
+            pos = self.solid.scatter.positions(self.elements).ravel()
+            self._positions = np.unique(pos, return_inverse=True)
+        where, inverse = self._positions
+        data[where] += factor * np.bincount(inverse, weights=Ke.ravel(), minlength=len(where))
 
 
 def _dcofN(F, N):
@@ -148,7 +158,13 @@ class CavityVolume:
         return -self.f.vector(g)
 
     def hessian_data(self, u) -> np.ndarray:
-        """d^2V/du^2 as CSR data in the solid's pattern (symmetric).
+        """d^2V/du^2 as CSR data in the solid's pattern (symmetric)."""
+        data = np.zeros(self.f.solid.scatter.nnz)
+        self.add_hessian_data(data, u)
+        return data
+
+    def _hessian_blocks(self, u) -> np.ndarray:
+        """-d^2V/du^2 per wall facet, (nf, nloc, 3, nloc, 3) (minus: V carries a minus sign).
 
         The second-derivative term factorises: y_b eps_bac eps_JKL N_J = Y_ac M_KL with the
         skew matrices Y = [y]_x (y = D x) and M = [N]_x, so per point it is Y_ac s_nm with
@@ -165,8 +181,12 @@ class CavityVolume:
         M = np.einsum("JKL,Jeq->eqKL", EPS, N)
         S = np.matmul(G, np.matmul(M, G.transpose(0, 1, 3, 2)))             # (e, q, n, m)
         H2 = np.einsum("eqac,eqnm->enamc", Y * W[:, :, None, None], S, optimize=True)
-        H = H1 + H1.transpose(0, 3, 4, 1, 2) + H2
-        return -self.f.matrix_data(H)
+        return H1 + H1.transpose(0, 3, 4, 1, 2) + H2
+
+    def add_hessian_data(self, data, u, factor: float = 1.0) -> None:
+        """data += factor * d^2V/du^2, data: CSR data in the solid's pattern (only the
+        positions of the wall's elements are touched)."""
+        self.f.add_matrix_data(data, self._hessian_blocks(u), -factor)
 
     def hessian(self, u) -> sp.csr_matrix:
         return self.f.solid.scatter.csr(self.hessian_data(u))

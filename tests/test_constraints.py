@@ -149,3 +149,23 @@ def test_reduced_tangent_is_the_triple_product_in_a_fixed_pattern_even_for_unsym
         np.testing.assert_allclose(r, B.T @ R, rtol=1e-12, atol=1e-12 * np.abs(R).max())
         patterns.append((Kr.indptr.copy(), Kr.indices.copy()))
     assert all(np.array_equal(a, b) for a, b in zip(*patterns))
+
+
+def test_symmetric_reduction_equals_the_triple_product():
+    """``symmetric=True`` forms K J_m once and uses it for both off-diagonal blocks: on a
+    symmetric K the result must be T'^T K T' + sum R . T'' (the sparse products), and on an
+    unsymmetric one it must differ (the flag is a promise about K, not ignored)."""
+    c = _random_constraint()
+    n, n_f = c.n_dofs, len(c.free)
+    A = sp.random(n, n, density=0.1, random_state=3, format="csr")
+    K = (A + A.T + sp.eye(n)).tocsr()
+    y, R = RNG.normal(scale=0.3, size=c.n_reduced), RNG.normal(size=n)
+    r, Kr = c.reduce(y, R, K, symmetric=True)
+    B = c.operator(y)
+    _, _, H = CHAIN.point_map(c.q(y), c.links, c.X)
+    ref = (B.T @ K @ B).toarray()
+    ref[n_f:, n_f:] += np.einsum("majl,ma->jl", H, R[c.nodes[:, :2]])
+    np.testing.assert_allclose(Kr.toarray(), ref, rtol=1e-12, atol=1e-12 * np.abs(ref).max())
+    U = K.copy()
+    U.data = RNG.normal(size=U.nnz)
+    assert not np.allclose(c.reduce(y, R, U, symmetric=True)[1].toarray(), c.reduce(y, R, U)[1].toarray())

@@ -148,10 +148,10 @@ class FingerModel:
         self.windings.add_residual_tangent(u, R, Ke)  # rubber + windings: one scatter
         R = R - P * self.cavity.gradient(u)
         data = self.solid.scatter.block_matrix_data(Ke)
-        data -= P * self.cavity.hessian_data(u)
+        self.cavity.add_hessian_data(data, u, -P)
         K = self.solid.scatter.csr(data)
         Q, dQ = (None, None) if link_load is None else link_load(self.constraint.q(y))
-        r, Kr = self.constraint.reduce(y, R, K, None if dQ is None else -np.asarray(dQ))
+        r, Kr = self.constraint.reduce(y, R, K, None if dQ is None else -np.asarray(dQ), symmetric=True)
         if Q is not None:
             r[len(self.constraint.free):] -= Q
         return r, Kr
