@@ -41,7 +41,7 @@ written in a block layout that needs no transposed copy into one buffer for the
 whole mesh (kept between iterates: nel (3 nloc)^2 doubles, 117 MB at 80k DOFs), and
 scattered by :class:`fem.assembly.ElementScatter` into a CSR pattern built once, in
 one pass. Elements are processed in chunks (memory of the intermediates), never one
-by one.
+by one, the chunks side by side in threads (:mod:`fem.threads`).
 """
 from __future__ import annotations
 
@@ -50,6 +50,7 @@ import scipy.sparse as sp
 from skfem import Basis, ElementTetP2
 
 from softhand.fem import kinematics as kin
+from softhand.fem import threads
 from softhand.fem.assembly import ElementScatter, Restriction
 from softhand.fem.mixed import MixedNewton, PressureAnchor
 
@@ -68,7 +69,7 @@ class Solid:
     """
 
     def __init__(self, mesh, law, *, element=None, intorder: int = 2,
-                 formulation: str | None = None, chunk: int = 2048):
+                 formulation: str | None = None, chunk: int = threads.CHUNK):
         self.mesh, self.law = mesh, law
         self.element = element or ElementTetP2()
         self.sbasis = Basis(mesh, self.element, intorder=intorder)
@@ -222,9 +223,12 @@ class Solid:
         """(R, CSR data of the tangent or None); scatter=False: (R, the element matrix buffer)."""
         R = np.zeros(self.ndofs)
         Ke = self._element_matrix_buffer() if tangent else None
-        for c in self._chunks:
+
+        def kernels(c):  # in a thread: writes only its own chunk of Ke
             p_geo = None if anchor is None else anchor.pressure(u, c, self.scatter.vector_dofs(c))
-            re = self._element_kernels(u, c, None if Ke is None else Ke[c], p_geo)
+            return self._element_kernels(u, c, None if Ke is None else Ke[c], p_geo)
+
+        for c, re in zip(self._chunks, threads.map_chunks(kernels, self._chunks)):
             self.scatter.add_vector(R, re, c)
         if not tangent or not scatter:
             return R, Ke

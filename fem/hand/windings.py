@@ -13,6 +13,7 @@ import numpy as np
 from skfem import Basis, ElementTetP2
 
 from softhand.fem import kinematics as kin
+from softhand.fem import threads
 from softhand.fem.materials import Fibers
 
 
@@ -94,7 +95,7 @@ class Windings:
     (:meth:`fem.assembly.ElementScatter.block_matrix_data`).
     """
 
-    def __init__(self, mesh, fibers_k: float, toe: float, intorder: int, scatter, chunk=2048):
+    def __init__(self, mesh, fibers_k: float, toe: float, intorder: int, scatter, chunk=threads.CHUNK):
         basis = Basis(mesh, ElementTetP2(), intorder=intorder)
         self.law = WindingFibers(fibers_k, hoop_directions(np.asarray(basis.global_coordinates().value)), toe)
         a0 = self.law.a0                                                    # (3, nel, nq)
@@ -104,7 +105,6 @@ class Windings:
         self.scatter = scatter
         nel = self.W.shape[0]
         self.chunks = [slice(i, min(i + chunk, nel)) for i in range(0, nel, chunk)]
-        self._ke = None  # element matrices of one chunk, block layout; allocated at first use
 
     def stretch(self, u: np.ndarray, elements=slice(None)):
         """(f = F a0 (3, ne, nq), fiber stretch lam (ne, nq)) at the rule's points."""
@@ -126,26 +126,30 @@ class Windings:
 
     def add_residual(self, u: np.ndarray, R: np.ndarray) -> None:
         """R += the windings' internal force."""
-        for c in self.chunks:
+        def forces(c):
             _, lam, G1, _, v = self._chunk(u, c)
-            self.scatter.add_vector(R, np.einsum("eq,eqi->ei", self.W[c] * self.law.k * G1 / lam, v), c)
+            return np.einsum("eq,eqi->ei", self.W[c] * self.law.k * G1 / lam, v)
+
+        for c, re in zip(self.chunks, threads.map_chunks(forces, self.chunks)):
+            self.scatter.add_vector(R, re, c)
 
     def add_residual_tangent(self, u: np.ndarray, R: np.ndarray, Ke_all: np.ndarray) -> None:
         """R += the windings' internal force; Ke_all (element matrices of the whole mesh in the
         block layout of :func:`fem.solid.element_matrices`, e.g. the rubber's) += their tangent."""
         k = self.law.k
-        nel, nq, nloc = self.g.shape
-        if self._ke is None:
-            self._ke = np.empty((len(range(nel)[self.chunks[0]]), nloc, 3, 3, nloc))
-        for c in self.chunks:
+        nloc = self.g.shape[2]
+
+        def kernels(c):  # in a thread: adds only to its own chunk of Ke_all
             f, lam, G1, G2, v = self._chunk(u, c)
             g, W = self.g[c], self.W[c]
-            self.scatter.add_vector(R, np.einsum("eq,eqi->ei", W * k * G1 / lam, v), c)
             c1, c2 = W * k * (G2 / lam ** 2 - G1 / lam ** 3), W * k * G1 / lam
             vt = np.einsum("aeq,eqn->eqan", f, g).reshape(*W.shape, -1)     # (ne, nq, (b m))
-            Ke = self._ke[:len(W)]
-            np.matmul(v.transpose(0, 2, 1) * c1[:, None, :], vt, out=Ke.reshape(len(W), 3 * nloc, 3 * nloc))
+            Ke = np.matmul(v.transpose(0, 2, 1) * c1[:, None, :], vt).reshape(len(W), nloc, 3, 3, nloc)
             S = np.matmul(g.transpose(0, 2, 1) * c2[:, None, :], g)         # (ne, nloc, nloc)
             for a in range(3):  # + delta_ab S_nm
                 Ke[:, :, a, a, :] += S
             Ke_all[c] += Ke
+            return np.einsum("eq,eqi->ei", c2, v)
+
+        for c, re in zip(self.chunks, threads.map_chunks(kernels, self.chunks)):
+            self.scatter.add_vector(R, re, c)

@@ -1,0 +1,40 @@
+"""Threads for the element kernels: chunks of elements evaluated side by side.
+
+NumPy's batched products release the GIL, so the chunks of an assembly run in parallel
+in threads of one process. What decides the speed-up is the chunk's size, not the
+thread count alone: on the finger's 8664 P2 tetrahedra (2 cores) the rubber's residual
+and tangent took 68 ms in chunks of 2048 elements on one thread, 71 ms on two (the two
+chunks' intermediates, ~20 MB, evict each other from the cache), and 40 ms in chunks of
+512 on two (:data:`CHUNK`).
+
+Threads: ``OMP_NUM_THREADS`` when it is set (a batch worker's share of the cores, see
+:mod:`studies.batch.pool`), else the cores this process may run on.
+"""
+from __future__ import annotations
+
+import os
+from concurrent.futures import ThreadPoolExecutor
+
+CHUNK = 512  #: elements per chunk of an element kernel (see the module docstring)
+
+_pools: dict = {}  # (process id, threads) -> executor: a forked child must not reuse its parent's
+
+
+def count() -> int:
+    """Threads the element kernels may use (see the module docstring)."""
+    try:
+        return max(1, int(os.environ["OMP_NUM_THREADS"].split(",")[0]))
+    except (KeyError, ValueError):
+        return len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 1
+
+
+def map_chunks(fn, chunks) -> list:
+    """[fn(c) for c in chunks], evaluated in up to :func:`count` threads (in order)."""
+    n = min(count(), len(chunks))
+    if n <= 1:
+        return [fn(c) for c in chunks]
+    key = (os.getpid(), n)
+    pool = _pools.get(key)
+    if pool is None:
+        pool = _pools[key] = ThreadPoolExecutor(n, thread_name_prefix="softhand-kernels")
+    return list(pool.map(fn, chunks))
