@@ -15,6 +15,8 @@ from __future__ import annotations
 import os
 from concurrent.futures import ThreadPoolExecutor
 
+import numpy as np
+
 CHUNK = 512  #: elements per chunk of an element kernel (see the module docstring)
 
 _pools: dict = {}  # (process id, threads) -> executor: a forked child must not reuse its parent's
@@ -29,7 +31,9 @@ def count() -> int:
 
 
 def map_chunks(fn, chunks) -> list:
-    """[fn(c) for c in chunks], evaluated in up to :func:`count` threads (in order)."""
+    """[fn(c) for c in chunks], evaluated in up to :func:`count` threads (in order), each under
+    the caller's floating-point error handling (NumPy's ``errstate`` is per thread: a line
+    search's trial point that inverts an element must stay as quiet in a worker thread)."""
     n = min(count(), len(chunks))
     if n <= 1:
         return [fn(c) for c in chunks]
@@ -37,4 +41,10 @@ def map_chunks(fn, chunks) -> list:
     pool = _pools.get(key)
     if pool is None:
         pool = _pools[key] = ThreadPoolExecutor(n, thread_name_prefix="softhand-kernels")
-    return list(pool.map(fn, chunks))
+    errors = np.geterr()
+
+    def task(c):
+        with np.errstate(**errors):
+            return fn(c)
+
+    return list(pool.map(task, chunks))

@@ -1,6 +1,9 @@
 """Element kernels in threads: the thread count, order of results, and an assembly that is the
 same on one thread as on several (each chunk's arithmetic does not depend on the threads)."""
+import warnings
+
 import numpy as np
+import pytest
 import skfem as fe
 
 from softhand.fem import threads
@@ -36,3 +39,15 @@ def test_assembly_on_two_threads_equals_one_thread(monkeypatch):
         out[n] = (R, K.toarray(), solid.residual(u))
     for a, b in zip(out["1"], out["2"]):
         np.testing.assert_array_equal(a, b)
+
+
+def test_worker_threads_keep_the_callers_error_handling(monkeypatch):
+    monkeypatch.setenv("OMP_NUM_THREADS", "2")
+    chunks = [slice(0, 1), slice(1, 2), slice(2, 3)]
+    with np.errstate(invalid="raise"):
+        with pytest.raises(FloatingPointError):
+            threads.map_chunks(lambda c: np.sqrt(-np.ones(2)), chunks)
+    with np.errstate(invalid="ignore"), warnings.catch_warnings():
+        warnings.simplefilter("error")
+        out = threads.map_chunks(lambda c: np.sqrt(-np.ones(2)), chunks)
+    assert all(np.isnan(o).all() for o in out)
