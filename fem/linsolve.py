@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import warnings
 
+from softhand.fem import threads
 from softhand.fem.linsolve_backends import (REFINE_MAX, REFINE_RTOL, LinearSolver, PardisoSolver,
                                             QdldlSolver, SuperLUSolver, UmfpackSolver, _pardiso_handle)
 
@@ -56,6 +57,7 @@ def make_solver(method: str = "auto", *, symmetric: bool = False, precision: str
     ``precision``: "mixed" (PARDISO only; see the module docstring) or "double"."""
     if method not in METHODS:
         raise ValueError(f"linear solver {method!r} not in {METHODS}")
+    threads.quiet_blas()  # OpenBLAS's spinning threads would slow the factorisations (fem.threads)
     if precision not in PRECISIONS:
         raise ValueError(f"precision {precision!r} not in {PRECISIONS}")
     if method == "auto":

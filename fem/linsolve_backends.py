@@ -28,7 +28,10 @@ REFINE_MAX = 8  #: mixed precision: refinement steps before falling back to doub
 
 def _pardiso_handle(**kwargs):
     """A new pypardiso solver. pypardiso looks for MKL by a recursive glob of the environment
-    (~0.2 s) unless PYPARDISO_MKL_RT names the library: the first handle's library is put there."""
+    (~0.2 s) unless PYPARDISO_MKL_RT names the library: the first handle's library is put there.
+    MKL's OpenMP threads sleep as soon as a parallel region ends (``KMP_BLOCKTIME=0``, read when
+    MKL starts its threads; see :mod:`fem.threads`) unless the environment sets it."""
+    os.environ.setdefault("KMP_BLOCKTIME", "0")
     import pypardiso
     ps = pypardiso.PyPardisoSolver(**kwargs)
     os.environ.setdefault("PYPARDISO_MKL_RT", ps.libmkl._name)

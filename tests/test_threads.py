@@ -51,3 +51,16 @@ def test_worker_threads_keep_the_callers_error_handling(monkeypatch):
         warnings.simplefilter("error")
         out = threads.map_chunks(lambda c: np.sqrt(-np.ones(2)), chunks)
     assert all(np.isnan(o).all() for o in out)
+
+
+def test_a_fem_solver_puts_openblas_on_one_thread_and_leaves_mkl_its_threads():
+    threadpoolctl = pytest.importorskip("threadpoolctl")
+    from softhand.fem.linsolve import make_solver
+
+    make_solver(symmetric=True)  # loads MKL where it is installed
+    mkl = {i["filepath"]: i["num_threads"] for i in threadpoolctl.threadpool_info() if i["internal_api"] == "mkl"}
+    threads._quiet.clear()  # as in a new process
+    make_solver(symmetric=True)
+    info = threadpoolctl.threadpool_info()
+    assert all(i["num_threads"] == 1 for i in info if i["internal_api"] == "openblas")
+    assert {i["filepath"]: i["num_threads"] for i in info if i["internal_api"] == "mkl"} == mkl
