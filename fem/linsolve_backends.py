@@ -80,22 +80,26 @@ class LinearSolver:
         self.n_factorizations += 1
         self.seconds += time.perf_counter() - t0
 
-    def apply(self, b: np.ndarray) -> np.ndarray:
-        """x with K x = b for the last factorised K."""
+    def apply(self, b: np.ndarray, rtol: float | None = None) -> np.ndarray:
+        """x with K x = b for the last factorised K; ``rtol``: a relative residual
+        ||b - K x|| / ||b|| that is enough (an inexact Newton step): a solver that refines its
+        solution (PARDISO in mixed precision) stops there instead of at ``REFINE_RTOL``;
+        the direct solvers' one solve is more accurate anyway."""
         if self._K is None:
             raise RuntimeError(f"{self.name}: apply() before factorize()")
         t0 = time.perf_counter()
-        x = self._apply(np.asarray(b, dtype=float))
+        x = self._apply(np.asarray(b, dtype=float), rtol)
         self.n_solves += 1
         self.seconds += time.perf_counter() - t0
         if not np.all(np.isfinite(x)):
             raise np.linalg.LinAlgError(f"{self.name}: non-finite solution (singular tangent?)")
         return x
 
-    def solve(self, K: sp.spmatrix, b: np.ndarray) -> np.ndarray:
-        """x with K x = b (K square sparse, b of shape (n,)); K's factor is kept."""
+    def solve(self, K: sp.spmatrix, b: np.ndarray, rtol: float | None = None) -> np.ndarray:
+        """x with K x = b (K square sparse, b of shape (n,)); K's factor is kept; ``rtol`` as
+        in :meth:`apply`."""
         self.factorize(K)
-        return self.apply(b)
+        return self.apply(b, rtol)
 
     def describe(self) -> str:
         """One line for reports."""
@@ -148,9 +152,9 @@ class PardisoSolver(LinearSolver):
         self._ps.set_phase(22)  # numerical factorisation
         self._ps._call_pardiso(A, work)
 
-    def _apply(self, b):
+    def _apply(self, b, rtol=None):
         if self.precision == "mixed":
-            x = self._refine(self._K, b)
+            x = self._refine(self._K, b, rtol)
             if x is not None:
                 return x
             self.precision, self._ps, self._pattern = "double", self._handle("double"), None
@@ -178,15 +182,17 @@ class PardisoSolver(LinearSolver):
         A.has_sorted_indices = True
         return A
 
-    def _refine(self, K, b):
-        """Single-precision factor + double-precision refinement; None when it stalls."""
+    def _refine(self, K, b, rtol=None):
+        """Single-precision factor + double-precision refinement to max(REFINE_RTOL, rtol);
+        None when it stalls."""
+        target = REFINE_RTOL if rtol is None else max(REFINE_RTOL, rtol)
         A32 = self._A
         work = np.zeros((len(b), 1), dtype=np.float32, order="F")
         self._ps.set_phase(33)  # solves with the stored factor
         bnorm = float(np.linalg.norm(b))
         x, r, last = np.zeros_like(b), b, bnorm
         for step in range(REFINE_MAX):
-            if last <= REFINE_RTOL * bnorm:
+            if last <= target * bnorm:
                 return x
             work[:, 0] = r
             x = x + self._ps._call_pardiso(A32, work).ravel()
@@ -197,12 +203,12 @@ class PardisoSolver(LinearSolver):
                 self.fallback = f"mixed precision stalled at relative residual {norm / bnorm:.1e}"
                 return None
             left = REFINE_MAX - (step + 1)
-            if norm * (norm / last) ** left > REFINE_RTOL * bnorm:  # too slow to get there in time
+            if norm * (norm / last) ** left > target * bnorm:  # too slow to get there in time
                 self.fallback = (f"mixed precision too slow (relative residual {norm / bnorm:.1e}, "
                                  f"{norm / last:.2f} per step)")
                 return None
             last = norm
-        if last <= REFINE_RTOL * bnorm:
+        if last <= target * bnorm:
             return x
         self.fallback = f"mixed precision reached only {last / bnorm:.1e} in {REFINE_MAX} steps"
         return None
@@ -228,7 +234,7 @@ class UmfpackSolver(LinearSolver):
         self._ctx.numeric(Kc)
         self._Kc = Kc
 
-    def _apply(self, b):
+    def _apply(self, b, rtol=None):
         return self._ctx.solve(self._um.UMFPACK_A, self._Kc, b, autoTranspose=True)
 
 
@@ -257,7 +263,7 @@ class QdldlSolver(LinearSolver):
             self._f, self._pattern = None, None
             self._lu = spla.splu(K.tocsc(), permc_spec="MMD_AT_PLUS_A")
 
-    def _apply(self, b):
+    def _apply(self, b, rtol=None):
         if self._lu is None:
             x = self._f.solve(b)
             with np.errstate(over="ignore", invalid="ignore"):  # a tiny pivot's huge x
@@ -276,5 +282,5 @@ class SuperLUSolver(LinearSolver):
         self._same_pattern(K)
         self._lu = spla.splu(K.tocsc(), permc_spec="MMD_AT_PLUS_A")
 
-    def _apply(self, b):
+    def _apply(self, b, rtol=None):
         return self._lu.solve(b)

@@ -67,6 +67,9 @@ class NewtonOptions:
     refactor: str = "always"
     contraction: float = 0.1  #: "adaptive": largest ||R_new|| / ||R|| kept on an old factorisation
     memory: int = 10  #: "adaptive": secant pairs of the BFGS update kept
+    #: inexact Newton: the largest relative residual ||K dx + R|| / ||R|| a Newton system is
+    #: solved to (None: as accurately as the solver can); see :func:`forcing_term`
+    forcing: float | None = 1e-2
 
     def __post_init__(self):
         if self.merit not in MERITS:
@@ -143,7 +146,7 @@ def newton(fun, x0, options: NewtonOptions = NewtonOptions(), *, solver=None, sc
     t_asm = time.perf_counter() - t0
     norm = float(np.linalg.norm(R))
     tol = options.atol + options.rtol * (norm if scale is None else scale)
-    history, steps, t_solve, factorizations, pairs = [norm], [], 0.0, 0, []
+    history, steps, t_solve, factorizations, pairs, etas = [norm], [], 0.0, 0, [], []
     done = (lambda x, R, it: float(np.linalg.norm(R)) <= tol) if converged is None else converged
     for it in range(options.max_iter + 1):
         if not np.isfinite(norm):
@@ -162,7 +165,9 @@ def newton(fun, x0, options: NewtonOptions = NewtonOptions(), *, solver=None, sc
             if it == 0 and direction is not None:
                 dx = np.asarray(direction)
             elif K is not None:
-                dx, pairs = solver.solve(K, -R), []
+                eta = None if options.forcing is None else forcing_term(history, tol, options.forcing, etas)
+                dx, pairs = solver.solve(K, -R, rtol=eta), []
+                etas.append(eta)
                 factorizations += 1
             else:
                 dx, old = bfgs_direction(R, pairs, solver.apply), True
@@ -194,6 +199,26 @@ def newton(fun, x0, options: NewtonOptions = NewtonOptions(), *, solver=None, sc
         if small and s == 1.0 and np.isfinite(norm) and (not old or rate <= options.contraction):
             return NewtonResult(x, it + 1, history, steps, t_asm, t_solve, factorizations)  # round-off
     raise NotConverged(f"no convergence in {options.max_iter} iterations (tol {tol:.2e})", history, x)
+
+
+def forcing_term(history, tol: float, largest: float, etas) -> float:
+    r"""The relative residual :math:`\eta_k` a Newton system needs to be solved to
+    (Eisenstat and Walker's choice 2): :math:`0.9\,(\|R_k\| / \|R_{k-1}\|)^2`, kept
+    from falling faster than :math:`0.9\,\eta_{k-1}^2` while that is above 0.1, at most
+    ``largest``, and at least :math:`0.5\,\mathrm{tol} / \|R_k\|` (a solve more accurate
+    than the tolerance on R asks gains nothing). history: ||R|| of the iterates so far,
+    etas: the earlier terms (None where none was used). The converged answer is tested on
+    R as before; only how accurately each step is solved changes, which for PARDISO in mixed
+    precision is how many refinement steps follow the single-precision factorisation."""
+    norm = history[-1]
+    eta = largest
+    if len(history) > 1 and history[-2] > 0:
+        eta = 0.9 * (norm / history[-2]) ** 2
+        last = etas[-1] if etas and etas[-1] is not None else None
+        if last is not None and 0.9 * last ** 2 > 0.1:
+            eta = max(eta, 0.9 * last ** 2)
+    floor = 0.5 * tol / norm if norm > 0 else largest
+    return float(min(largest, max(eta, floor)))
 
 
 @dataclass(frozen=True)

@@ -75,8 +75,10 @@ def test_cut_back_recovers_a_hard_step():
     assert res.x[-1][0] ** 3 + res.x[-1][0] == pytest.approx(30.0, rel=2e-8)  # rtol 1e-8 of |R0| <= 30
 
 
-def test_quadratic_convergence_on_inflated_block():
-    mesh = fe.MeshTet.init_tensor(*(np.linspace(0, 1, 3),) * 3).with_defaults()
+def inflated_block(n: int):
+    """(unknowns, fun) of a Neo-Hookean unit cube on n^3 P2 tets' grid, clamped on the left,
+    0.3 MPa follower pressure on the right."""
+    mesh = fe.MeshTet.init_tensor(*(np.linspace(0, 1, n + 1),) * 3).with_defaults()
     solid = Solid(mesh, NeoHookean(1.0, 100.0))
     red = Restriction(solid.ndofs, solid.free_dofs(solid.dofs("left")))
     load = FollowerPressure(solid, "right")
@@ -86,7 +88,12 @@ def test_quadratic_convergence_on_inflated_block():
         R, data = solid.residual_tangent_data(u)
         return red.vector(R + load.residual(u, 0.3)), red.restrict(solid.scatter.csr(data + load.tangent_data(u, 0.3)))
 
-    r = newton(fun, np.zeros(len(red.keep)), NewtonOptions(rtol=1e-12, atol=0.0, xtol=0.0))
+    return len(red.keep), fun
+
+
+def test_quadratic_convergence_on_inflated_block():
+    n, fun = inflated_block(2)
+    r = newton(fun, np.zeros(n), NewtonOptions(rtol=1e-12, atol=0.0, xtol=0.0))
     h = np.array(r.history)
     # the last steps: log r_{k+1} ~ 2 log r_k + c  (order 2, before round-off at ~1e-14 |R0|)
     tail = h[(h < 1e-1 * h[0]) & (h > 1e-12 * h[0])]
@@ -210,7 +217,8 @@ def test_decrease_merit_takes_the_first_step_whole_then_halves_until_the_merit_d
         calls.append(float(x[0]))
         return abs(float(x[0]))
 
-    r = newton(ATAN, [1.5], NewtonOptions(merit="decrease"), merit=merit)
+    # forcing=None: exact Newton steps (an inexact one is the Newton step only to ~1e-8 in single precision)
+    r = newton(ATAN, [1.5], NewtonOptions(merit="decrease", forcing=None), merit=merit)
     assert abs(r.x[0]) < 1e-8 and r.steps[0] == 1.0 and min(r.steps[1:]) < 1.0
     x1 = 1.5 - np.arctan(1.5) * (1 + 1.5**2)  # the first, whole Newton step
     assert abs(x1) > 1.5 and calls[1] == pytest.approx(x1, rel=1e-12)
@@ -233,3 +241,32 @@ def test_path_lands_on_its_stops_up_and_down_within_the_largest_step():
     assert down.x[down.stops[-1]][0] == pytest.approx(root(1.0), abs=1e-11)
     with pytest.raises(ValueError, match="monotonically"):
         solve_path(fun_t, [0.0], opts, stops=(2.0, 1.0))
+
+
+def test_forcing_term_is_eisenstat_walker_within_its_bounds():
+    from softhand.fem.newton import forcing_term
+    assert forcing_term([1.0], 1e-12, 1e-2, []) == 1e-2                    # first step: the largest
+    assert forcing_term([1.0, 0.01], 1e-12, 1e-2, [1e-2]) == pytest.approx(0.9e-4)  # 0.9 (ratio)^2
+    assert forcing_term([1.0, 0.9], 1e-12, 1e-2, [1e-2]) == 1e-2             # capped at the largest
+    # near the tolerance no solve needs to be more accurate than 0.5 tol / ||R||
+    assert forcing_term([1e-3, 1e-9], 1e-10, 1e-2, [1e-4]) == 1e-2            # floor 0.05, capped
+    assert forcing_term([1e-3, 1e-9], 1e-13, 1e-2, [1e-4]) == pytest.approx(0.5e-4)  # the floor
+    # a large last term may not collapse at once: 0.9 eta_{k-1}^2 = 0.225 > 0.1 stands
+    assert forcing_term([1.0, 1e-4], 1e-7, 0.5, [0.5]) == pytest.approx(0.225)
+
+
+@pytest.mark.skipif("pardiso" not in available(), reason="mixed precision needs PARDISO")
+def test_inexact_newton_gives_the_answer_to_tolerance_with_fewer_refinement_steps():
+    """Mixed-precision PARDISO refines every exact solve to 1e-10; an inexact Newton step stops
+    at the forcing term. Same iterations, the same answer to the tolerance, fewer refinements."""
+    n, fun = inflated_block(3)
+    out = {}
+    for forcing in (None, 1e-2):
+        solver = make_solver("pardiso", precision="mixed")
+        r = newton(fun, np.zeros(n), NewtonOptions(rtol=1e-10, forcing=forcing), solver=solver)
+        out[forcing] = (r, solver.refinement_steps)
+    (exact, n_exact), (inexact, n_inexact) = out[None], out[1e-2]
+    assert inexact.iterations == exact.iterations and n_inexact < n_exact
+    # both meet ||R|| <= 1e-10 ||R0||: their difference is of the size of that residual's error
+    scale = np.abs(exact.x).max()
+    np.testing.assert_allclose(inexact.x, exact.x, atol=1e-8 * scale)
