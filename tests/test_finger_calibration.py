@@ -1,5 +1,6 @@
 """softhand calibrate finger on a CI-sized space: a table from two FEM designs, checked on a third."""
 import json
+from pathlib import Path
 
 import pytest
 
@@ -40,6 +41,10 @@ def test_table_from_two_ties_predicts_the_middle_one(tmp_path, capsys):
                  "--results", results, "--no-progress"]) == 0
     text = table.read_text()
     assert "p_terms=s2 th, q_terms=lt th" in text and "mesher gmsh" in text
+    # each case's record says what its FEM cost: Newton iterations and tangent factorisations
+    solvers = [json.loads(p.read_text())["provenance"]["solver"] for p in Path(results).rglob("result.json")]
+    assert len(solvers) == 2
+    assert all(isinstance(s["factorizations"], int) and 0 < s["factorizations"] for s in solvers)
     held = _space(tmp_path / "held.toml", "held", (10.0,))
     capsys.readouterr()
     assert main(["calibrate", "finger", "--check", str(held), "--table", str(table),
