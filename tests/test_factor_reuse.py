@@ -1,4 +1,5 @@
 """Factorisation reuse: quasi-Newton on an old factor, the solvers' factor/apply, the fallback."""
+import os
 import warnings
 
 import numpy as np
@@ -106,3 +107,17 @@ def test_pardiso_solves_without_refinement_and_to_the_same_accuracy():
     x = solver.solve(K, b)
     assert solver._ps.iparm[6] == 0  # refinement steps performed
     assert np.linalg.norm(K @ x - b) <= 1e-12 * np.linalg.norm(b)
+
+
+@pytest.mark.skipif("pardiso" not in linsolve.available(), reason="needs MKL PARDISO")
+def test_the_mkl_runtime_found_without_a_search_is_the_one_pypardiso_finds(monkeypatch):
+    """The shortcut to MKL's runtime (where the wheel puts it) must name the library pypardiso's
+    own search of the environment loads, or nothing."""
+    import pypardiso
+
+    from softhand.fem.linsolve_backends import _wheel_mkl_rt
+
+    monkeypatch.delenv("PYPARDISO_MKL_RT", raising=False)
+    found = _wheel_mkl_rt()
+    searched = pypardiso.PyPardisoSolver().libmkl._name
+    assert found is None or os.path.samefile(found, searched)
