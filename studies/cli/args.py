@@ -93,6 +93,11 @@ def add_json_option(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--json", action="store_true", help="print one JSON object on stdout")
 
 
+def add_progress_option(parser: argparse.ArgumentParser) -> None:
+    """``--no-progress``: no progress bar on stderr (logs, CI)."""
+    parser.add_argument("--no-progress", action="store_true", help="no progress bar")
+
+
 def design_from_args(args) -> HandDesign:
     return load_design(args.design)
 

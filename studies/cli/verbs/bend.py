@@ -13,7 +13,7 @@ import sys
 from pathlib import Path
 
 from softhand.studies.cli.args import MAX_FEM_POINTS, MOST_FEM_POINTS, add_design_option, add_json_option, \
-    add_max_cases_option, design_from_args, max_cases, parse_values, print_json, print_table
+    add_max_cases_option, add_progress_option, design_from_args, max_cases, parse_values, print_json, print_table
 
 HELP = "finger FEM: free bending under pressure vs the reduced model (eqs. 28, 2)"
 
@@ -57,6 +57,7 @@ def configure(parser) -> None:
     add_max_cases_option(parser, MAX_FEM_POINTS, MOST_FEM_POINTS)
     add_design_option(parser)
     add_json_option(parser)
+    add_progress_option(parser)
 
 
 #: option -> (lowest, highest) allowed; the mesh and quadrature options of the finger FEM
@@ -132,7 +133,8 @@ def run(args) -> int:
     out = Path(args.out)
     clear_outputs(out)
     n_steps = len(pressures) + (1 if study.peak_mpa else 0)
-    bar = tqdm(total=n_steps, desc="bend", unit="pressure", file=sys.stderr, leave=False)
+    bar = tqdm(total=n_steps, desc="bend", unit="pressure", file=sys.stderr, leave=False,
+               disable=args.no_progress)
     converged = []
 
     def progress(model, state):

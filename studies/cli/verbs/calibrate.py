@@ -16,7 +16,7 @@ from __future__ import annotations
 import shlex
 import sys
 
-from softhand.studies.cli.args import add_json_option, print_json, print_table
+from softhand.studies.cli.args import add_json_option, add_progress_option, print_json, print_table
 
 HELP = "calibrate the reduced finger model 'fem' from the finger FEM (design space or one design)"
 
@@ -38,7 +38,7 @@ def configure(parser) -> None:
                         help="run on a Dask cluster at ADDRESS ('local' starts a LocalCluster)")
     finger.add_argument("--results", default="results", metavar="DIR",
                         help="results root of the FEM cases (default: results)")
-    finger.add_argument("--no-progress", action="store_true", help="no progress bar")
+    add_progress_option(finger)
     finger.add_argument("--finished", action="store_true",
                         help="run no FEM: use the designs already finished in --results (the "
                              "others are listed as pending)")

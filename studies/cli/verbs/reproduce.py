@@ -1,7 +1,7 @@
 """``softhand reproduce [--out DIR] [--quick]``: the paper's results, end to end, in one report."""
 from __future__ import annotations
 
-from softhand.studies.cli.args import add_design_option, design_from_args
+from softhand.studies.cli.args import add_design_option, add_progress_option, design_from_args
 
 HELP = "recompute every result of the paper into a report (Markdown + PNG + CSV + VTK)"
 
@@ -15,7 +15,7 @@ def configure(parser) -> None:
                         help="build only these sections (keys as in the report's folders)")
     parser.add_argument("--fresh", action="store_true",
                         help="recompute every section, even those a previous run finished")
-    parser.add_argument("--no-progress", action="store_true", help="no progress bar")
+    add_progress_option(parser)
     add_design_option(parser)
 
 

@@ -15,7 +15,7 @@ from pathlib import Path
 
 from softhand.reduced.errors import InputError
 from softhand.studies.cli.args import MAX_FEM_POINTS, MOST_FEM_POINTS, add_design_option, add_json_option, \
-    add_max_cases_option, design_from_args, max_cases, parse_values, print_json, print_table
+    add_max_cases_option, add_progress_option, design_from_args, max_cases, parse_values, print_json, print_table
 from softhand.studies.io.files import write_outputs
 
 HELP = "inflate the reservoir sheet (FEM) and measure the ellipse assumption (eqs. 11-18)"
@@ -34,6 +34,7 @@ def configure(parser) -> None:
     add_max_cases_option(parser, MAX_FEM_POINTS, MOST_FEM_POINTS)
     add_design_option(parser)
     add_json_option(parser)
+    add_progress_option(parser)
 
 
 def _study(args):
@@ -66,7 +67,7 @@ def run(args) -> int:
     from softhand.fem.volume_path import NotConverged
 
     try:
-        with tqdm(desc="inflating", unit=" mm³", leave=False) as bar:  # whole mm³ of oil
+        with tqdm(desc="inflating", unit=" mm³", leave=False, disable=args.no_progress) as bar:  # whole mm³ of oil
             result = run_study(study, progress=lambda v: bar.update(round(v) - bar.n))
     except NotConverged as exc:
         return _failed(exc, study, Path(args.out or FAILED_OUT))

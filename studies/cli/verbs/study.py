@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import sys
 
-from softhand.studies.cli.args import print_json
+from softhand.studies.cli.args import add_progress_option, print_json
 
 HELP = "run a batch study (TOML file) on a process pool or a Dask cluster; status; report"
 
@@ -19,7 +19,7 @@ def configure(parser) -> None:
                      help="run on a Dask cluster at ADDRESS ('local' starts a LocalCluster)")
     run.add_argument("--fresh", action="store_true",
                      help="recompute every case, also those already done")
-    run.add_argument("--no-progress", action="store_true", help="no progress bar")
+    add_progress_option(run)
     status = actions.add_parser("status", help="print done / pending / failed cases")
     status.add_argument("--json", action="store_true", help="print one JSON object on stdout")
     actions.add_parser("report", help="write plots and a Markdown summary of the results")

@@ -4,7 +4,7 @@ from __future__ import annotations
 import sys
 
 from softhand.reduced.errors import InputError
-from softhand.studies.cli.args import add_json_option, print_json, print_table
+from softhand.studies.cli.args import add_json_option, add_progress_option, print_json, print_table
 
 HELP = "FEM verification suite: closed forms vs FEM on small meshes (exit 1 if any fails)"
 
@@ -17,6 +17,7 @@ def configure(parser) -> None:
     parser.add_argument("--case", action="append", default=None, metavar="NAME",
                         help="run only this case (repeatable); default: all")
     add_json_option(parser)
+    add_progress_option(parser)
 
 
 def run(args) -> int:
@@ -29,7 +30,8 @@ def run(args) -> int:
     if unknown:
         raise InputError("--case", unknown[0], f"allowed: {', '.join(REGISTRY)}")
     rows = []
-    for name in tqdm(names, desc="verify", unit="case", file=sys.stderr, leave=False):
+    for name in tqdm(names, desc="verify", unit="case", file=sys.stderr, leave=False,
+                     disable=args.no_progress):
         checks, seconds = run_case(name, quick=args.quick)
         rows += [c.row() for c in checks]
         if not args.json:

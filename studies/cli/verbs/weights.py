@@ -16,7 +16,7 @@ from pathlib import Path
 from softhand.reduced.errors import InputError
 from softhand.reduced.paper import FIG8
 from softhand.studies.cli.args import MOST_FEM_POINTS, add_design_option, add_json_option, \
-    add_max_cases_option, design_from_args, max_cases, parse_values, print_json, print_table
+    add_max_cases_option, add_progress_option, design_from_args, max_cases, parse_values, print_json, print_table
 from softhand.studies.io.files import kept_if_unwritable
 
 HELP = "hinge weight vectors w for an object diameter from the grasp FEM; F_v vs eq. (25)"
@@ -48,6 +48,7 @@ def configure(parser) -> None:
     add_max_cases_option(parser, MAX_DIAMETERS, MOST_FEM_POINTS)
     add_design_option(parser)
     add_json_option(parser)
+    add_progress_option(parser)
 
 
 #: option -> (lowest, highest) allowed, in the option's unit
@@ -166,7 +167,8 @@ def _sweep(args, case, diameters) -> int:
 
     check = None if args.check_mm is None else _scalar(args.check_mm, "--check-mm")
     study = WeightsStudy(case=case, diameters_mm=tuple(float(D) for D in diameters), check_mm=check)
-    with tqdm(total=len(diameters), desc="weights", unit="D", file=sys.stderr) as bar:
+    with tqdm(total=len(diameters), desc="weights", unit="D", file=sys.stderr,
+              disable=args.no_progress) as bar:
         result = run_study(study, cache=not args.no_cache, progress=lambda row: bar.update())
     if args.plot:
         with kept_if_unwritable(args.plot, "weights"):
