@@ -68,3 +68,15 @@ def test_cli(tmp_path, capsys):
     assert re.search(r"table2_reduced +done", capsys.readouterr().out)
     assert main(["reproduce", "--out", out, "--only", "fig99"]) == 2
     assert capsys.readouterr().err.count("\n") == 1
+
+
+def test_no_progress_silences_the_sections_own_bars_too(tmp_path, capsys):
+    """A FEM section draws its own bar under the run's; --no-progress silences both, and the
+    flag is no parameter of the case (the run with bars reuses the quiet one's result)."""
+    argv = ["reproduce", "--quick", "--only", "reservoir_fem", "--out", str(tmp_path)]
+    assert main([*argv, "--no-progress"]) == 0
+    assert capsys.readouterr().err == ""
+    assert main([*argv, "--fresh"]) == 0
+    assert "inflating the sheet" in capsys.readouterr().err
+    assert main(argv) == 0
+    assert re.search(r"reservoir_fem\s+reused", capsys.readouterr().out)

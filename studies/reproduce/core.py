@@ -33,6 +33,7 @@ from softhand.studies.batch.runner import FAILED, RESULT, code_version, commit, 
 
 SECTION_MD = "section.md"
 _ACTIVE: dict = {}  #: the sections of the current reproduce() call, by key
+_SHOW: dict = {"progress": True}  #: whether the current reproduce() call shows progress
 
 
 @dataclass
@@ -75,7 +76,9 @@ def run_section(params: dict, design: HandDesign, outdir: Path) -> dict:
     """A batch-runner kind: build one section into ``outdir``; return its numbers."""
     section = _ACTIVE.get(params["section"]) or next(
         s for s in sections() if s.key == params["section"])
-    markdown, numbers = section.build(Context(design=design, quick=params["quick"]), outdir)
+    # progress is not a parameter of the case (it must not change what is reused)
+    markdown, numbers = section.build(Context(design=design, quick=params["quick"],
+                                              progress=_SHOW["progress"]), outdir)
     (outdir / SECTION_MD).write_text(markdown.strip() + "\n")
     return numbers
 
@@ -86,7 +89,8 @@ def reproduce(out: str | Path = "results/reproduce", *, quick: bool = False,
               section_list: list[Section] | None = None) -> list[Outcome]:
     """Build every section (or those in ``only``) and write ``<out>/report.md``."""
     out = Path(out)
-    ctx = Context(design=design or HandDesign(), quick=quick)
+    ctx = Context(design=design or HandDesign(), quick=quick, progress=progress)
+    _SHOW["progress"] = progress
     todo = section_list if section_list is not None else sections()
     _ACTIVE.clear()
     _ACTIVE.update((s.key, s) for s in todo)

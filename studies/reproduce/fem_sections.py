@@ -58,7 +58,7 @@ def fig7_fem(ctx: Context, outdir: Path):
     pressures = tuple(np.round(np.arange(0.0, 0.8 + 1e-9, step), 10))
     options = FingerOptions(mesher="gmsh", mesh_size=6.0, edge_ratio=1.0, mesh_refine=0) if ctx.quick else FingerOptions()
     folder = outdir / "bend"  # the files of `softhand bend --hand --out bend`
-    with progress_bar("  bending the finger", "pressure") as bar:
+    with progress_bar("  bending the finger", "pressure", ctx.progress) as bar:
         result = run(BendingStudy(ctx.design, pressures, options, hand=True),
                      on_state=vtk_writer(folder / "finger.pvd", then=lambda model, state: bar.update(1)))
     result.write(folder)
@@ -99,7 +99,7 @@ def reservoir_fem(ctx: Context, outdir: Path):
     from softhand.studies.reservoir import COLUMNS, ReservoirStudy, run
 
     mesh = {"n_radial": 16, "n_thick": 1} if ctx.quick else {}
-    with progress_bar("  inflating the sheet", " mm³") as bar:  # whole mm³ of oil
+    with progress_bar("  inflating the sheet", " mm³", ctx.progress) as bar:  # whole mm³ of oil
         result = run(ReservoirStudy(design=ctx.design, **mesh),
                      progress=lambda v: bar.update(round(v) - bar.n))
     folder = outdir / "reservoir"  # the files of `softhand reservoir --out reservoir`
@@ -206,11 +206,11 @@ errors against its measurements:
     return text, numbers
 
 
-def progress_bar(desc: str, unit: str):
-    """A nested tqdm bar (stderr, removed when done) for a long FEM path."""
+def progress_bar(desc: str, unit: str, show: bool = True):
+    """A nested tqdm bar (stderr, removed when done) for a long FEM path; ``show`` False: none."""
     from tqdm import tqdm
 
-    return tqdm(desc=desc, unit=unit, leave=False, position=1, file=sys.stderr)
+    return tqdm(desc=desc, unit=unit, leave=False, position=1, file=sys.stderr, disable=not show)
 
 
 SECTIONS: list[Section] = [

@@ -19,6 +19,7 @@ class Context:
 
     design: HandDesign  #: the hand (default: the paper's Table I)
     quick: bool = False  #: CI-sized meshes and fewer points
+    progress: bool = True  #: the sections' own progress bars (long FEM paths) on stderr
 
 
 @dataclass(frozen=True)
