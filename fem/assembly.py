@@ -102,11 +102,6 @@ class ElementScatter:
         return (3 * self.dofs[elements][:, :, None] + np.arange(3)).reshape(
             self.dofs[elements].shape[0], -1)
 
-    def add_matrix(self, data: np.ndarray, Ke: np.ndarray, elements) -> None:
-        """data += scatter of element matrices Ke (ne, 3nloc, 3nloc) of the given elements
-        (e.g. facet loads; whole-mesh volume terms go through :meth:`block_matrix_data`)."""
-        data += np.bincount(self.positions(elements).ravel(), weights=Ke.ravel(), minlength=self.nnz)
-
     def block_matrix_data(self, Ke: np.ndarray) -> np.ndarray:
         """CSR data of the sum of ALL elements' matrices given in the block layout
         Ke[e, n, a, b, m] (row dof: node n, component a; column dof: node m, component b;
@@ -136,6 +131,14 @@ class ElementScatter:
     def add_vector(self, out: np.ndarray, re: np.ndarray, elements) -> None:
         """out += scatter of element vectors re (ne, 3nloc)."""
         out += np.bincount(self.vector_dofs(elements).ravel(), weights=re.ravel(), minlength=self.n)
+
+    def add_chunk_vectors(self, out: np.ndarray, parts: list) -> None:
+        """out += scatter of the element vectors of ALL elements, given chunk by chunk in order
+        (the parts of :func:`fem.threads.map_chunks`): one bincount, the dofs kept."""
+        dofs = self._cache.get("vector_dofs")
+        if dofs is None:
+            dofs = self._cache["vector_dofs"] = self.vector_dofs().ravel()
+        out += np.bincount(dofs, weights=np.concatenate(parts).ravel(), minlength=self.n)
 
     def csr(self, data: np.ndarray) -> sp.csr_matrix:
         """The CSR matrix with this pattern and the given data (index arrays shared, not copied)."""

@@ -57,9 +57,9 @@ def make_solver(method: str = "auto", *, symmetric: bool = False, precision: str
     ``precision``: "mixed" (PARDISO only; see the module docstring) or "double"."""
     if method not in METHODS:
         raise ValueError(f"linear solver {method!r} not in {METHODS}")
-    threads.quiet_blas()  # OpenBLAS's spinning threads would slow the factorisations (fem.threads)
     if precision not in PRECISIONS:
         raise ValueError(f"precision {precision!r} not in {PRECISIONS}")
+    threads.quiet_blas()  # OpenBLAS's spinning threads would slow the factorisations (fem.threads)
     if method == "auto":
         method = next(m for m in available() if symmetric or m != "qdldl")
         _announce(method)

@@ -167,7 +167,7 @@ def newton(fun, x0, options: NewtonOptions = NewtonOptions(), *, solver=None, sc
             elif K is not None:
                 eta = None if options.forcing is None else forcing_term(history, tol, options.forcing, etas)
                 dx, pairs = solver.solve(K, -R, rtol=eta), []
-                etas.append(eta)
+                etas.append(eta)  # None throughout when forcing is None (then never read)
                 factorizations += 1
             else:
                 dx, old = bfgs_direction(R, pairs, solver.apply), True
@@ -207,16 +207,15 @@ def forcing_term(history, tol: float, largest: float, etas) -> float:
     from falling faster than :math:`0.9\,\eta_{k-1}^2` while that is above 0.1, at most
     ``largest``, and at least :math:`0.5\,\mathrm{tol} / \|R_k\|` (a solve more accurate
     than the tolerance on R asks gains nothing). history: ||R|| of the iterates so far,
-    etas: the earlier terms (None where none was used). The converged answer is tested on
+    etas: the earlier terms. The converged answer is tested on
     R as before; only how accurately each step is solved changes, which for PARDISO in mixed
     precision is how many refinement steps follow the single-precision factorisation."""
     norm = history[-1]
     eta = largest
     if len(history) > 1 and history[-2] > 0:
         eta = 0.9 * (norm / history[-2]) ** 2
-        last = etas[-1] if etas and etas[-1] is not None else None
-        if last is not None and 0.9 * last ** 2 > 0.1:
-            eta = max(eta, 0.9 * last ** 2)
+        if etas and 0.9 * etas[-1] ** 2 > 0.1:
+            eta = max(eta, 0.9 * etas[-1] ** 2)
     floor = 0.5 * tol / norm if norm > 0 else largest
     return float(min(largest, max(eta, floor)))
 

@@ -228,8 +228,7 @@ class Solid:
             p_geo = None if anchor is None else anchor.pressure(u, c, self.scatter.vector_dofs(c))
             return self._element_kernels(u, c, None if Ke is None else Ke[c], p_geo)
 
-        for c, re in zip(self._chunks, threads.map_chunks(kernels, self._chunks)):
-            self.scatter.add_vector(R, re, c)
+        self.scatter.add_chunk_vectors(R, threads.map_chunks(kernels, self._chunks))
         if not tangent or not scatter:
             return R, Ke
         return R, self.scatter.block_matrix_data(Ke)

@@ -130,8 +130,7 @@ class Windings:
             _, lam, G1, _, v = self._chunk(u, c)
             return np.einsum("eq,eqi->ei", self.W[c] * self.law.k * G1 / lam, v)
 
-        for c, re in zip(self.chunks, threads.map_chunks(forces, self.chunks)):
-            self.scatter.add_vector(R, re, c)
+        self.scatter.add_chunk_vectors(R, threads.map_chunks(forces, self.chunks))
 
     def add_residual_tangent(self, u: np.ndarray, R: np.ndarray, Ke_all: np.ndarray) -> None:
         """R += the windings' internal force; Ke_all (element matrices of the whole mesh in the
@@ -151,5 +150,4 @@ class Windings:
             Ke_all[c] += Ke
             return np.einsum("eq,eqi->ei", c2, v)
 
-        for c, re in zip(self.chunks, threads.map_chunks(kernels, self.chunks)):
-            self.scatter.add_vector(R, re, c)
+        self.scatter.add_chunk_vectors(R, threads.map_chunks(kernels, self.chunks))
