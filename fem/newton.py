@@ -70,6 +70,10 @@ class NewtonOptions:
     #: inexact Newton: the largest relative residual ||K dx + R|| / ||R|| a Newton system is
     #: solved to (None: as accurately as the solver can); see :func:`forcing_term`
     forcing: float | None = 1e-2
+    #: give up as soon as ||R|| exceeds this multiple of the smallest ||R|| of the solve so far
+    #: (None: only after max_iter); a diverging solve then costs a few iterations, not max_iter
+    #: (PETSc's SNES divergence tolerance, taken relative to the best iterate)
+    diverge: float | None = None
 
     def __post_init__(self):
         if self.merit not in MERITS:
@@ -78,6 +82,8 @@ class NewtonOptions:
             raise ValueError(f"refactor {self.refactor!r} not in ('always', 'adaptive')")
         if not 0 < self.contraction < 1:
             raise ValueError(f"contraction {self.contraction!r} not in (0, 1)")
+        if self.diverge is not None and not self.diverge > 1:
+            raise ValueError(f"diverge {self.diverge!r} must be None or > 1")
 
 
 class NotConverged(RuntimeError):
@@ -151,6 +157,8 @@ def newton(fun, x0, options: NewtonOptions = NewtonOptions(), *, solver=None, sc
     for it in range(options.max_iter + 1):
         if not np.isfinite(norm):
             raise NotConverged("residual is not finite", history, x)
+        if options.diverge is not None and norm > options.diverge * min(history):
+            raise NotConverged(f"diverging (||R|| above {options.diverge:g} times its smallest)", history, x)
         if done(x, R, len(history) - 1):
             return NewtonResult(x, it, history, steps, t_asm, t_solve, factorizations)
         if it == options.max_iter:

@@ -52,6 +52,26 @@ def test_residual_only_trials_give_the_same_iterates_with_one_tangent_per_iterat
     assert calls["fun"] == given.iterations - 1 == given.factorizations  # none at x0 either
 
 
+CUBE_ROOT = scalar_system(np.cbrt, lambda x: 1.0 / (3.0 * np.cbrt(x) ** 2))
+
+
+def test_a_diverging_solve_is_given_up_when_its_residual_grows_past_diverge():
+    # cbrt(x) = 0 from x0 = 1: full Newton steps give x_k+1 = -2 x_k, ||R|| x 2^(1/3) per step
+    opts = NewtonOptions(line_search=False, max_iter=50)
+    with pytest.raises(NotConverged) as plain:
+        newton(CUBE_ROOT, [1.0], opts)
+    assert len(plain.value.history) == 51  # without the test: all of max_iter
+    with pytest.raises(NotConverged, match="diverging") as err:
+        newton(CUBE_ROOT, [1.0], NewtonOptions(line_search=False, max_iter=50, diverge=10.0))
+    h = err.value.history
+    assert h[-1] > 10.0 * min(h) and h[-2] <= 10.0 * min(h[:-1])  # the first iterate past 10x
+    assert len(h) == 1 + int(np.ceil(np.log(10.0) / np.log(2.0 ** (1 / 3))))  # 10 steps, not 50
+    r = newton(CUBE_ROOT, [1.0], NewtonOptions(diverge=10.0))  # a converging solve is not stopped
+    assert abs(r.x[0]) < 1e-20
+    with pytest.raises(ValueError, match="diverge"):
+        NewtonOptions(diverge=1.0)
+
+
 def test_cut_back_and_last_converged_state():
     """arctan(x) = 2 t has a solution only for t < pi/4: the path stops just before it."""
     def fun_t(x, t):

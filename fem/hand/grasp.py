@@ -52,7 +52,10 @@ class GraspOptions:
     share_tol: float = 1e-3   #: ... and the weight shares changed less than this
     max_updates: int = 20     #: Uzawa updates before giving up
     steps: int = 2            #: initial load steps from P = 0
-    newton: NewtonOptions = field(default_factory=lambda: NewtonOptions(rtol=1e-9))
+    #: a load step whose residual grows 100-fold is cut back at once, not after max_iter
+    #: factorisations: at 1.2 MPa, 120-180 mm, the first step's two failed tries took 33-41
+    #: of a solve's 88-104 factorisations (benchmarks/bench_grasp.py)
+    newton: NewtonOptions = field(default_factory=lambda: NewtonOptions(rtol=1e-9, diverge=100.0))
 
     def __post_init__(self):
         for name in ("penalty", "gap_tol", "share_tol"):
