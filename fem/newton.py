@@ -172,13 +172,14 @@ def newton(fun, x0, options: NewtonOptions = NewtonOptions(), *, solver=None, sc
         try:
             if it == 0 and direction is not None:
                 dx = np.asarray(direction)
-            elif K is not None:
-                eta = None if options.forcing is None else forcing_term(history, tol, options.forcing, etas)
-                dx, pairs = solver.solve(K, -R, rtol=eta), []
-                etas.append(eta)  # None throughout when forcing is None (then never read)
-                factorizations += 1
             else:
-                dx, old = bfgs_direction(R, pairs, solver.apply), True
+                eta = None if options.forcing is None else forcing_term(history, tol, options.forcing, etas)
+                etas.append(eta)  # None throughout when forcing is None (then never read)
+                if K is not None:
+                    dx, pairs = solver.solve(K, -R, rtol=eta), []
+                    factorizations += 1
+                else:  # the stored factor's inverse, as accurate as a Newton system would be solved
+                    dx, old = bfgs_direction(R, pairs, lambda q: solver.apply(q, rtol=eta)), True
         except (RuntimeError, np.linalg.LinAlgError, ValueError) as err:
             raise NotConverged(f"linear solve failed ({err})", history, x) from err
         t_solve += time.perf_counter() - t1
@@ -295,7 +296,8 @@ def solve_path(fun_t, x0, options: PathOptions = PathOptions(), *, solver=None, 
             t = float(stop if dt >= sign * (stop - res.t[-1]) else res.t[-1] + sign * dt)
             if on_accept is not None:
                 on_accept(res.x[-1])
-            x_start, step = predict(res, t, fun_t, solver, options.predictor, residual_t, reuse)
+            x_start, step = predict(res, t, fun_t, solver, options.predictor, residual_t, reuse,
+                                    rtol=options.newton.forcing)
             try:
                 r = newton(lambda x: fun_t(x, t), x_start, options.newton, solver=solver,
                            scale=None if scale_t is None else scale_t(t), direction=step,

@@ -97,13 +97,16 @@ def record(res, t, r, options, dt, streak, reuse):
     return min(dt, options.max_step), streak
 
 
-def predict(res, t: float, fun_t, solver, kind: str, residual_t=None, reuse=False):
+def predict(res, t: float, fun_t, solver, kind: str, residual_t=None, reuse=False, rtol=None):
     """(Newton's start, its first direction) for the step from the last converged state to t;
     the direction None: Newton's own (no predictor, the secant's start, or a singular tangent).
 
     ``residual_t``: the residual at t0 + eps costs no tangent; with ``reuse`` (quasi-Newton)
     and a factorisation of this size in ``solver`` the tangent predictor solves with that
-    factorisation (the last iterate's tangent) instead of factorising K(x0)."""
+    factorisation (the last iterate's tangent) instead of factorising K(x0), and only to the
+    relative residual ``rtol`` (a guess on an old factor: Newton's largest forcing term); with
+    K(x0) factorised the Euler step is solved exactly (solved to 1e-2, the mixed (u, p)
+    iteration of a nearly incompressible tube needed one more iteration)."""
     if kind not in ("tangent", "secant", "none"):
         raise ValueError(f"predictor {kind!r} not in ('tangent', 'secant', 'none')")
     t0, x0 = res.t[-1], res.x[-1]
@@ -118,6 +121,6 @@ def predict(res, t: float, fun_t, solver, kind: str, residual_t=None, reuse=Fals
     R1 = residual_t(x0, t0 + eps) if residual_t is not None else fun_t(x0, t0 + eps)[0]
     try:
         rhs = R0 + (R1 - R0) * ((t - t0) / eps)
-        return x0, -(solver.apply(rhs) if old else solver.solve(K0, rhs))
+        return x0, -(solver.apply(rhs, rtol=rtol) if old else solver.solve(K0, rhs))
     except (RuntimeError, np.linalg.LinAlgError, ValueError):
         return x0, None

@@ -52,6 +52,29 @@ def test_quasi_newton_on_old_factors_reaches_the_same_path_with_fewer_factorisat
     assert full.factorizations == full.total_iterations  # Newton: one per iteration (the predictor's too)
 
 
+@pytest.mark.parametrize("forcing", [1e-2, None])
+def test_solves_with_the_stored_factor_ask_only_the_accuracy_newton_needs(forcing):
+    """The predictor on a stored factor and the quasi-Newton directions pass a tolerance to the
+    solver, as the Newton systems do (a mixed-precision factor is then refined only that far);
+    forcing=None asks every solve to be exact."""
+    fun_t, n = inflated_block()
+    solver, asked = make_solver(), {"apply": [], "solve": []}
+    apply, solve = solver.apply, solver.solve
+    solver.apply = lambda b, rtol=None: asked["apply"].append(rtol) or apply(b, rtol=rtol)
+    solver.solve = lambda K, b, rtol=None: asked["solve"].append(rtol) or solve(K, b, rtol=rtol)
+    opts = PathOptions(steps=4, newton=NewtonOptions(rtol=1e-10, refactor="adaptive", contraction=0.5,
+                                                     forcing=forcing))
+    res = solve_path(fun_t, np.zeros(n), opts, solver=solver, residual_t=lambda x, t: fun_t(x, t)[0])
+    assert res.t[-1] == 1.0
+    # solve() factorises and applies the new factor: every other apply used a stored factor
+    assert len(asked["apply"]) > len(asked["solve"]) > 0
+    if forcing is None:
+        assert set(asked["apply"]) == {None}
+    else:  # exact only where a predictor factorised K(x0) itself (the first step: no factor yet)
+        assert asked["apply"].count(None) == asked["solve"].count(None) >= 1
+        assert all(0 < r <= forcing for r in asked["apply"] if r is not None)
+
+
 def test_bfgs_direction_satisfies_the_secant_condition():
     rng = np.random.default_rng(3)
     n = 12

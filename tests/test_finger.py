@@ -157,6 +157,22 @@ def test_layered_and_unstructured_meshes_agree(sweep):
     assert states[-1].dQ == pytest.approx(sweep[-1].dQ, rel=0.03)
 
 
+def test_sweeps_keep_mixed_precision_and_its_answer_is_double_precisions(model, sweep, monkeypatch):
+    """A pressure sweep factorises in single precision and refines each solve only as far as
+    Newton needs: it must not fall back to double, and theta and dQ must be what a
+    double-precision sweep gives, to the Newton tolerance."""
+    from softhand.fem.hand import finger_sweep
+    from softhand.fem.linsolve import make_solver
+
+    _, mixed = solve_pressures(model, PRESSURES)
+    assert "mixed precision (" in mixed.solver and "double precision" not in mixed.solver, mixed.solver
+    monkeypatch.setattr(finger_sweep, "make_solver", lambda **kw: make_solver(**{**kw, "precision": "double"}))
+    double, stats = solve_pressures(model, PRESSURES)
+    assert "mixed" not in stats.solver
+    for a, b in zip(sweep, double):
+        assert a.theta == pytest.approx(b.theta, rel=1e-7) and a.dQ == pytest.approx(b.dQ, rel=1e-7)
+
+
 def test_hand_frame_matches_the_reduced_kinematics(model):
     q = np.radians([5.0, 10.0, 15.0, 20.0, 25.0])
     ours = to_hand_frame(model.chain.hinge_positions(q), DESIGN)

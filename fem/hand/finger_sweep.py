@@ -11,10 +11,11 @@ from softhand.fem.newton import NewtonOptions, NotConverged, PathOptions, solve_
 
 #: quasi-Newton on the last factorisation (:func:`fem.newton.newton`, ``refactor="adaptive"``),
 #: re-factorised only when a step lowers the residual by less than half: on the default mesh,
-#: 0-0.8 MPa in 0.1 MPa steps, 37 factorisations and 37 tangent assemblies (102 cheap
-#: iterations) against Newton's 51 and 51 (51 iterations), theta equal to 1e-8 deg; a step
-#: then needs up to ~18 iterations, hence max_iter 40. Since Newton assembles no tangent it
-#: does not use, the two take about equal time (20.8 s against 19.7 s, 2026-12-02)
+#: 0-0.8 MPa in 0.1 MPa steps, 35 factorisations and tangent assemblies (97 cheap
+#: iterations; 37 and 102 in double precision) against Newton's 51 and 51 (51 iterations),
+#: theta equal to 1e-8 deg; a step then needs up to ~18 iterations, hence max_iter 40.
+#: contraction 0.9 (max_iter 80) saves 4-6 factorisations for ~35 more iterations and was
+#: not faster (2026-12-03); the windings' tension-only jump keeps 3-8 per pressure
 SWEEP_NEWTON = NewtonOptions(rtol=1e-9, max_iter=40, refactor="adaptive", contraction=0.5, memory=20)
 
 
@@ -40,10 +41,13 @@ def solve_pressures(model, pressures, *, link_load=None, y0=None, callback=None,
     ([FingerState], SweepStats); raises :class:`fem.newton.NotConverged` with the last
     converged state when even the cut-back fails.
     """
-    # double precision: single-precision PARDISO plus refinement gains only ~0.06-0.16 per
-    # refinement step on the finger (fibers 1000 mu stiffer than the rubber), so "mixed" always
-    # fell back after one wasted factorisation (fem.linsolve)
-    solver = make_solver(symmetric=True, precision="double")
+    # mixed precision: a single-precision factor, refined in double only as far as each use needs
+    # (a Newton system to its forcing term, a quasi-Newton direction likewise, the predictor to
+    # 1e-2). Refined to 1e-10 every time, as before the quasi-Newton directions and the
+    # predictor passed their tolerances, it stalled near 1e-10 (the fibers are 1000 mu stiffer
+    # than the rubber) and fell back to double after one wasted factorisation. On the default
+    # mesh, 0-0.8 MPa: 11.6-12.4 s against 14.1-14.2 s in double, theta equal to 1e-8 deg
+    solver = make_solver(symmetric=True, precision="mixed")
     t0 = time.perf_counter()
     history = [(0.0, model.constraint.zero() if y0 is None else np.array(y0, dtype=float))]
     states, totals = [], np.zeros(5)  # assembly s, solve s, iterations, cutbacks, factorisations
