@@ -2,7 +2,7 @@
 
 Run: ``python benchmarks/bench_finger.py [--mesh-size-mm H ...]``. Prints, per mesh size,
 the unknowns, tetrahedra, Newton iterations, tangent factorisations, assembly /
-linear-solve / total seconds and theta at the last pressure. Issue 5's target: the default mesh under 5 minutes.
+linear-solve / total seconds and theta at the last pressure.
 """
 from __future__ import annotations
 
