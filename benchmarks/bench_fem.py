@@ -17,8 +17,8 @@ mesh with NGSolve (same quadrature, sparse Cholesky, plain Newton) and prints ra
                                                              # load steps ours converges with
 
 ``--refactor adaptive`` (quasi-Newton on the last factorisation) and ``--precision double``
-try the other solver settings (on this tube, 80k DOFs, 2 steps: 19.8 s, no faster than Newton
-in mixed precision).
+try the other solver settings (on this tube, 80k DOFs, 2 steps: quasi-Newton 14 factorisations,
+14.0 s; Newton 22, 21.0 s; docs/fem-core.md).
 """
 from __future__ import annotations
 
