@@ -45,6 +45,9 @@ def test_table_from_two_ties_predicts_the_middle_one(tmp_path, capsys):
     solvers = [json.loads(p.read_text())["provenance"]["solver"] for p in Path(results).rglob("result.json")]
     assert len(solvers) == 2
     assert all(isinstance(s["factorizations"], int) and 0 < s["factorizations"] for s in solvers)
+    # ... and in which precision each sweep's factors were (a fall-back to double says why)
+    assert all(s["linear_solvers"] and all("factorisations" in d for d in s["linear_solvers"])
+               for s in solvers)
     held = _space(tmp_path / "held.toml", "held", (10.0,))
     capsys.readouterr()
     assert main(["calibrate", "finger", "--check", str(held), "--table", str(table),

@@ -119,12 +119,15 @@ def bend_case(params: dict, design: HandDesign, outdir: Path) -> dict:
     states, stats = solve_pressures(model, params["pressures_mpa"])
     more = load_path(states[-1].theta, params)
     its, facs, wall = stats.newton_iterations, stats.factorizations, stats.wall_seconds
+    linear = [stats.solver]  # each sweep's solver: its precision, and why it fell back if it did
     if more:  # restart at the last pressure (its state is converged: ~1 iteration) for the history
         extra, s2 = solve_pressures(model, [states[-1].P, *more], y0=states[-1].y)
         states = states + extra[1:]
         its, facs, wall = its + s2.newton_iterations, facs + s2.factorizations, wall + s2.wall_seconds
+        linear.append(s2.solver)
     return {"P_MPa": [s.P for s in states], "theta_deg": [math.degrees(s.theta) for s in states],
             "dQ_mm3": [s.dQ for s in states],
             "mesh": {"mesher": model.options.mesher, "dofs": model.ndofs,
                      "elements": model.mesh.nelements},
-            "solver": {"newton_iterations": its, "factorizations": facs, "wall_time_s": wall}}
+            "solver": {"newton_iterations": its, "factorizations": facs, "wall_time_s": wall,
+                       "linear_solvers": linear}}
