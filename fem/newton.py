@@ -70,9 +70,10 @@ class NewtonOptions:
     #: inexact Newton: the largest relative residual ||K dx + R|| / ||R|| a Newton system is
     #: solved to (None: as accurately as the solver can); see :func:`forcing_term`
     forcing: float | None = 1e-2
-    #: give up as soon as ||R|| exceeds this multiple of the smallest ||R|| of the solve so far
+    #: give up as soon as ||R|| exceeds this multiple of the smallest ||R|| since the first step
     #: (None: only after max_iter); a diverging solve then costs a few iterations, not max_iter
-    #: (PETSc's SNES divergence tolerance, taken relative to the best iterate)
+    #: (PETSc's SNES divergence tolerance, taken relative to the best iterate). Not the start's
+    #: ||R||: a small load step starts tiny, and its first step may raise ||R|| 1e5-fold and converge
     diverge: float | None = None
 
     def __post_init__(self):
@@ -157,7 +158,7 @@ def newton(fun, x0, options: NewtonOptions = NewtonOptions(), *, solver=None, sc
     for it in range(options.max_iter + 1):
         if not np.isfinite(norm):
             raise NotConverged("residual is not finite", history, x)
-        if options.diverge is not None and norm > options.diverge * min(history):
+        if options.diverge is not None and len(history) > 2 and norm > options.diverge * min(history[1:]):
             raise NotConverged(f"diverging (||R|| above {options.diverge:g} times its smallest)", history, x)
         if done(x, R, len(history) - 1):
             return NewtonResult(x, it, history, steps, t_asm, t_solve, factorizations)
