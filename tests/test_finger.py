@@ -22,9 +22,13 @@ def model():
 
 
 @pytest.fixture(scope="module")
-def sweep(model):
-    states, _ = solve_pressures(model, PRESSURES)
-    return states
+def sweep_run(model):
+    return solve_pressures(model, PRESSURES)  # (states, stats)
+
+
+@pytest.fixture(scope="module")
+def sweep(sweep_run):
+    return sweep_run[0]
 
 
 def test_a_link_carrying_the_whole_tube_moves_it_without_strain(model):
@@ -157,7 +161,7 @@ def test_layered_and_unstructured_meshes_agree(sweep):
     assert states[-1].dQ == pytest.approx(sweep[-1].dQ, rel=0.03)
 
 
-def test_mixed_precision_sweeps_give_double_precisions_answer(model, sweep, monkeypatch):
+def test_mixed_precision_sweeps_give_double_precisions_answer(model, sweep_run, monkeypatch):
     """A pressure sweep factorises in single precision and refines each solve only as far as
     Newton needs (or falls back to double, saying why, where a tangent refines too slowly:
     on this mesh's two 0.4 MPa steps it sometimes does, PARDISO's threads making each run's
@@ -166,7 +170,7 @@ def test_mixed_precision_sweeps_give_double_precisions_answer(model, sweep, monk
     from softhand.fem.hand import finger_sweep
     from softhand.fem.linsolve import make_solver
 
-    _, mixed = solve_pressures(model, PRESSURES)
+    sweep, mixed = sweep_run
     assert "mixed precision (" in mixed.solver or "double precision (mixed precision " in mixed.solver, mixed.solver
     monkeypatch.setattr(finger_sweep, "make_solver", lambda **kw: make_solver(**{**kw, "precision": "double"}))
     double, stats = solve_pressures(model, PRESSURES)
