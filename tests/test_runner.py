@@ -164,6 +164,34 @@ def test_a_killed_worker_loses_nothing_and_its_cases_are_rerun(tmp_path, monkeyp
     assert sorted(v["y"] for v in results_by_key(tmp_path / "res", study).values()) == list(range(1, 9))
 
 
+def test_a_pool_broken_between_two_submissions_loses_nothing(tmp_path, monkeypatch):
+    """A worker can die after wait() returned and before the next case is submitted: then
+    submit() itself raises BrokenProcessPool. That case, too, goes to the next pool."""
+    from concurrent.futures import ProcessPoolExecutor
+    from concurrent.futures.process import BrokenProcessPool
+
+    from softhand.studies.batch import pool
+
+    class BreaksOnThirdSubmit(ProcessPoolExecutor):
+        submitted = 0
+
+        def submit(self, *args, **kwargs):
+            type(self).submitted += 1
+            if type(self).submitted == 3:
+                raise BrokenProcessPool("a worker died")
+            return super().submit(*args, **kwargs)
+
+    monkeypatch.setattr(pool, "ProcessPoolExecutor", BreaksOnThirdSubmit)
+    install_kind(tmp_path, "echokind", "def case(params, design, outdir):\n"
+                                       "    return {'y': params['x']}\n")
+    monkeypatch.syspath_prepend(str(tmp_path))
+    study = load_study(write_study(tmp_path, 'kind = "echokind"\n[sweep]\nx = "1:6:1"\n'))
+    summary = run_study(study, results_root=tmp_path / "res", workers=2, progress=False)
+    assert BreaksOnThirdSubmit.submitted > 6  # the broken submission was made again
+    assert summary.ok and summary.computed == 6
+    assert sorted(v["y"] for v in results_by_key(tmp_path / "res", study).values()) == list(range(1, 7))
+
+
 THREADS_KIND = '''
 def case(params, design, outdir):
     from threadpoolctl import threadpool_info

@@ -44,7 +44,15 @@ def _one_pool(study: Study, todo, workers: int, lost: list[Case]):
     futures, broken = {}, False
 
     def submit(case):
-        futures[pool.submit(execute_case, study.kind, case.params, case.design)] = case
+        """In flight, or lost if the pool is broken: a worker can die after wait() returned."""
+        nonlocal broken
+        try:
+            if not broken:
+                futures[pool.submit(execute_case, study.kind, case.params, case.design)] = case
+                return
+        except BrokenProcessPool:
+            broken = True
+        lost.append(case)
 
     try:
         submit(first)
