@@ -7,11 +7,13 @@ from pathlib import Path
 
 from .errors import InputError
 
-__all__ = ["MAX_FILE_BYTES", "read_input_file", "read_toml"]
+__all__ = ["MAX_FILE_BYTES", "MAX_NESTING", "nesting_depth", "read_input_file", "read_toml"]
 
 
 #: largest design / study / data file read [bytes]; a bigger one (or /dev/zero) is refused
 MAX_FILE_BYTES = 1_000_000
+#: deepest nesting of tables and arrays in an input file (the files' own need at most 4)
+MAX_NESTING = 16
 
 
 def read_input_file(path: str | Path, field: str, what: str) -> bytes:
@@ -38,6 +40,25 @@ def read_toml(path: str | Path, field: str, what: str) -> dict:
     """A small TOML file as a dict; InputError (one line) if unreadable or not TOML."""
     data = read_input_file(path, field, what)
     try:
-        return tomllib.loads(data.decode("utf-8"))
+        table = tomllib.loads(data.decode("utf-8"))
     except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
         raise InputError(field, str(path), f"is not valid TOML ({exc})") from None
+    except RecursionError:  # arrays nested thousands deep
+        raise InputError(field, str(path), f"nests arrays or tables more than the parser's "
+                         f"limit; give {what}") from None
+    if nesting_depth(table, MAX_NESTING + 1) > MAX_NESTING:  # dotted keys nest without recursion
+        raise InputError(field, str(path), f"nests tables or arrays more than {MAX_NESTING} "
+                         f"deep; give {what}")
+    return table
+
+
+def nesting_depth(value, limit: int = 10_000) -> int:
+    """How deep dicts and lists nest in ``value`` (a scalar: 0); iterative, so any depth is
+    measured without recursion; stops counting at ``limit``."""
+    deepest, stack = 0, [(value, 0)]
+    while stack:
+        item, depth = stack.pop()
+        if isinstance(item, (dict, list)) and depth < limit:
+            deepest = max(deepest, depth + 1)
+            stack.extend((v, depth + 1) for v in (item.values() if isinstance(item, dict) else item))
+    return deepest

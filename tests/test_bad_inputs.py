@@ -36,7 +36,11 @@ FILES = {
     "push_huge.csv": "t_s,force_N\n0,0\n1,1e300\n",
     "a_file": "not a folder",
     "result.vtu": "<VTKFile>",
+    "deep.toml": "a_mm = " + "[" * 5000 + "]" * 5000 + "\n",  # the parser's recursion limit
+    "dotted.toml": "a_mm" + ".x" * 20_000 + " = 1\n",  # nested 20 000 deep without recursion
 }
+#: a file name longer than any file system allows (255 bytes), and a path past PATH_MAX
+LONG, DEEP_PATH = "x" * 300, "/".join(["y" * 200] * 25)
 #: design tasks (softhand design --task): a good one, and each of its mistakes
 GOOD_TASK = ("[object]\ndiameter_mm = 180.0\nmass_kg = 2.0\n[pump]\nmax_pressure_MPa = 2.0\n"
              "[free]\nd_mm = [12.0, 18.0]\n")
@@ -252,6 +256,22 @@ def _cases():
         for k, extra in enumerate(variants):
             cases.append((f"{verb}-{k}-{' '.join(extra)[:40]}", [verb, *extra]))
     cases += [("verb-unknown", ["bnd"]), ("verb-huge", ["x" * 100_000])]
+    nested = [["curve", "--theta-deg", "10", "--design", f] for f in ("deep.toml", "dotted.toml")]
+    nested += [["design", "--task", "deep.toml", "--no-fem"], ["study", "run", "dotted.toml"],
+               ["calibrate", "finger", "--space", "deep.toml", "--out", "t.csv"], ["study", "run", "deep.toml"]]
+    paths = [["curve", "--theta-deg", "10", "--plot", f"{LONG}.png"],
+             ["curve", "--theta-deg", "10", "--plot", f"{DEEP_PATH}/p.png"],
+             ["curve", "--theta-deg", "10", "--plot", f"adir/{LONG}/p.png"],
+             ["control", "--theta-ref-deg", "50", "--mass-kg", "1", "--out", LONG],
+             ["reproduce", "--quick", "--out", LONG], ["study", "run", STUDY, "--results", LONG],
+             ["material", "fit", "--data", "good_material.csv", "--model", "yeoh", "--out", f"{LONG}.toml"],
+             ["inspect", "good.vtu", "--out", f"{LONG}.png"], ["inspect", "good.vtu", "--animate", f"{LONG}.gif"],
+             ["reservoir", "--write-calibration", f"{LONG}.csv"], ["curve", "--theta-deg", "10", "--design", LONG]]
+    flags = [["inspect", "good.vtu", "--out", "o.PNG"], ["inspect", "good.vtu", "--fields", "--out", "o.png"],
+             ["inspect", "good.vtu", "--fields", "--animate", "o.gif"],
+             ["inspect", "good.vtu", "--animate", "o.gif", "--out", "o.png"],
+             ["inspect", "good.vtu", "--animate", "o.GIF"]]
+    cases += [(f"file-{k}-{' '.join(argv)[:40]}", argv) for k, argv in enumerate(nested + paths + flags)]
     return cases + replay_cases()  # calibrate, design, material, inspect, ranges, ...
 
 

@@ -22,13 +22,19 @@ from softhand.reduced.errors import InputError
 #: picture suffixes of matplotlib's writers (--plot) and of the 3D renderer (inspect --out)
 PLOT_SUFFIXES = (".png", ".pdf", ".svg", ".jpg", ".jpeg", ".eps", ".ps", ".tif", ".tiff", ".webp")
 RENDER_SUFFIXES = (".png", ".jpg", ".jpeg")
+#: suffixes of the renderer's animations (inspect --animate)
+ANIMATION_SUFFIXES = (".gif", ".mp4")
 
 #: argument name -> kind of output, per verb where it differs from the default
 OUTPUTS = {"out": "dir", "plot": "plot", "results": "dir", "write_calibration": "file"}
-VERB_OUTPUTS = {"fit": {"out": "toml"}, "material": {"out": "toml"}, "inspect": {"out": "render"},
+VERB_OUTPUTS = {"fit": {"out": "toml"}, "material": {"out": "toml"},
+                "inspect": {"out": "render", "animate": "animation"},
                 "calibrate": {"out": "csv"}, "reservoir": {"write_calibration": "csv"}}
 #: file suffixes an output kind must end in (a design TOML, a table)
-SUFFIXES = {"plot": PLOT_SUFFIXES, "render": RENDER_SUFFIXES, "toml": (".toml",), "csv": (".csv",)}
+SUFFIXES = {"plot": PLOT_SUFFIXES, "render": RENDER_SUFFIXES, "animation": ANIMATION_SUFFIXES,
+            "toml": (".toml",), "csv": (".csv",)}
+#: output kinds whose writer reads the suffix as it is spelled (the 3D renderer: not '.PNG')
+EXACT_SUFFIX = ("render", "animation")
 #: verbs that may use the on-disk caches (meshes, grasp weights)
 CACHE_VERBS = ("bend", "weights", "grasp", "study", "reproduce", "reservoir")
 
@@ -68,6 +74,7 @@ def check_writable(path, kind: str, field: str) -> None:
     if not text.strip() or "\0" in text:
         raise InputError(field, text, "must be a file or folder name")
     p = Path(text)
+    _check_name_lengths(p, field, text)
     if kind == "dir":
         if p.exists() and not p.is_dir():
             raise InputError(field, text, "exists and is not a folder; give a folder")
@@ -76,10 +83,31 @@ def check_writable(path, kind: str, field: str) -> None:
         if p.is_dir() or text.endswith(os.sep):
             raise InputError(field, text, "is a folder; give a file name")
         suffixes = SUFFIXES.get(kind)
-        if suffixes and p.suffix.lower() not in suffixes:
-            raise InputError(field, text, f"must end in one of {', '.join(suffixes)}")
+        suffix = p.suffix if kind in EXACT_SUFFIX else p.suffix.lower()
+        if suffixes and suffix not in suffixes:
+            case = " (lower case)" if kind in EXACT_SUFFIX else ""
+            raise InputError(field, text, f"must end in one of {', '.join(suffixes)}{case}")
         folder = p.parent
     _probe(folder, field, text)
+
+
+def _check_name_lengths(p: Path, field: str, text: str) -> None:
+    """Each part of ``p`` within the file system's name length, the whole within its path
+    length (else the first write fails with 'File name too long', after the work is done)."""
+    existing = p
+    while not os.path.exists(existing) and existing != existing.parent:  # False, not an error,
+        existing = existing.parent  # for a name too long
+    try:
+        name_max = os.pathconf(existing, "PC_NAME_MAX")
+        path_max = os.pathconf(existing, "PC_PATH_MAX")
+    except (OSError, ValueError, AttributeError):  # not POSIX, or not known: common limits
+        name_max, path_max = 255, 4096
+    longest = max(p.parts, key=lambda part: len(os.fsencode(part)), default="")
+    if len(os.fsencode(longest)) > name_max:
+        raise InputError(field, text, f"has a name of {len(os.fsencode(longest))} bytes; "
+                         f"at most {name_max} per folder or file name")
+    if len(os.fsencode(str(p.absolute()))) >= path_max:
+        raise InputError(field, text, f"is a path of more than {path_max} bytes")
 
 
 def check_readable_folder(path, field: str) -> None:

@@ -36,6 +36,13 @@ def run(args) -> int:
 
     if args.field is not None and not args.field.strip():
         raise InputError("--field", args.field, "must name a field (see --fields)")
+    drawn = {"--out": args.out, "--animate": args.animate, "--interactive": args.interactive or None}
+    if args.fields and (given := [k for k, v in drawn.items() if v is not None]):
+        raise InputError("--fields", True, f"lists the fields and draws nothing; not with {given[0]}")
+    if args.animate and (args.out is not None or args.step is not None):
+        option = "--out" if args.out is not None else "--step"
+        raise InputError(option, args.out if args.out is not None else args.step,
+                         "not with --animate, which renders every step into its own file")
     if args.fields:
         rows = describe(args.file, args.step)
         if args.json:
