@@ -39,6 +39,15 @@ FILES = {
     "deep.toml": "a_mm = " + "[" * 5000 + "]" * 5000 + "\n",  # the parser's recursion limit
     "dotted.toml": "a_mm" + ".x" * 20_000 + " = 1\n",  # nested 20 000 deep without recursion
 }
+#: VTK files that VTK reads but whose rendering crashed or aborted the process
+_VTU = EXTRA_FILES["good.vtu"]
+FILES.update({
+    "v_negative_id.vtu": _VTU.replace(">0 1 2 3<", ">0 1 2 -5<"),  # was a segmentation fault
+    "v_id_past_end.vtu": _VTU.replace(">0 1 2 3<", ">0 1 2 99<"),
+    "v_cell_type.vtu": _VTU.replace('format="ascii">10<', 'format="ascii">255<'),
+    "v_nan_point.vtu": _VTU.replace(">0 0 0 1 0 0 ", ">nan 0 0 1 0 0 "),
+    "v_huge_count.vtu": _VTU.replace('NumberOfPoints="4"', 'NumberOfPoints="1000000000000"'),  # bad_alloc
+})
 #: a file name longer than any file system allows (255 bytes), and a path past PATH_MAX
 LONG, DEEP_PATH = "x" * 300, "/".join(["y" * 200] * 25)
 #: design tasks (softhand design --task): a good one, and each of its mistakes
@@ -271,6 +280,8 @@ def _cases():
              ["inspect", "good.vtu", "--fields", "--animate", "o.gif"],
              ["inspect", "good.vtu", "--animate", "o.gif", "--out", "o.png"],
              ["inspect", "good.vtu", "--animate", "o.GIF"]]
+    flags += [["inspect", f, *extra] for f in sorted(FILES) if f.startswith("v_")
+              for extra in ([], ["--fields"])]
     cases += [(f"file-{k}-{' '.join(argv)[:40]}", argv) for k, argv in enumerate(nested + paths + flags)]
     return cases + replay_cases()  # calibrate, design, material, inspect, ranges, ...
 

@@ -28,6 +28,7 @@ def load_scene(path: str | Path, step: int | None = None) -> tuple[pv.MultiBlock
     if path.suffix not in SUFFIXES or not path.is_file():
         raise InputError("file", str(path), f"must be an existing {'/'.join(SUFFIXES)} file")
     _sniff(path)
+    _check_sizes(path)
     with pv.vtk_verbosity("off"), _quiet_logging():
         try:
             reader = pv.get_reader(str(path))
@@ -43,7 +44,61 @@ def load_scene(path: str | Path, step: int | None = None) -> tuple[pv.MultiBlock
     scene = _flatten(data, path.stem)
     if not any(b.n_points for b in scene):
         raise InputError("file", str(path), "must be a VTK file with a mesh (found no points)")
+    for name, block in zip(scene.keys(), scene):
+        _check_block(block, name, path)
     return scene, index, n
+
+
+#: most points or cells a piece of a file may declare (a result of this toolkit has < 1e7)
+MAX_ENTITIES = 100_000_000
+#: how much of each XML file is searched for its pieces' declared sizes [bytes]
+HEADER_BYTES = 1 << 20
+
+
+def _check_sizes(path: Path, depth: int = 0) -> None:
+    """No piece of the file (or of the files a .pvd / .vtm names) declares more than
+    MAX_ENTITIES points or cells: VTK allocates them before reading and aborts the process
+    when it cannot."""
+    try:
+        with path.open("rb") as f:
+            head = f.read(HEADER_BYTES)
+    except OSError:
+        return  # VTK's reader reports it
+    for key, count in re.findall(rb'(NumberOf\w+)\s*=\s*"\s*(\d+)', head):
+        if int(count) > MAX_ENTITIES:
+            raise InputError("file", str(path), f"declares {key.decode()} = {int(count)}; "
+                             f"at most {MAX_ENTITIES} (not a result of this toolkit?)")
+    if path.suffix in (".pvd", ".vtm") and depth < 2:
+        for name in dict.fromkeys(re.findall(rb'file\s*=\s*"([^"]+)"', head)):
+            child = path.parent / name.decode("utf-8", "replace")
+            if child.is_file():
+                _check_sizes(child, depth + 1)
+
+
+#: VTK's cell type ids (pyvista.CellType)
+CELL_TYPES = np.array(sorted(int(t) for t in pv.CellType))
+
+
+def _check_block(block: pv.DataSet, name: str, path: Path) -> None:
+    """Finite points, cells that name existing points, known cell types: VTK's renderer
+    crashes the process on a cell with an index out of range."""
+    if not np.all(np.isfinite(block.points)):
+        raise InputError("file", str(path), f"block {name!r} has points that are not finite numbers")
+    arrays = []
+    if isinstance(block, pv.UnstructuredGrid):
+        arrays.append(block.cell_connectivity)
+        if not np.isin(block.celltypes, CELL_TYPES).all():
+            bad = block.celltypes[~np.isin(block.celltypes, CELL_TYPES)][0]
+            raise InputError("file", str(path), f"block {name!r} has cells of unknown VTK type {bad}")
+    elif isinstance(block, pv.PolyData):
+        from vtkmodules.util.numpy_support import vtk_to_numpy
+
+        for cells in (block.GetVerts(), block.GetLines(), block.GetPolys(), block.GetStrips()):
+            arrays.append(vtk_to_numpy(cells.GetConnectivityArray()))
+    for ids in arrays:
+        if ids.size and (ids.min() < 0 or ids.max() >= block.n_points):
+            raise InputError("file", str(path), f"block {name!r} has cells naming points outside "
+                             f"0..{block.n_points - 1}")
 
 
 def _flatten(data, name: str) -> pv.MultiBlock:
