@@ -280,6 +280,9 @@ def _cases():
              ["inspect", "good.vtu", "--fields", "--animate", "o.gif"],
              ["inspect", "good.vtu", "--animate", "o.gif", "--out", "o.png"],
              ["inspect", "good.vtu", "--animate", "o.GIF"]]
+    flags += [["calibrate", "finger", "--check", "good_space.toml", "--finished"],
+              ["calibrate", "finger", "--check", "good_space.toml", "--out", "t.csv"],
+              ["calibrate", "finger", "--space", "good_space.toml", "--finished", "--out", "t.csv"]]
     flags += [["inspect", f, *extra] for f in sorted(FILES) if f.startswith("v_")
               for extra in ([], ["--fields"])]
     cases += [(f"file-{k}-{' '.join(argv)[:40]}", argv) for k, argv in enumerate(nested + paths + flags)]

@@ -63,6 +63,9 @@ def run(args) -> int:
             raise exc.renamed("--table") from None
     if args.check is None and not args.out:
         raise InputError("--out", None, "give the table to write, e.g. --out finger_fem.csv")
+    if args.check is not None and args.out:
+        raise InputError("--out", args.out, "not with --check, which compares a table with the "
+                                            "FEM and writes none")
     if args.check is not None:
         return _check(fc.load_space(args.check), args)
     space = fc.load_space(args.space) if args.space else fc.single_design_space(args.design)
@@ -85,6 +88,7 @@ def run(args) -> int:
 def _run(space, args):
     """Run the space's FEM cases (resumable); [(design, record)] or None if some failed.
     With --finished: only the cases already done, without running any."""
+    from softhand.reduced.errors import InputError
     from softhand.studies.calibration.finger import as_study
     from softhand.studies.batch.runner import case_state, plan, read_case, run_study, study_dir
 
@@ -93,6 +97,9 @@ def _run(space, args):
     if args.finished:
         cases = plan(study)
         done = [case_state(sdir, c) == "done" for c in cases]
+        if not any(done):
+            raise InputError("--finished", f"0 of {len(cases)} cases finished in {sdir}",
+                             "needs finished cases; run without --finished")
         print(f"FEM: {sum(done)} of {len(cases)} cases finished in {sdir}; "
               f"{len(cases) - sum(done)} pending, not run (--finished)", file=sys.stderr)
         return [(c.design, read_case(sdir, c) if ok else None) for c, ok in zip(cases, done)]
@@ -126,12 +133,16 @@ def _finished_only(space, results):
 
 
 def _check(space, args) -> int:
+    from softhand.reduced.errors import InputError
     from softhand.studies.calibration.finger_table import heldout_rows
 
     results = _run(space, args)
     if results is None:
         return 1
     results = [r for r in results if r[1] is not None]
+    if not results:  # --finished, and only the mesh_pair cases are
+        raise InputError("--finished", "0 finished designs", "needs a finished design; run "
+                                                             "without --finished")
     rows, worst = heldout_rows(results, args.table)
     if args.json:
         print_json({"rows": rows, "worst": worst})
