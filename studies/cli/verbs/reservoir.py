@@ -49,9 +49,10 @@ def _study(args):
     volumes = ()
     if args.volume_mm3 is not None:
         volumes = tuple(parse_values(args.volume_mm3, "--volume-mm3", limit))
-        if min(volumes) <= 0 or max(volumes) > 100 * design.V0:
+        low, high = 1e-4 * design.V0, 100 * design.V0  # below 1e-4 V0 the sheet barely moves
+        if min(volumes) < low or max(volumes) > high:
             raise InputError("--volume-mm3", args.volume_mm3,
-                             f"volumes must be in (0, {100 * design.V0:g}] mm^3 (100 V0)")
+                             f"volumes must be in [{low:.4g}, {high:.4g}] mm^3 (1e-4 V0 .. 100 V0)")
     return ReservoirStudy(design=design, volumes_mm3=volumes, n_radial=args.n_radial,
                           n_thick=args.n_thick)
 
