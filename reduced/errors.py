@@ -21,6 +21,8 @@ class InputError(ValueError):
     """Bad user input: names the field, the value given and what is allowed."""
 
     def __init__(self, field: str, value, allowed: str):
+        if getattr(value, "ndim", None) == 0 and hasattr(value, "item"):
+            value = value.item()  # a numpy scalar shown as the number, not np.float64(7.0)
         self.field = field
         self.value = value
         self.allowed = allowed

@@ -215,11 +215,12 @@ def _weight_groups(data: Measurements, weights, design: HandDesign, normalise: b
 
 def check_params(params, n_points: int) -> tuple[str, ...]:
     """Validate the names of the parameters to fit; a comma list or a sequence."""
-    keys = tuple(k.strip() for k in (params.split(",") if isinstance(params, str) else params)
-                 if k.strip())
-    if not keys:
+    keys = tuple(k.strip() for k in (params.split(",") if isinstance(params, str) else params))
+    if not any(keys):
         raise InputError("--params", params, f"name at least one of {', '.join(FITTABLE)}")
     for k in keys:
+        if not k:
+            raise InputError("--params", params, "a name in the list is empty")
         if k not in FITTABLE:
             why = "is not a number that can be fitted" if k in PUBLIC_KEYS else "unknown key"
             raise InputError("--params", k, f"{why}; allowed: {', '.join(FITTABLE)}")

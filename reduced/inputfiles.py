@@ -18,6 +18,8 @@ MAX_NESTING = 16
 
 def read_input_file(path: str | Path, field: str, what: str) -> bytes:
     """The bytes of a small regular input file; InputError (one line) for anything else."""
+    if not str(path).strip():  # Path('') is '.', which would be reported instead
+        raise InputError(field, str(path), f"is empty; give {what}")
     path = Path(path)
     try:
         with open(path, "rb") as f:

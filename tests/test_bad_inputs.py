@@ -280,6 +280,13 @@ def _cases():
              ["inspect", "good.vtu", "--fields", "--animate", "o.gif"],
              ["inspect", "good.vtu", "--animate", "o.gif", "--out", "o.png"],
              ["inspect", "good.vtu", "--animate", "o.GIF"]]
+    flags += [["curve", "--theta-deg", v] for v in ("1,,2", "1,", "1_0", "\u0661\u0660", "0x10")]
+    flags += [["fit", "--data", "good.csv", *extra] for extra in (
+        ["--params", "V0_mm3,"], ["--params", "V0_mm3", "--bounds", ""],
+        ["--params", "V0_mm3", "--bounds", "V0_mm3=1e4:2e4,V0_mm3=1e4:3e4"],
+        ["--params", "V0_mm3", "--diameter-mm", "180"], ["--params", "V0_mm3", "--normalise"])]
+    flags += [["calibrate", "finger", "--space", "", "--out", "t.csv"], ["fit", "--data", "", "--params", "V0_mm3"],
+              ["design", "--task", " ", "--no-fem"], ["inspect", ""]]
     flags += [["calibrate", "finger", "--check", "good_space.toml", "--finished"],
               ["calibrate", "finger", "--check", "good_space.toml", "--out", "t.csv"],
               ["calibrate", "finger", "--space", "good_space.toml", "--finished", "--out", "t.csv"]]

@@ -121,6 +121,13 @@ def test_missing_file():
         read_measurements("/nonexistent/x.csv")
 
 
+def test_a_numpy_number_is_shown_as_the_number_it_is():
+    """A value read from a CSV column is a numpy scalar: the line shows 7.0, not np.float64(7.0)."""
+    assert str(InputError("diameter_mm", np.float64(7.0), "x")) == "diameter_mm = 7.0: x"
+    assert str(InputError("n", np.int64(3), "x")) == "n = 3: x"
+    assert "array" in str(InputError("w", np.zeros(2), "x"))  # arrays stay arrays
+
+
 # ---------------------------------------------------------------- Shore A
 def test_gent_relation_limits_and_paper_value():
     # Gent's formula at its end points: S = 0 -> 0.0981*56/(0.137505*254)

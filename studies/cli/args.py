@@ -4,6 +4,7 @@ from __future__ import annotations
 import argparse
 import json
 import math
+import re
 import sys
 
 import numpy as np
@@ -22,6 +23,10 @@ MAX_TEXT = 100_000
 _FORMS = "start:stop:step (step > 0, stop >= start) or a comma-separated list of finite numbers"
 
 
+_NUMBER = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?|[+-]?(?:nan|inf|infinity)",
+                     re.IGNORECASE | re.ASCII)
+
+
 def parse_values(text: str, field: str, max_count: int = MAX_POINTS) -> np.ndarray:
     """``'0:90:10'`` (start:stop:step, stop included) or ``'1,2.5,3'`` -> float array.
 
@@ -29,11 +34,9 @@ def parse_values(text: str, field: str, max_count: int = MAX_POINTS) -> np.ndarr
     """
     if len(text) > MAX_TEXT:
         raise InputError(field, text, f"is longer than {MAX_TEXT} characters")
-    try:
-        numbers = [float(x) for x in (text.split(":") if ":" in text else text.split(","))
-                   if x.strip() or ":" in text]
-    except ValueError:
-        numbers = []
+    parts = [x.strip() for x in (text.split(":") if ":" in text else text.split(","))]
+    # plain ASCII decimals only: float() would also take '1_0' and other scripts' digits
+    numbers = [float(x) for x in parts] if all(map(_NUMBER.fullmatch, parts)) else []
     if ":" in text:
         if len(numbers) != 3 or not all(map(math.isfinite, numbers)) or not numbers[2] > 0 \
                 or numbers[1] < numbers[0]:

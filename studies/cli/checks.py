@@ -1,6 +1,7 @@
 """Checks the CLI runs on every verb's arguments before any work starts.
 
-* every float option is finite (argparse's ``float`` accepts ``nan`` and ``inf``);
+* every float option is finite (argparse's ``float`` accepts ``nan`` and ``inf``), every
+  text option not blank;
 * every output (``--out``, ``--plot``, ``--results``, ``--write-calibration``) can be
   written: the right kind of path (folder or file, a known picture suffix) under a folder
   this process can create files in; probed with a temporary file that is removed at once,
@@ -53,10 +54,13 @@ def option_name(dest: str, parser) -> str:
 
 
 def check_finite(args, parser) -> None:
-    """Every float argument finite; InputError naming its option."""
+    """Every float argument finite, every text argument not blank; InputError naming its
+    option (a blank file name would be read as the current folder, '')."""
     for dest, value in vars(args).items():
         if isinstance(value, float) and not math.isfinite(value):
             raise InputError(option_name(dest, parser), value, "must be a finite number")
+        if isinstance(value, str) and not value.strip():
+            raise InputError(option_name(dest, parser), value, "is empty")
 
 
 def check_outputs(verb: str, args, parser) -> None:

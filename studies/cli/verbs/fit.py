@@ -55,7 +55,7 @@ def run(args) -> int:
     data = read_measurements(args.data)
     keys = check_params(args.params, len(data))
     design = _start_from_shore_a(design, keys, args.shore_a)
-    w = _weights(args, design)
+    w = _weights(args, design, data)
     study = FitStudy(data, keys, design, model=args.model, reservoir=not args.no_reservoir,
                      weights=None if w is None else tuple(float(x) for x in w), normalise=args.normalise,
                      bounds=_parse_bounds(args.bounds), data_name=args.data)
@@ -91,9 +91,22 @@ def _start_from_shore_a(design, keys, shore_a):
     return design_from_dict(start, design)
 
 
-def _weights(args, design):
+def _weights(args, design, data):
+    """w from --diameter-mm or --weights, each only where the data need it."""
     from softhand.reduced.errors import InputError
 
+    given = [(o, v) for o, v in (("--diameter-mm", args.diameter_mm), ("--weights", args.weights),
+                                 ("--normalise", args.normalise or None)) if v is not None]
+    if data.kind == "bending" and given:
+        raise InputError(given[0][0], given[0][1], f"only for grasp data; {args.data} holds "
+                                                   "bending angles")
+    if data.kind != "bending" and data.diameter is not None and given[:1] and given[0][0] != "--normalise":
+        raise InputError(given[0][0], given[0][1], f"{args.data} has a diameter_mm column, which "
+                                                   "picks w; drop the option")
+    if data.kind != "bending" and data.diameter is None and args.weights is None \
+            and args.diameter_mm is None:
+        raise InputError("--data", args.data, "grasp data without a diameter_mm column need "
+                                              "--diameter-mm D or --weights w1,..,wn")
     if args.weights is not None and args.diameter_mm is not None:
         raise InputError("--weights", args.weights, "give --weights or --diameter-mm, not both")
     if args.diameter_mm is not None:
@@ -110,7 +123,7 @@ def _weights(args, design):
 
 def _parse_bounds(text):
     """'K=lo:hi,K2=lo:hi' -> {K: (lo, hi)}."""
-    if not text:
+    if text is None:
         return None
     import math
 
@@ -128,6 +141,8 @@ def _parse_bounds(text):
         if not (math.isfinite(lo) and math.isfinite(hi) and limits[0] <= lo and hi <= limits[1]):
             raise InputError(f"--bounds {key.strip()}", rng, f"must be finite and within the design "
                              f"bounds [{limits[0]:g}, {limits[1]:g}]")
+        if key.strip() in bounds:
+            raise InputError("--bounds", text, f"{key.strip()} is bounded twice")
         bounds[key.strip()] = (lo, hi)
     return bounds
 
