@@ -57,7 +57,7 @@ class ControlStudy:
             return ramp(self.push_n, self.push_at_s, self.push_rise_s)
         from softhand.studies.io.control_files import read_disturbance
 
-        return read_disturbance(self.disturbance)
+        return read_disturbance(self.disturbance, t_end=self.t_end_s)
 
     def gains(self, w) -> Gains:
         """kp, ki as given, the missing ones from the plant (:func:`reduced.control.default_gains`)."""

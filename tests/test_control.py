@@ -237,6 +237,7 @@ def test_bad_inputs(tables):
 
 # ---------------------------------------------------------------------------- the CLI
 CLI = ["control", "--theta-ref-deg", "50", "--mass-kg", "2", "--t-end-s", "6", "--push-at-s", "3"]
+BASE = CLI[:-2]  #: without the ramp's start, which a disturbance file replaces
 
 
 def test_cli_json_reports_table_ii(capsys, tmp_path):
@@ -260,7 +261,7 @@ def test_cli_disturbance_file_equals_push_options(capsys, tmp_path):
     """A file holding the same ramp as --push-N 5 --push-at-s 3 gives the same numbers."""
     path = tmp_path / "push.csv"
     path.write_text("# a 5 N push from 3 s, 0.5 s rise\nt_s,force_N\n0,0\n3,0\n3.5,5\n")
-    assert main([*CLI, "--json", "--disturbance", str(path)]) == 0
+    assert main([*BASE, "--json", "--disturbance", str(path)]) == 0
     from_file = json.loads(capsys.readouterr().out)["table2"]
     assert main([*CLI, "--json"]) == 0
     from_options = json.loads(capsys.readouterr().out)["table2"]
@@ -275,13 +276,25 @@ def test_cli_disturbance_file_equals_push_options(capsys, tmp_path):
     ("t_s,force_N\n0,1\n2,1\n1,1\n", "strictly increasing"),
     ("t_s,force_N\n0,1,2\n", "two numbers"),
     ("t_s,force_N\n0,inf\n", "finite"),
+    ("t_s,force_N\n0,1\n5,1\n", "must be 0 until 1 s"),  # no quiet second to measure the hold in
+    ("t_s,force_N\n0,0\n0.5,2\n", "from t_s = 0 s"),  # the ramp to 0.5 s starts at 0
+    ("t_s,force_N\n7,1\n8,1\n", "not before the run's end"),  # t_end 6 s: never felt
 ])
 def test_cli_bad_disturbance_file_is_one_line(capsys, tmp_path, text, message):
     path = tmp_path / "bad.csv"
     path.write_text(text)
-    assert main([*CLI, "--disturbance", str(path)]) == 2
+    assert main([*BASE, "--disturbance", str(path)]) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and message in err
+
+
+def test_cli_ramp_options_are_refused_with_a_disturbance_file(capsys, tmp_path):
+    path = tmp_path / "push.csv"
+    path.write_text("t_s,force_N\n0,0\n3,0\n3.5,5\n")
+    for option in ("--push-at-s", "--push-rise-s"):
+        assert main([*BASE, "--disturbance", str(path), option, "1.5"]) == 2
+        err = capsys.readouterr().err
+        assert err.count("\n") == 1 and f"{option} = 1.5: not with --disturbance" in err
 
 
 def test_cli_bad_values_are_one_line(capsys, tmp_path):

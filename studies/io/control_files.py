@@ -18,10 +18,14 @@ from softhand.studies.io.files import save_figure
 DISTURBANCE_HEADER = ("t_s", "force_N")
 #: allowed push force [N], of ``--push-N`` and of a disturbance file's rows
 PUSH_LIMITS_N = (-1000.0, 1000.0)
+#: the quiet time before any push [s]: the window the summary measures the hold in
+#: (:func:`reduced.control.summarize`), as for --push-at-s
+QUIET_S = 1.0
 
 
-def read_disturbance(path: str | Path):
-    """The push profile of a ``t_s,force_N`` CSV file as a function of t [s]; InputError on bad files."""
+def read_disturbance(path: str | Path, t_end: float | None = None):
+    """The push profile of a ``t_s,force_N`` CSV file as a function of t [s]; InputError on bad
+    files, and on a profile that starts at or after ``t_end`` [s] (the run would not see it)."""
     path = Path(path)
     from softhand.reduced.design import read_input_file
 
@@ -42,6 +46,14 @@ def read_disturbance(path: str | Path):
         bad = int(np.flatnonzero(np.concatenate([[t[0] < 0], np.diff(t) <= 0]))[0])
         raise InputError(f"--disturbance {path.name}: line {rows[bad + 1][0]}", float(t[bad]),
                          "times must be >= 0 and strictly increasing")
+    moving = np.flatnonzero((force != 0) | (np.r_[force[1:], 0.0] != 0))  # pushes just after t_k
+    if moving.size and t[moving[0]] < QUIET_S:
+        raise InputError("--disturbance", str(path), f"pushes from t_s = {t[moving[0]]:g} s; the "
+                                                     f"force must be 0 until {QUIET_S:g} s (the "
+                                                     "controller settles first)")
+    if t_end is not None and t[0] >= t_end:
+        raise InputError("--disturbance", str(path), f"starts at t_s = {t[0]:g} s, not before the "
+                                                     f"run's end --t-end-s = {t_end:g} s")
     return lambda x: np.interp(x, t, force, left=0.0, right=force[-1])
 
 

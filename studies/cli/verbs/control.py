@@ -33,9 +33,11 @@ def configure(parser) -> None:
     push = parser.add_mutually_exclusive_group()
     push.add_argument("--disturbance", metavar="FILE", help="push profile, CSV t_s,force_N")
     push.add_argument("--push-N", type=float, default=5.0, help="push force [N] (default 5)")
-    parser.add_argument("--push-at-s", type=float, default=5.0, help="push start [s] (default 5)")
-    parser.add_argument("--push-rise-s", type=float, default=0.5,
-                        help="time the push takes to build up [s] (default 0.5; 0 = a step)")
+    parser.add_argument("--push-at-s", type=float, default=None,
+                        help=f"push start [s] (default {PUSH_AT_S:g}; not with --disturbance)")
+    parser.add_argument("--push-rise-s", type=float, default=None,
+                        help=f"time the push takes to build up [s] (default {PUSH_RISE_S:g}; 0 = a "
+                             "step; not with --disturbance)")
     parser.add_argument("--push-azimuth-deg", type=float, default=0.0,
                         help="push direction about the vertical, from finger 1's outward direction")
     parser.add_argument("--push-elevation-deg", type=float, default=0.0,
@@ -70,11 +72,23 @@ def _plant_options(parser) -> None:
     parser.add_argument("--seed", type=int, default=0, help="of the sensor noise")
 
 
+#: the ramp push's start and rise time [s] when not given
+PUSH_AT_S, PUSH_RISE_S = 5.0, 0.5
+
+
 def _check_inputs(args) -> None:
+    """Every option in range; the ramp's options only without --disturbance (then filled in)."""
+    if args.disturbance is not None:
+        for option, value in (("--push-at-s", args.push_at_s), ("--push-rise-s", args.push_rise_s)):
+            if value is not None:
+                raise InputError(option, value, "not with --disturbance, whose file gives the push")
+    args.push_at_s = PUSH_AT_S if args.push_at_s is None else args.push_at_s
+    args.push_rise_s = PUSH_RISE_S if args.push_rise_s is None else args.push_rise_s
     checks = [("--theta-ref-deg", args.theta_ref_deg, -30 < args.theta_ref_deg < 120, "in (-30, 120) deg"),
               ("--mass-kg", args.mass_kg, args.mass_kg >= 0, ">= 0"),
               ("--t-end-s", args.t_end_s, 2.0 <= args.t_end_s <= 600, "in [2, 600] s"),
-              ("--push-at-s", args.push_at_s, 1.0 <= args.push_at_s < args.t_end_s, "in [1 s, t_end)"),
+              ("--push-at-s", args.push_at_s, args.disturbance is not None
+               or 1.0 <= args.push_at_s < args.t_end_s, "in [1 s, --t-end-s)"),
               ("--push-rise-s", args.push_rise_s, args.push_rise_s >= 0, ">= 0"),
               ("--plant-mu-scale", args.plant_mu_scale, args.plant_mu_scale > 0, "> 0"),
               ("--noise-deg", args.noise_deg, args.noise_deg >= 0, ">= 0"),
