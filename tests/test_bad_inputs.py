@@ -285,6 +285,10 @@ def _cases():
         ["--params", "V0_mm3,"], ["--params", "V0_mm3", "--bounds", ""],
         ["--params", "V0_mm3", "--bounds", "V0_mm3=1e4:2e4,V0_mm3=1e4:3e4"],
         ["--params", "V0_mm3", "--diameter-mm", "180"], ["--params", "V0_mm3", "--normalise"])]
+    flags += [["bend", "--peak-mpa", "0.3"], ["bend", "--tie", "full", "--tie-width-mm", "10"],
+              ["weights", "--diameter-mm", "120:300:60", "--fig8", "0.5"],
+              ["weights", "--diameter-mm", "180,180"], ["weights", "--diameter-mm", "180", "--fig8", "0.5,0.5"],
+              ["weights", "--diameter-mm", "120:300:60", "--check-mm", "180"]]
     flags += [["calibrate", "finger", "--space", "", "--out", "t.csv"], ["fit", "--data", "", "--params", "V0_mm3"],
               ["design", "--task", " ", "--no-fem"], ["inspect", ""]]
     flags += [["calibrate", "finger", "--check", "good_space.toml", "--finished"],

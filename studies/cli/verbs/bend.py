@@ -44,9 +44,9 @@ def configure(parser) -> None:
     parser.add_argument("--tie-width-mm", type=float, default=None,
                         help="width of each ring for --tie ring [mm]; overrides the design's "
                              "tie_width_mm (default 10)")
-    parser.add_argument("--peak-mpa", type=float, default=2.0,
-                        help="go on to this pressure and report peak stretch and stress "
-                             "(default 2.0; 0: skip)")
+    parser.add_argument("--peak-mpa", type=float, default=None,
+                        help=f"go on to this pressure and report peak stretch and stress "
+                             f"(default {PEAK_MPA:g} when above the last pressure; 0: skip)")
     parser.add_argument("--hand", action="store_true",
                         help="also the whole hand: P = p_finger - p_reservoir(V0 - n dQ) with the "
                              "reservoir-sheet FEM, against eq. (27)")
@@ -68,6 +68,8 @@ LIMITS = {"--axial-size-mm": (0.25, 20.0), "--mesh-size-mm": (0.5, 12.0),
 FIBER_INTORDERS = (2, 5, 6, 7)
 #: pressures the finger FEM is run at [MPa]
 PRESSURE_RANGE = (0.0, 5.0)
+#: the pressure the path goes on to for the peak stretch and stress, when not given [MPa]
+PEAK_MPA = 2.0
 
 
 def _check(args) -> tuple[float, ...]:
@@ -91,7 +93,20 @@ def _check(args) -> tuple[float, ...]:
         raise InputError("--pressure-mpa", args.pressure_mpa, f"pressures must be in [{lo:g}, {hi:g}] MPa")
     if np.any(np.diff(pressures) <= 0):
         raise InputError("--pressure-mpa", args.pressure_mpa, "pressures must increase (a load path)")
+    if args.peak_mpa is not None and 0 < args.peak_mpa <= pressures[-1]:
+        raise InputError("--peak-mpa", args.peak_mpa, f"must be 0 (no peak) or above the last "
+                                                      f"pressure, {pressures[-1]:g} MPa")
+    if args.tie == "full" and args.tie_width_mm is not None:
+        raise InputError("--tie-width-mm", args.tie_width_mm, "is the ring's width, for --tie ring "
+                                                              "only")
     return tuple(float(p) for p in pressures)
+
+
+def _peak(peak_mpa, pressures) -> float:
+    """The peak pressure asked for (checked), or the default when above the path, else 0 (none)."""
+    if peak_mpa is not None:
+        return peak_mpa
+    return PEAK_MPA if PEAK_MPA > pressures[-1] else 0.0
 
 
 def _options(args):
@@ -128,7 +143,7 @@ def run(args) -> int:
     if args.tie_width_mm is not None:
         design = design.replace(tie_width=args.tie_width_mm)
     study = BendingStudy(design, pressures, _options(args),
-                         peak_mpa=args.peak_mpa if args.peak_mpa > pressures[-1] else 0.0,
+                         peak_mpa=_peak(args.peak_mpa, pressures),
                          hand=args.hand)
     out = Path(args.out)
     clear_outputs(out)

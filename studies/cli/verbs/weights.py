@@ -13,6 +13,8 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
+import numpy as np
+
 from softhand.reduced.errors import InputError
 from softhand.reduced.paper import FIG8
 from softhand.studies.cli.args import MOST_FEM_POINTS, add_design_option, add_json_option, \
@@ -112,6 +114,12 @@ def _failed(exc, out: Path) -> int:
         record, write_files=lambda: write_vtk(out, exc.model, exc.states), files="grasp.pvd")
 
 
+def _distinct(values, text: str, option: str) -> None:
+    """Each value once (a repeated one would be one more FEM for the same answer)."""
+    if np.unique(values).size != values.size:
+        raise InputError(option, text, "gives a value twice; give each once")
+
+
 def _run(args) -> int:
     from dataclasses import replace
 
@@ -123,11 +131,18 @@ def _run(args) -> int:
                          "(--diameter-mm a,b,.. or start:stop:step), not to one or to --fig8")
     if args.out is not None and (diameters.size > 1 or args.fig8 is not None):
         raise InputError("--out", args.out, "applies to one diameter, not to a sweep or --fig8")
+    if args.fig8 is not None and diameters.size > 1:
+        raise InputError("--fig8", args.fig8, "is for one object: give one --diameter-mm")
+    _distinct(diameters, args.diameter_mm, "--diameter-mm")
     if check is not None and not diameters.min() <= check <= diameters.max():
         raise InputError("--check-mm", args.check_mm, f"must lie within the diameters "
                          f"[{diameters.min():g}, {diameters.max():g}] mm")
+    if check is not None and np.isclose(diameters, check, rtol=0.0, atol=1e-9).any():
+        raise InputError("--check-mm", args.check_mm, "is one of the swept diameters; the check "
+                         "is of w interpolated at a diameter between them")
     if args.fig8 is not None:
         pressures = _values(args.fig8, "--fig8", max_cases(args, MAX_FIG8, MOST_FEM_POINTS))
+        _distinct(pressures, args.fig8, "--fig8")
         return _fig8(args, replace(case, diameter_mm=float(diameters[0])), pressures)
     if diameters.size == 1:
         result = _one(replace(case, diameter_mm=float(diameters[0])), args)
