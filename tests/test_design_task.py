@@ -276,3 +276,88 @@ def test_optimum_on_a_bound_is_the_bound():
     task = task_from_dict({**CI_TASK, "free": {"b_mm": [4.5, 6.0], "V0_mm3": [12000.0, 30000.0]}})
     opt = design_opt.optimise(task, FAST)
     assert opt.evaluation.design.b == 4.5  # a thinner wall is cheaper: the optimum is on the bound
+
+
+# ---------------------------------------------------------------- bad and edge inputs (fuzzer)
+@pytest.mark.parametrize("change, field", [
+    ({"grasp": {"force_factor": 1e-300}}, "grasp.force_factor"),   # ran for minutes
+    ({"grasp": {"force_factor": 0.5}}, "grasp.force_factor"),      # fingers not carrying the weight
+    ({"grasp": {"margin_N": 1e-300}}, "grasp.margin_N"),
+    ({"object": {"diameter_mm": 180.0, "mass_kg": 1e-300}}, "object.mass_kg"),
+    ({"grasp": {"opening_mm": 1e-9}}, "grasp.opening_mm"),          # narrower than the object
+    ({"pump": {"max_pressure_MPa": 1e-9}}, "pump.max_pressure_MPa"),
+    ({"design": {"d_mm": 15.0}}, "design.d_mm"),                    # also in [free]
+])
+def test_unusable_task_numbers_and_contradictions_are_refused(change, field):
+    with pytest.raises(InputError) as info:
+        task_from_dict({**CI_TASK, **change})
+    assert info.value.field == field
+
+
+def test_zero_mass_and_margin_and_a_wider_opening_are_accepted():
+    assert task_from_dict({**CI_TASK, "object": {"diameter_mm": 180.0, "mass_kg": 0.0}}).mass == 0.0
+    assert task_from_dict({**CI_TASK, "grasp": {"margin_N": 0.0}}).margin == 0.0
+    assert task_from_dict({**CI_TASK, "grasp": {"opening_mm": 200.0}}).opening_mm == 200.0
+
+
+def test_a_massless_object_is_held_where_the_fingers_touch_it():
+    """F_v = 0 is the contact itself (the hold's root finder found no sign change there and the
+    varying constraint count broke differential evolution)."""
+    task = task_from_dict({**CI_TASK, "object": {"diameter_mm": 180.0, "mass_kg": 0.0},
+                           "free": {"a_mm": [3.5, 4.5]}})
+    opt = design_opt.optimise(task, FAST)
+    ev = opt.evaluation
+    assert ev.feasible and ev.F_v == 0.0
+    assert ev.P_grasp == ev.P_contact and ev.theta_hold == ev.theta_grasp
+
+
+def test_every_point_of_the_box_has_the_same_constraints():
+    """A design without an answer (V0 = 1 mm^3 holds no oil) had one constraint more than one
+    with an answer: scipy's 'array returned from a Constraint has the wrong shape'."""
+    task = task_from_dict({**CI_TASK, "free": {"V0_mm3": [1.0, 1e8]}})
+    problem = design_opt.Problem(task)
+    lengths = {len(problem.slacks([v])) for v in np.geomspace(1.0, 1e8, 12)}
+    assert len(lengths) == 1
+    assert all(np.isfinite(problem.slacks([1.0])))
+    opt = design_opt.optimise(task, FAST)
+    assert opt.evaluation.feasible
+
+
+def test_free_values_the_design_rules_refuse_are_infeasible_points_not_errors():
+    """a, b and d free over the calibrated box: a + b >= d at some points (the design refuses
+    them) must steer the optimiser, not end the run naming a value the user never gave."""
+    task = task_from_dict({**CI_TASK, "free": {"a_mm": [3.0, 6.0], "b_mm": [3.0, 7.0], "d_mm": [10.0, 20.0]}})
+    problem = design_opt.Problem(task)
+    bad = problem.evaluation([6.0, 7.0, 10.0])   # a + b = 13 > d = 10
+    assert not bad.feasible and len(bad.constraints) == len(problem.evaluation([4.0, 5.0, 15.0]).constraints)
+    opt = design_opt.optimise(task, FAST)
+    d = opt.evaluation.design
+    assert d.a + d.b < d.d
+
+
+def test_all_eight_free_keys_at_their_full_bounds():
+    from softhand.reduced.design import BOUNDS
+    from softhand.studies.design.task import FREE_KEYS
+
+    free = {k: list(BOUNDS[k]) for k in FREE_KEYS}
+    task = task_from_dict({**CI_TASK, "free": free, "design": {"finger_model": "paper", "reservoir_model": "ellipse"}})
+    opt = design_opt.optimise(task, FAST)  # the short fingers of l0 = 10 mm do not reach the object
+    assert np.isfinite(opt.evaluation.P_grasp)
+
+
+def test_cli_infeasible_task_writes_nothing(tmp_path):
+    task = _write(tmp_path, CI_TASK_TOML.replace("max_pressure_MPa = 2.0", "max_pressure_MPa = 0.05"))
+    out = tmp_path / "out"
+    proc = _cli("design", "--task", str(task), "--no-fem", "--out", str(out))
+    assert proc.returncode == 1 and "The task cannot be met" in proc.stdout
+    assert "none written" in proc.stdout and not out.exists()
+    proc = _cli("design", "--task", str(task), "--no-fem", "--out", str(out), "--json")
+    assert proc.returncode == 1 and json.loads(proc.stdout)["design_file"] is None and not out.exists()
+
+
+def test_cli_impossible_pump_is_one_line_exit_2_and_writes_nothing(tmp_path):
+    task = _write(tmp_path, CI_TASK_TOML.replace("max_pressure_MPa = 2.0", "max_pressure_MPa = 1e-9"))
+    out = tmp_path / "out"
+    proc = _cli("design", "--task", str(task), "--no-fem", "--out", str(out))
+    assert proc.returncode == 2 and not out.exists()
+    assert proc.stderr.count("\n") == 1 and proc.stderr.startswith("softhand design: error: pump.max_pressure_MPa")

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+import math
 import os
 import shutil
 import sys
@@ -102,14 +103,24 @@ def read_case(sdir: Path, case: Case) -> dict | None:
 
 
 def _record(path: Path) -> dict | None:
-    """A case file's record if it parses and has the record's shape, else None."""
+    """A case file's record if it parses and has the record's shape (its numbers finite numbers,
+    null or lists of them, as :func:`execute_case` writes them), else None."""
     try:
         record = json.loads(path.read_text())
-    except (OSError, ValueError):
+    except (OSError, ValueError, RecursionError):
         return None
     ok = (isinstance(record, dict) and record.get("status") == ("done" if path.name == RESULT else "failed")
-          and isinstance(record.get("numbers"), dict) and isinstance(record.get("provenance"), dict))
+          and isinstance(record.get("numbers"), dict) and isinstance(record.get("provenance"), dict)
+          and all(_stored_number(v) for v in record["numbers"].values()))
     return record if ok else None
+
+
+def _stored_number(value) -> bool:
+    """A finite number (or bool), null (a kind's nan: not applicable) or a list of these; NaN,
+    Infinity or a string in a case file is an edited or damaged file."""
+    if isinstance(value, list):
+        return all(map(_stored_number, value))
+    return value is None or (isinstance(value, (int, float)) and math.isfinite(value))
 
 
 # ---------------------------------------------------------------------- one case
@@ -147,8 +158,16 @@ def _split_output(out) -> tuple[dict, dict]:
         array = np.asarray(value)
         if array.dtype.kind not in "biuf":
             raise TypeError(f"a kind's result {key!r} must be a number or list of numbers")
-        numbers[key] = array.tolist()
+        numbers[key] = _finite_or_none(array.tolist())
     return numbers, extra
+
+
+def _finite_or_none(value):
+    """nan and +-inf as None (JSON null: not applicable, e.g. a run that never settles); a case
+    file holds no NaN or Infinity, so one that does is damaged (see :func:`_record`)."""
+    if isinstance(value, list):
+        return [_finite_or_none(v) for v in value]
+    return value if isinstance(value, bool) or math.isfinite(value) else None
 
 
 def commit_case(sdir: Path, study: Study, case: Case, output: dict) -> Path:

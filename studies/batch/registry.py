@@ -33,19 +33,51 @@ class Num:
 
 @dataclass(frozen=True)
 class NumList:
-    """A case parameter that is a list of finite numbers (at most ``max_len``)."""
+    """A case parameter that is a list of finite numbers (at most ``max_len``), each in [lo, hi]
+    (``above_lo``: in (lo, hi]); ``increasing``: strictly."""
 
     max_len: int = 100
+    lo: float = -math.inf
+    hi: float = math.inf
+    increasing: bool = False
+    above_lo: bool = False
 
     def check(self, where: str, value) -> None:
-        if not isinstance(value, list) or not value or len(value) > self.max_len \
-                or not all(_is_number(v) and math.isfinite(v) for v in value):
-            raise InputError(where, value, f"must be a list of 1 to {self.max_len} finite numbers")
+        ok = isinstance(value, list) and 0 < len(value) <= self.max_len \
+            and all(_is_number(v) and math.isfinite(v) for v in value)
+        if ok:
+            ok = all((self.lo < v if self.above_lo else self.lo <= v) and v <= self.hi for v in value) \
+                and (not self.increasing or all(a < b for a, b in zip(value, value[1:])))
+        if not ok:
+            within = "" if math.isinf(self.lo) and math.isinf(self.hi) else \
+                f" in {'(' if self.above_lo else '['}{self.lo:g}, {self.hi:g}]"
+            raise InputError(where, value, f"must be a list of 1 to {self.max_len} "
+                             f"{'increasing ' if self.increasing else ''}finite numbers{within}")
 
 
-def _one_weight_per_hinge(params: dict, design: HandDesign, src: str) -> None:
-    if "weights" in params and len(params["weights"]) != design.n_s:
-        raise InputError(f"{src}: weights", params["weights"], f"must be n_s = {design.n_s} numbers")
+def _grasp_weights(params: dict, design: HandDesign, src: str) -> None:
+    """weights or diameter_mm, not both (as ``softhand grasp``); weights: n_s numbers that move
+    the tip sideways at the case's theta (else F_x is undetermined, as the verb refuses). Their
+    sum is not checked: eq. (23) asks for 1, but the paper's own w for 180 mm sums to 1.4."""
+    if "weights" in params and "diameter_mm" in params:
+        raise InputError(f"{src}: diameter_mm", params["diameter_mm"], "give weights or diameter_mm, not both")
+    if "weights" not in params:
+        return
+    from softhand.reduced.grasp import projected_jacobian
+
+    w = params["weights"]
+    if len(w) != design.n_s:
+        raise InputError(f"{src}: weights", w, f"must be n_s = {design.n_s} numbers")
+    J_xw, _ = projected_jacobian(math.radians(params["theta_deg"]), w, design)
+    if not abs(float(J_xw)) >= 1e-9:
+        raise InputError(f"{src}: weights", w, f"make J_x w = 0 at theta_deg = {params['theta_deg']:g}: "
+                         "the tip does not move sideways, F_x is undetermined")
+
+
+def _one_mesh(params: dict, design: HandDesign, src: str) -> None:
+    if "mesh_size_mm" in params and "axial_size_mm" in params:
+        raise InputError(f"{src}: axial_size_mm", params["axial_size_mm"],
+                         "applies to the layered mesh; remove mesh_size_mm (a uniform gmsh mesh)")
 
 
 def _push_before_end(params: dict, design: HandDesign, src: str) -> None:
@@ -82,8 +114,8 @@ KINDS: dict[str, Kind] = {
                   exactly_one=("theta_deg", "pressure_mpa"), checks=(_enough_oil,)),
     "grasp": Kind("softhand.studies.batch.kinds:grasp",
                   {"pressure_mpa": _PRESSURE, "theta_deg": _THETA, "mass_kg": _MASS,
-                   "diameter_mm": _PAPER_D, "weights": NumList(20)},
-                  required=("pressure_mpa", "theta_deg"), checks=(_one_weight_per_hinge,)),
+                   "diameter_mm": _PAPER_D, "weights": NumList(20, -10.0, 10.0)},
+                  required=("pressure_mpa", "theta_deg"), checks=(_grasp_weights,)),
     "control": Kind("softhand.studies.batch.kinds:control",
                     {"theta_ref_deg": Num(-29.9, 119.9), "mass_kg": _MASS, "diameter_mm": _PAPER_D,
                      "push_n": Num(-1000.0, 1000.0), "push_at_s": Num(1.0, 600.0),
@@ -94,11 +126,13 @@ KINDS: dict[str, Kind] = {
                     {"diameter_mm": Num(60.0, 500.0), "mass_kg": Num(0.0, 20.0),
                      "pressure_mpa": Num(0.01, 3.0), "dP_mpa": Num(0.001, 0.5)}, fem=True,
                     mesh=Num(2.0, 12.0)),
+    # the load path as a design space's (studies.calibration.space.LIMITS); bend_case needs all four
     "finger_bend": Kind("softhand.studies.calibration.finger:bend_case",
-                        {"pressures_mpa": NumList(200), "theta_target_deg": Num(1.0, 180.0),
-                         "p_max_mpa": Num(0.01, 5.0), "p_step_mpa": Num(0.001, 1.0),
-                         "axial_size_mm": Num(0.2, 20.0)},
-                        fem=True, mesh=Num(2.0, 12.0), required=("pressures_mpa",)),
+                        {"pressures_mpa": NumList(200, 0.0, 5.0, increasing=True, above_lo=True),
+                         "theta_target_deg": Num(1.0, 180.0), "p_max_mpa": Num(0.01, 5.0),
+                         "p_step_mpa": Num(0.01, 5.0), "axial_size_mm": Num(0.25, 20.0)},
+                        fem=True, mesh=Num(2.0, 12.0), checks=(_one_mesh,),
+                        required=("pressures_mpa", "theta_target_deg", "p_max_mpa", "p_step_mpa")),
 }
 #: the entry-point group where installed packages declare more kinds
 ENTRY_POINT_GROUP = "softhand.kinds"

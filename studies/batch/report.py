@@ -30,7 +30,9 @@ def write_report(study: Study, results_root: str | Path = "results") -> Path:
 def _scalar_outputs(rows: list[dict], axes: list[str]) -> list[str]:
     skip = {"case", "status", "wall_time_s", "error", *axes}
     names = dict.fromkeys(k for r in rows for k in r if k not in skip)
-    return [n for n in names if all(_is_number(r.get(n)) for r in rows)]
+    # null: a case's nan (not applicable, e.g. a run that never settles), drawn as a gap
+    return [n for n in names if all(_is_number(r.get(n)) or (n in r and r[n] is None) for r in rows)
+            and any(_is_number(r.get(n)) for r in rows)]
 
 
 def _is_number(value) -> bool:
@@ -55,7 +57,7 @@ def _plot(study: Study, rows: list[dict], axes: list[str], name: str, path: Path
     for label, members in itertools.islice(groups.items(), MAX_LINES):
         members.sort(key=lambda r: r[xaxis])
         x = np.array([r[xaxis] for r in members], dtype=float)
-        y = np.array([r[name] for r in members], dtype=float)
+        y = np.array([np.nan if r[name] is None else r[name] for r in members], dtype=float)
         text = ", ".join(f"{a}={v}" for a, v in zip(others, label)) or None
         ax.plot(x, y, "o-", ms=3, label=text)
     ax.set_xlabel(xaxis)

@@ -114,6 +114,11 @@ def study_from_dict(doc: dict, *, path: Path | None = None, max_cases: int = MAX
     mesh = _mesh_size(doc.get("mesh_size_mm"), kind, src)
     params = _params(doc.get("params", {}), kind, src)
     axes = _axes(doc.get("sweep"), kind, params, src)
+    inline = doc.get("design") if isinstance(doc.get("design"), dict) else {}
+    for key, values in axes:
+        if key in inline:
+            raise InputError(f"{src}: sweep.{key}", list(values), "is also in [design]; give it once "
+                             "(the sweep would override it)")
     count = math.prod(len(values) for _, values in axes)
     if count > max_cases:
         raise InputError(f"{src}: sweep", f"{count} cases", f"at most {max_cases} cases "

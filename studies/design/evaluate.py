@@ -29,7 +29,7 @@ finger model changes the answer by a design key alone.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from functools import lru_cache
 from typing import NamedTuple
 
@@ -168,7 +168,8 @@ def evaluate(design: HandDesign, task: Task, *, exact: bool = True) -> Evaluatio
     try:
         P_grasp, P_contact, P_open, F_lim, theta_hold = grasp_relation(design, task, theta, w, theta_open)
     except InputError:  # e.g. V0 too small for the oil, a design outside the calibrated range
-        P_grasp, P_contact, P_open, F_lim, theta_hold = math.inf, math.inf, -math.inf, -math.inf, theta
+        F_lim = -math.inf if asks_force_at_limit(design, task) else math.nan
+        P_grasp, P_contact, P_open, theta_hold = math.inf, math.inf, -math.inf, theta
     theta_hold = max(theta, theta_hold)
     try:  # the oil of the design's finger model; outside its calibrated range: none (see below)
         oil = design.n * float(finger.oil_taken(theta_hold, design))
@@ -176,7 +177,14 @@ def evaluate(design: HandDesign, task: Task, *, exact: bool = True) -> Evaluatio
         oil = math.inf
     stretch = 1.0 + task.stretch_factor * (peak_stretch(theta_hold, design) - 1.0)
     sheet = float(reservoir.stretch(design.V0, design))
-    cons = [
+    cons = _constraints(design, task, oil, stretch, sheet, P_grasp, F_lim, P_open)
+    return Evaluation(design, depth, theta, link, w, P_grasp, P_contact, F_req, F_lim, stretch, sheet,
+                      tuple(cons), theta_hold)
+
+
+def _constraints(design: HandDesign, task: Task, oil, stretch, sheet, P_grasp, F_lim, P_open) -> list:
+    """Every constraint of a design; how many depends on the task and the finger model alone."""
+    return [
         Constraint("tube_fits_links (a + b < d) [mm]", design.a + design.b, design.d, "<="),
         Constraint("tube_wall b [mm]", design.b, task.min_wall, ">="),
         Constraint("sheet_thickness t [mm]", design.t, 0.0, ">=", 1.0),
@@ -185,13 +193,23 @@ def evaluate(design: HandDesign, task: Task, *, exact: bool = True) -> Evaluatio
         Constraint("max_principal_stretch", stretch, task.max_stretch, "<="),
         Constraint("sheet_stretch at V0, eq. (16)", sheet, task.max_stretch, "<="),
         Constraint("pump_pressure at the grasp [MPa]", P_grasp, task.max_pressure, "<="),
-        *([] if math.isnan(F_lim) else [Constraint("F_v at the pump limit [N]", F_lim, F_req, ">=")]),
+        *([Constraint("F_v at the pump limit [N]", F_lim, task.required_F_v(), ">=")]
+          if asks_force_at_limit(design, task) else []),
         Constraint("opening: P(theta_open), the free hand's pump pressure where the tips "
                    f"span {task.opening_mm:g} mm [MPa]", P_open, 0.0, ">=", task.max_pressure),
         *calibrated_range(design),
     ]
-    return Evaluation(design, depth, theta, link, w, P_grasp, P_contact, F_req, F_lim, stretch, sheet,
-                      tuple(cons), theta_hold)
+
+
+def unanswered(task: Task) -> Evaluation:
+    """The evaluation of free values the model has no answer for (the design rules refuse them,
+    a + b >= d, t >= R, ...; the finger does not reach the object): the constraints of
+    :func:`evaluate` for the task, each violated (value nan: slack -1e3), so that the optimiser
+    sees as many constraints as anywhere else and leaves the point."""
+    base, nan = task.base, math.nan
+    cons = _constraints(base, task, nan, nan, nan, math.inf, nan, nan)
+    return Evaluation(base, nan, nan, -1, np.full(base.n_s, nan), math.inf, math.inf, task.required_F_v(),
+                      nan, nan, nan, tuple(replace(c, value=nan) for c in cons), nan)
 
 
 class GraspRelation(NamedTuple):
@@ -200,6 +218,14 @@ class GraspRelation(NamedTuple):
     P_open: float      #: free hand's pump pressure where the tips span the opening [MPa]; -inf: never
     F_at_limit: float  #: F_v at the pump limit [N]; nan: not asked (see grasp_relation)
     theta_hold: float  #: the finger's bend when it presses with the required F_v [rad]
+
+
+def asks_force_at_limit(design: HandDesign, task: Task) -> bool:
+    """Whether F_v at the pump limit is a constraint: always for the paper's finger model, for
+    the FEM-informed grasp only with the "margin" objective. Decided by the task and the finger
+    model alone, never by an evaluation's outcome, so that every design of one optimisation has
+    the same constraints (the optimiser needs a constraint vector of fixed length)."""
+    return design.finger_model != "fem" or task.objective == "margin"
 
 
 def grasp_relation(design: HandDesign, task: Task, theta: float, w, theta_open: float) -> GraspRelation:
@@ -225,9 +251,12 @@ def _fem_relation(design: HandDesign, task: Task, theta: float, theta_open: floa
     P_grasp is the same condition, F_v growing with the pump pressure: nan)."""
     P_contact = float(hand.pressure(theta, design))
     P_open = float(hand.pressure(theta_open, design)) if math.isfinite(theta_open) else -math.inf
-    held = grasp_hold.hold(design, task.diameter, task.mass, "F_v", task.required_F_v())
+    F_req = task.required_F_v()
+    # F_v = 0 (a massless object, no margin): the fingers only touch it, at the contact pressure
+    held = grasp_hold.hold(design, task.diameter, task.mass, "F_v", F_req) if F_req > 0.0 else \
+        grasp_hold.Hold(math.nan, P_contact, 0.0, theta, -1, True)
     F_lim = math.nan
-    if task.objective == "margin":
+    if asks_force_at_limit(design, task):
         F_lim = 0.0 if task.max_pressure <= P_contact else \
             grasp_hold.hold(design, task.diameter, task.mass, "P_pump", task.max_pressure).F_v
     return GraspRelation(held.P_pump, P_contact, P_open, F_lim, held.theta)

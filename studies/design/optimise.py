@@ -15,7 +15,8 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.optimize import NonlinearConstraint, differential_evolution, minimize
 
-from softhand.studies.design.evaluate import Constraint, Evaluation, design_at, evaluate
+from softhand.reduced.errors import InputError
+from softhand.studies.design.evaluate import Constraint, Evaluation, design_at, evaluate, unanswered
 from softhand.studies.design.task import Task
 
 __all__ = ["Constraint", "Evaluation", "design_at", "evaluate", "objective", "Problem", "OptimiserOptions",
@@ -45,7 +46,10 @@ class Problem:
                 self._memo.clear()
             self.evaluations += 1
             exact = "l0_mm" not in (key for key, _, _ in self.task.free)
-            self._memo[k] = evaluate(design_at(self.task, x), self.task, exact=exact)
+            try:
+                self._memo[k] = evaluate(design_at(self.task, x), self.task, exact=exact)
+            except InputError:  # no such design (a + b >= d, t >= R, ...) or no answer (no contact)
+                self._memo[k] = unanswered(self.task)
         return self._memo[k]
 
     def f(self, x) -> float:
@@ -91,7 +95,12 @@ def optimise(task: Task, options: OptimiserOptions = OptimiserOptions()) -> Opti
     if options.polish and problem.evaluation(x).feasible:
         x = polish(problem, x)
     x = on_bounds(x, problem.bounds)
-    ev = evaluate(design_at(task, x), task)  # exact kinematics
+    try:
+        ev = evaluate(design_at(task, x), task)  # exact kinematics
+    except InputError as exc:  # not one point the optimiser tried has an answer
+        bounds = {key: [lo, hi] for key, lo, hi in task.free}
+        raise InputError("free", bounds, f"no design within these bounds is one the model can answer "
+                                         f"for this task; the optimiser's best try: {exc}") from None
     return Optimum(x, ev, problem.evaluations, time.perf_counter() - t0, int(res.nit), str(res.message),
                    time.process_time() - cpu)
 

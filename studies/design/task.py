@@ -5,11 +5,11 @@ A task is a TOML file (``studies/designs/tasks/paper_task.toml`` is the paper's)
     base_design = "studies/designs/paper.toml"   # optional; default the paper's
     [object]
     diameter_mm = 180.0
-    mass_kg = 2.0
+    mass_kg = 2.0             # 0: a massless object (with force_factor the fingers just touch it)
     [grasp]
-    force_factor = 2.0        # F_v >= force_factor * m g / n  (or margin_N: F_v >= m g / n + margin)
+    force_factor = 2.0        # F_v >= force_factor * m g / n, 1 to 100  (or margin_N: F_v >= m g / n + margin)
     objective = "pressure"    # "pressure": least pump pressure; "margin": largest F_v margin at the pump limit
-    opening_mm = 180.0        # optional: the open hand's tip span must pass this (default: the diameter)
+    opening_mm = 180.0        # optional: the open hand's tip span must pass this (default and least: the diameter)
     [pump]
     max_pressure_MPa = 1.0
     [limits]                  # optional
@@ -17,7 +17,7 @@ A task is a TOML file (``studies/designs/tasks/paper_task.toml`` is the paper's)
     min_wall_mm = 1.0
     [material]                # optional: mu per part, over the base design
     mu_sf_MPa = 1.15
-    [design]                  # optional: any other design key over the base design
+    [design]                  # optional: any other design key over the base design (not one of [free])
     finger_model = "fem"      # the default: the FEM-calibrated finger and reservoir models
     reservoir_model = "fem"
     [free]                    # design variables and their bounds
@@ -62,8 +62,15 @@ CALIBRATED_SPACE = PAPER_DESIGN_FILE.parents[1] / "finger_space.toml"
 UPPER = {"diameter_mm": 500.0, "mass_kg": 20.0, "max_pressure_MPa": 5.0, "force_factor": 100.0,
          "margin_N": 1000.0, "opening_mm": 1000.0, "max_principal_stretch": 10.0, "min_wall_mm": 50.0,
          "mesh_size_mm": 12.0, "edge_ratio": 1.0, "dP_MPa": 0.5}
-#: lowest value of the FEM proof's mesh and step (a finer one is refused, not run for hours)
-LOWER = {"mesh_size_mm": 0.5, "edge_ratio": 0.05, "dP_MPa": 0.001}
+#: lowest value of the FEM proof's mesh and step (a finer one is refused, not run for hours), of the
+#: force factor (below 1 the fingers would not carry the object's weight) and of the pump limit
+#: (10 kPa: far below the contact pressure of any finger in the calibrated space, ~0.1-0.5 MPa)
+LOWER = {"mesh_size_mm": 0.5, "edge_ratio": 0.05, "dP_MPa": 0.001, "force_factor": 1.0,
+         "max_pressure_MPa": 0.01}
+#: least non-zero mass [kg] and margin [N]: 0 is a massless object or no margin (the fingers
+#: press with m g / n, or just touch), a positive value below it asks for a force the grasp
+#: model does not resolve (a root at 1e-300 N ran for minutes)
+LEAST_NONZERO = {"mass_kg": 1e-3, "margin_N": 1e-3}
 _TOP = {"base_design", "object", "grasp", "pump", "limits", "material", "design", "free", "fem"}
 
 
@@ -119,6 +126,10 @@ def task_from_dict(data: dict, *, folder: Path = Path("."), name: str = "task") 
             if key not in allowed:
                 raise InputError(f"{section}.{key}", tables[section][key],
                                  f"unknown key; allowed: {', '.join(sorted(allowed))}")
+    for key in tables["design"]:
+        if key in tables["free"]:
+            raise InputError(f"design.{key}", tables["design"][key],
+                             "is also in [free]; give a fixed value in [design] or bounds in [free], not both")
     base = _base_design(data.get("base_design"), folder)
     base = design_from_dict({**MODELS, **tables["design"], **tables["material"]}, base, source="design")
     free, clipped = _calibrated(_free(tables["free"], base), base)
@@ -128,16 +139,21 @@ def task_from_dict(data: dict, *, folder: Path = Path("."), name: str = "task") 
     objective = grasp.get("objective", "pressure")
     if objective not in OBJECTIVES:
         raise InputError("grasp.objective", objective, f"must be one of {', '.join(OBJECTIVES)}")
+    diameter = _number(obj, "object", "diameter_mm", required=True)
+    opening = _number(grasp, "grasp", "opening_mm", default=None)
+    if opening is not None and opening < diameter:
+        raise InputError("grasp.opening_mm", grasp["opening_mm"], f"must be >= the object's diameter_mm "
+                         f"= {diameter:g} (the open hand must pass the object) and <= {UPPER['opening_mm']:g}")
     return Task(
         base=base, name=name, source=data,
-        diameter=_number(obj, "object", "diameter_mm", required=True),
+        diameter=diameter,
         mass=_number(obj, "object", "mass_kg", required=True, positive=False),
         free=free, clipped=clipped,
         max_pressure=_number(pump, "pump", "max_pressure_MPa", required=True),
         force_factor=_number(grasp, "grasp", "force_factor", default=2.0),
         margin=_number(grasp, "grasp", "margin_N", default=None, positive=False),
         objective=objective,
-        opening=_number(grasp, "grasp", "opening_mm", default=None),
+        opening=opening,
         max_stretch=_number(limits, "limits", "max_principal_stretch", default=1.5, above=1.0),
         min_wall=_number(limits, "limits", "min_wall_mm", default=1.0),
         mesh_size=_number(fem, "fem", "mesh_size_mm", default=6.0),
@@ -174,10 +190,11 @@ def _number(table: dict, section: str, key: str, *, required: bool = False, defa
     ok = isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
     limit, upper = above if above is not None else 0.0, UPPER[key]
     if not ok or (value <= limit if positive or above is not None else value < 0) or value > upper \
-            or value < LOWER.get(key, -math.inf):
+            or value < LOWER.get(key, -math.inf) or 0 < value < LEAST_NONZERO.get(key, 0.0):
         what = f"> {limit:g}" if positive or above is not None else ">= 0"
         what = f">= {LOWER[key]:g}" if key in LOWER else what
-        raise InputError(f"{section}.{key}", value, f"must be a number {what} and <= {upper:g}")
+        what = f"0 or a number >= {LEAST_NONZERO[key]:g}" if key in LEAST_NONZERO else f"a number {what}"
+        raise InputError(f"{section}.{key}", value, f"must be {what} and <= {upper:g}")
     return float(value)
 
 

@@ -6,7 +6,8 @@ model (differential evolution, seeded) goes through the FEM -- free bend with th
 and the grasp at the task's object -- unless ``--no-fem``. Written to ``--out DIR``: the
 design TOML (usable by every verb), ``result.json``, with ``--pareto`` the front's plot and the
 FEM proof of its knee (``knee/``), and the VTK of the verified grasp (``grasp.pvd``). A task that cannot be met: one paragraph
-naming the binding constraint and the nearest design, exit code 1.
+naming the binding constraint and the nearest design, exit code 1, and nothing written (no ``--out``
+folder: its design is not one to use; ``--json`` prints the whole record).
 """
 from __future__ import annotations
 
@@ -58,6 +59,10 @@ def run(args) -> int:
     opt = design_opt.optimise(task, options)
     ev = opt.evaluation
     base = design_opt.evaluate(task.base, task)
+    if not ev.feasible:  # the documented outcome, before anything is written
+        result = {**_result(task, opt, base, None, args.seed), "report": design_opt.infeasible_report(task, opt)}
+        print_json(result) if args.json else _print(result, task, opt)
+        return 1
     out = Path(args.out) if args.out else Path("results") / "design" / task.name
     out.mkdir(parents=True, exist_ok=True)
     design_file = write_atomic(out / "design.toml", ev.design.to_toml())
@@ -68,9 +73,7 @@ def run(args) -> int:
         rows = design_pareto.front(task, opt, options)
         plot = design_pareto.plot(rows, args.plot or out / "pareto.png", task=task, base=base)
         result["pareto"] = {"rows": rows, "knee": design_pareto.knee(rows), "plot": str(plot)}
-    if not ev.feasible:
-        result["report"] = design_opt.infeasible_report(task, opt)
-    elif not args.no_fem:
+    if not args.no_fem:
         result = _prove_and_correct(result, task, opt, base, args, out, say, options)
         if args.pareto:
             result["pareto"]["knee_proof"] = _prove_knee(result["pareto"], task, args, out, say)
@@ -164,7 +167,7 @@ def _result(task, opt, base, design_file, seed: int) -> dict:
         "base_design": {"design": task.base.to_dict(), "predicted": base.predicted(),
                         "feasible": base.feasible},
         "constraints": [c.as_dict() for c in ev.constraints],
-        "design_file": str(design_file),
+        "design_file": None if design_file is None else str(design_file),
         "optimiser": {"method": "differential_evolution + SLSQP polish", "seed": seed,
                       "evaluations": opt.evaluations, "generations": opt.generations,
                       "seconds": opt.seconds, "cpu_seconds": opt.cpu_seconds, "message": opt.message},
@@ -212,7 +215,7 @@ def _print(result: dict, task, opt) -> None:
             print(f"knee: P_grasp {knee['predicted']['P_grasp_MPa']:.4g} MPa predicted, "
                   f"{knee['fem']['P_grasp_MPa']:.4g} MPa FEM; F_v {knee['predicted']['F_v_N']:.4g} N "
                   f"predicted, {knee['fem']['F_v_N']:.4g} N FEM; design {knee['design_file']}")
-    print(f"design: {result['design_file']}")
+    print(f"design: {result['design_file'] or 'none written (the task cannot be met)'}")
 
 
 def _rel(a, b):
