@@ -6,6 +6,14 @@ in the stretched direction); ``lambda`` and ``nominal_stress_MPa`` are accepted 
 names of the last two, ``biaxial``, ``planar`` (and ``ut``, ``et``, ``ps``) of the modes.
 Lines starting with ``#`` are comments.
 
+Refused (one :class:`~reduced.errors.InputError`), as no rubber test gives them: a stretch
+outside :data:`STRETCH_LIMITS`, a stress beyond :data:`MAX_STRESS` MPa, data whose largest
+stress is below :data:`MIN_STRESS` MPa, a stress of the wrong sign (negative in tension,
+positive in compression, nonzero at stretch 1) beyond :data:`SIGN_SCATTER` of the largest,
+and fewer distinct (mode, stretch) points other than stretch 1 than the model has parameters
+(repeats only measure the scatter; at stretch 1 every model has zero stress). Data the model's
+numerics cannot fit (no finite optimum) are refused too, never printed.
+
 Least squares in the stress itself (MPa), all rows with equal weight:
 
 .. math:: S(p) = \sum_i (P^{model}_{m_i}(\lambda_i; p) - P_i)^2 .
@@ -53,6 +61,14 @@ _COLUMN_ALIASES = {"mode": "mode", "stretch": "stretch", "lambda": "stretch",
 #: a modulus near zero); added in quadrature to the standard errors, so that data without
 #: scatter (S ~ round-off) do not report errors below what the numbers can resolve
 PRECISION = 1e-10
+#: stretches a rubber test can give [-]; also the bounds of ``--stability-range``
+STRETCH_LIMITS = (0.01, 100.0)
+#: largest |nominal stress| of a rubber test [MPa]
+MAX_STRESS = 1e4
+#: the data's largest |stress| must reach this [MPa] (1 Pa): else there is no stiffness to fit
+MIN_STRESS = 1e-6
+#: a stress of the wrong sign is allowed as scatter up to this fraction of the largest |stress|
+SIGN_SCATTER = 0.01
 
 
 @dataclass(frozen=True)
@@ -63,6 +79,7 @@ class StressData:
     stretch: np.ndarray
     stress: np.ndarray
     source: str = "data"
+    lines: np.ndarray | None = None  #: line number in the file per row (for messages)
 
     def __len__(self):
         return int(self.stretch.size)
@@ -82,7 +99,7 @@ def read_test_data(path) -> StressData:
     header = [_COLUMN_ALIASES.get(c.lower(), c) for c in given]
     if sorted(header) != sorted(COLUMNS):
         raise InputError(f"{path.name}: columns", ",".join(given), f"must be {','.join(COLUMNS)}")
-    mode, lam, stress = [], [], []
+    mode, lam, stress, lines = [], [], [], []
     for line, cells in rows:
         if len(cells) != len(header):
             raise InputError(f"{path.name}: line {line}", ",".join(cells),
@@ -95,7 +112,52 @@ def read_test_data(path) -> StressData:
         mode.append(name)
         lam.append(_number(path.name, line, "stretch", cell["stretch"], positive=True))
         stress.append(_number(path.name, line, "stress_MPa", cell["stress_MPa"]))
-    return StressData(np.array(mode), np.array(lam), np.array(stress), path.name)
+        lines.append(line)
+    data = StressData(np.array(mode), np.array(lam), np.array(stress), path.name, np.array(lines))
+    check_data(data)
+    return data
+
+
+def check_data(data: StressData) -> None:
+    """Refuse data no rubber test gives (see the module docstring); one InputError naming the row."""
+    lo, hi = STRETCH_LIMITS
+    bad = np.flatnonzero(~((data.stretch >= lo) & (data.stretch <= hi)))
+    if bad.size:
+        i = bad[0]
+        raise InputError(_cell(data, i, "stretch"), f"{data.stretch[i]:g}",
+                         f"must be in [{lo:g}, {hi:g}]: rubber tests never leave that range")
+    bad = np.flatnonzero(~(np.abs(data.stress) <= MAX_STRESS))
+    if bad.size:
+        i = bad[0]
+        raise InputError(_cell(data, i, "stress_MPa"), f"{data.stress[i]:g}",
+                         f"must be in [{-MAX_STRESS:g}, {MAX_STRESS:g}] MPa (nominal stress of a rubber)")
+    top = float(np.max(np.abs(data.stress)))
+    if not top >= MIN_STRESS:
+        raise InputError(f"{data.source}: column stress_MPa", f"largest |stress| {top:g} MPa",
+                         f"must be at least {MIN_STRESS:g} MPa (1 Pa): no stiffness to fit "
+                         "(stresses are in MPa)")
+    tol = SIGN_SCATTER * top
+    side = np.sign(data.stretch - 1.0)
+    wrong = np.where(side == 0, np.abs(data.stress) > tol, side * data.stress < -tol)
+    if np.any(wrong):
+        i = int(np.flatnonzero(wrong)[0])
+        lam, what = data.stretch[i], data.mode[i]
+        if side[i] == 0:
+            need = "must be 0 at stretch 1 (undeformed: every model has zero stress there)"
+        elif side[i] > 0:
+            need = f"must be positive in tension (stretch {lam:g} > 1, {what})"
+        else:
+            need = f"must be negative in compression (stretch {lam:g} < 1, {what})"
+        other = "nonzero" if side[i] == 0 else "the other sign"
+        raise InputError(_cell(data, i, "stress_MPa"), f"{data.stress[i]:g}",
+                         f"{need}; {other} only as scatter up to {SIGN_SCATTER:.0%} of the "
+                         f"largest |stress| ({top:g} MPa)")
+
+
+def _cell(data, i, col):
+    """Where row i is: the file's line, or the row number of data built in code."""
+    where = f"line {data.lines[i]}" if data.lines is not None else f"row {i + 1}"
+    return f"{data.source}: {where}, column {col}"
 
 
 def _number(name, line, col, text, positive=False):
@@ -155,6 +217,29 @@ def fit_material(data: StressData, fit_model: str, options: FitOptions = FitOpti
     if len(data) <= len(names):
         raise InputError("--data", f"{len(data)} points",
                          f"need more points than the {len(names)} parameters of {fit_model}")
+    check_data(data)
+    moved = data.stretch != 1.0
+    distinct = len(set(zip(data.mode[moved], data.stretch[moved])))
+    if distinct < len(names):
+        raise InputError("--data", f"{distinct} distinct stretch" + ("" if distinct == 1 else "es"),
+                         f"need at least {len(names)} distinct (mode, stretch) points other than "
+                         f"stretch 1 for the {len(names)} parameters of {fit_model} (repeats only "
+                         "measure the scatter; stretch 1 carries no information)")
+    try:
+        x, r, diag = _solve(data, fit_model, names, residual, material, options)
+    except InputError:
+        raise
+    except (np.linalg.LinAlgError, ValueError, ArithmeticError):  # the numerics failed on these data
+        raise InputError("--data", data.source, f"cannot be fitted by {fit_model}: the least "
+                         "squares have no finite solution for these data") from None
+    fitted = material(x)
+    scale = np.array([max(abs(v), fitted.mu0 if k.endswith("_MPa") else 1.0) for k, v in zip(names, x)])
+    stderr = np.hypot(diag.stderr, PRECISION * scale)
+    return MaterialFit(fit_model, fitted, names, x, stderr, diag.correlation, r, data, diag.warnings)
+
+
+def _solve(data, fit_model, names, residual, material, options):
+    """Parameters, residuals and their diagnosis; ValueError unless all are finite."""
     model = FIT_MODELS[fit_model][0]
     if model in ("neo-hookean", "mooney-rivlin", "yeoh"):
         x = _linear_fit(data, names, material)
@@ -165,19 +250,21 @@ def fit_material(data: StressData, fit_model: str, options: FitOptions = FitOpti
         x, lo, hi = _ogden_fit(data, names, residual)
         order = np.argsort(x[1::2])  # terms in ascending alpha (W does not depend on the order)
         x = np.column_stack([x[0::2][order], x[1::2][order]]).ravel()
+    if not np.all(np.isfinite(x)):
+        raise ValueError("non-finite parameters")
     J = jacobian(residual, x, lo, hi, options.rel_step)
     r = residual(x)
-    diag = diagnose(names, J, r, x, options)
-    fitted = material(x)
-    scale = np.array([max(abs(v), fitted.mu0 if k.endswith("_MPa") else 1.0) for k, v in zip(names, x)])
-    stderr = np.hypot(diag.stderr, PRECISION * scale)
-    return MaterialFit(fit_model, fitted, names, x, stderr, diag.correlation, r, data, diag.warnings)
+    if not (np.all(np.isfinite(J)) and np.all(np.isfinite(r))):
+        raise ValueError("non-finite residuals or Jacobian")
+    return x, r, diagnose(names, J, r, x, options)
 
 
 def _linear_fit(data, names, material):
     """Stress is linear in the parameters: the columns are the stresses of unit parameters."""
     k = len(names)
     A = np.column_stack([data.predict(material(np.eye(k)[j])) for j in range(k)])
+    if not np.all(np.isfinite(A)):
+        raise ValueError("non-finite model stresses")
     return np.linalg.lstsq(A, data.stress, rcond=None)[0]
 
 
@@ -191,10 +278,14 @@ def _gent_fit(data, residual):
     """Starts: Jm on a log grid above the data's largest I1 - 3, mu linear for each."""
     I1 = sum(s**2 for s in _stretch_triples(data))
     jm_min = float(np.max(I1) - 3.0) * (1.0 + 1e-9) + 1e-12
+    if not np.isfinite(jm_min):
+        raise ValueError("no finite locking limit")
     lo, hi = np.array([1e-12, jm_min]), np.array([np.inf, np.inf])
     starts = []
     for jm in jm_min * np.geomspace(1.01, 1e4, 41):
         unit = residual(np.array([1.0, jm])) + data.stress  # stress of mu = 1
+        if not (np.all(np.isfinite(unit)) and unit @ unit > 0):
+            continue
         mu = max(float(unit @ data.stress / (unit @ unit)), 1e-6)
         r = mu * unit - data.stress
         starts.append((float(r @ r), np.array([mu, jm])))
@@ -208,6 +299,8 @@ def _best_refined(residual, starts, lo, hi, count):
         x, S = _refine(residual, x0, lo, hi)
         if np.isfinite(S) and (best is None or S < best[1]):
             best = (x, S)
+    if best is None:
+        raise ValueError("no start converged to a finite sum of squares")
     return best[0]
 
 
@@ -219,6 +312,8 @@ def _ogden_fit(data, names, residual):
     starts = []
     for alpha in sets:
         A = np.column_stack([data.predict(rubber.Ogden((1.0,), (a,))) for a in alpha])
+        if not np.all(np.isfinite(A)):
+            continue
         mu = np.linalg.lstsq(A, data.stress, rcond=None)[0]
         x = np.empty(2 * n)
         x[0::2], x[1::2] = mu, alpha

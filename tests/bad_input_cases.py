@@ -5,7 +5,9 @@ Shared by tests/test_bad_inputs.py (in-process) and benchmarks/bad_input_replay.
 """
 from __future__ import annotations
 
-GOOD_MATERIAL = "mode,stretch,stress_MPa\nuniaxial,1.5,0.5\nuniaxial,2,0.9\nuniaxial,3,1.6\n"
+#: uniaxial test of a ~0.4 MPa rubber: enough points for every model (ogden3: 6 parameters)
+GOOD_MATERIAL = ("mode,stretch,stress_MPa\nuniaxial,1.2,0.203\nuniaxial,1.5,0.421\nuniaxial,1.8,0.598\n"
+                 "uniaxial,2.1,0.748\nuniaxial,2.4,0.893\nuniaxial,2.7,1.024\nuniaxial,3,1.157\n")
 SPACE = ('name = "sp"\nlhs = 0\n[space]\na_mm = [3.0, 6.0]\nb_mm = [3.0, 7.0]\nd_mm = [10.0, 20.0]\n'
          'l0_mm = [120.0, 200.0]\ntie_width_mm = [5.0, 15.0]\n[[design]]\na_mm = 4.0\nb_mm = 5.0\n'
          'd_mm = 15.0\nl0_mm = 180.0\ntie_width_mm = 10.0\n')
@@ -36,6 +38,18 @@ EXTRA_FILES = {
     "m_one_row.csv": "mode,stretch,stress_MPa\nuniaxial,1.5,0.5\n",
     "m_short.csv": "mode,stretch,stress_MPa\nuniaxial,1.5\n",
     "m_binary.csv": b"\x00\xff\xfe\x89PNG\r\n",
+    "m_stretch_huge.csv": GOOD_MATERIAL.replace("uniaxial,1.2,", "uniaxial,1e250,"),
+    "m_stretch_tiny.csv": GOOD_MATERIAL.replace("uniaxial,1.2,", "uniaxial,1e-250,"),
+    "m_stretch_1e-5.csv": GOOD_MATERIAL.replace("uniaxial,1.2,", "uniaxial,1e-5,"),
+    "m_stress_huge.csv": GOOD_MATERIAL.replace(",0.203", ",1e30"),
+    "m_stress_tiny.csv": "mode,stretch,stress_MPa\n" + "".join(f"uniaxial,{l},1e-300\n" for l in range(2, 9)),
+    "m_stress_zero.csv": "mode,stretch,stress_MPa\n" + "".join(f"uniaxial,{l},0\n" for l in range(2, 9)),
+    "m_all_one.csv": "mode,stretch,stress_MPa\n" + "".join(f"uniaxial,1,0.{s}\n" for s in range(1, 8)),
+    "m_all_same.csv": "mode,stretch,stress_MPa\n" + "".join(f"uniaxial,2,0.{s}\n" for s in range(1, 8)),
+    "m_tension_negative.csv": "mode,stretch,stress_MPa\n" + "".join(f"uniaxial,{l},-0.{l}\n" for l in range(2, 9)),
+    "m_tension_one_negative.csv": GOOD_MATERIAL.replace(",0.748", ",-0.748"),
+    "m_compression_positive.csv": GOOD_MATERIAL.replace("uniaxial,1.2,0.203", "uniaxial,0.5,0.3"),
+    "m_stretch_one_stress.csv": GOOD_MATERIAL.replace("uniaxial,1.2,0.203", "uniaxial,1,0.5"),
     "good_space.toml": SPACE,
     "sp_unknown.toml": _space("colour = 1\n"),
     "sp_lhs_text.toml": SPACE.replace("lhs = 0", 'lhs = "six"'),
@@ -156,9 +170,14 @@ def replay_cases() -> list[tuple[str, list[str]]]:
         ["--model", "yeoh", "--stability-range", "0:5"], ["--model", "yeoh", "--stability-range", "nan:5"],
         ["--model", "yeoh", "--stability-range", "1:inf"], ["--model", "yeoh", "--stability-range", "x"],
         ["--model", "yeoh", "--stability-range", "0.2:5:1"], ["--model", "yeoh", "--stability-range", "1e-300:1e300"],
+        ["--model", "yeoh", "--stability-range", "1:1e6"], ["--model", "yeoh", "--stability-range", "0.001:5"],
         ["--model", "yeoh", "--out", "."], ["--model", "yeoh", "--out", "a_file/m.toml"],
         ["--model", "yeoh", "--out", "/proc/m.toml"], ["--model", "yeoh", "--plot", "m.txt"],
         ["--model", "yeoh", "--plot", "adir"])]
+    material += [["--data", d, "--model", m] for m in ("gent", "ogden3", "neo-hookean")
+                 for d in ("m_stretch_huge.csv", "m_stretch_tiny.csv", "m_stress_huge.csv",
+                           "m_stress_tiny.csv", "m_all_one.csv", "m_tension_negative.csv")]
+    material += [["--data", "m_all_same.csv", "--model", m] for m in ("mooney-rivlin", "gent", "ogden2")]
     cases += [("material", ["material", "fit", *m]) for m in material]
     cases += [("material", ["material"]), ("material", ["material", "unfit"])]
     inspect = [[f] for f in ("bad.vtu", "bad.pvd", "trunc.vtm", "x.obj", "a_file/x.vtu", "adir",

@@ -34,7 +34,7 @@ def configure(parser) -> None:
     fit.add_argument("--model", required=True, metavar="|".join(FIT_MODELS),
                      help="the strain energy to fit")
     fit.add_argument("--stability-range", default=None, metavar="LO:HI",
-                     help="stretches of the Drucker check in every mode "
+                     help="stretches of the Drucker check in every mode, within 0.01:100 "
                           "(default: 1/max .. max stretch of the data)")
     add_json_option(fit)
     fit.add_argument("--plot", metavar="FILE.png", help="data and fitted curves per mode")
@@ -70,6 +70,9 @@ def run(args) -> int:
 
 
 def _stretch_range(text, data) -> tuple[float, float]:
+    """``--stability-range`` LO:HI within the stretches of rubber tests (default: the data's)."""
+    from softhand.reduced.material_fit import STRETCH_LIMITS
+
     if text is None:
         top = float(np.max(np.maximum(data.stretch, 1.0 / data.stretch)))
         return 1.0 / top, top
@@ -77,8 +80,10 @@ def _stretch_range(text, data) -> tuple[float, float]:
         lo, hi = (float(x) for x in text.split(":"))
     except ValueError:
         lo = hi = float("nan")
-    if not 0 < lo < hi < float("inf"):
-        raise InputError("--stability-range", text, "must be LO:HI with 0 < LO < HI")
+    low, high = STRETCH_LIMITS
+    if not low <= lo < hi <= high:
+        raise InputError("--stability-range", text, f"must be LO:HI with {low:g} <= LO < HI <= "
+                         f"{high:g} (the stretches of rubber tests)")
     return lo, hi
 
 
