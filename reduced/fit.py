@@ -136,6 +136,7 @@ def fit(data: Measurements, params, predictor: Callable[[HandDesign], np.ndarray
                         ftol=options.tol, xtol=options.tol, gtol=options.tol,
                         diff_step=1e-7)
     values = sol.x * scale
+    _check_answered(predictor, keys, values, design, lo, hi)
     J = jacobian(residual, sol.x, lo / scale, hi / scale, options.rel_step) / scale
     fitted = _with(keys, values, design)
     diag = diagnose(keys, J, sol.fun, values, options)
@@ -266,6 +267,18 @@ def _bounds(keys, p0, design, data, bounds, options):
 
 def _with(keys, values, design: HandDesign) -> HandDesign:
     return design_from_dict({k: float(v) for k, v in zip(keys, values)}, design)
+
+
+def _check_answered(predictor, keys, values, design, lo, hi) -> None:
+    """InputError if the model has no answer for the data where the fit ended: the bounds
+    held it where no design reaches the data (e.g. a V0 too small for the fingers' oil)."""
+    try:
+        _predict(predictor, keys, values, design)
+    except InputError as exc:
+        at = ", ".join(f"{k} = {v:.6g}" for k, v in zip(keys, values))
+        box = ",".join(f"{k}={a:.6g}:{b:.6g}" for k, a, b in zip(keys, lo, hi))
+        raise InputError("--bounds", box, f"the fit ended at {at}, where the model has no answer "
+                         f"for the data ({exc}); move or widen the bounds") from None
 
 
 def _predict(predictor, keys, values, design) -> np.ndarray:

@@ -284,7 +284,10 @@ def _cases():
     flags += [["fit", "--data", "good.csv", *extra] for extra in (
         ["--params", "V0_mm3,"], ["--params", "V0_mm3", "--bounds", ""],
         ["--params", "V0_mm3", "--bounds", "V0_mm3=1e4:2e4,V0_mm3=1e4:3e4"],
-        ["--params", "V0_mm3", "--diameter-mm", "180"], ["--params", "V0_mm3", "--normalise"])]
+        ["--params", "V0_mm3", "--diameter-mm", "180"], ["--params", "V0_mm3", "--normalise"],
+        ["--params", "V0_mm3", "--bounds", "V0_mm3=1:2"])]  # no V0 there holds the fingers' oil
+    flags += [["design", "--task", "t_good.toml", *extra] for extra in (
+        ["--plot", "p.png"], ["--no-fem", "--mesh-size-mm", "4"], ["--no-fem", "--no-correct"])]
     flags += [["bend", "--peak-mpa", "0.3"], ["bend", "--tie", "full", "--tie-width-mm", "10"],
               ["weights", "--diameter-mm", "120:300:60", "--fig8", "0.5"],
               ["weights", "--diameter-mm", "180,180"], ["weights", "--diameter-mm", "180", "--fig8", "0.5,0.5"],

@@ -53,6 +53,12 @@ def run(args) -> int:
         raise InputError("--mesh-size-mm", args.mesh_size_mm, f"must be a number in [{lo:g}, {hi:g}]")
     if not 0 <= args.seed < 2**32:
         raise InputError("--seed", args.seed, "must be a whole number in [0, 4294967295]")
+    if args.plot is not None and not args.pareto:
+        raise InputError("--plot", args.plot, "is the Pareto front's plot: give --pareto too")
+    if args.no_fem:
+        for option, value in (("--mesh-size-mm", args.mesh_size_mm), ("--no-correct", args.no_correct or None)):
+            if value is not None:
+                raise InputError(option, value, "sets the FEM proof, which --no-fem skips")
     task = load_task(args.task)
     say = (lambda text: print(f"softhand design: {text}", file=sys.stderr)) if args.json else print
     options = design_opt.OptimiserOptions(seed=args.seed)
