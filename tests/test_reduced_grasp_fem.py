@@ -116,6 +116,16 @@ def test_agrees_with_the_grasp_fem(state):
     assert abs(F_v - state["F_v_fem_N"]) <= max(0.1 * state["F_v_fem_N"], 0.05 * grasp.KGF)
 
 
+def test_cli_model_fem_table_without_a_contact(capsys):
+    """Below the free finger's pressure at that angle the finger does not reach the object:
+    no contact point, printed as 'none' (the table had crashed on it half-way)."""
+    argv = ["grasp", "--pressure-mpa", "0.8", "--theta-deg", "40", "--mass-kg", "1", "--diameter-mm", "180",
+            "--model", "fem"]
+    assert main(argv) == 0
+    rows = dict(line.split(None, 1) for line in capsys.readouterr().out.splitlines())
+    assert rows["contact_link"] == "-1" and rows["contact_point_mm"] == "none" and rows["F_v_N"] == "0"
+
+
 def test_cli_model_fem_and_its_bad_inputs(capsys):
     argv = ["grasp", "--pressure-mpa", "0.7", "--theta-deg", "15", "--mass-kg", "2"]
     assert main([*argv, "--diameter-mm", "180", "--model", "fem", "--json"]) == 0

@@ -131,8 +131,15 @@ def _print(args, result: dict) -> int:
         print_json(result)
     else:
         width = max(map(len, result))
-        for key, value in result.items():
-            text = "[" + ", ".join(f"{v:g}" for v in value) + "]" if isinstance(value, list) \
-                else value if isinstance(value, str) else f"{value:.4g}"
-            print(f"{key:<{width}}  {text}")
+        lines = [f"{key:<{width}}  {_text(value)}" for key, value in result.items()]
+        print("\n".join(lines))  # formatted first: nothing half-printed
     return 0
+
+
+def _text(value) -> str:
+    """One value of the result table (None: not applicable, e.g. no contact point)."""
+    if value is None:
+        return "none"
+    if isinstance(value, list):
+        return "[" + ", ".join(f"{v:g}" for v in value) + "]"
+    return value if isinstance(value, str) else f"{value:.4g}"
