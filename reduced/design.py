@@ -117,9 +117,10 @@ class HandDesign:
             raise InputError("hinge_s_mm", list(self.hinge_s),
                              f"must have n_s = {self.n_s} values")
         s = (0.0, *self.hinge_s, self.l0)
-        if any(s1 <= s0 for s0, s1 in zip(s, s[1:])):
+        if not all(isinstance(v, (int, float)) and math.isfinite(v) for v in s) \
+                or any(not s1 > s0 for s0, s1 in zip(s, s[1:])):  # nan compares false both ways
             raise InputError("hinge_s_mm", list(self.hinge_s),
-                             f"must increase strictly within (0, l0 = {self.l0:g}) mm")
+                             f"must be finite and increase strictly within (0, l0 = {self.l0:g}) mm")
         for check in CONSISTENCY:
             check(self)
         _check_model("reservoir_model", self.reservoir_model, RESERVOIR_MODELS,

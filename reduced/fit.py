@@ -136,7 +136,7 @@ def fit(data: Measurements, params, predictor: Callable[[HandDesign], np.ndarray
                         ftol=options.tol, xtol=options.tol, gtol=options.tol,
                         diff_step=1e-7)
     values = sol.x * scale
-    _check_answered(predictor, keys, values, design, lo, hi)
+    _check_answered(predictor, keys, values, design, lo, hi, bounded=bool(bounds))
     J = jacobian(residual, sol.x, lo / scale, hi / scale, options.rel_step) / scale
     fitted = _with(keys, values, design)
     diag = diagnose(keys, J, sol.fun, values, options)
@@ -269,16 +269,21 @@ def _with(keys, values, design: HandDesign) -> HandDesign:
     return design_from_dict({k: float(v) for k, v in zip(keys, values)}, design)
 
 
-def _check_answered(predictor, keys, values, design, lo, hi) -> None:
+def _check_answered(predictor, keys, values, design, lo, hi, bounded: bool) -> None:
     """InputError if the model has no answer for the data where the fit ended: the bounds
-    held it where no design reaches the data (e.g. a V0 too small for the fingers' oil)."""
+    held it where no design reaches the data (e.g. a V0 too small for the fingers' oil), or the
+    design has none anywhere (e.g. a material past its limit); named ``--bounds`` if given."""
     try:
-        _predict(predictor, keys, values, design)
+        predicted = _predict(predictor, keys, values, design)
+        why = None if np.all(np.isfinite(predicted)) else "its prediction is not finite"
     except InputError as exc:
+        why = str(exc)
+    if why is not None:
         at = ", ".join(f"{k} = {v:.6g}" for k, v in zip(keys, values))
         box = ",".join(f"{k}={a:.6g}:{b:.6g}" for k, a, b in zip(keys, lo, hi))
-        raise InputError("--bounds", box, f"the fit ended at {at}, where the model has no answer "
-                         f"for the data ({exc}); move or widen the bounds") from None
+        raise InputError("--bounds" if bounded else "--params", box, f"the fit ended at {at}, where "
+                         f"the model has no answer for the data ({why}); move or widen the bounds, "
+                         "or check --design")
 
 
 def _predict(predictor, keys, values, design) -> np.ndarray:

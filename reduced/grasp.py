@@ -60,7 +60,15 @@ def weights_for_diameter(diameter_mm: float, design: HandDesign) -> np.ndarray:
     if w is None:
         raise InputError("diameter_mm", diameter_mm, "no weight vector for this diameter; "
                          f"available: {', '.join(f'{D:g}' for D in PAPER_WEIGHTS)}")
+    if len(w) != design.n_s:
+        raise InputError("n_s", design.n_s, f"the paper's w for {float(diameter_mm):g} mm has "
+                         f"{len(w)} hinges; give a design with n_s = {len(w)}, or w itself")
     return np.array(w, dtype=float)
+
+
+#: largest |w_i|: a hinge turning more than ten times the mean bend is no grasp (the paper's
+#: w lie in [-0.2, 0.8]; the studies' grasp kind has the same bound)
+MAX_WEIGHT = 10.0
 
 
 def check_weights(w, design: HandDesign, normalise: bool = False) -> np.ndarray:
@@ -69,9 +77,9 @@ def check_weights(w, design: HandDesign, normalise: bool = False) -> np.ndarray:
         w = np.asarray(w, dtype=float)
     except (TypeError, ValueError):
         raise InputError("weights", w, f"must be {design.n_s} numbers") from None
-    if w.shape != (design.n_s,) or not np.all(np.isfinite(w)):
+    if w.shape != (design.n_s,) or not np.all(np.abs(w) <= MAX_WEIGHT):
         raise InputError("weights", w.tolist() if w.ndim else w.item(),
-                         f"must be n_s = {design.n_s} finite numbers")
+                         f"must be n_s = {design.n_s} numbers in [-{MAX_WEIGHT:g}, {MAX_WEIGHT:g}]")
     total = float(w.sum())
     if normalise:
         if abs(total) < 1e-12:

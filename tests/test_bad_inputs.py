@@ -48,6 +48,13 @@ FILES.update({
     "v_nan_point.vtu": _VTU.replace(">0 0 0 1 0 0 ", ">nan 0 0 1 0 0 "),
     "v_huge_count.vtu": _VTU.replace('NumberOfPoints="4"', 'NumberOfPoints="1000000000000"'),  # bad_alloc
 })
+#: designs each of whose numbers passes its own check, but whose model has no finite answer
+FILES.update({
+    "x_hinge_nan.toml": "hinge_s_mm = [30.0, nan, 90.0, 120.0, 150.0]\n",  # nan < x is False
+    "x_gent_locked.toml": '[finger.material]\nmodel = "gent"\nmu_MPa = 1.0\nJm = 1e-6\n',
+    "x_gent_sheet.toml": '[reservoir.material]\nmodel = "gent"\nmu_MPa = 1.0\nJm = 1e-6\n',
+    "x_three_hinges.toml": "n_s = 3\n",  # the paper's w have five
+})
 #: a file name longer than any file system allows (255 bytes), and a path past PATH_MAX
 LONG, DEEP_PATH = "x" * 300, "/".join(["y" * 200] * 25)
 #: design tasks (softhand design --task): a good one, and each of its mistakes
@@ -286,6 +293,13 @@ def _cases():
         ["--params", "V0_mm3", "--bounds", "V0_mm3=1e4:2e4,V0_mm3=1e4:3e4"],
         ["--params", "V0_mm3", "--diameter-mm", "180"], ["--params", "V0_mm3", "--normalise"],
         ["--params", "V0_mm3", "--bounds", "V0_mm3=1:2"])]  # no V0 there holds the fingers' oil
+    grasp = ["grasp", "--pressure-mpa", "0.8", "--theta-deg", "40", "--mass-kg", "1"]
+    flags += [[*verb, "--design", f] for f in ("x_hinge_nan.toml", "x_gent_locked.toml", "x_gent_sheet.toml")
+              for verb in (["curve", "--theta-deg", "10,45"], [*grasp, "--weights", "paper180"],
+                           ["fit", "--data", "good.csv", "--params", "V0_mm3"])]
+    flags += [["control", "--theta-ref-deg", "50", "--mass-kg", "1", "--design", "x_three_hinges.toml"],
+              [*grasp, "--weights", "paper180", "--design", "x_three_hinges.toml"],
+              [*grasp, "--weights", "1e308,1e308,0,0,0"], [*grasp, "--weights", "1e308,1e308,0,0,0", "--normalise"]]
     flags += [["design", "--task", "t_good.toml", *extra] for extra in (
         ["--plot", "p.png"], ["--no-fem", "--mesh-size-mm", "4"], ["--no-fem", "--no-correct"])]
     flags += [["bend", "--peak-mpa", "0.3"], ["bend", "--tie", "full", "--tie-width-mm", "10"],

@@ -117,3 +117,21 @@ def test_usage_errors_exit_2(capsys):
     with pytest.raises(SystemExit) as exc:
         main(["grasp", "--pressure-mpa", "0.9", "--theta-deg", "50", "--mass-kg", "2"])
     assert exc.value.code == 2
+
+
+def test_grasp_whose_fem_w_does_not_converge_is_one_line_exit_1(capsys, monkeypatch):
+    """--diameter-mm takes w from the grasp FEM; when that stops, one line (no residual history,
+    no traceback) and exit 1, as for every FEM that gives up."""
+    from softhand.fem.newton import NotConverged
+    from softhand.studies import weights
+
+    def stops(case):
+        raise NotConverged("Newton stopped at P = 0.6 MPa on the way to 0.8 MPa; residual history ['1']",
+                           [1.0], None)
+
+    monkeypatch.setattr(weights, "weights", stops)
+    argv = ["grasp", "--pressure-mpa", "0.8", "--theta-deg", "40", "--mass-kg", "1", "--diameter-mm", "150"]
+    assert main(argv) == 1
+    out, err = capsys.readouterr()
+    assert out == "" and err.count("\n") == 1 and "Traceback" not in err
+    assert "P = 0.6 MPa" in err and "residual history" not in err

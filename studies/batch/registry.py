@@ -12,6 +12,7 @@ from dataclasses import dataclass
 
 from softhand.reduced.design import HandDesign
 from softhand.reduced.errors import InputError
+from softhand.reduced.grasp import MAX_WEIGHT
 
 
 @dataclass(frozen=True)
@@ -114,7 +115,7 @@ KINDS: dict[str, Kind] = {
                   exactly_one=("theta_deg", "pressure_mpa"), checks=(_enough_oil,)),
     "grasp": Kind("softhand.studies.batch.kinds:grasp",
                   {"pressure_mpa": _PRESSURE, "theta_deg": _THETA, "mass_kg": _MASS,
-                   "diameter_mm": _PAPER_D, "weights": NumList(20, -10.0, 10.0)},
+                   "diameter_mm": _PAPER_D, "weights": NumList(20, -MAX_WEIGHT, MAX_WEIGHT)},
                   required=("pressure_mpa", "theta_deg"), checks=(_grasp_weights,)),
     "control": Kind("softhand.studies.batch.kinds:control",
                     {"theta_ref_deg": Num(-29.9, 119.9), "mass_kg": _MASS, "diameter_mm": _PAPER_D,

@@ -105,6 +105,24 @@ def design_from_args(args) -> HandDesign:
     return load_design(args.design)
 
 
+def require_finite(result, args, where: str) -> None:
+    """InputError naming ``--design`` if a number of ``result`` (nested dicts and lists; text,
+    None and bools skipped) is not finite: the model has no answer for that design there
+    (a material beyond its limit, e.g. past Gent's locking stretch), and a NaN is not printed."""
+    stack = [("", result)]
+    while stack:
+        key, value = stack.pop()
+        if isinstance(value, dict):
+            stack.extend(value.items())
+        elif isinstance(value, (list, tuple, np.ndarray)):
+            stack.extend((key, v) for v in value)
+        elif isinstance(value, (float, np.floating)) and not math.isfinite(value):
+            design = getattr(args, "design", None) or "the paper's design"
+            raise InputError("--design", design, f"has no finite {key or 'result'} {where}: its "
+                             "model has no answer there (a material past its limit, e.g. Gent's "
+                             "locking stretch, or sizes that do not fit together)")
+
+
 def print_json(obj) -> None:
     """One JSON object on stdout (numpy arrays and scalars converted)."""
     json.dump(obj, sys.stdout, indent=1, default=jsonable)

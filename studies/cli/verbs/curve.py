@@ -13,7 +13,7 @@ import numpy as np
 from softhand.reduced import hand, reservoir
 from softhand.reduced.design import HandDesign
 from softhand.studies.cli.args import MAX_POINTS, MOST_POINTS, add_design_option, add_json_option, \
-    add_max_cases_option, design_from_args, max_cases, parse_values, print_json, print_table
+    add_max_cases_option, design_from_args, max_cases, parse_values, print_json, print_table, require_finite
 
 HELP = "pressure <-> bend angle of the free hand, with and without reservoir (eqs. 27, 28)"
 
@@ -65,6 +65,8 @@ def run(args) -> int:
         if exc.field in ("theta_deg", "pressure_MPa"):
             raise exc.renamed(option) from None
         raise
+    for row in rows:
+        require_finite(row, args, f"at {option} {row['theta_deg' if option == '--theta-deg' else 'P_MPa']:g}")
     if args.plot:
         from softhand.studies.io.files import kept_if_unwritable
 

@@ -23,7 +23,8 @@ import numpy as np
 from softhand.reduced import grasp
 from softhand.reduced.errors import InputError
 from softhand.studies.cli.args import add_design_option, add_json_option, design_from_args, parse_values, \
-    print_json
+    print_json, require_finite
+from softhand.fem.newton import NotConverged
 from softhand.studies.grasp import state, state_fem
 
 #: the paper's weight vectors by name (--weights paper180)
@@ -119,14 +120,26 @@ def run(args) -> int:
                 grasp.check_weights(parse_values(args.weights, "--weights", max_count=1000), design)
         except InputError as exc:
             raise exc.renamed("--weights") from None
-    w, source, notes = _weights(args, design, mass)
+    try:
+        w, source, notes = _weights(args, design, mass)
+    except NotConverged as exc:  # the grasp FEM behind --diameter-mm: one line, exit 1
+        print(f"softhand grasp: error: the grasp FEM for w at --diameter-mm {args.diameter_mm} did not "
+              f"converge: {str(exc).split(';')[0]}; 'softhand weights --diameter-mm "
+              f"{args.diameter_mm}' keeps the state it reached", file=sys.stderr)
+        return 1
     result = state(P, theta_deg, mass, w, design) | {"model": "paper", "w_source": source}
+    _require_finite(result, args)
     for note in notes:  # only once the inputs are known to be good
         print(f"softhand grasp: warning: {note}", file=sys.stderr)
     return _print(args, result)
 
 
+def _require_finite(result: dict, args) -> None:
+    require_finite(result, args, f"at P = {result['P_MPa']:g} MPa, theta = {result['theta_deg']:g} deg")
+
+
 def _print(args, result: dict) -> int:
+    _require_finite(result, args)
     if args.json:
         print_json(result)
     else:
