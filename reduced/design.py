@@ -45,7 +45,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from . import rubber
-from .design_rules import BOUNDS, CONSISTENCY, _check_model, _in_bounds, _is_number
+from .design_rules import BOUNDS, CONSISTENCY, _check_model, _in_bounds, _is_number, check_sheet_holds_v0
 from .errors import InputError
 from .inputfiles import MAX_FILE_BYTES, read_input_file, read_toml
 
@@ -308,4 +308,6 @@ def load_design(path: str | Path | None = None) -> HandDesign:
     table = values.get("finger_table")
     if isinstance(table, str) and table and not Path(table).is_absolute():
         values["finger_table"] = str((path.parent / table).resolve())  # relative to the file
-    return design_from_dict(values, source=path.name)
+    design = design_from_dict(values, source=path.name)
+    check_sheet_holds_v0(design)
+    return design

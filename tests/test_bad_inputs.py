@@ -54,6 +54,8 @@ FILES.update({
     "x_gent_locked.toml": '[finger.material]\nmodel = "gent"\nmu_MPa = 1.0\nJm = 1e-6\n',
     "x_gent_sheet.toml": '[reservoir.material]\nmodel = "gent"\nmu_MPa = 1.0\nJm = 1e-6\n',
     "x_three_hinges.toml": "n_s = 3\n",  # the paper's w have five
+    "x_v0_balloon.toml": "V0_mm3 = 1.0e7\n",  # eq. (16): the sheet stretched 344-fold
+    "x_tiny_sheet.toml": "R_mm = 1.0\nt_mm = 0.01\n",
 })
 #: a file name longer than any file system allows (255 bytes), and a path past PATH_MAX
 LONG, DEEP_PATH = "x" * 300, "/".join(["y" * 200] * 25)
@@ -297,6 +299,7 @@ def _cases():
     flags += [[*verb, "--design", f] for f in ("x_hinge_nan.toml", "x_gent_locked.toml", "x_gent_sheet.toml")
               for verb in (["curve", "--theta-deg", "10,45"], [*grasp, "--weights", "paper180"],
                            ["fit", "--data", "good.csv", "--params", "V0_mm3"])]
+    flags += [["curve", "--theta-deg", "10", "--design", f] for f in ("x_v0_balloon.toml", "x_tiny_sheet.toml")]
     flags += [["control", "--theta-ref-deg", "50", "--mass-kg", "1", "--design", "x_three_hinges.toml"],
               [*grasp, "--weights", "paper180", "--design", "x_three_hinges.toml"],
               [*grasp, "--weights", "1e308,1e308,0,0,0"], [*grasp, "--weights", "1e308,1e308,0,0,0", "--normalise"]]

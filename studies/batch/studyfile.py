@@ -47,6 +47,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from softhand.reduced.design import PUBLIC_KEYS, HandDesign, design_from_dict, load_design, read_toml
+from softhand.reduced.design_rules import check_sheet_holds_v0
 from softhand.reduced.errors import InputError
 from softhand.studies.cli.args import parse_values
 from softhand.studies.batch.registry import ENTRY_POINT_GROUP, KINDS, MAX_CASES, Kind, Num, NumList, all_kinds, \
@@ -181,7 +182,9 @@ def _design(spec, base: Path, src: str) -> HandDesign:
         start = load_design(base / file) if file else HandDesign()
     except InputError as exc:
         raise (exc.renamed(f"{src}: design.file") if exc.field == "--design" else exc) from None
-    return design_from_dict(overrides, start, source=f"{src}: design")
+    design = design_from_dict(overrides, start, source=f"{src}: design")
+    check_sheet_holds_v0(design)
+    return design
 
 
 def _mesh_size(value, kind: str, src: str) -> float | None:
