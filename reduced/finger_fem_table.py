@@ -10,6 +10,8 @@ and uses it.
 """
 from __future__ import annotations
 
+import math
+
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -48,6 +50,11 @@ def _bad(path, allowed: str):
     return InputError("finger_table", str(path), allowed)
 
 
+#: column -> (lowest, highest) of a row: theta [rad] of a bend up to a full turn; the
+#: pressure and oil per mu_sf and a^3 of any finger the FEM can solve
+ROW_LIMITS = {"theta": (1e-6, 2 * math.pi), "p_tilde": (1e-9, 1e6), "q_tilde": (1e-9, 1e6)}
+
+
 def read_table(path: str | Path = TABLE_FILE) -> Table:
     """Read a finger calibration CSV; InputError naming the file on any problem."""
     from softhand.reduced.design import read_input_file
@@ -71,6 +78,11 @@ def read_table(path: str | Path = TABLE_FILE) -> Table:
     rows = {c: values[:, i] for i, c in enumerate(COLUMNS)}
     if np.any(rows["theta"] <= 0) or np.any(rows["p_tilde"] <= 0) or np.any(rows["q_tilde"] <= 0):
         raise _bad(path, "theta, p_tilde and q_tilde must be positive (the P = 0 state is implied)")
+    for column, (lo, hi) in ROW_LIMITS.items():
+        bad = np.flatnonzero((rows[column] < lo) | (rows[column] > hi))
+        if bad.size:
+            raise _bad(path, f"has {column} = {rows[column][bad[0]]:g} in data row {bad[0] + 1}; a "
+                             f"finger's FEM gives {lo:g} to {hi:g}")
     ranges, spec, prior = _header(comments, path)
     for g in GROUPS:
         lo, hi = ranges[g]
@@ -124,8 +136,8 @@ def _header(comments: list[str], path) -> tuple[dict, dict, str]:
         raise _bad(path, "needs the lines '# range: b_a=lo:hi, d_a=..., link_a=..., tie_link=...' "
                          "and '# fit: p_terms=..., q_terms=...' (or design_degree=D, "
                          "theta_degree=T)") from None
-    if any(len(r) != 2 or not 0 < r[0] <= r[1] for r in ranges.values()):
-        raise _bad(path, "has a range lo:hi with not 0 < lo <= hi")
+    if any(len(r) != 2 or not 0 < r[0] <= r[1] < math.inf for r in ranges.values()):
+        raise _bad(path, "has a range lo:hi with not 0 < lo <= hi < inf")
     prior = spec.get("prior", "paper")
     if prior not in PRIORS:
         raise _bad(path, f"has prior={prior}; allowed: {', '.join(PRIORS)}")

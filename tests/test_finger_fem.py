@@ -153,6 +153,20 @@ def test_missing_table_and_too_few_designs(tmp_path):
         hand.pressure(0.5, designs[0].replace(finger_model="fem", finger_table=str(path)))
 
 
+@pytest.mark.parametrize("edit, match", [
+    (lambda text: text.replace("b_a=0.5:2.333333333", "b_a=0.5:inf"), "hi < inf"),  # extrapolated silently
+    (lambda text: text.replace(",2.812647618\n", ",1e300\n", 1), "q_tilde = 1e\\+300 in data row 1"),
+    (lambda text: text.replace(",0.1606386471,", ",1e-300,", 1), "theta = 1e-300 in data row 1"),
+])
+def test_a_table_out_of_any_fem_is_refused_naming_it(tmp_path, edit, match):
+    path = tmp_path / "t.csv"
+    path.write_text(edit(finger_fem.TABLE_FILE.read_text()))
+    assert path.read_text() != finger_fem.TABLE_FILE.read_text()
+    with pytest.raises(InputError, match=match) as info:
+        finger_fem.read_table(path)
+    assert info.value.field == "finger_table"
+
+
 def test_a_design_file_names_its_own_table_relative_to_itself(tmp_path):
     """write_design_with_table: FILE.toml next to FILE.csv, finger_model "fem", the table found
     relative to the design file; the CLI's error for a design outside it is one line, exit 2."""
