@@ -300,6 +300,9 @@ def _cases():
               for verb in (["curve", "--theta-deg", "10,45"], [*grasp, "--weights", "paper180"],
                            ["fit", "--data", "good.csv", "--params", "V0_mm3"])]
     flags += [["curve", "--theta-deg", "10", "--design", f] for f in ("x_v0_balloon.toml", "x_tiny_sheet.toml")]
+    control = ["control", "--theta-ref-deg", "50", "--mass-kg", "1"]
+    flags += [[*control, "--kp", "0", "--ki", "0"], [*control, "--push-rise-s", "600"],
+              [*control, "--push-at-s", "9.99"], ["fit", "--data", "good.csv", "--params", "V0_mm3", "--no-reservoir"]]
     flags += [["control", "--theta-ref-deg", "50", "--mass-kg", "1", "--design", "x_three_hinges.toml"],
               [*grasp, "--weights", "paper180", "--design", "x_three_hinges.toml"],
               [*grasp, "--weights", "1e308,1e308,0,0,0"], [*grasp, "--weights", "1e308,1e308,0,0,0", "--normalise"]]

@@ -100,6 +100,12 @@ def _check_inputs(args) -> None:
         value = getattr(args, option[2:].replace("-", "_"))
         if value is not None:
             check_range(option, value, lo, hi)
+    if args.kp == 0 and args.ki == 0:
+        raise InputError("--kp", args.kp, "and --ki are both 0: angle control would not act; give "
+                                          "one of them > 0 (or neither, for the plant's gains)")
+    if args.disturbance is None and args.push_at_s + args.push_rise_s >= args.t_end_s:
+        raise InputError("--push-at-s + --push-rise-s", f"{args.push_at_s:g} + {args.push_rise_s:g} s",
+                         f"must bring the push to its full force before --t-end-s = {args.t_end_s:g} s")
     if args.diameter_mm not in grasp.PAPER_WEIGHTS:
         raise InputError("--diameter-mm", args.diameter_mm,
                          f"must be one of {', '.join(f'{D:g}' for D in grasp.PAPER_WEIGHTS)}")

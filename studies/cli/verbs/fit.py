@@ -47,6 +47,7 @@ def configure(parser) -> None:
 
 def run(args) -> int:
     from softhand.reduced.csvdata import read_measurements
+    from softhand.reduced.errors import InputError
     from softhand.reduced.fit import check_params
     from softhand.studies.fit import FitStudy, run as run_study
     from softhand.studies.io.files import write_outputs
@@ -54,6 +55,10 @@ def run(args) -> int:
     design = design_from_args(args)
     data = read_measurements(args.data)
     keys = check_params(args.params, len(data))
+    sheet = [k for k in keys if k in RESERVOIR_KEYS]
+    if args.no_reservoir and sheet:
+        raise InputError("--params", args.params, f"{sheet[0]} is the reservoir's; with --no-reservoir "
+                                                  "the model has no reservoir to fit it to")
     design = _start_from_shore_a(design, keys, args.shore_a)
     w = _weights(args, design, data)
     study = FitStudy(data, keys, design, model=args.model, reservoir=not args.no_reservoir,
@@ -68,6 +73,10 @@ def run(args) -> int:
     for note in result.notes:
         print(f"softhand fit: warning: {note}", file=sys.stderr)
     return 0
+
+
+#: the fitted keys that only the reservoir sheet uses (eqs. (11)-(18))
+RESERVOIR_KEYS = ("V0_mm3", "mu_sr_MPa", "R_mm", "t_mm")
 
 
 def _start_from_shore_a(design, keys, shore_a):
