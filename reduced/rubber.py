@@ -251,4 +251,31 @@ def from_parameters(model: str, values: dict, *, source: str = "material") -> Ru
                          f"initial shear modulus {rubber.mu0:.6g} MPa must be positive")
     if model == "gent" and not rubber.Jm > 0:
         raise InputError(f"{source}.Jm", rubber.Jm, "must be positive")
+    if model == "ogden" and not all(abs(a) <= MAX_OGDEN_ALPHA for a in rubber.alpha):
+        raise InputError(f"{source}.alpha", list(rubber.alpha), f"Ogden exponents must be within "
+                         f"+-{MAX_OGDEN_ALPHA:g} (rubber fits need at most ~10)")
+    _check_working_range(rubber, source)
     return rubber
+
+
+#: largest |alpha_p| of an Ogden term: a hand's stretches of 2 raised to 300 give 1e90 MPa
+MAX_OGDEN_ALPHA = 30.0
+#: stretches every mode of a hand's rubber reaches in use (tube walls, reservoir sheet): the
+#: material must be defined and Drucker-stable over them, or the models' answers are nonsense
+#: (negative pressures from an unstable Mooney-Rivlin, nan past Gent's locking)
+WORKING_STRETCHES = (0.5, 2.0)
+
+
+def _check_working_range(rubber: Rubber, source: str) -> None:
+    from .material_fit import drucker_check
+
+    check = drucker_check(rubber, WORKING_STRETCHES, n=61)
+    lo, hi = WORKING_STRETCHES
+    if check["skipped"]:
+        raise InputError(f"{source}", rubber.parameters(), f"is not defined at every stretch in "
+                         f"[{lo:g}, {hi:g}] (past Gent's locking?), which a hand's rubber reaches")
+    if not check["stable"]:
+        bad = check["first_unstable"]
+        raise InputError(f"{source}", rubber.parameters(), f"is not stable (Drucker) in {bad['mode']} "
+                         f"at stretch {bad['stretch']:.3g}, inside [{lo:g}, {hi:g}], which a hand's "
+                         "rubber reaches")

@@ -55,6 +55,10 @@ FILES.update({
     "x_gent_sheet.toml": '[reservoir.material]\nmodel = "gent"\nmu_MPa = 1.0\nJm = 1e-6\n',
     "x_three_hinges.toml": "n_s = 3\n",  # the paper's w have five
     "x_v0_balloon.toml": "V0_mm3 = 1.0e7\n",  # eq. (16): the sheet stretched 344-fold
+    # materials with a positive initial modulus, unstable or locked where a hand's rubber goes
+    "x_mr_unstable.toml": '[finger.material]\nmodel = "mooney-rivlin"\nC10_MPa = 0.5\nC01_MPa = -0.4\n',
+    "x_yeoh_unstable.toml": '[reservoir.material]\nmodel = "yeoh"\nC10_MPa = 0.5\nC20_MPa = -5\n',
+    "x_ogden_alpha.toml": '[finger.material]\nmodel = "ogden"\nmu1_MPa = 0.01\nalpha1 = 300\n',
     "x_tiny_sheet.toml": "R_mm = 1.0\nt_mm = 0.01\n",
 })
 #: a file name longer than any file system allows (255 bytes), and a path past PATH_MAX
@@ -299,7 +303,8 @@ def _cases():
     flags += [[*verb, "--design", f] for f in ("x_hinge_nan.toml", "x_gent_locked.toml", "x_gent_sheet.toml")
               for verb in (["curve", "--theta-deg", "10,45"], [*grasp, "--weights", "paper180"],
                            ["fit", "--data", "good.csv", "--params", "V0_mm3"])]
-    flags += [["curve", "--theta-deg", "10", "--design", f] for f in ("x_v0_balloon.toml", "x_tiny_sheet.toml")]
+    flags += [["curve", "--theta-deg", "10", "--design", f] for f in (
+        "x_v0_balloon.toml", "x_tiny_sheet.toml", "x_mr_unstable.toml", "x_yeoh_unstable.toml", "x_ogden_alpha.toml")]
     control = ["control", "--theta-ref-deg", "50", "--mass-kg", "1"]
     flags += [[*control, "--kp", "0", "--ki", "0"], [*control, "--push-rise-s", "600"],
               [*control, "--push-at-s", "9.99"], ["fit", "--data", "good.csv", "--params", "V0_mm3", "--no-reservoir"]]
