@@ -310,4 +310,7 @@ def load_design(path: str | Path | None = None) -> HandDesign:
         values["finger_table"] = str((path.parent / table).resolve())  # relative to the file
     design = design_from_dict(values, source=path.name)
     check_sheet_holds_v0(design)
+    if design.finger_table and design.finger_model != "fem":  # a file's table would be unused
+        raise InputError(f"{path.name}: finger_table", table, f"is the table of finger_model = "
+                         f"'fem'; this design's finger_model is {design.finger_model!r}")
     return design

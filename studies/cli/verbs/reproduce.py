@@ -26,10 +26,12 @@ def run(args) -> int:
     keys = [s.key for s in sections()]
     only = None
     if args.only is not None:
-        only = tuple(k.strip() for k in args.only.split(",") if k.strip())
+        only = tuple(k.strip() for k in args.only.split(","))
         unknown = [k for k in only if k not in keys]
         if unknown or not only:
             raise InputError("--only", args.only, f"allowed section keys: {', '.join(keys)}")
+        if len(set(only)) != len(only):
+            raise InputError("--only", args.only, "names a section twice; name each once")
     outcomes = reproduce(args.out, quick=args.quick, design=design_from_args(args), only=only,
                          fresh=args.fresh, progress=not args.no_progress)
     width = max(len(o.section.key) for o in outcomes)

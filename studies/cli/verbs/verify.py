@@ -26,6 +26,8 @@ def run(args) -> int:
     from softhand.studies.verification.registry import REGISTRY, run_case
 
     names = args.case or list(REGISTRY)
+    if len(set(names)) != len(names):
+        raise InputError("--case", ",".join(names), "names a case twice; name each once")
     unknown = [n for n in names if n not in REGISTRY]
     if unknown:
         raise InputError("--case", unknown[0], f"allowed: {', '.join(REGISTRY)}")
