@@ -94,3 +94,21 @@ def test_a_kinds_nan_is_stored_as_null_and_read_back_as_done(tmp_path):
 
     out = execute_case(lambda params, design, outdir: {"y": float("nan"), "z": [1.0, float("inf")]}, {}, None)
     assert out["status"] == "done" and out["numbers"] == {"y": None, "z": [1.0, None]}
+
+
+def test_a_study_of_another_kind_under_the_same_name_is_refused(tmp_path, capsys):
+    """Two studies named alike share results/<name>: the second's run, status or report would
+    overwrite the first's index.csv and report. Refused naming the name; the first's files stay."""
+    (tmp_path / "a.toml").write_text('name = "sa"\nkind = "curve"\n[sweep]\ntheta_deg = [10, 20]\n')
+    (tmp_path / "b.toml").write_text(GRASP.replace('kind = "grasp"', 'name = "sa"\nkind = "grasp"')
+                                     .format(extra="diameter_mm = 180.0\n"))
+    root = tmp_path / "res"
+    assert main(["study", "run", str(tmp_path / "a.toml"), "--results", str(root), "--no-progress"]) == 0
+    capsys.readouterr()
+    index = (root / "sa" / "index.csv").read_text()
+    for verb in ("run", "status", "report"):
+        assert main(["study", verb, str(tmp_path / "b.toml"), "--results", str(root)]) == 2
+        err = capsys.readouterr().err
+        assert err.count("\n") == 1 and "name = 'sa'" in err and "'curve' study" in err
+    assert (root / "sa" / "index.csv").read_text() == index and not (root / "sa" / "report.md").exists()
+    assert main(["study", "report", str(tmp_path / "a.toml"), "--results", str(root)]) == 0

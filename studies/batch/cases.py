@@ -84,6 +84,30 @@ def study_dir(study: Study, results_root: str | Path = "results") -> Path:
     return Path(results_root) / study.name
 
 
+#: the file in a study's folder that says which kind of study it holds
+OWNER = "study.json"
+
+
+def own_study_dir(study: Study, results_root: str | Path = "results", *, write: bool) -> Path:
+    """The study's folder, after checking it holds no study of another kind under the same
+    name (whose index.csv and report this one would overwrite); ``write``: record this kind
+    there (a run, a report). InputError naming the study's name."""
+    from softhand.reduced.errors import InputError
+
+    sdir = study_dir(study, results_root)
+    try:
+        held = json.loads((sdir / OWNER).read_text()).get("kind")
+    except (OSError, ValueError, AttributeError, RecursionError):
+        held = None  # none yet (or a folder from before this record): this study takes it
+    if held is not None and held != study.kind:
+        raise InputError("name", study.name, f"{sdir} holds a {held!r} study of that name; this one "
+                         f"is {study.kind!r}: rename it or give another --results")
+    if write and held is None:
+        sdir.mkdir(parents=True, exist_ok=True)
+        write_json(sdir / OWNER, {"study": study.name, "kind": study.kind})
+    return sdir
+
+
 def case_state(sdir: Path, case: Case) -> str:
     """'done', 'failed', 'pending' or 'corrupt' (a case file that does not parse)."""
     folder = sdir / case.key

@@ -3,14 +3,14 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from softhand.studies.batch.cases import Case, case_state, code_version, plan, read_case, study_dir
+from softhand.studies.batch.cases import Case, case_state, code_version, own_study_dir, plan, read_case, study_dir
 from softhand.studies.batch.studyfile import Study
 from softhand.studies.io.files import write_csv
 
 
 def status(study: Study, results_root: str | Path = "results") -> dict[str, list[Case]]:
     """Cases grouped by state: {'done', 'failed', 'pending', 'corrupt' (recomputed by a run)}."""
-    sdir = study_dir(study, results_root)
+    sdir = own_study_dir(study, results_root, write=False)
     groups = {"done": [], "failed": [], "pending": [], "corrupt": []}
     for case in plan(study):
         groups[case_state(sdir, case)].append(case)

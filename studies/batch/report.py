@@ -7,7 +7,8 @@ from pathlib import Path
 import numpy as np
 
 from softhand.studies.io.files import save_figure, write_atomic
-from softhand.studies.batch.runner import index_rows, study_dir, write_index
+from softhand.studies.batch.cases import own_study_dir
+from softhand.studies.batch.runner import index_rows, write_index
 from softhand.studies.batch.studyfile import Study
 
 MAX_LINES = 10  #: curves per plot; more combinations of the other axes are not drawn
@@ -15,7 +16,7 @@ MAX_LINES = 10  #: curves per plot; more combinations of the other axes are not 
 
 def write_report(study: Study, results_root: str | Path = "results") -> Path:
     """Write ``results/<study>/report.md`` and ``report/*.png``; return the Markdown path."""
-    sdir = study_dir(study, results_root)
+    sdir = own_study_dir(study, results_root, write=True)
     rows = index_rows(study, results_root)
     write_index(study, results_root)
     axes = [name for name, _ in study.axes]

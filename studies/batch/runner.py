@@ -36,7 +36,7 @@ from pathlib import Path
 
 from softhand.studies.batch.cases import (FAILED, RESULT, Case, case_key, case_state, code_version,  # noqa: F401
                                           commit, commit_case, execute_case, outcome_record,
-                                          package_versions, plan, read_case, study_dir,
+                                          own_study_dir, package_versions, plan, read_case, study_dir,
                                           _remove_leftovers)
 from softhand.studies.batch.claims import Claims
 from softhand.studies.batch.index import index_rows, other_sources, status, write_index  # noqa: F401
@@ -68,7 +68,7 @@ def run_study(study: Study, *, results_root: str | Path = "results", workers: in
     ``workers``: processes (default: the CPU count); 1 runs in this process.
     ``scheduler``: a Dask scheduler address, or 'local' for a LocalCluster.
     """
-    sdir = study_dir(study, results_root)
+    sdir = own_study_dir(study, results_root, write=False)
     cases = plan(study)
     states = {c.key: case_state(sdir, c) for c in cases}
     todo = [c for c in cases if fresh or states[c.key] != "done"]
@@ -83,6 +83,7 @@ def run_study(study: Study, *, results_root: str | Path = "results", workers: in
         from softhand.studies.batch.cluster import open_cluster
 
         dask = open_cluster(scheduler, workers)  # reached before anything is written
+    own_study_dir(study, results_root, write=True)
     bar = _progress_bar(study, summary, progress)
     claims = Claims(sdir)
     try:
