@@ -217,7 +217,10 @@ def from_parameters(model: str, values: dict, *, source: str = "material") -> Ru
     """A validated model from its public parameter names (as in ``[finger.material]``; names
     and the model are matched regardless of case)."""
     model = canonical_model(model)
-    cls = _model_class(model)
+    try:
+        cls = _model_class(model)
+    except InputError as exc:
+        raise exc.renamed(f"{source}.model") from None
     for key, value in values.items():
         if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
             raise InputError(f"{source}.{key}", value, "must be a finite number")

@@ -60,6 +60,7 @@ FILES.update({
     "x_yeoh_unstable.toml": '[reservoir.material]\nmodel = "yeoh"\nC10_MPa = 0.5\nC20_MPa = -5\n',
     "x_ogden_alpha.toml": '[finger.material]\nmodel = "ogden"\nmu1_MPa = 0.01\nalpha1 = 300\n',
     "x_table_unused.toml": 'finger_table = "nope.csv"\nfinger_model = "paper"\n',  # was ignored
+    "x_steel.toml": '[finger.material]\nmodel = "steel"\n',
     "x_tiny_sheet.toml": "R_mm = 1.0\nt_mm = 0.01\n",
 })
 #: a file name longer than any file system allows (255 bytes), and a path past PATH_MAX
@@ -306,7 +307,7 @@ def _cases():
                            ["fit", "--data", "good.csv", "--params", "V0_mm3"])]
     flags += [["curve", "--theta-deg", "10", "--design", f] for f in (
         "x_v0_balloon.toml", "x_tiny_sheet.toml", "x_mr_unstable.toml", "x_yeoh_unstable.toml", "x_ogden_alpha.toml",
-        "x_table_unused.toml")]
+        "x_table_unused.toml", "x_steel.toml")]
     control = ["control", "--theta-ref-deg", "50", "--mass-kg", "1"]
     flags += [[*control, "--kp", "0", "--ki", "0"], [*control, "--push-rise-s", "600"],
               [*control, "--push-at-s", "9.99"], ["fit", "--data", "good.csv", "--params", "V0_mm3", "--no-reservoir"]]
@@ -319,6 +320,7 @@ def _cases():
               ["weights", "--diameter-mm", "120:300:60", "--fig8", "0.5"],
               ["weights", "--diameter-mm", "180,180"], ["weights", "--diameter-mm", "180", "--fig8", "0.5,0.5"],
               ["weights", "--diameter-mm", "120:300:60", "--check-mm", "180"]]
+    flags += [["fit", "--data", "good.csv", "--params", "mu_sf_MPa", "--shore-a", "99.9"]]
     flags += [["verify", "--case", "uniaxial", "--case", "uniaxial"], ["reproduce", "--only", "fig7_reduced, ,table2_reduced"],
               ["reproduce", "--only", "fig7_reduced,fig7_reduced"]]
     flags += [["calibrate", "finger", "--space", "", "--out", "t.csv"], ["fit", "--data", "", "--params", "V0_mm3"],

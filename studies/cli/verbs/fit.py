@@ -91,6 +91,12 @@ def _start_from_shore_a(design, keys, shore_a):
         mu = shear_modulus_from_shore_a(shore_a)
     except InputError as exc:
         raise exc.renamed("--shore-a") from None
+    from softhand.reduced.design import BOUNDS
+
+    lo, hi = BOUNDS["mu_sf_MPa"]
+    if not lo <= mu <= hi:
+        raise InputError("--shore-a", shore_a, f"gives a shear modulus of {mu:.4g} MPa (Gent's "
+                         f"relation), outside the design's [{lo:g}, {hi:g}] MPa")
     start = {k: mu for k in ("mu_sf_MPa", "mu_sr_MPa") if k in keys}
     if not start:
         from softhand.reduced.errors import InputError
