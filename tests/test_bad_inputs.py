@@ -258,7 +258,7 @@ def _cases():
                    + [["--diameter-mm", "120:300:60", "--check-mm", "500"]],
         "reservoir": [[*extra] for extra in (
             ["--n-radial", "0"], ["--n-radial", "100000"], ["--n-thick", "0"], ["--n-thick", "1000"],
-            ["--volume-mm3", "-1"], ["--volume-mm3", "1e-300"], ["--volume-mm3", "0:1e9:1"], ["--volume-mm3", "nan"],
+            ["--volume-mm3", "-1"], ["--volume-mm3", "1e-300"], ["--volume-mm3", "5e5"], ["--volume-mm3", "0:1e9:1"], ["--volume-mm3", "nan"],
             ["--volume-mm3", "1e12"], ["--plot", "r.doc"], ["--out", "a_file"],
             ["--write-calibration", "."], ["--n-radial", "two"])],
         "study": [["run", s] for s in sorted(STUDIES) if s != STUDY]
