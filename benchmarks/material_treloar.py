@@ -11,7 +11,8 @@ import time
 from pathlib import Path
 
 from softhand.reduced import rubber
-from softhand.reduced.material_fit import FIT_MODELS, drucker_check, fit_material, read_test_data
+from softhand.reduced.material_fit import FIT_MODELS, fit_material, read_test_data
+from softhand.reduced.rubber import drucker_check
 
 DATA = Path(__file__).resolve().parent.parent / "studies" / "data" / "treloar1944.csv"
 KGF_CM2 = 0.0980665  #: MPa

@@ -45,7 +45,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from . import rubber
-from .design_rules import BOUNDS, CONSISTENCY, _check_model, _in_bounds, _is_number, check_sheet_holds_v0
+from .design_rules import BOUNDS, CONSISTENCY, _check_model, _in_bounds, _is_number
 from .errors import InputError
 from .inputfiles import MAX_FILE_BYTES, read_input_file, read_toml
 
@@ -309,7 +309,6 @@ def load_design(path: str | Path | None = None) -> HandDesign:
     if isinstance(table, str) and table and not Path(table).is_absolute():
         values["finger_table"] = str((path.parent / table).resolve())  # relative to the file
     design = design_from_dict(values, source=path.name)
-    check_sheet_holds_v0(design)
     if design.finger_table and design.finger_model != "fem":  # a file's table would be unused
         raise InputError(f"{path.name}: finger_table", table, f"is the table of finger_model = "
                          f"'fem'; this design's finger_model is {design.finger_model!r}")

@@ -7,7 +7,7 @@ import math
 
 from .errors import InputError
 
-__all__ = ["BOUNDS", "CONSISTENCY", "MAX_SHEET_STRETCH", "check_sheet_holds_v0"]
+__all__ = ["BOUNDS", "CONSISTENCY"]
 
 
 #: public key -> (lowest, highest) allowed value, both included, in the key's unit. Every
@@ -56,24 +56,6 @@ def _ties_fit_links(design: "HandDesign") -> None:
     if design.tie_width >= shortest:
         raise InputError("tie_width_mm", design.tie_width,
                          f"must be shorter than every link (shortest {shortest:g} mm)")
-
-
-#: largest stretch of the reservoir sheet holding V0, eq. (16): rubber sheets break before
-#: (NBR's elongation at break is 300-500 %, a stretch of 4-6)
-MAX_SHEET_STRETCH = 6.0
-
-
-def check_sheet_holds_v0(design: "HandDesign") -> None:
-    """A design file's V0 within what its sheet can hold. Not one of :data:`CONSISTENCY`: the
-    optimiser's trial designs may pass it (the task's sheet-stretch limit makes them
-    infeasible, and their answers steer it back); a design given to a verb may not (its
-    reduced model's answers there are negative pressures and stretches in the hundreds)."""
-    from .reservoir import stretch
-
-    lam = float(stretch(design.V0, design))
-    if not lam <= MAX_SHEET_STRETCH:
-        raise InputError("V0_mm3", design.V0, f"stretches the sheet (R_mm = {design.R:g}) to "
-                         f"{lam:.4g} by eq. (16); at most {MAX_SHEET_STRETCH:g}, where rubber breaks")
 
 
 #: checks between fields, run after the bounds; each raises InputError naming one field

@@ -341,23 +341,3 @@ def _stretch_triples(data):
     return l
 
 
-def drucker_check(material: rubber.Rubber, stretch_range: tuple[float, float], n: int = 200) -> dict:
-    """Drucker stability in the three modes at n log-spaced stretches of ``stretch_range``.
-
-    Returns {"stable", "range", "first_unstable": {"mode", "stretch"} or None, "skipped"}:
-    points where W is not defined (beyond Gent's locking) are skipped and counted."""
-    lo, hi = stretch_range
-    lam = np.geomspace(lo, hi, n)
-    first, skipped = None, 0
-    for mode in rubber.MODES:
-        H = material.drucker_hessian(*rubber.stretches(mode, lam))
-        ok = np.all(np.isfinite(H), axis=(0, 1))
-        skipped += int(np.sum(~ok))
-        eig = np.full(lam.shape, np.inf)
-        eig[ok] = np.linalg.eigvalsh(np.moveaxis(H[:, :, ok], -1, 0))[:, 0]
-        bad = np.flatnonzero(eig <= 0)
-        if bad.size and first is None:
-            near = bad[np.argmin(np.abs(np.log(lam[bad])))]  # the one nearest the reference
-            first = {"mode": mode, "stretch": float(lam[near])}
-    return {"stable": first is None, "range": [float(lo), float(hi)], "first_unstable": first,
-            "skipped": skipped}

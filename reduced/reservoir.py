@@ -73,6 +73,22 @@ def stretch(V, design: HandDesign):
     return half_perimeter(height(V, design), design) / (2.0 * design.R)
 
 
+#: largest stretch of the reservoir sheet by eq. (16): rubber sheets break before (NBR's
+#: elongation at break is 300-500 %, a stretch of 4-6)
+MAX_SHEET_STRETCH = 6.0
+
+
+def check_holds(V, design: HandDesign, field: str = "V0_mm3") -> None:
+    """InputError naming ``field`` if the sheet holding V [mm^3] stretches past
+    MAX_SHEET_STRETCH. For a design a user gives (its V0) and the volumes asked of it; not for
+    the optimiser's trial designs, which the task's own sheet-stretch limit steers back (its
+    answers beyond, negative pump pressures and stretches in the hundreds, are no answers)."""
+    lam = float(stretch(V, design))
+    if not lam <= MAX_SHEET_STRETCH:
+        raise InputError(field, V, f"stretches the sheet (R_mm = {design.R:g}) to {lam:.4g} by "
+                                   f"eq. (16); at most {MAX_SHEET_STRETCH:g}, where rubber breaks")
+
+
 def dstretch_dV(V, design: HandDesign):
     """d lambda_r / dV [1/mm^3] from (13), (14), (16), analytic."""
     return dhalf_perimeter_dh(height(V, design), design) * 3.0 / (4.0 * np.pi * design.R**3)

@@ -42,7 +42,7 @@ import numpy as np
 from .errors import InputError
 from .rubber_base import _PUBLIC, MODES, InvariantRubber, Rubber, invariants, stretches
 
-__all__ = ["MODES", "Rubber", "InvariantRubber", "invariants", "stretches", "NeoHookean",
+__all__ = ["MODES", "Rubber", "InvariantRubber", "invariants", "stretches", "drucker_check", "NeoHookean",
            "MooneyRivlin", "Yeoh", "Gent", "Ogden", "MODELS", "parameter_names", "canonical_model",
            "from_parameters"]
 
@@ -261,6 +261,28 @@ def from_parameters(model: str, values: dict, *, source: str = "material") -> Ru
     return rubber
 
 
+def drucker_check(material: Rubber, stretch_range: tuple[float, float], n: int = 200) -> dict:
+    """Drucker stability in the three modes at n log-spaced stretches of ``stretch_range``.
+
+    Returns {"stable", "range", "first_unstable": {"mode", "stretch"} or None, "skipped"}:
+    points where W is not defined (beyond Gent's locking) are skipped and counted."""
+    lo, hi = stretch_range
+    lam = np.geomspace(lo, hi, n)
+    first, skipped = None, 0
+    for mode in MODES:
+        H = material.drucker_hessian(*stretches(mode, lam))
+        ok = np.all(np.isfinite(H), axis=(0, 1))
+        skipped += int(np.sum(~ok))
+        eig = np.full(lam.shape, np.inf)
+        eig[ok] = np.linalg.eigvalsh(np.moveaxis(H[:, :, ok], -1, 0))[:, 0]
+        bad = np.flatnonzero(eig <= 0)
+        if bad.size and first is None:
+            near = bad[np.argmin(np.abs(np.log(lam[bad])))]  # the one nearest the reference
+            first = {"mode": mode, "stretch": float(lam[near])}
+    return {"stable": first is None, "range": [float(lo), float(hi)], "first_unstable": first,
+            "skipped": skipped}
+
+
 #: largest |alpha_p| of an Ogden term: a hand's stretches of 2 raised to 300 give 1e90 MPa
 MAX_OGDEN_ALPHA = 30.0
 #: stretches every mode of a hand's rubber reaches in use (tube walls, reservoir sheet): the
@@ -270,8 +292,6 @@ WORKING_STRETCHES = (0.5, 2.0)
 
 
 def _check_working_range(rubber: Rubber, source: str) -> None:
-    from .material_fit import drucker_check
-
     check = drucker_check(rubber, WORKING_STRETCHES, n=61)
     lo, hi = WORKING_STRETCHES
     if check["skipped"]:

@@ -47,7 +47,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from softhand.reduced.design import PUBLIC_KEYS, HandDesign, design_from_dict, load_design, read_toml
-from softhand.reduced.design_rules import check_sheet_holds_v0
+from softhand.reduced import reservoir
 from softhand.reduced.errors import InputError
 from softhand.studies.cli.args import parse_values
 from softhand.studies.batch.registry import ENTRY_POINT_GROUP, KINDS, MAX_CASES, Kind, Num, NumList, all_kinds, \
@@ -169,9 +169,11 @@ def _design(spec, base: Path, src: str) -> HandDesign:
         return HandDesign()
     if isinstance(spec, str):
         try:
-            return load_design(base / spec)
+            design = load_design(base / spec)
         except InputError as exc:
             raise (exc.renamed(f"{src}: design") if exc.field == "--design" else exc) from None
+        reservoir.check_holds(design.V0, design)
+        return design
     if not isinstance(spec, dict):
         raise InputError(f"{src}: design", spec, "must be a file name or a table of design keys")
     overrides = dict(spec)
@@ -183,7 +185,7 @@ def _design(spec, base: Path, src: str) -> HandDesign:
     except InputError as exc:
         raise (exc.renamed(f"{src}: design.file") if exc.field == "--design" else exc) from None
     design = design_from_dict(overrides, start, source=f"{src}: design")
-    check_sheet_holds_v0(design)
+    reservoir.check_holds(design.V0, design)
     return design
 
 

@@ -102,7 +102,12 @@ def add_progress_option(parser: argparse.ArgumentParser) -> None:
 
 
 def design_from_args(args) -> HandDesign:
-    return load_design(args.design)
+    """The design of ``--design`` (the paper's without it), its V0 one its sheet can hold."""
+    from softhand.reduced.reservoir import check_holds
+
+    design = load_design(args.design)
+    check_holds(design.V0, design)
+    return design
 
 
 def require_finite(result, args, where: str) -> None:

@@ -43,7 +43,8 @@ def configure(parser) -> None:
 
 
 def run(args) -> int:
-    from softhand.reduced.material_fit import drucker_check, fit_material, read_test_data
+    from softhand.reduced.material_fit import fit_material, read_test_data
+    from softhand.reduced.rubber import drucker_check
 
     data = read_test_data(args.data)
     stretch_range = _stretch_range(args.stability_range, data)

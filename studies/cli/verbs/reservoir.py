@@ -53,13 +53,9 @@ def _study(args):
         if min(volumes) < low or max(volumes) > high:
             raise InputError("--volume-mm3", args.volume_mm3,
                              f"volumes must be in [{low:.4g}, {high:.4g}] mm^3 (1e-4 V0 .. 100 V0)")
-        from softhand.reduced.design_rules import MAX_SHEET_STRETCH
-        from softhand.reduced.reservoir import stretch
+        from softhand.reduced.reservoir import check_holds
 
-        if not float(stretch(max(volumes), design)) <= MAX_SHEET_STRETCH:
-            raise InputError("--volume-mm3", args.volume_mm3, f"{max(volumes):g} mm^3 stretches the "
-                             f"sheet to {float(stretch(max(volumes), design)):.3g} by eq. (16); at most "
-                             f"{MAX_SHEET_STRETCH:g}, where rubber breaks")
+        check_holds(max(volumes), design, "--volume-mm3")
     return ReservoirStudy(design=design, volumes_mm3=volumes, n_radial=args.n_radial,
                           n_thick=args.n_thick)
 
