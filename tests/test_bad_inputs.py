@@ -63,6 +63,15 @@ FILES.update({
     "x_steel.toml": '[finger.material]\nmodel = "steel"\n',
     "x_tiny_sheet.toml": "R_mm = 1.0\nt_mm = 0.01\n",
 })
+#: design spaces whose load path no FEM run should take (the FEM started on each)
+_SPACE = EXTRA_FILES["good_space.toml"]
+FILES.update({
+    "sp_pair_huge.toml": _SPACE + "[mesh_pair]\na_mm = 4.0\nb_mm = 5.0\nd_mm = 15.0\nl0_mm = 180.0\n"
+                                  "tie_width_mm = 10.0\npressures_mpa = [0.2, 1e9]\n",
+    "sp_design_pmax.toml": _SPACE.replace("tie_width_mm = 10.0\n", "tie_width_mm = 10.0\np_max_mpa = 1e9\n"),
+    "sp_design_pstep.toml": _SPACE.replace("tie_width_mm = 10.0\n", "tie_width_mm = 10.0\np_step_mpa = 1e-9\n"),
+    "sp_past_pmax.toml": "pressures_mpa = [0.2, 3.0]\np_max_mpa = 1.0\n" + _SPACE,
+})
 #: a file name longer than any file system allows (255 bytes), and a path past PATH_MAX
 LONG, DEEP_PATH = "x" * 300, "/".join(["y" * 200] * 25)
 #: design tasks (softhand design --task): a good one, and each of its mistakes
@@ -321,6 +330,8 @@ def _cases():
               ["weights", "--diameter-mm", "180,180"], ["weights", "--diameter-mm", "180", "--fig8", "0.5,0.5"],
               ["weights", "--diameter-mm", "120:300:60", "--check-mm", "180"]]
     flags += [["fit", "--data", "good.csv", "--params", "mu_sf_MPa", "--shore-a", "99.9"]]
+    flags += [["calibrate", "finger", "--space", f, "--out", "t.csv"] for f in (
+        "sp_pair_huge.toml", "sp_design_pmax.toml", "sp_design_pstep.toml", "sp_past_pmax.toml")]
     flags += [["verify", "--case", "uniaxial", "--case", "uniaxial"], ["reproduce", "--only", "fig7_reduced, ,table2_reduced"],
               ["reproduce", "--only", "fig7_reduced,fig7_reduced"]]
     flags += [["calibrate", "finger", "--space", "", "--out", "t.csv"], ["fit", "--data", "", "--params", "V0_mm3"],

@@ -110,10 +110,18 @@ def test_killed_run_resumes_with_only_the_missing_cases(tmp_path, monkeypatch, s
     assert len(status(study, root)["done"]) == N_SLOW
 
 
-def test_a_failing_case_is_recorded_and_the_others_finish(tmp_path, capsys):
-    # 4.5 MPa passes the study file's check ([-5, 5] MPa) but is beyond the largest pressure
-    # of the paper's hand (3.76 MPa, at 180 deg): that case raises an InputError when it runs
-    path = write_study(tmp_path, 'kind = "curve"\n[sweep]\npressure_mpa = [0.5, 4.5, 0.8]\n')
+FAILING_KIND = '''
+def case(params, design, outdir):   # a case that raises when it runs (after the study's checks)
+    if params["pressure_mpa"] == 4.5:
+        raise ValueError("pressure_MPa = 4.5: beyond this hand's largest pressure")
+    return {"theta_deg": 10.0 * params["pressure_mpa"]}
+'''
+
+
+def test_a_failing_case_is_recorded_and_the_others_finish(tmp_path, capsys, monkeypatch):
+    install_kind(tmp_path, "failingkind", FAILING_KIND)
+    monkeypatch.syspath_prepend(str(tmp_path))
+    path = write_study(tmp_path, 'kind = "failingkind"\n[sweep]\npressure_mpa = [0.5, 4.5, 0.8]\n')
     root = tmp_path / "res"
     args = ["study", "run", str(path), "--workers", "1", "--results", str(root), "--no-progress"]
     assert main(args) == 1

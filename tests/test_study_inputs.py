@@ -23,6 +23,18 @@ def _load(tmp_path, text):
 
 
 @pytest.mark.parametrize("text, field", [
+    ('kind = "curve"\n[sweep]\npressure_mpa = [0.5, 5.0]\n', "pressure_mpa"),  # beyond the design's range
+    ('kind = "reservoir"\nmesh_size_mm = 24.0\n[design]\nV0_mm3 = 100.0\n[sweep]\ntheta_max_deg = [180.0]\n',
+     "V0_mm3"),  # less oil than the fingers take
+])
+def test_cases_the_design_cannot_answer_are_refused_at_load_time(tmp_path, text, field):
+    """These failed as cases (exit 1, a failed.json) after the run began."""
+    with pytest.raises(InputError) as info:
+        _load(tmp_path, text)
+    assert field in info.value.field or field in str(info.value)
+
+
+@pytest.mark.parametrize("text, field", [
     # finger_bend: every key bend_case reads is required (it ran the FEM, then raised KeyError)
     ('kind = "finger_bend"\n[params]\npressures_mpa = [0.2, 0.5]\n[sweep]\na_mm = [4.0]\n', "theta_target_deg"),
     (FINGER.format(extra="pressures_mpa = [-0.2, 0.5]\n"), "pressures_mpa"),

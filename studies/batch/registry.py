@@ -92,6 +92,27 @@ def _enough_oil(params: dict, design: HandDesign, src: str) -> None:
         design.check_volume(math.radians(params["theta_deg"]))
 
 
+def _oil_to_theta_max(params: dict, design: HandDesign, src: str) -> None:
+    """The reservoir holds the oil the fingers take up to the stroke's end (default: the
+    design's own), checked at load time as the curve kind checks its angles."""
+    from softhand.reduced.reservoir import check_holds
+
+    check_holds(design.V0, design)
+    design.check_volume(math.radians(params.get("theta_max_deg", 90.0)))  # the kind's default
+
+
+def _pressure_reached(params: dict, design: HandDesign, src: str) -> None:
+    """A pressure the design's free hand reaches (its range depends on the design): the reduced
+    model's inverse, at load time, not as a failed case."""
+    if "pressure_mpa" in params:
+        from softhand.reduced import hand
+
+        try:
+            hand.bend_angle(params["pressure_mpa"], design)
+        except InputError as exc:
+            raise InputError(f"{src}: pressure_mpa", params["pressure_mpa"], exc.allowed) from None
+
+
 @dataclass(frozen=True)
 class Kind:
     """What one case of a study computes, and the parameters it accepts."""
@@ -112,7 +133,7 @@ _PAPER_D = Num(choices=(180.0, 240.0))  #: the paper's weight vectors
 #: kind name -> Kind. Add a kind with one line here.
 KINDS: dict[str, Kind] = {
     "curve": Kind("softhand.studies.batch.kinds:curve", {"theta_deg": _THETA, "pressure_mpa": _PRESSURE},
-                  exactly_one=("theta_deg", "pressure_mpa"), checks=(_enough_oil,)),
+                  exactly_one=("theta_deg", "pressure_mpa"), checks=(_enough_oil, _pressure_reached)),
     "grasp": Kind("softhand.studies.batch.kinds:grasp",
                   {"pressure_mpa": _PRESSURE, "theta_deg": _THETA, "mass_kg": _MASS,
                    "diameter_mm": _PAPER_D, "weights": NumList(20, -MAX_WEIGHT, MAX_WEIGHT)},
@@ -122,7 +143,7 @@ KINDS: dict[str, Kind] = {
                      "push_n": Num(-1000.0, 1000.0), "push_at_s": Num(1.0, 600.0),
                      "t_end_s": Num(2.0, 600.0)}, checks=(_push_before_end,)),
     "reservoir": Kind("softhand.studies.batch.kinds:reservoir", {"theta_max_deg": Num(1.0, 180.0)}, fem=True,
-                      mesh=Num(0.05, 24.0)),
+                      mesh=Num(0.05, 24.0), checks=(_oil_to_theta_max,)),
     "weights": Kind("softhand.studies.batch.kinds:weights",
                     {"diameter_mm": Num(60.0, 500.0), "mass_kg": Num(0.0, 20.0),
                      "pressure_mpa": Num(0.01, 3.0), "dP_mpa": Num(0.001, 0.5)}, fem=True,

@@ -127,6 +127,9 @@ def load_space(path: str | Path) -> DesignSpace:
                          f"must be 1 to {MAX_PRESSURES} increasing numbers in ({lo:g}, {hi:g}] MPa")
     numbers = {key: _bounded(doc, key, default, src)
                for key, default in (("theta_target_deg", 64.0), ("p_max_mpa", 2.0), ("p_step_mpa", 0.5))}
+    if pressures[-1] > numbers["p_max_mpa"]:
+        raise InputError(f"{src}: pressures_mpa", pressures, f"must end at or below p_max_mpa = "
+                         f"{numbers['p_max_mpa']:g} MPa, the load path's end")
     mesh, axial = (_bounded(doc, key, None, src) for key in ("mesh_size_mm", "axial_size_mm"))
     if mesh is not None and axial is not None:
         raise InputError(f"{src}: axial_size_mm", axial, "applies to the layered mesh; remove mesh_size_mm")
@@ -142,10 +145,10 @@ def load_space(path: str | Path) -> DesignSpace:
             raise InputError(f"{src}: mesh_pair", pair, f"must give {', '.join(VARIABLES)} and pressures_mpa")
         pair = dict(pair)
         pressures_pair = pair.pop("pressures_mpa")
-        if not isinstance(pressures_pair, list) or len(pressures_pair) < 2 or any(
-                not _number(p) or p <= 0 for p in pressures_pair) or any(np.diff(pressures_pair) <= 0):
+        if not isinstance(pressures_pair, list) or not 2 <= len(pressures_pair) <= MAX_PRESSURES or any(
+                not _number(p) or not lo < p <= hi for p in pressures_pair) or any(np.diff(pressures_pair) <= 0):
             raise InputError(f"{src}: mesh_pair.pressures_mpa", pressures_pair,
-                             "must be 2 or more increasing numbers > 0 [MPa]")
+                             f"must be 2 to {MAX_PRESSURES} increasing numbers in ({lo:g}, {hi:g}] MPa")
         pair = (_point(pair, {k: (0.0, math.inf) for k in VARIABLES}, f"{src}: mesh_pair"),
                 tuple(float(p) for p in pressures_pair))
     from softhand.reduced.finger_fem import PRIORS
@@ -203,9 +206,10 @@ def _point(table, box: dict, where: str) -> dict:
     for key in VARIABLES:
         if not _number(table[key]) or not box[key][0] <= table[key] <= box[key][1]:
             raise InputError(f"{where}.{key}", table[key], f"must be in [{box[key][0]}, {box[key][1]}]")
-    for key in set(table) & set(_PATH_KEYS):
-        if not _number(table[key]) or not table[key] > 0:
-            raise InputError(f"{where}.{key}", table[key], "must be a positive number [MPa]")
+    for key in sorted(set(table) & set(_PATH_KEYS)):
+        lo, hi = LIMITS[key]
+        if not _number(table[key]) or not lo <= table[key] <= hi:
+            raise InputError(f"{where}.{key}", table[key], f"must be a number in [{lo:g}, {hi:g}] MPa")
     return {key: float(value) for key, value in table.items()}
 
 
