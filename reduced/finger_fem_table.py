@@ -11,7 +11,6 @@ and uses it.
 from __future__ import annotations
 
 import math
-
 from dataclasses import dataclass
 from pathlib import Path
 

@@ -136,7 +136,7 @@ def fit(data: Measurements, params, predictor: Callable[[HandDesign], np.ndarray
                         ftol=options.tol, xtol=options.tol, gtol=options.tol,
                         diff_step=1e-7)
     values = sol.x * scale
-    _check_answered(predictor, keys, values, design, lo, hi, bounded=bool(bounds))
+    predicted = _answered(predictor, keys, values, design, lo, hi, bounded=bool(bounds))
     J = jacobian(residual, sol.x, lo / scale, hi / scale, options.rel_step) / scale
     fitted = _with(keys, values, design)
     diag = diagnose(keys, J, sol.fun, values, options)
@@ -144,7 +144,7 @@ def fit(data: Measurements, params, predictor: Callable[[HandDesign], np.ndarray
     return FitResult(
         params=keys, initial=p0, values=values, stderr=diag.stderr,
         correlation=diag.correlation, observed=observed,
-        predicted=_predict(predictor, keys, values, design),
+        predicted=predicted,
         initial_predicted=_try_predict(predictor, keys, p0, design, observed.shape), design=fitted,
         quantity=data.quantity, condition=diag.condition,
         singular_values=diag.singular_values, unidentifiable=diag.unidentifiable,
@@ -203,8 +203,8 @@ def _weight_groups(data: Measurements, weights, design: HandDesign, normalise: b
 
     if data.diameter is None:
         if weights is None:
-            raise InputError("--weights", None, "grasp data need the weight vector w: a "
-                             "diameter_mm column or --diameter-mm / --weights")
+            raise InputError("--data", data.source, "grasp data without a diameter_mm column "
+                             "need the weight vector w: --diameter-mm D or --weights w1,..,wn")
         return [(check_weights(weights, design, normalise), np.ones(len(data), dtype=bool))]
     if weights is not None:
         raise InputError("--weights", "given", f"{data.source} has a diameter_mm column, "
@@ -269,8 +269,8 @@ def _with(keys, values, design: HandDesign) -> HandDesign:
     return design_from_dict({k: float(v) for k, v in zip(keys, values)}, design)
 
 
-def _check_answered(predictor, keys, values, design, lo, hi, bounded: bool) -> None:
-    """InputError if the model has no answer for the data where the fit ended: the bounds
+def _answered(predictor, keys, values, design, lo, hi, bounded: bool) -> np.ndarray:
+    """The prediction where the fit ended; InputError if the model has no answer there: the bounds
     held it where no design reaches the data (e.g. a V0 too small for the fingers' oil), or the
     design has none anywhere (e.g. a material past its limit); named ``--bounds`` if given."""
     try:
@@ -284,6 +284,7 @@ def _check_answered(predictor, keys, values, design, lo, hi, bounded: bool) -> N
         raise InputError("--bounds" if bounded else "--params", box, f"the fit ended at {at}, where "
                          f"the model has no answer for the data ({why}); move or widen the bounds, "
                          "or check --design")
+    return predicted
 
 
 def _predict(predictor, keys, values, design) -> np.ndarray:

@@ -72,7 +72,8 @@ MAX_WEIGHT = 10.0
 
 
 def check_weights(w, design: HandDesign, normalise: bool = False) -> np.ndarray:
-    """w as an (n_s,) array: InputError unless n_s finite numbers; warns when sum(w) != 1 (23)."""
+    """w as an (n_s,) array: InputError unless n_s numbers within +-MAX_WEIGHT; warns when
+    sum(w) != 1 (23)."""
     try:
         w = np.asarray(w, dtype=float)
     except (TypeError, ValueError):

@@ -26,6 +26,7 @@ def _load(tmp_path, text):
     ('kind = "curve"\n[sweep]\npressure_mpa = [0.5, 5.0]\n', "pressure_mpa"),  # beyond the design's range
     ('kind = "reservoir"\nmesh_size_mm = 24.0\n[design]\nV0_mm3 = 100.0\n[sweep]\ntheta_max_deg = [180.0]\n',
      "V0_mm3"),  # less oil than the fingers take
+    ('kind = "curve"\n[sweep]\ntheta_deg = [10]\nV0_mm3 = [17800.0, 1.0e7]\n', "V0_mm3"),  # sheet x344
 ])
 def test_cases_the_design_cannot_answer_are_refused_at_load_time(tmp_path, text, field):
     """These failed as cases (exit 1, a failed.json) after the run began."""

@@ -95,9 +95,6 @@ def _enough_oil(params: dict, design: HandDesign, src: str) -> None:
 def _oil_to_theta_max(params: dict, design: HandDesign, src: str) -> None:
     """The reservoir holds the oil the fingers take up to the stroke's end (default: the
     design's own), checked at load time as the curve kind checks its angles."""
-    from softhand.reduced.reservoir import check_holds
-
-    check_holds(design.V0, design)
     design.check_volume(math.radians(params.get("theta_max_deg", 90.0)))  # the kind's default
 
 

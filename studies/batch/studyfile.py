@@ -46,8 +46,8 @@ import re
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from softhand.reduced.design import PUBLIC_KEYS, HandDesign, design_from_dict, load_design, read_toml
 from softhand.reduced import reservoir
+from softhand.reduced.design import PUBLIC_KEYS, HandDesign, design_from_dict, load_design, read_toml
 from softhand.reduced.errors import InputError
 from softhand.studies.cli.args import parse_values
 from softhand.studies.batch.registry import ENTRY_POINT_GROUP, KINDS, MAX_CASES, Kind, Num, NumList, all_kinds, \
@@ -128,6 +128,10 @@ def study_from_dict(doc: dict, *, path: Path | None = None, max_cases: int = MAX
                   mesh_size_mm=mesh, description=description, path=path)
     spec = all_kinds()[kind]
     for case_params, case_design in study.cases():  # every case now, not in a worker
+        try:
+            reservoir.check_holds(case_design.V0, case_design)  # a swept V0 or R too
+        except InputError as exc:
+            raise exc.renamed(f"{src}: {exc.field}") from None
         _check_case(case_params, case_design, spec, src)
     return study
 
@@ -169,11 +173,9 @@ def _design(spec, base: Path, src: str) -> HandDesign:
         return HandDesign()
     if isinstance(spec, str):
         try:
-            design = load_design(base / spec)
+            return load_design(base / spec)
         except InputError as exc:
             raise (exc.renamed(f"{src}: design") if exc.field == "--design" else exc) from None
-        reservoir.check_holds(design.V0, design)
-        return design
     if not isinstance(spec, dict):
         raise InputError(f"{src}: design", spec, "must be a file name or a table of design keys")
     overrides = dict(spec)
@@ -184,9 +186,7 @@ def _design(spec, base: Path, src: str) -> HandDesign:
         start = load_design(base / file) if file else HandDesign()
     except InputError as exc:
         raise (exc.renamed(f"{src}: design.file") if exc.field == "--design" else exc) from None
-    design = design_from_dict(overrides, start, source=f"{src}: design")
-    reservoir.check_holds(design.V0, design)
-    return design
+    return design_from_dict(overrides, start, source=f"{src}: design")
 
 
 def _mesh_size(value, kind: str, src: str) -> float | None:

@@ -98,9 +98,7 @@ def check_writable(path, kind: str, field: str) -> None:
 def _check_name_lengths(p: Path, field: str, text: str) -> None:
     """Each part of ``p`` within the file system's name length, the whole within its path
     length (else the first write fails with 'File name too long', after the work is done)."""
-    existing = p
-    while not os.path.exists(existing) and existing != existing.parent:  # False, not an error,
-        existing = existing.parent  # for a name too long
+    existing = _nearest_existing(p)
     try:
         name_max = os.pathconf(existing, "PC_NAME_MAX")
         path_max = os.pathconf(existing, "PC_PATH_MAX")
@@ -123,10 +121,16 @@ def check_readable_folder(path, field: str) -> None:
         raise InputError(field, text, "exists and is not a folder; give a folder")
 
 
+def _nearest_existing(path: Path) -> Path:
+    """``path`` or its nearest ancestor that exists (os.path.exists: False, not an error, for a
+    name too long)."""
+    while not os.path.exists(path) and path != path.parent:
+        path = path.parent
+    return path
+
+
 def _probe(folder: Path, field: str, text: str) -> None:
-    existing = folder
-    while not existing.exists() and existing != existing.parent:
-        existing = existing.parent
+    existing = _nearest_existing(folder)
     if not existing.is_dir():
         raise InputError(field, text, f"cannot be created: {existing} is not a folder")
     try:

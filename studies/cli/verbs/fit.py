@@ -80,30 +80,26 @@ RESERVOIR_KEYS = ("V0_mm3", "mu_sr_MPa", "R_mm", "t_mm")
 
 
 def _start_from_shore_a(design, keys, shore_a):
+    """The fitted moduli's start from a Shore A hardness (Gent's relation), named --shore-a."""
     if shore_a is None:
         return design
     from softhand.reduced.design import design_from_dict
-    from softhand.reduced.materials_data import shear_modulus_from_shore_a
-
     from softhand.reduced.errors import InputError
+    from softhand.reduced.materials_data import shear_modulus_from_shore_a
 
     try:
         mu = shear_modulus_from_shore_a(shore_a)
     except InputError as exc:
         raise exc.renamed("--shore-a") from None
-    from softhand.reduced.design import BOUNDS
-
-    lo, hi = BOUNDS["mu_sf_MPa"]
-    if not lo <= mu <= hi:
-        raise InputError("--shore-a", shore_a, f"gives a shear modulus of {mu:.4g} MPa (Gent's "
-                         f"relation), outside the design's [{lo:g}, {hi:g}] MPa")
     start = {k: mu for k in ("mu_sf_MPa", "mu_sr_MPa") if k in keys}
     if not start:
-        from softhand.reduced.errors import InputError
-
         raise InputError("--shore-a", shore_a, "only sets the start of a fitted mu_sf_MPa "
                          "or mu_sr_MPa; name one in --params")
-    return design_from_dict(start, design)
+    try:
+        return design_from_dict(start, design)
+    except InputError as exc:  # the modulus is outside the design's bounds
+        raise InputError("--shore-a", shore_a, f"gives {exc.field} = {mu:.4g} MPa (Gent's "
+                         f"relation): {exc.allowed}") from None
 
 
 def _weights(args, design, data):
@@ -118,10 +114,6 @@ def _weights(args, design, data):
     if data.kind != "bending" and data.diameter is not None and given[:1] and given[0][0] != "--normalise":
         raise InputError(given[0][0], given[0][1], f"{args.data} has a diameter_mm column, which "
                                                    "picks w; drop the option")
-    if data.kind != "bending" and data.diameter is None and args.weights is None \
-            and args.diameter_mm is None:
-        raise InputError("--data", args.data, "grasp data without a diameter_mm column need "
-                                              "--diameter-mm D or --weights w1,..,wn")
     if args.weights is not None and args.diameter_mm is not None:
         raise InputError("--weights", args.weights, "give --weights or --diameter-mm, not both")
     if args.diameter_mm is not None:

@@ -20,11 +20,11 @@ import warnings
 
 import numpy as np
 
+from softhand.fem.newton import NotConverged
 from softhand.reduced import grasp
 from softhand.reduced.errors import InputError
 from softhand.studies.cli.args import add_design_option, add_json_option, design_from_args, parse_values, \
     print_json, require_finite
-from softhand.fem.newton import NotConverged
 from softhand.studies.grasp import state, state_fem
 
 #: the paper's weight vectors by name (--weights paper180)
@@ -112,7 +112,9 @@ def run(args) -> int:
     mass = _scalar(args.mass_kg, "--mass-kg")
     if _model(args) == "fem":
         diameter = _scalar(args.diameter_mm, "--diameter-mm")
-        return _print(args, state_fem(P, theta_deg, mass, diameter, design))
+        result = state_fem(P, theta_deg, mass, diameter, design)
+        _require_finite(result, args)
+        return _print(args, result)
     if args.weights is not None and args.weights.strip() not in PAPER_NAMES:
         try:
             with warnings.catch_warnings():
@@ -128,7 +130,7 @@ def run(args) -> int:
               f"{args.diameter_mm}' keeps the state it reached", file=sys.stderr)
         return 1
     result = state(P, theta_deg, mass, w, design) | {"model": "paper", "w_source": source}
-    _require_finite(result, args)
+    _require_finite(result, args)  # before the warnings: a refused result prints one line only
     for note in notes:  # only once the inputs are known to be good
         print(f"softhand grasp: warning: {note}", file=sys.stderr)
     return _print(args, result)
@@ -139,7 +141,6 @@ def _require_finite(result: dict, args) -> None:
 
 
 def _print(args, result: dict) -> int:
-    _require_finite(result, args)
     if args.json:
         print_json(result)
     else:
