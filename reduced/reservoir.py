@@ -73,6 +73,12 @@ def stretch(V, design: HandDesign):
     return half_perimeter(height(V, design), design) / (2.0 * design.R)
 
 
+#: thickest sheet, as t / R, that the sheet models describe: they are membrane models (eqs.
+#: (11)-(18); the "fem" model adds the bending share measured by the FEM at t/R = 1/24 and
+#: 1/12, the thickest of its tables, where it is 5 % of the pressure: p t / (mu R) at the
+#: paper's V0 is 1.435, 1.463, 1.512 for t/R = 1/48, 1/24, 1/12)
+MAX_THICKNESS_RATIO = 1.0 / 12.0
+
 #: largest stretch of the reservoir sheet by eq. (16): rubber sheets break before (NBR's
 #: elongation at break is 300-500 %, a stretch of 4-6)
 MAX_SHEET_STRETCH = 6.0

@@ -361,3 +361,20 @@ def test_cli_impossible_pump_is_one_line_exit_2_and_writes_nothing(tmp_path):
     proc = _cli("design", "--task", str(task), "--no-fem", "--out", str(out))
     assert proc.returncode == 2 and not out.exists()
     assert proc.stderr.count("\n") == 1 and proc.stderr.startswith("softhand design: error: pump.max_pressure_MPa")
+
+
+def test_a_free_sheet_stays_a_thin_sheet_that_the_pump_pushes():
+    """R, t and V0 free over their whole bounds: the optimiser had found a 50 mm thick "sheet"
+    (t/R = 0.34, far outside the membrane models and the FEM tables' 1/24-1/12) whose pump
+    pressure at the grasp was negative (-0.017 MPa). Both are constraints now."""
+    from softhand.reduced.design import BOUNDS
+    from softhand.reduced.reservoir import MAX_THICKNESS_RATIO
+
+    task = task_from_dict({**CI_TASK, "free": {k: list(BOUNDS[k]) for k in ("R_mm", "t_mm", "V0_mm3")}})
+    thick = design_opt.evaluate(task.base.replace(R=146.06, t=49.69, V0=5.009e6), task)
+    assert not thick.feasible
+    assert any(c.name.startswith("thin_sheet") for c in design_opt.binding(thick))
+    opt = design_opt.optimise(task, FAST)
+    d, ev = opt.evaluation.design, opt.evaluation
+    assert ev.feasible and d.t / d.R <= MAX_THICKNESS_RATIO * (1 + 1e-9)
+    assert 0.0 <= ev.P_contact <= ev.P_grasp <= task.max_pressure

@@ -21,8 +21,10 @@ FEM's peak (at the tied rings and the end cap) lies above it.
 Constraints (each ``(name, value, limit, sense)``, normalised slack >= 0 when met): the tube
 fits its links (a + b < d), walls (b >= min wall, t > 0), the reservoir keeps oil at the grasp
 and sits below the first pressure maximum of its model p_r(V) (limit point), peak stretch,
-pump pressure, the open hand passes the object, and the finger model's calibrated range
-when it has one. The whole model's P(theta) and theta(P) are those of
+pump pressure (at most the pump's limit, at least 0: the pump pushes oil into the fingers),
+the open hand passes the object, the sheet is thin enough for the membrane models of the
+reservoir (t/R <= :data:`reduced.reservoir.MAX_THICKNESS_RATIO`), and the finger model's
+calibrated range when it has one. The whole model's P(theta) and theta(P) are those of
 ``design.finger_model``/``design.reservoir_model`` through :mod:`reduced.hand`, so another
 finger model changes the answer by a design key alone.
 """
@@ -193,10 +195,14 @@ def _constraints(design: HandDesign, task: Task, oil, stretch, sheet, P_grasp, F
         Constraint("max_principal_stretch", stretch, task.max_stretch, "<="),
         Constraint("sheet_stretch at V0, eq. (16)", sheet, task.max_stretch, "<="),
         Constraint("pump_pressure at the grasp [MPa]", P_grasp, task.max_pressure, "<="),
+        Constraint("pump_pressure at the grasp, pushing oil into the fingers [MPa]", P_grasp, 0.0, ">=",
+                   task.max_pressure),
         *([Constraint("F_v at the pump limit [N]", F_lim, task.required_F_v(), ">=")]
           if asks_force_at_limit(design, task) else []),
         Constraint("opening: P(theta_open), the free hand's pump pressure where the tips "
                    f"span {task.opening_mm:g} mm [MPa]", P_open, 0.0, ">=", task.max_pressure),
+        Constraint("thin_sheet t/R (membrane models)", design.t / design.R,
+                   reservoir.MAX_THICKNESS_RATIO, "<="),
         *calibrated_range(design),
     ]
 
