@@ -378,3 +378,25 @@ def test_a_free_sheet_stays_a_thin_sheet_that_the_pump_pushes():
     d, ev = opt.evaluation.design, opt.evaluation
     assert ev.feasible and d.t / d.R <= MAX_THICKNESS_RATIO * (1 + 1e-9)
     assert 0.0 <= ev.P_contact <= ev.P_grasp <= task.max_pressure
+
+
+def test_a_design_run_stopped_mid_proof_leaves_none_of_its_files(tmp_path, monkeypatch):
+    """Ctrl-C during the FEM proof had left design.toml without result.json, next to an
+    earlier run's result.json that no longer matched it. The earlier record goes when a run
+    starts, the stopped run's files (design, VTK) when it stops; other files stay."""
+    from softhand.studies.cli import main as cli
+    from softhand.studies.cli.verbs import design as design_verb
+
+    task, out = _write(tmp_path, CI_TASK_TOML), tmp_path / "out"
+    out.mkdir()
+    (out / "result.json").write_text('{"design_file": "design.toml"}\n')  # an earlier run's record
+    (out / "notes.txt").write_text("mine\n")
+
+    def stopped_proof(ev, task, args, out, say):
+        (out / "grasp").mkdir()
+        (out / "grasp" / "step_0.vtu").write_text("half a VTK")
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(design_verb, "_prove", stopped_proof)
+    assert cli.main(["design", "--task", str(task), "--out", str(out), "--seed", "3"]) == 130
+    assert sorted(p.name for p in out.iterdir()) == ["notes.txt"]

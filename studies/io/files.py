@@ -74,6 +74,41 @@ def jsonable(value):
 
 
 @contextmanager
+def removed_unless_finished(folder: str | Path):
+    """The files written under ``folder`` in this block (new, or rewritten: another inode, size
+    or time) and the folders it made are removed if the block does not finish (an error,
+    Ctrl-C, SIGTERM): a run stopped half-way leaves none of its outputs. Others' files stay."""
+    folder = Path(folder)
+    before = _stamps(folder)
+    try:
+        yield
+    except BaseException:
+        after = _stamps(folder)
+        for path in sorted(after, key=lambda p: -len(p.parts)):  # files first, then their folders
+            if before.get(path) != after[path]:
+                try:
+                    path.rmdir() if after[path] == "folder" else path.unlink()
+                except OSError:
+                    pass  # a folder of others' files; a file already gone
+        raise
+
+
+def _stamps(folder: Path, depth: int = 3) -> dict:
+    """{path: (inode, size, mtime) of a file, "folder" for a folder} under ``folder``, down to
+    ``depth`` levels (a run's outputs: a VTK series' blocks are at the third; ``--out .``
+    must not walk a whole home folder)."""
+    out = {}
+    levels = ("/".join(["*"] * k) for k in range(1, depth + 1))
+    for path in (p for pattern in levels for p in folder.glob(pattern)) if folder.is_dir() else ():
+        try:
+            st = path.lstat()
+        except OSError:
+            continue
+        out[path] = "folder" if path.is_dir() and not path.is_symlink() else (st.st_ino, st.st_size, st.st_mtime_ns)
+    return out
+
+
+@contextmanager
 def kept_if_unwritable(what, verb: str):
     """Write ``what`` inside this block; if the disk refuses (full, gone, read-only) after the
     computation, a warning instead of losing the results, which the verb still prints."""

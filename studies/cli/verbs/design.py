@@ -44,9 +44,8 @@ def configure(parser) -> None:
 def run(args) -> int:
     from softhand.studies.design import optimise as design_opt
     from softhand.studies.design.task import load_task
-    from softhand.studies.io.files import write_atomic, write_json
-
     from softhand.studies.design.task import LOWER, UPPER
+    from softhand.studies.io.files import removed_unless_finished, write_atomic, write_json
 
     lo, hi = LOWER["mesh_size_mm"], UPPER["mesh_size_mm"]
     if args.mesh_size_mm is not None and not lo <= args.mesh_size_mm <= hi:
@@ -71,19 +70,21 @@ def run(args) -> int:
         return 1
     out = Path(args.out) if args.out else Path("results") / "design" / task.name
     out.mkdir(parents=True, exist_ok=True)
-    design_file = write_atomic(out / "design.toml", ev.design.to_toml())
-    result = _result(task, opt, base, design_file, args.seed)
-    if args.pareto:
-        from softhand.studies.design import pareto as design_pareto
-
-        rows = design_pareto.front(task, opt, options)
-        plot = design_pareto.plot(rows, args.plot or out / "pareto.png", task=task, base=base)
-        result["pareto"] = {"rows": rows, "knee": design_pareto.knee(rows), "plot": str(plot)}
-    if not args.no_fem:
-        result = _prove_and_correct(result, task, opt, base, args, out, say, options)
+    (out / "result.json").unlink(missing_ok=True)  # the record of an earlier run, which this one replaces
+    with removed_unless_finished(out):  # a run stopped mid-proof leaves none of its files
+        design_file = write_atomic(out / "design.toml", ev.design.to_toml())
+        result = _result(task, opt, base, design_file, args.seed)
         if args.pareto:
-            result["pareto"]["knee_proof"] = _prove_knee(result["pareto"], task, args, out, say)
-    write_json(out / "result.json", result)
+            from softhand.studies.design import pareto as design_pareto
+
+            rows = design_pareto.front(task, opt, options)
+            plot = design_pareto.plot(rows, args.plot or out / "pareto.png", task=task, base=base)
+            result["pareto"] = {"rows": rows, "knee": design_pareto.knee(rows), "plot": str(plot)}
+        if not args.no_fem:
+            result = _prove_and_correct(result, task, opt, base, args, out, say, options)
+            if args.pareto:
+                result["pareto"]["knee_proof"] = _prove_knee(result["pareto"], task, args, out, say)
+        write_json(out / "result.json", result)
     if args.json:
         print_json(result)
     else:
