@@ -34,6 +34,9 @@ from .errors import InputError
 
 #: tolerance of the fast solve (Newton step, relative on the unknowns) and of the slow path's brentq [MPa]
 _XTOL, _PTOL = 1e-13, 1e-13
+#: the slow path's bracket: the least pressure step [MPa] towards where one pad stops holding
+#: the object alone (a heavy object: the condition is not met before; without it, 60 halvings)
+BRACKET_RESOLUTION = 1e-3
 
 
 class Hold(NamedTuple):
@@ -163,21 +166,28 @@ def slow_hold(design: HandDesign, diameter_mm: float, mass_kg: float, target: st
     theta_c, _ = contact.contact_angle(diameter_mm, design, depth=depth)
     state = lambda P: grasp_fem.grasp_state(design, diameter_mm, P, mass_kg)  # noqa: E731
     cond = _condition(target, value, design, reservoir)
-    f = lambda P: cond(state(P).q, P, state(P).F_v)  # noqa: E731
+
+    def f(P):
+        s = state(P)
+        return cond(s.q, P, s.F_v)
+
     lo = float(hand.finger_pressure(theta_c, design)) + 1e-9
-    f_lo, step = f(lo), 0.05
+    f_lo, step, grow = f(lo), 0.05, 2.0
+    hi, f_hi = lo, f_lo
     for _ in range(60):  # the first sign change above the contact pressure: steps 0.05, 0.1, ... MPa
         hi = min(lo + step, P_max)
         try:
             f_hi = f(hi)
-        except InputError:  # e.g. several pads on the object: closer
-            step *= 0.5
+        except InputError:  # e.g. several pads on the object: closer, down to BRACKET_RESOLUTION
+            hi, f_hi, step, grow = lo, f_lo, 0.5 * step, 1.0
+            if step < BRACKET_RESOLUTION:
+                break
             continue
         if f_lo * f_hi <= 0.0:
             break
         if hi == P_max:
             break
-        lo, f_lo, step = hi, f_hi, 2.0 * step
+        lo, f_lo, step = hi, f_hi, grow * step
     if not f_lo * f_hi <= 0.0:
         raise InputError(target, value, f"not reached by the finger on one pad between its contact "
                                         f"pressure and {hi:.4g} MPa")

@@ -75,3 +75,24 @@ def test_the_equations_at_a_batch_are_those_of_each_state():
     M = grasp_fem.hinge_moments(q, 0.7, PAPER)
     assert batch[0, 0] == pytest.approx(M[0] - 5.0 * grad[0] - Tq[0], rel=1e-12)
     assert math.isfinite(F[0])
+
+
+def test_a_force_one_pad_cannot_give_is_refused_at_the_edge_of_one_pad(monkeypatch):
+    """20 kg on the paper's hand: F_v = 2 m g / n = 98 N is more than pad 3 gives before a second
+    pad touches (~75 N at ~2.9 MPa). The bracket used to halve its step 60 times at that edge
+    (82 equilibria, each evaluated twice per trial pressure); now it stops at BRACKET_RESOLUTION
+    and names the edge, where one pad holds with less than the force asked and just above which
+    it no longer holds alone."""
+    from softhand.reduced.errors import InputError
+
+    calls = []
+    state = grasp_fem.grasp_state
+    monkeypatch.setattr(grasp_fem, "grasp_state", lambda *a: calls.append(a) or state(*a))
+    with pytest.raises(InputError, match="not reached by the finger on one pad") as info:
+        grasp_hold.slow_hold(PAPER, 180.0, 20.0, "F_v", 98.0665)
+    assert len(calls) <= 30
+    edge = float(str(info.value).split(" and ")[-1].split(" MPa")[0])
+    below = state(PAPER, 180.0, edge - 2 * grasp_hold.BRACKET_RESOLUTION, 20.0)
+    assert below.F_v < 98.0665
+    with pytest.raises(InputError):
+        state(PAPER, 180.0, edge + 2 * grasp_hold.BRACKET_RESOLUTION, 20.0)
