@@ -400,3 +400,14 @@ def test_a_design_run_stopped_mid_proof_leaves_none_of_its_files(tmp_path, monke
     monkeypatch.setattr(design_verb, "_prove", stopped_proof)
     assert cli.main(["design", "--task", str(task), "--out", str(out), "--seed", "3"]) == 130
     assert sorted(p.name for p in out.iterdir()) == ["notes.txt"]
+
+
+def test_the_optimiser_reports_each_generation():
+    """The design verb's progress bar: one call per differential-evolution generation, with
+    the model evaluations so far, and the same optimum as without it."""
+    task = task_from_dict(CI_TASK)
+    calls = []
+    opt = design_opt.optimise(task, FAST, progress=calls.append)
+    assert len(calls) == opt.generations > 0
+    assert calls == sorted(calls) and calls[-1] <= opt.evaluations
+    assert np.array_equal(opt.x, design_opt.optimise(task, FAST).x)

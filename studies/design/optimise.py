@@ -83,14 +83,21 @@ class Optimum:
     cpu_seconds: float = 0.0  #: the process's CPU time (the wall time of a loaded machine is a multiple)
 
 
-def optimise(task: Task, options: OptimiserOptions = OptimiserOptions()) -> Optimum:
-    """Differential evolution (seeded) + SLSQP polish on the reduced model."""
+def optimise(task: Task, options: OptimiserOptions = OptimiserOptions(), *, progress=None) -> Optimum:
+    """Differential evolution (seeded) + SLSQP polish on the reduced model. ``progress``: called
+    after each generation with the model evaluations so far (at most ``options.maxiter`` calls)."""
     t0, cpu = time.perf_counter(), time.process_time()
     problem = Problem(task)
     cons = NonlinearConstraint(problem.slacks, 0.0, np.inf)
+
+    def generation(intermediate_result):  # scipy's callback: this name is its new-style signature
+        if progress is not None:
+            progress(problem.evaluations)
+
     res = differential_evolution(problem.f, problem.bounds, constraints=cons, seed=options.seed,
                                  popsize=options.popsize, maxiter=options.maxiter, tol=options.tol,
-                                 polish=False, init="sobol", updating="immediate", workers=1)
+                                 polish=False, init="sobol", updating="immediate", workers=1,
+                                 callback=generation)
     x = np.asarray(res.x, dtype=float)
     if options.polish and problem.evaluation(x).feasible:
         x = polish(problem, x)

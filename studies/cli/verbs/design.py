@@ -19,7 +19,7 @@ from pathlib import Path
 import numpy as np
 
 from softhand.reduced.errors import InputError
-from softhand.studies.cli.args import add_json_option, print_json, print_table
+from softhand.studies.cli.args import add_json_option, add_progress_option, print_json, print_table
 
 HELP = "size finger and reservoir for an object (reduced model, optimiser) and prove it with the FEM"
 
@@ -38,6 +38,7 @@ def configure(parser) -> None:
     parser.add_argument("--mesh-size-mm", type=float, metavar="H",
                         help="finger element size of the FEM proof [mm] (default: the task's, 6; "
                              "at most 6 for walls b > 5 mm)")
+    add_progress_option(parser)
     add_json_option(parser)
 
 
@@ -61,7 +62,7 @@ def run(args) -> int:
     task = load_task(args.task)
     say = (lambda text: print(f"softhand design: {text}", file=sys.stderr)) if args.json else print
     options = design_opt.OptimiserOptions(seed=args.seed)
-    opt = design_opt.optimise(task, options)
+    opt = _optimise(task, options, args)
     ev = opt.evaluation
     base = design_opt.evaluate(task.base, task)
     if not ev.feasible:  # the documented outcome, before anything is written
@@ -92,6 +93,22 @@ def run(args) -> int:
     return 0 if result["feasible"] and "fem_report" not in result and "report" not in result else 1
 
 
+def _optimise(task, options, args):
+    """The optimiser, with a bar of its generations on stderr (one second of evaluations each
+    for a heavy object, where one pad's force is found by bracketing)."""
+    from tqdm import tqdm
+
+    from softhand.studies.design import optimise as design_opt
+
+    with tqdm(total=options.maxiter, desc="optimiser", unit="gen", file=sys.stderr, leave=False,
+              disable=args.no_progress) as bar:
+        def step(evaluations):
+            bar.set_postfix_str(f"{evaluations} evaluations", refresh=False)
+            bar.update()
+
+        return design_opt.optimise(task, options, progress=step)
+
+
 def _prove_and_correct(result, task, opt, base, args, out, say, options) -> dict:
     """The FEM proof of the optimum; if the FEM's peak stretch breaks the task's limit, one
     re-optimisation with eq. (8)'s strain scaled to the FEM's and the proof of that design
@@ -112,7 +129,7 @@ def _prove_and_correct(result, task, opt, base, args, out, say, options) -> dict
     say(f"the FEM's peak stretch is {corrected.stretch_factor:.3g} x eq. (8)'s strain: optimising again with it")
     rejected = {k: result[k] for k in ("design", "predicted", "fem", "constraints", "fem_report")}
     rejected["design_file"] = str(write_atomic(out / "rejected_design.toml", ev.design.to_toml()))
-    opt = design_opt.optimise(corrected, options)
+    opt = _optimise(corrected, options, args)
     design_file = write_atomic(out / "design.toml", opt.evaluation.design.to_toml())
     new = {**_result(corrected, opt, base, design_file, args.seed), "stretch_factor": corrected.stretch_factor,
            "rejected": rejected, **{k: result[k] for k in ("pareto",) if k in result}}
