@@ -29,6 +29,7 @@ Units: mm, mm^3, MPa, N*mm, rad.
 """
 from __future__ import annotations
 
+import warnings
 from typing import Callable
 
 import numpy as np
@@ -86,9 +87,14 @@ MAX_SHEET_STRETCH = 6.0
 
 def check_holds(V, design: HandDesign, field: str = "V0_mm3") -> None:
     """InputError naming ``field`` if the sheet holding V [mm^3] stretches past
-    MAX_SHEET_STRETCH. For a design a user gives (its V0) and the volumes asked of it; not for
-    the optimiser's trial designs, which the task's own sheet-stretch limit steers back (its
-    answers beyond, negative pump pressures and stretches in the hundreds, are no answers)."""
+    MAX_SHEET_STRETCH; a warning if the sheet is thicker than MAX_THICKNESS_RATIO (the models
+    are extrapolated there). For a design a user gives (its V0) and the volumes asked of it; not
+    for the optimiser's trial designs, which the task's own limits steer back (its answers
+    beyond, negative pump pressures and stretches in the hundreds, are no answers)."""
+    if design.t / design.R > MAX_THICKNESS_RATIO:
+        warnings.warn(f"the reservoir sheet's t/R = {design.t:g}/{design.R:g} is above 1/12: the reservoir "
+                      f"models are membrane models, checked against the sheet FEM up to 1/12 (bending "
+                      f"adds 5 % to the pressure there); beyond, their answers are extrapolations")
     lam = float(stretch(V, design))
     if not lam <= MAX_SHEET_STRETCH:
         raise InputError(field, V, f"stretches the sheet (R_mm = {design.R:g}) to {lam:.4g} by "
