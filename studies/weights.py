@@ -29,7 +29,7 @@ import numpy as np
 from softhand.reduced import grasp
 from softhand.reduced.design import HandDesign
 from softhand.reduced.errors import InputError
-from softhand.studies.io.files import jsonable, write_json
+from softhand.studies.io.files import json_text, jsonable, write_json
 
 #: bump when the FEM or the result's fields change, to invalidate cached results
 CACHE_FORMAT = 5  # 5: entries {format, key, sha256, result}; 4: factorisations counted; 3: the finger's windings on their own degree-5 rule, mesh graded at the ring edges
@@ -224,7 +224,7 @@ def read_entry(path: Path, key: str) -> dict | None:
 
 def write_entry(path: Path, key: str, result: dict) -> None:
     """Cache ``result`` with its format, key and checksum; a failure to write is a warning."""
-    result = json.loads(json.dumps(result, default=jsonable))  # as it reads back
+    result = json.loads(json_text(result))  # as it reads back
     try:
         write_json(path, {"format": CACHE_FORMAT, "key": key, "sha256": _checksum(result),
                           "result": result})

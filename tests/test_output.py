@@ -14,6 +14,34 @@ def test_write_json_round_trip_with_numpy(tmp_path):
     assert json.loads(path.read_text()) == {"a": [0, 1, 2], "b": 1.5}
 
 
+def _strict(text):
+    """json.loads refusing NaN / Infinity, as JavaScript's, Go's and serde's parsers do."""
+    def refuse(constant):
+        raise ValueError(f"not JSON: {constant}")
+    return json.loads(text, parse_constant=refuse)
+
+
+def test_numbers_that_are_not_finite_are_null_in_strict_json(tmp_path):
+    """A design's constraint 'below the limit point' had "limit": Infinity: Python reads it,
+    strict parsers refuse the whole file."""
+    obj = {"inf": float("inf"), "list": [float("nan"), 1.0], "np": np.float64(-np.inf),
+           "array": np.array([1.0, np.inf]), "nested": ({"x": -float("inf")},), "ok": 2.5, "flag": True}
+    expected = {"inf": None, "list": [None, 1.0], "np": None, "array": [1.0, None],
+                "nested": [{"x": None}], "ok": 2.5, "flag": True}
+    assert _strict(write_json(tmp_path / "r.json", obj).read_text()) == expected
+
+
+def test_json_printed_by_a_verb_is_strict(tmp_path, capsys):
+    from softhand.studies.cli.main import main
+
+    assert main(["design", "--task", "studies/designs/tasks/paper_task.toml", "--no-fem", "--json",
+                 "--no-progress", "--out", str(tmp_path)]) == 0
+    printed = _strict(capsys.readouterr().out)
+    limit = next(c for c in printed["constraints"] if c["name"].startswith("reservoir_below_limit_point"))
+    assert limit["limit"] is None  # no limit point: the sheet's p_r(V) rises throughout
+    assert _strict((tmp_path / "result.json").read_text()) == printed
+
+
 def test_files_get_ordinary_permissions_not_mkstemps_0600(tmp_path):
     path = write_atomic(tmp_path / "f.txt", "x")
     umask = os.umask(0)

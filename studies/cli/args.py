@@ -2,7 +2,6 @@
 from __future__ import annotations
 
 import argparse
-import json
 import math
 import re
 import sys
@@ -11,7 +10,7 @@ import numpy as np
 
 from softhand.reduced.design import HandDesign, load_design
 from softhand.reduced.errors import InputError
-from softhand.studies.io.files import jsonable
+from softhand.studies.io.files import json_text
 
 
 #: most values one range or list may give: reduced-model verbs, and FEM runs (one solve each),
@@ -129,9 +128,8 @@ def require_finite(result, args, where: str) -> None:
 
 
 def print_json(obj) -> None:
-    """One JSON object on stdout (numpy arrays and scalars converted)."""
-    json.dump(obj, sys.stdout, indent=1, default=jsonable)
-    sys.stdout.write("\n")
+    """One strict JSON object on stdout (numpy converted, numbers that are not finite null)."""
+    sys.stdout.write(json_text(obj) + "\n")
 
 
 def print_table(rows: list[dict], columns: list[str] | None = None, *, digits: int = 4,

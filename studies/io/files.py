@@ -4,6 +4,7 @@ from __future__ import annotations
 import csv
 import io
 import json
+import math
 import sys
 from contextlib import contextmanager
 from pathlib import Path
@@ -22,7 +23,25 @@ def write_atomic(path: str | Path, data: bytes | str) -> Path:
 
 
 def write_json(path: str | Path, obj) -> Path:
-    return write_atomic(path, json.dumps(obj, indent=1, default=jsonable) + "\n")
+    return write_atomic(path, json_text(obj) + "\n")
+
+
+def json_text(obj, indent: int | None = 1) -> str:
+    """Strict JSON of ``obj``, which every parser reads: numpy arrays and scalars converted, and
+    a number that is not finite (an unbounded limit, a value never reached) as null."""
+    return json.dumps(_strict(obj), indent=indent, default=jsonable, allow_nan=False)
+
+
+def _strict(value):
+    if isinstance(value, float):  # numpy's float64 too
+        return value if math.isfinite(value) else None
+    if isinstance(value, dict):
+        return {k: _strict(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_strict(v) for v in value]
+    if isinstance(value, (np.ndarray, np.generic)):
+        return _strict(value.tolist())
+    return value
 
 
 def write_csv(path: str | Path, rows: list[dict], columns: list[str] | None = None) -> Path:
