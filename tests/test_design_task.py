@@ -411,3 +411,19 @@ def test_the_optimiser_reports_each_generation():
     assert len(calls) == opt.generations > 0
     assert calls == sorted(calls) and calls[-1] <= opt.evaluations
     assert np.array_equal(opt.x, design_opt.optimise(task, FAST).x)
+
+
+def test_the_hand_at_rest_does_not_reach_into_the_objects_place():
+    """A charged reservoir can bend the fingers past the grasp angle with the pump off: the
+    object could pass the open tips but not reach its grasp place (pad 2 in the way) unless
+    the pump sucked oil out. Such a design (P_contact = -0.033 MPa, a thin 3 mm wall, a thick
+    sheet) was reported feasible; the free hand's pump pressure at the grasp angle is now >= 0."""
+    task = task_from_dict({**CI_TASK, "limits": {"min_wall_mm": 3.0},
+                           "free": {"a_mm": [3.0, 6.0], "b_mm": [3.0, 7.0], "d_mm": [10.0, 20.0],
+                                    "t_mm": [0.5, 3.0], "V0_mm3": [10000.0, 40000.0]}})
+    pre_bent = design_opt.evaluate(task.base.replace(a=6.0, b=3.0, d=20.0, t=2.0, V0=22000.0), task)
+    assert pre_bent.P_contact < 0.0 and not pre_bent.feasible
+    assert [c.name for c in design_opt.binding(pre_bent)] == [
+        next(c.name for c in pre_bent.constraints if c.name.startswith("contact:"))]  # the only one
+    ev = design_opt.optimise(task, FAST).evaluation
+    assert ev.feasible and ev.P_contact >= -1e-9 and ev.P_grasp > ev.P_contact

@@ -21,8 +21,9 @@ FEM's peak (at the tied rings and the end cap) lies above it.
 Constraints (each ``(name, value, limit, sense)``, normalised slack >= 0 when met): the tube
 fits its links (a + b < d), walls (b >= min wall, t > 0), the reservoir keeps oil at the grasp
 and sits below the first pressure maximum of its model p_r(V) (limit point), peak stretch,
-pump pressure (at most the pump's limit, at least 0: the pump pushes oil into the fingers),
-the open hand passes the object, the sheet is thin enough for the membrane models of the
+pump pressure (at most the pump's limit), the open hand passes the object and at rest (pump
+off) does not reach into the object's place (the free hand's pump pressure at the grasp angle,
+P_contact >= 0, so P_grasp >= 0 too: the pump pushes oil into the fingers), the sheet is thin enough for the membrane models of the
 reservoir (t/R <= :data:`reduced.reservoir.MAX_THICKNESS_RATIO`), and the finger model's
 calibrated range when it has one. The whole model's P(theta) and theta(P) are those of
 ``design.finger_model``/``design.reservoir_model`` through :mod:`reduced.hand`, so another
@@ -179,12 +180,12 @@ def evaluate(design: HandDesign, task: Task, *, exact: bool = True) -> Evaluatio
         oil = math.inf
     stretch = 1.0 + task.stretch_factor * (peak_stretch(theta_hold, design) - 1.0)
     sheet = float(reservoir.stretch(design.V0, design))
-    cons = _constraints(design, task, oil, stretch, sheet, P_grasp, F_lim, P_open)
+    cons = _constraints(design, task, oil, stretch, sheet, P_grasp, P_contact, F_lim, P_open)
     return Evaluation(design, depth, theta, link, w, P_grasp, P_contact, F_req, F_lim, stretch, sheet,
                       tuple(cons), theta_hold)
 
 
-def _constraints(design: HandDesign, task: Task, oil, stretch, sheet, P_grasp, F_lim, P_open) -> list:
+def _constraints(design: HandDesign, task: Task, oil, stretch, sheet, P_grasp, P_contact, F_lim, P_open) -> list:
     """Every constraint of a design; how many depends on the task and the finger model alone."""
     return [
         Constraint("tube_fits_links (a + b < d) [mm]", design.a + design.b, design.d, "<="),
@@ -195,7 +196,8 @@ def _constraints(design: HandDesign, task: Task, oil, stretch, sheet, P_grasp, F
         Constraint("max_principal_stretch", stretch, task.max_stretch, "<="),
         Constraint("sheet_stretch at V0, eq. (16)", sheet, task.max_stretch, "<="),
         Constraint("pump_pressure at the grasp [MPa]", P_grasp, task.max_pressure, "<="),
-        Constraint("pump_pressure at the grasp, pushing oil into the fingers [MPa]", P_grasp, 0.0, ">=",
+        Constraint("contact: P(theta_g), the free hand's pump pressure where a pad touches the object "
+                   "[MPa] (the hand at rest must not reach into the object's place)", P_contact, 0.0, ">=",
                    task.max_pressure),
         *([Constraint("F_v at the pump limit [N]", F_lim, task.required_F_v(), ">=")]
           if asks_force_at_limit(design, task) else []),
@@ -213,7 +215,7 @@ def unanswered(task: Task) -> Evaluation:
     :func:`evaluate` for the task, each violated (value nan: slack -1e3), so that the optimiser
     sees as many constraints as anywhere else and leaves the point."""
     base, nan = task.base, math.nan
-    cons = _constraints(base, task, nan, nan, nan, math.inf, nan, nan)
+    cons = _constraints(base, task, nan, nan, nan, math.inf, nan, nan, nan)
     return Evaluation(base, nan, nan, -1, np.full(base.n_s, nan), math.inf, math.inf, task.required_F_v(),
                       nan, nan, nan, tuple(replace(c, value=nan) for c in cons), nan)
 
