@@ -427,3 +427,22 @@ def test_the_hand_at_rest_does_not_reach_into_the_objects_place():
         next(c.name for c in pre_bent.constraints if c.name.startswith("contact:"))]  # the only one
     ev = design_opt.optimise(task, FAST).evaluation
     assert ev.feasible and ev.P_contact >= -1e-9 and ev.P_grasp > ev.P_contact
+
+
+@pytest.mark.parametrize("outcome, code, proven", [("met", 0, True), ("not met", 1, False), ("no fem", 0, None)])
+def test_proven_says_in_one_word_what_the_exit_code_says(tmp_path, monkeypatch, outcome, code, proven):
+    """A proof whose FEM fails (or breaks a limit) exits 1 but writes the design for a look;
+    "feasible" (the reduced model's word) stayed true, so a script reading it took an unproven
+    design. The proof itself is stood in for: its FEM is tested in test_design_fem.py."""
+    from softhand.studies.cli import main as cli
+    from softhand.studies.cli.verbs import design as design_verb
+
+    def proof(result, *rest):
+        return result if outcome == "met" else {**result, "fem_report": "the FEM failed"}
+
+    monkeypatch.setattr(design_verb, "_prove_and_correct", proof)
+    task, out = _write(tmp_path, CI_TASK_TOML), tmp_path / "out"
+    argv = ["design", "--task", str(task), "--out", str(out), "--seed", "3", "--no-progress"]
+    assert cli.main(argv + (["--no-fem"] if outcome == "no fem" else [])) == code
+    result = json.loads((out / "result.json").read_text())
+    assert result["feasible"] is True and result["proven"] is proven

@@ -85,12 +85,14 @@ def run(args) -> int:
             result = _prove_and_correct(result, task, opt, base, args, out, say, options)
             if args.pareto:
                 result["pareto"]["knee_proof"] = _prove_knee(result["pareto"], task, args, out, say)
+        ok = result["feasible"] and "fem_report" not in result and "report" not in result
+        result["proven"] = None if args.no_fem else ok  # by the FEM; None: not asked (--no-fem)
         write_json(out / "result.json", result)
     if args.json:
         print_json(result)
     else:
         _print(result, task, opt)
-    return 0 if result["feasible"] and "fem_report" not in result and "report" not in result else 1
+    return 0 if ok else 1
 
 
 def _optimise(task, options, args):
@@ -188,6 +190,7 @@ def _result(task, opt, base, design_file, seed: int) -> dict:
         "bounds_clipped_from": {k: [lo, hi] for k, lo, hi in task.clipped},
         "predicted": ev.predicted(),
         "fem": None,
+        "proven": None,  # set once the FEM proof is done: True if it met the task (see run)
         "base_design": {"design": task.base.to_dict(), "predicted": base.predicted(),
                         "feasible": base.feasible},
         "constraints": [c.as_dict() for c in ev.constraints],
