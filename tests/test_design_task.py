@@ -446,3 +446,15 @@ def test_proven_says_in_one_word_what_the_exit_code_says(tmp_path, monkeypatch, 
     assert cli.main(argv + (["--no-fem"] if outcome == "no fem" else [])) == code
     result = json.loads((out / "result.json").read_text())
     assert result["feasible"] is True and result["proven"] is proven
+
+
+def test_an_object_wider_than_the_open_hand_names_its_widest_span():
+    """260 mm: the straight hand's tips span 2 (base_offset + l0 sin theta0) = 243.1 mm; the
+    report said only 'opening ... = -inf against the limit 0'."""
+    task = task_from_dict({**CI_TASK, "object": {"diameter_mm": 260.0, "mass_kg": 1.0}})
+    opt = design_opt.optimise(task, FAST)
+    assert not opt.evaluation.feasible
+    base = task.base
+    widest = 2.0 * (base.base_offset + base.l0 * math.sin(base.theta0))
+    assert design_opt.open_span(base) == pytest.approx(widest, rel=1e-12)
+    assert f"straight, its tips span {widest:.4g} mm" in design_opt.infeasible_report(task, opt)

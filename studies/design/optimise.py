@@ -20,7 +20,7 @@ from softhand.studies.design.evaluate import Constraint, Evaluation, design_at, 
 from softhand.studies.design.task import Task
 
 __all__ = ["Constraint", "Evaluation", "design_at", "evaluate", "objective", "Problem", "OptimiserOptions",
-           "Optimum", "optimise", "on_bounds", "polish", "binding", "infeasible_report"]
+           "Optimum", "optimise", "on_bounds", "polish", "binding", "infeasible_report", "open_span"]
 
 
 def objective(ev: Evaluation, task: Task) -> float:
@@ -142,6 +142,13 @@ def binding(ev: Evaluation, tol: float = 1e-4) -> list[Constraint]:
     return violated or [c for c in cons if c.slack < tol]
 
 
+def open_span(design) -> float:
+    """The tips' span [mm] of the straight hand (every hinge at 0), the widest it opens."""
+    from softhand.reduced import kinematics
+
+    return float(2.0 * kinematics.tip_position(np.zeros(design.n_s), design)[0])
+
+
 def infeasible_report(task: Task, opt: Optimum) -> str:
     """One paragraph: the task cannot be met, the binding constraint, the nearest design."""
     ev = opt.evaluation
@@ -149,6 +156,9 @@ def infeasible_report(task: Task, opt: Optimum) -> str:
     names = "; ".join(f"{c.name} = {c.value:.4g} against the limit {c.limit:.4g} ({c.sense})"
                       for c in worst)
     free = ", ".join(f"{k} = {v:.4g}" for (k, _, _), v in zip(task.free, opt.x))
+    if any(c.name.startswith("opening") and not math.isfinite(c.value) for c in worst):
+        names += (f" (no bend opens the hand that wide: straight, its tips span "
+                  f"{open_span(ev.design):.4g} mm; l0_mm, theta0_deg and base_offset_mm set that span)")
     return (f"The task cannot be met within the free bounds: the binding constraint is {names}. "
             f"The nearest design (least constraint violation found by the optimiser) has {free}: "
             f"it touches the object at {math.degrees(ev.theta_grasp):.2f} deg and would need {ev.P_grasp:.4g} MPa "
