@@ -36,3 +36,22 @@ def facet_basis(mesh, element, **kwargs) -> FacetBasis:
     if getattr(mesh, "affine", True) or mesh.t.shape[0] != mesh.dim() + 1:
         return FacetBasis(mesh, element, **kwargs)
     return FacetBasis(mesh, element, mapping=RobustIsoparametric(mesh, mesh.elem(), mesh.bndelem), **kwargs)
+
+
+#: how deep an element's map may fold before the element is refused: det J anywhere below
+#: -FOLD_DEPTH x its largest det J (measured on the finger's gmsh meshes: the ones whose FEM
+#: converges to the right bend have at most a sliver, -0.11 at uniform h = 4 mm; the ones
+#: whose Newton stops, or converges to a ballooned tube, -1.36 to -1.49)
+FOLD_DEPTH = 0.5
+
+
+def folded_elements(mesh, lattice: int = 5) -> np.ndarray:
+    """Indices of the curved tetrahedra whose map folds over itself (see :data:`FOLD_DEPTH`):
+    det J on a lattice of ``lattice`` points per reference edge (35 for 5, the vertices
+    among them; the quadrature points alone miss a fold between them). Straight meshes: none."""
+    if getattr(mesh, "affine", True):
+        return np.zeros(0, dtype=int)
+    g = np.linspace(0.0, 1.0, lattice)
+    X = np.array([(x, y, z) for x in g for y in g for z in g if x + y + z <= 1.0 + 1e-12]).T
+    J = mesh.mapping().detDF(X)                              # (elements, points)
+    return np.flatnonzero(J.min(axis=1) < -FOLD_DEPTH * J.max(axis=1))

@@ -192,3 +192,33 @@ def test_robust_facet_map_equals_scikit_fem_where_both_work():
     _, thin = layered(axial_size=20.0)
     with pytest.raises(Exception, match="Newton"):
         skfem.FacetBasis(thin, skfem.ElementTetP2(), facets=thin.boundaries["cavity"], intorder=4)
+
+
+@pytest.mark.parametrize("s", [0.5, 0.3, 0.1, -0.2, -0.3, -0.6])
+def test_a_fold_is_found_where_the_quadratic_edge_map_says(s):
+    """One P2 tetrahedron whose midside node of edge (0, 1) sits at s along the edge: along it
+    x(xi) = xi (2 xi - 1) + 4 xi (1 - xi) s, so det J = dx/dxi is 4 s - 1 at vertex 0 and 3 - 4 s
+    at vertex 1 (the other directions straight), linear between. It is folded, for
+    folded_elements, where (4 s - 1) / (3 - 4 s) < -FOLD_DEPTH (s < -1/4 for 0.5)."""
+    from softhand.fem.mapping import FOLD_DEPTH, folded_elements
+
+    mesh = skfem.MeshTet2.from_mesh(skfem.MeshTet.init_refdom())
+    nodes = mesh.doflocs.copy()
+    assert np.allclose(nodes[:, 4], [0.5, 0.0, 0.0])  # skfem's first edge node: edge (0, 1)
+    nodes[0, 4] = s
+    folded = (4 * s - 1) / (3 - 4 * s) < -FOLD_DEPTH
+    assert folded_elements(skfem.MeshTet2(nodes, mesh.t)).tolist() == ([0] if folded else [])
+
+
+def test_a_finger_mesh_with_folded_elements_is_refused_before_its_fem():
+    """gmsh 10 mm graded to 5 mm at the ring edges: positive det J at every quadrature point,
+    folded between them; its FEM 'converged' to a ballooned tube (theta 7.9 deg, stretch 3.1 at
+    0.05 MPa; the uniform 10 mm mesh gives 1.1 deg). The uniform 4 mm mesh, with slivers of
+    negative det J at a few vertices and the right bend (docs/finger.md), is kept."""
+    from softhand.fem.hand.finger import FingerModel, FingerOptions
+    from softhand.reduced.design import HandDesign
+
+    with pytest.raises(InputError, match="fold over themselves") as info:
+        FingerModel(HandDesign(), FingerOptions(mesher="gmsh", mesh_size=10.0, edge_ratio=0.5, mesh_refine=0))
+    assert info.value.field == "mesh"
+    FingerModel(HandDesign(), FingerOptions(mesher="gmsh", mesh_size=4.0, edge_ratio=1.0, mesh_refine=0))

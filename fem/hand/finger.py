@@ -49,6 +49,7 @@ from softhand.fem.hand.frame import to_hand_frame
 from softhand.fem.hand.windings import Windings, WindingFibers, hoop_directions
 from softhand.fem.hyperelastic import rubber_law
 from softhand.fem.loads import CavityVolume
+from softhand.fem.mapping import folded_elements
 from softhand.fem.solid import Solid
 from softhand.meshes.finger import FingerTube
 from softhand.reduced.design import HandDesign
@@ -95,6 +96,12 @@ class FingerModel:
             raise InputError("mesh", describe_mesh(options),
                              "has curved elements turned inside out (negative Jacobian); "
                              "try another mesh size, edge_ratio 1 (uniform) or the layered mesher")
+        folded = folded_elements(self.mesh)
+        if folded.size:  # positive at the quadrature points, folded between them
+            raise InputError("mesh", describe_mesh(options),
+                             f"has {folded.size} curved elements that fold over themselves (its FEM "
+                             f"stops or balloons the tube); try a finer mesh size, edge_ratio 1 "
+                             f"(uniform) or the layered mesher")
         self.windings = Windings(self.mesh, options.fiber_ratio * mu, options.fiber_toe,
                                  options.fiber_intorder, self.solid.scatter)
         X_q = self.solid.sbasis.global_coordinates().value

@@ -174,8 +174,10 @@ def _prove(ev, task, args, out, say) -> dict:
             options = ProofOptions(mesh_size_mm=size, dP_mpa=task.dP, edge_ratio=task.edge_ratio)
             fem = prove(ev, task, options, out=out, progress=say)
             return {**fem, "failed_meshes": failed} if failed else fem
-        except (NotConverged, RuntimeError) as exc:
-            say(f"the FEM proof on the {size:g} mm finger mesh failed: {str(exc)[:300]}")
+        except (NotConverged, RuntimeError, InputError) as exc:
+            if isinstance(exc, InputError) and exc.field != "mesh":
+                raise
+            say(f"the FEM proof on the {size:g} mm finger mesh failed: {str(exc)[:300]}")  # e.g. folded
             failed.append({"mesh_size_mm": size, "error": str(exc)[:300]})
     return {"error": failed[-1]["error"], "failed_meshes": failed}
 
