@@ -27,7 +27,7 @@ import numpy as np
 from softhand.reduced.design import HandDesign
 from softhand.reduced.versions import package_version
 from softhand.studies.batch.studyfile import Study, resolve_kind
-from softhand.studies.io.files import write_json
+from softhand.studies.io.files import finite_or_none, write_json
 
 RESULT, FAILED = "result.json", "failed.json"
 _PACKAGES = ("fem", "meshes", "reduced", "studies")
@@ -182,16 +182,8 @@ def _split_output(out) -> tuple[dict, dict]:
         array = np.asarray(value)
         if array.dtype.kind not in "biuf":
             raise TypeError(f"a kind's result {key!r} must be a number or list of numbers")
-        numbers[key] = _finite_or_none(array.tolist())
+        numbers[key] = finite_or_none(array)  # a case file holds no NaN or Infinity (see _record)
     return numbers, extra
-
-
-def _finite_or_none(value):
-    """nan and +-inf as None (JSON null: not applicable, e.g. a run that never settles); a case
-    file holds no NaN or Infinity, so one that does is damaged (see :func:`_record`)."""
-    if isinstance(value, list):
-        return [_finite_or_none(v) for v in value]
-    return value if isinstance(value, bool) or math.isfinite(value) else None
 
 
 def commit_case(sdir: Path, study: Study, case: Case, output: dict) -> Path:

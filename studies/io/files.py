@@ -29,18 +29,20 @@ def write_json(path: str | Path, obj) -> Path:
 def json_text(obj, indent: int | None = 1) -> str:
     """Strict JSON of ``obj``, which every parser reads: numpy arrays and scalars converted, and
     a number that is not finite (an unbounded limit, a value never reached) as null."""
-    return json.dumps(_strict(obj), indent=indent, default=jsonable, allow_nan=False)
+    return json.dumps(finite_or_none(obj), indent=indent, default=jsonable, allow_nan=False)
 
 
-def _strict(value):
+def finite_or_none(value):
+    """``value`` with every number that is not finite as None (JSON null: not applicable, e.g.
+    an unbounded limit, a run that never settles), through dicts, lists, tuples and numpy."""
     if isinstance(value, float):  # numpy's float64 too
         return value if math.isfinite(value) else None
     if isinstance(value, dict):
-        return {k: _strict(v) for k, v in value.items()}
+        return {k: finite_or_none(v) for k, v in value.items()}
     if isinstance(value, (list, tuple)):
-        return [_strict(v) for v in value]
+        return [finite_or_none(v) for v in value]
     if isinstance(value, (np.ndarray, np.generic)):
-        return _strict(value.tolist())
+        return finite_or_none(value.tolist())
     return value
 
 
