@@ -32,6 +32,25 @@ def test_without_contact_every_hinge_bends_as_the_free_finger():
     np.testing.assert_allclose(grasp_fem.hinge_moments(s.q, 0.8, DESIGN), 0.0, atol=1e-6)
 
 
+def test_a_large_object_touched_near_the_tip_stops_the_finger_at_every_pressure():
+    """A 260 mm object touches pad 5 at a 1.3 deg bend; from 2.6 MPa on the free finger would
+    have bent past it (89 deg and more) and clears it, which it cannot do: the pad keeps
+    pressing, F_v growing with P (it was reported as no contact, F_v = 0)."""
+    D, mass = 260.0, 1.0
+    theta_c, _ = contact.contact_angle(D, DESIGN)
+    P = np.linspace(float(hand.finger_pressure(theta_c, DESIGN)) + 0.05,
+                    float(hand.finger_pressure(math.radians(170.0), DESIGN)), 12)
+    free = [grasp_fem.grasp_state(DESIGN, D, p, 0.0, depth_mm=contact.object_depth(D, DESIGN)) for p in P]
+    swept = [float(np.min(contact.pad_gaps(np.full(DESIGN.n_s, hand.bend_angle(p, DESIGN, reservoir=False)
+                                                    / DESIGN.n_s), (0.0, s.depth), 0.5 * D, DESIGN))) > 0
+             for p, s in zip(P, free)]
+    assert swept[-1] and not swept[0]  # the case: the free finger clears the object at the top
+    states = [grasp_fem.grasp_state(DESIGN, D, p, mass) for p in P]
+    assert all(s.link == 5 for s in states)
+    assert np.all(np.diff([s.F_v for s in states]) > 0) and states[0].F_v > 0
+    assert all(s.theta < math.radians(20.0) for s in states)  # held far below the free bend
+
+
 def test_one_link_contact_is_the_lever_law():
     """Pad 1 touches (160 mm object at depth 70 mm): only hinge 1 is held; the pad is tangent to
     the circle, closed form for its angle, and N s = -M_1 with s the distance from hinge 1."""
