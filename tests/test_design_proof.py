@@ -38,17 +38,17 @@ def test_the_proof_mesh_follows_the_wall():
     assert proof_mesh(task.base.replace(b=5.69), 4.0) == 4.0    # a finer mesh is kept
 
 
-def test_a_failed_proof_mesh_is_retried_on_the_thick_walls_mesh(monkeypatch):
+def test_a_failed_proof_mesh_is_retried_on_the_next_finer_one(monkeypatch):
     from types import SimpleNamespace
 
     from softhand.studies.cli.verbs import design as verb
     from softhand.studies.design import proof
 
-    tried = []
+    tried, works = [], 6.0
 
     def prove(ev, task, options, out=None, progress=None):
         tried.append(options.mesh_size_mm)
-        if options.mesh_size_mm > 6.0:
+        if options.mesh_size_mm > works:
             raise RuntimeError("free-bend FEM: Newton failed")
         return {"P_grasp_MPa": 0.5}
 
@@ -61,6 +61,17 @@ def test_a_failed_proof_mesh_is_retried_on_the_thick_walls_mesh(monkeypatch):
     tried.clear()
     fem = verb._prove(ev, task, SimpleNamespace(mesh_size_mm=6.0), None, lambda text: None)
     assert tried == [6.0] and "failed_meshes" not in fem
+    tried.clear()
+    works = 4.0  # a thin wall: the 10 and 6 mm meshes stall, 4 mm bends it
+    fem = verb._prove(ev, task, SimpleNamespace(mesh_size_mm=None), None, lambda text: None)
+    assert tried == [10.0, 6.0, 4.0] and [m["mesh_size_mm"] for m in fem["failed_meshes"]] == [10.0, 6.0]
+    tried.clear()
+    works = 3.0  # none works: the last error, every mesh named
+    fem = verb._prove(ev, task, SimpleNamespace(mesh_size_mm=None), None, lambda text: None)
+    assert tried == [10.0, 6.0, 4.0] and "error" in fem and len(fem["failed_meshes"]) == 3
+    tried.clear()
+    fem = verb._prove(ev, task, SimpleNamespace(mesh_size_mm=3.5), None, lambda text: None)
+    assert tried == [3.5]  # a finer mesh of the user's is the only one
 
 
 def test_a_fem_stretch_above_the_limit_reoptimises_with_the_fems_factor(tmp_path, monkeypatch, capsys):

@@ -165,12 +165,11 @@ def _prove_knee(pareto: dict, task, args, out, say) -> dict | None:
 
 def _prove(ev, task, args, out, say) -> dict:
     from softhand.fem.newton import NotConverged
-    from softhand.studies.design.proof import PROOF_MESH_THICK_WALL, ProofOptions, proof_mesh, prove
+    from softhand.studies.design.proof import ProofOptions, proof_meshes, prove
 
-    h = proof_mesh(ev.design, args.mesh_size_mm if args.mesh_size_mm is not None else task.mesh_size)
     failed = []
-    for size in (h, PROOF_MESH_THICK_WALL) if h > PROOF_MESH_THICK_WALL else (h,):
-        try:  # a coarse finger mesh that fails is retried once on the thick walls' mesh
+    for size in proof_meshes(ev.design, args.mesh_size_mm if args.mesh_size_mm is not None else task.mesh_size):
+        try:  # a finger mesh that fails is retried on the next finer one
             options = ProofOptions(mesh_size_mm=size, dP_mpa=task.dP, edge_ratio=task.edge_ratio)
             fem = prove(ev, task, options, out=out, progress=say)
             return {**fem, "failed_meshes": failed} if failed else fem
