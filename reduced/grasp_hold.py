@@ -19,7 +19,9 @@ state ``grasp_state`` reaches at that P (N >= 0, no other pad penetrating the ob
 otherwise, or if the solve fails, the same numbers come from a bracketing root finder on
 ``grasp_state`` (the slow path, :func:`slow_hold`). The solve is Newton's method with one
 batched evaluation of the equations per iteration (the state and its finite-difference
-neighbours at once), 5-6 iterations from the contact state. Units: mm, N, MPa, rad.
+neighbours at once), 5-6 iterations from the contact state (the pump pressure given: at that
+pressure). Neither path answers above the free finger's pressure at its largest bend, where
+``grasp_state`` has no state. Units: mm, N, MPa, rad.
 """
 from __future__ import annotations
 
@@ -131,10 +133,16 @@ def fast_hold(design: HandDesign, diameter_mm: float, mass_kg: float, target: st
     m = k + (k < n_s)  # the held hinges, and one unknown for the distal ones if there are any
     fun = lambda Z: _residuals(Z, k, depth, radius, weight, target, value, design, reservoir)  # noqa: E731
     P_c = float(hand.finger_pressure(theta_c, design))
-    z0 = np.concatenate([np.full(m, theta_c / n_s), [max(float(value), 1.0) if target == "F_v" else 1.0,
-                                                   P_c + 0.1]])
-    z = _newton(fun, z0, np.concatenate([np.full(m, 0.01), [1.0, 0.1]]))
-    if z is None:
+    # the cavity pressure starts just past contact, or (pump pressure given) at the pump's
+    # pressure plus the reservoir's at contact: a start 3 MPa below the answer often failed
+    P0 = P_c + 0.1 if target == "F_v" else \
+        max(P_c + 0.1, float(value) + float(reservoir_pressure(theta_c, design, reservoir)))
+    z0 = np.concatenate([np.full(m, theta_c / n_s), [max(float(value), 1.0) if target == "F_v" else 1.0, P0]])
+    try:
+        z = _newton(fun, z0, np.concatenate([np.full(m, 0.01), [1.0, 0.1]]))
+    except InputError:  # an iterate beyond the models' range (e.g. more oil than the reservoir holds)
+        return None
+    if z is None or not z[m + 1] <= _largest_pressure(design):  # grasp_state has no state there
         return None
     res, F_v = fun(z[None])
     q = np.concatenate([z[:k], np.full(n_s - k, z[k])])
@@ -144,6 +152,12 @@ def fast_hold(design: HandDesign, diameter_mm: float, mass_kg: float, target: st
         return None
     theta, P = float(np.sum(q)), float(z[m + 1])
     return Hold(P, float(P - reservoir_pressure(theta, design, reservoir)), float(F_v[0]), theta, k, True)
+
+
+def _largest_pressure(design: HandDesign) -> float:
+    """The largest cavity pressure [MPa] either path answers at: the free finger's at (nearly)
+    its largest bend, where :func:`reduced.grasp_fem.grasp_state` stops."""
+    return float(hand.finger_pressure(0.999 * hand.THETA_RANGE[1], design))
 
 
 def _condition(target: str, value: float, design: HandDesign, reservoir: bool):
@@ -161,7 +175,7 @@ def slow_hold(design: HandDesign, diameter_mm: float, mass_kg: float, target: st
     :func:`reduced.grasp_fem.grasp_state` (from the contact pressure up to the free finger's
     pressure at its largest bend)."""
     design = grasp_fem.fem_finger(design)
-    P_max = float(hand.finger_pressure(0.999 * hand.THETA_RANGE[1], design))
+    P_max = _largest_pressure(design)
     depth = contact.object_depth(diameter_mm, design)
     theta_c, _ = contact.contact_angle(diameter_mm, design, depth=depth)
     state = lambda P: grasp_fem.grasp_state(design, diameter_mm, P, mass_kg)  # noqa: E731

@@ -96,3 +96,58 @@ def test_a_force_one_pad_cannot_give_is_refused_at_the_edge_of_one_pad(monkeypat
     assert below.F_v < 98.0665
     with pytest.raises(InputError):
         state(PAPER, 180.0, edge + 2 * grasp_hold.BRACKET_RESOLUTION, 20.0)
+
+
+#: a big object held at the tip of a short, stiff finger with a small reservoir: the pump's 3.5 MPa
+#: are ~3.4 MPa above the contact pressure
+TIP_HOLD = PAPER.replace(a=4.1, b=4.3, d=17.0, R=19.5, t=1.5, V0=2200.0, tie_width=7.6, l0=154.0,
+                         hinge_s=tuple(s * 154.0 / PAPER.l0 for s in PAPER.hinge_s))
+
+
+def test_a_pump_pressure_far_above_contact_is_found_by_the_fast_path():
+    """Newton starts at the pump's pressure (plus the reservoir's at contact), not just past
+    contact, from where it failed (the slow path's 14 equilibria then): the same state as the
+    slow path."""
+    fast = grasp_hold.fast_hold(TIP_HOLD, 230.0, 3.5, "P_pump", 3.5)
+    slow = grasp_hold.slow_hold(TIP_HOLD, 230.0, 3.5, "P_pump", 3.5)
+    assert fast is not None and fast.link == slow.link == 5
+    for a, b in zip(fast[:4], slow[:4]):
+        assert a == pytest.approx(b, rel=1e-10, abs=1e-12)
+
+
+def test_both_paths_stop_where_the_free_finger_has_no_pressure():
+    """Above the free finger's pressure at its largest bend (4.0 MPa here) the FEM-calibrated curve
+    has no state for grasp_state: the slow path refuses, and the fast path, whose equations go
+    on, gives no answer there either (it gave F_v = 93 N at 4.5 MPa)."""
+    from softhand.reduced.errors import InputError
+
+    top = grasp_hold._largest_pressure(TIP_HOLD)
+    assert 3.9 < top < 4.1
+    with pytest.raises(InputError):
+        grasp_fem.grasp_state(TIP_HOLD, 230.0, top + 0.1, 3.5)
+    assert grasp_hold.fast_hold(TIP_HOLD, 230.0, 3.5, "P_pump", 4.5) is None
+    with pytest.raises(InputError, match="not reached"):
+        grasp_hold.hold(TIP_HOLD, 230.0, 3.5, "P_pump", 4.5)
+
+
+def test_a_fast_iterate_outside_the_models_is_left_to_the_slow_path(monkeypatch):
+    """A small reservoir: a Newton iterate of the fast path takes more oil than the reservoir
+    holds (InputError from the reservoir model), which ended the design's evaluation; now the
+    fast path gives no answer and the slow one finds the grasp (one pad, 3.5 MPa, F_v 96 N)."""
+    from softhand.reduced.errors import InputError
+
+    design = PAPER.replace(a=5.2, b=5.3, d=17.9, R=27.5, t=1.1, V0=5600.0, tie_width=14.1, l0=180.0)
+    raised, newton = [], grasp_hold._newton
+
+    def watched(*args, **kwargs):
+        try:
+            return newton(*args, **kwargs)
+        except InputError as err:
+            raised.append(err)
+            raise
+
+    monkeypatch.setattr(grasp_hold, "_newton", watched)
+    assert grasp_hold.fast_hold(design, 230.0, 3.5, "P_pump", 3.5) is None and raised
+    held = grasp_hold.hold(design, 230.0, 3.5, "P_pump", 3.5)
+    assert not held.fast and held.link == 5 and held.P_pump == pytest.approx(3.5, abs=1e-12)
+    assert grasp_fem.grasp_state(design, 230.0, held.P_cavity, 3.5).F_v == pytest.approx(held.F_v, rel=1e-9)
