@@ -32,3 +32,12 @@ class InputError(ValueError):
     def renamed(self, field: str) -> "InputError":
         """The same complaint under the name the user typed (an option, a file's key)."""
         return InputError(field, self.value, self.allowed)
+
+
+class MeshRejected(InputError):
+    """A mesh the FEM refuses before solving (elements inverted or folded, a map it cannot
+    invert): bad input when the user chose it; a caller that chose the mesh itself (the design
+    proof) tries another."""
+
+    def __init__(self, mesh: str, allowed: str):
+        super().__init__("mesh", mesh, allowed)

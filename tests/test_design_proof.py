@@ -41,6 +41,7 @@ def test_the_proof_mesh_follows_the_wall():
 def test_a_failed_proof_mesh_is_retried_on_the_next_finer_one(monkeypatch):
     from types import SimpleNamespace
 
+    from softhand.reduced.errors import InputError, MeshRejected
     from softhand.studies.cli.verbs import design as verb
     from softhand.studies.design import proof
 
@@ -48,6 +49,8 @@ def test_a_failed_proof_mesh_is_retried_on_the_next_finer_one(monkeypatch):
 
     def prove(ev, task, options, out=None, progress=None):
         tried.append(options.mesh_size_mm)
+        if options.mesh_size_mm == 10.0:  # the FEM refuses the mesh: the proof's choice, not the user's
+            raise MeshRejected("gmsh 10 mm", "has 39 curved elements that fold over themselves")
         if options.mesh_size_mm > works:
             raise RuntimeError("free-bend FEM: Newton failed")
         return {"P_grasp_MPa": 0.5}
@@ -72,6 +75,13 @@ def test_a_failed_proof_mesh_is_retried_on_the_next_finer_one(monkeypatch):
     tried.clear()
     fem = verb._prove(ev, task, SimpleNamespace(mesh_size_mm=3.5), None, lambda text: None)
     assert tried == [3.5]  # a finer mesh of the user's is the only one
+
+    def refuses(*args, **kwargs):
+        raise InputError("--pressure-mpa", -1.0, "must be positive")
+
+    monkeypatch.setattr(proof, "prove", refuses)
+    with pytest.raises(InputError):  # any other bad input is the user's: it ends the run
+        verb._prove(ev, task, SimpleNamespace(mesh_size_mm=None), None, lambda text: None)
 
 
 def test_a_fem_stretch_above_the_limit_reoptimises_with_the_fems_factor(tmp_path, monkeypatch, capsys):

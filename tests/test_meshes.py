@@ -217,8 +217,9 @@ def test_a_finger_mesh_with_folded_elements_is_refused_before_its_fem():
     negative det J at a few vertices and the right bend (docs/finger.md), is kept."""
     from softhand.fem.hand.finger import FingerModel, FingerOptions
     from softhand.reduced.design import HandDesign
+    from softhand.reduced.errors import MeshRejected
 
     with pytest.raises(InputError, match="fold over themselves") as info:
         FingerModel(HandDesign(), FingerOptions(mesher="gmsh", mesh_size=10.0, edge_ratio=0.5, mesh_refine=0))
-    assert info.value.field == "mesh"
+    assert info.value.field == "mesh" and isinstance(info.value, MeshRejected)
     FingerModel(HandDesign(), FingerOptions(mesher="gmsh", mesh_size=4.0, edge_ratio=1.0, mesh_refine=0))

@@ -53,7 +53,7 @@ from softhand.fem.mapping import folded_elements
 from softhand.fem.solid import Solid
 from softhand.meshes.finger import FingerTube
 from softhand.reduced.design import HandDesign
-from softhand.reduced.errors import InputError
+from softhand.reduced.errors import MeshRejected
 
 __all__ = ["FingerModel", "FingerOptions", "FingerState", "SweepStats", "WindingFibers",
            "ring_width", "solve_pressures", "tie_bands", "to_hand_frame"]
@@ -93,15 +93,15 @@ class FingerModel:
         rubber = rubber_law(design.finger_rubber, options.kappa_ratio * mu)
         self.solid = Solid(self.mesh, rubber)
         if not np.all(self.solid.W > 0):
-            raise InputError("mesh", describe_mesh(options),
-                             "has curved elements turned inside out (negative Jacobian); "
-                             "try another mesh size, edge_ratio 1 (uniform) or the layered mesher")
+            raise MeshRejected(describe_mesh(options),
+                               "has curved elements turned inside out (negative Jacobian); "
+                               "try another mesh size, edge_ratio 1 (uniform) or the layered mesher")
         folded = folded_elements(self.mesh)
         if folded.size:  # positive at the quadrature points, folded between them
-            raise InputError("mesh", describe_mesh(options),
-                             f"has {folded.size} curved elements that fold over themselves (its FEM "
-                             f"stops or balloons the tube); try a finer mesh size, edge_ratio 1 "
-                             f"(uniform) or the layered mesher")
+            raise MeshRejected(describe_mesh(options),
+                               f"has {folded.size} curved elements that fold over themselves (its FEM "
+                               f"stops or balloons the tube); try a finer mesh size, edge_ratio 1 "
+                               f"(uniform) or the layered mesher")
         self.windings = Windings(self.mesh, options.fiber_ratio * mu, options.fiber_toe,
                                  options.fiber_intorder, self.solid.scatter)
         X_q = self.solid.sbasis.global_coordinates().value
@@ -219,7 +219,7 @@ def _cavity(solid, mesh, options: FingerOptions) -> CavityVolume:
     except RuntimeError as err:  # fem.mapping.RobustIsoparametric.invF
         if "inverse isoparametric map" not in str(err):
             raise
-        raise InputError("mesh", describe_mesh(options),
-                         "has a curved element too distorted to map; try another mesh size, "
-                         "edge_ratio 1 (uniform) or the layered mesher") from None
+        raise MeshRejected(describe_mesh(options),
+                           "has a curved element too distorted to map; try another mesh size, "
+                           "edge_ratio 1 (uniform) or the layered mesher") from None
 

@@ -18,7 +18,7 @@ from pathlib import Path
 
 import numpy as np
 
-from softhand.reduced.errors import InputError
+from softhand.reduced.errors import InputError, MeshRejected
 from softhand.studies.cli.args import add_json_option, add_progress_option, print_json, print_table
 
 HELP = "size finger and reservoir for an object (reduced model, optimiser) and prove it with the FEM"
@@ -173,9 +173,7 @@ def _prove(ev, task, args, out, say) -> dict:
             options = ProofOptions(mesh_size_mm=size, dP_mpa=task.dP, edge_ratio=task.edge_ratio)
             fem = prove(ev, task, options, out=out, progress=say)
             return {**fem, "failed_meshes": failed} if failed else fem
-        except (NotConverged, RuntimeError, InputError) as exc:
-            if isinstance(exc, InputError) and exc.field != "mesh":
-                raise
+        except (NotConverged, RuntimeError, MeshRejected) as exc:
             say(f"the FEM proof on the {size:g} mm finger mesh failed: {str(exc)[:300]}")  # e.g. folded
             failed.append({"mesh_size_mm": size, "error": str(exc)[:300]})
     return {"error": failed[-1]["error"], "failed_meshes": failed}
