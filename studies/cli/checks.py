@@ -72,6 +72,18 @@ def check_outputs(verb: str, args, parser) -> None:
             check_writable(value, kind, option_name(dest, parser))
 
 
+def check_choices(option: str, names, allowed, what: str, shown: str | None = None) -> None:
+    """Each of ``names`` (a list the user gave to ``option``) is one of ``allowed`` and named
+    once; ``what`` names one of them ("case", "section"), ``shown`` the value as typed."""
+    shown = ",".join(names) if shown is None else shown
+    unknown = [n for n in names if n not in allowed]
+    if unknown or not names:
+        bad = unknown[0] if unknown and unknown[0] else shown  # a blank name: the whole value
+        raise InputError(option, bad, f"allowed: {', '.join(allowed)}")
+    if len(set(names)) != len(names):
+        raise InputError(option, shown, f"names a {what} twice; name each once")
+
+
 def check_writable(path, kind: str, field: str) -> None:
     """``path`` can be written as a ``kind`` ('dir', 'file' or one of SUFFIXES) output."""
     text = str(path)

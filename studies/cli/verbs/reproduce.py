@@ -20,18 +20,14 @@ def configure(parser) -> None:
 
 
 def run(args) -> int:
-    from softhand.reduced.errors import InputError
+    from softhand.studies.cli.checks import check_choices
     from softhand.studies.reproduce.core import exit_code, reproduce, sections
 
     keys = [s.key for s in sections()]
     only = None
     if args.only is not None:
         only = tuple(k.strip() for k in args.only.split(","))
-        unknown = [k for k in only if k not in keys]
-        if unknown or not only:
-            raise InputError("--only", args.only, f"allowed section keys: {', '.join(keys)}")
-        if len(set(only)) != len(only):
-            raise InputError("--only", args.only, "names a section twice; name each once")
+        check_choices("--only", only, keys, "section", shown=args.only)
     outcomes = reproduce(args.out, quick=args.quick, design=design_from_args(args), only=only,
                          fresh=args.fresh, progress=not args.no_progress)
     width = max(len(o.section.key) for o in outcomes)

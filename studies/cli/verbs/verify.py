@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import sys
 
-from softhand.reduced.errors import InputError
+from softhand.studies.cli.checks import check_choices
 from softhand.studies.cli.args import add_json_option, add_progress_option, print_json, print_table
 
 HELP = "FEM verification suite: closed forms vs FEM on small meshes (exit 1 if any fails)"
@@ -26,11 +26,7 @@ def run(args) -> int:
     from softhand.studies.verification.registry import REGISTRY, run_case
 
     names = args.case or list(REGISTRY)
-    if len(set(names)) != len(names):
-        raise InputError("--case", ",".join(names), "names a case twice; name each once")
-    unknown = [n for n in names if n not in REGISTRY]
-    if unknown:
-        raise InputError("--case", unknown[0], f"allowed: {', '.join(REGISTRY)}")
+    check_choices("--case", names, list(REGISTRY), "case")
     rows = []
     for name in tqdm(names, desc="verify", unit="case", file=sys.stderr, leave=False,
                      disable=args.no_progress):
