@@ -20,7 +20,7 @@ otherwise, or if the solve fails, the same numbers come from a bracketing root f
 ``grasp_state`` (the slow path, :func:`slow_hold`). The solve is Newton's method with one
 batched evaluation of the equations per iteration (the state and its finite-difference
 neighbours at once), 5-6 iterations from the contact state (the pump pressure given: at that
-pressure). Neither path answers above the free finger's pressure at its largest bend, where
+pressure; and on the later pads in turn, see :func:`fast_hold`). Neither path answers above the free finger's pressure at its largest bend, where
 ``grasp_state`` has no state. Units: mm, N, MPa, rad.
 """
 from __future__ import annotations
@@ -122,21 +122,46 @@ def fast_hold(design: HandDesign, diameter_mm: float, mass_kg: float, target: st
     """The grasp with F_v = value [N] (``target="F_v"``) or pump pressure value [MPa]
     (``target="P_pump"``), by one Newton solve of the module's equations from the contact; None
     if that solve fails or is not the state :func:`reduced.grasp_fem.grasp_state` reaches (see
-    module doc)."""
+    module doc).
+
+    A pump pressure well above contact often presses a later pad than the one that touched
+    first (the paper's hand at 2 MPa on 180 mm: pad 3, touching with pad 2): the later pads are
+    tried in turn, and such an answer is kept only if ``grasp_state`` at its pressure is the
+    same state (one equilibrium, against a dozen for the slow path). The pump pressure grows
+    with the cavity's, so its answer is the only one; F_v need not (it drops where the
+    touching pad changes), so for F_v only the first pad is tried: a later pad's answer
+    could be a second root."""
     design = grasp_fem.fem_finger(design)
     depth = contact.object_depth(diameter_mm, design)
-    radius, weight = 0.5 * float(diameter_mm), float(mass_kg) * design.g / design.n
-    theta_c, k = contact.contact_angle(diameter_mm, design, depth=depth)
-    if k == 0:
+    theta_c, first = contact.contact_angle(diameter_mm, design, depth=depth)
+    if first == 0:
         return None
-    n_s = design.n_s
-    m = k + (k < n_s)  # the held hinges, and one unknown for the distal ones if there are any
-    fun = lambda Z: _residuals(Z, k, depth, radius, weight, target, value, design, reservoir)  # noqa: E731
     P_c = float(hand.finger_pressure(theta_c, design))
     # the cavity pressure starts just past contact, or (pump pressure given) at the pump's
     # pressure plus the reservoir's at contact: a start 3 MPa below the answer often failed
     P0 = P_c + 0.1 if target == "F_v" else \
         max(P_c + 0.1, float(value) + float(reservoir_pressure(theta_c, design, reservoir)))
+    for k in range(first, first + 1 if target == "F_v" else design.n_s + 1):
+        held = _hold_on_pad(k, design, diameter_mm, depth, mass_kg, target, value, reservoir, theta_c, P0)
+        if held is None:
+            continue
+        if k == first:
+            return held
+        state = grasp_fem.grasp_state(design, diameter_mm, held.P_cavity, mass_kg)
+        if state.link == k and abs(state.theta - held.theta) <= 1e-9 * max(1.0, abs(held.theta)):
+            return held
+    return None
+
+
+def _hold_on_pad(k: int, design: HandDesign, diameter_mm: float, depth: float, mass_kg: float, target: str,
+                 value: float, reservoir: bool, theta_c: float, P0: float) -> Hold | None:
+    """:func:`fast_hold`'s Newton solve with pad k touching, from hinges at theta_c / n_s and
+    cavity pressure P0; None if it fails or its state is not acceptable (N < 0, another pad in
+    the object, a residual left)."""
+    radius, weight = 0.5 * float(diameter_mm), float(mass_kg) * design.g / design.n
+    n_s = design.n_s
+    m = k + (k < n_s)  # the held hinges, and one unknown for the distal ones if there are any
+    fun = lambda Z: _residuals(Z, k, depth, radius, weight, target, value, design, reservoir)  # noqa: E731
     z0 = np.concatenate([np.full(m, theta_c / n_s), [max(float(value), 1.0) if target == "F_v" else 1.0, P0]])
     try:
         z = _newton(fun, z0, np.concatenate([np.full(m, 0.01), [1.0, 0.1]]))
