@@ -191,16 +191,17 @@ def grasp_state(design: HandDesign, diameter_mm: float, P: float, mass_kg: float
     depth = contact.object_depth(diameter_mm, design) if depth_mm is None else float(depth_mm)
     radius, weight = 0.5 * float(diameter_mm), float(mass_kg) * design.g / design.n
     q_free = np.full(design.n_s, float(hand.bend_angle(P, design, reservoir=False)) / design.n_s)
-    if np.min(contact.pad_gaps(q_free, (0.0, depth), radius, design)) >= 0.0:
-        # the free finger clear of the object: it has not reached it yet (or never does) -- or,
-        # bent past the angle where it first touches, it has swept through it, which the object stops
-        try:
-            reached = float(np.sum(q_free)) >= contact.contact_angle(diameter_mm, design, depth=depth)[0]
-        except InputError:  # it does not reach the object
-            reached = False
-        if not reached:
+    # the free finger clear of the object has not reached it yet (or never does) -- or, bent past
+    # the angle where it first touches, it has swept through it, which the object stops
+    clear = np.min(contact.pad_gaps(q_free, (0.0, depth), radius, design)) >= 0.0
+    try:
+        theta_c, link = contact.contact_angle(diameter_mm, design, depth=depth)
+    except InputError:
+        if clear:  # it does not reach the object
             return _state(P, depth, q_free, -1, 0.0, weight, design)
-    theta_c, link = contact.contact_angle(diameter_mm, design, depth=depth)
+        raise
+    if clear and float(np.sum(q_free)) < theta_c:
+        return _state(P, depth, q_free, -1, 0.0, weight, design)
     q0 = np.concatenate([np.full(link, theta_c / design.n_s), q_free[link:]])
     corner, seen = False, set()
     for _ in range(design.n_s + 2):

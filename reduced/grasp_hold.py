@@ -20,8 +20,9 @@ otherwise, or if the solve fails, the same numbers come from a bracketing root f
 ``grasp_state`` (the slow path, :func:`slow_hold`). The solve is Newton's method with one
 batched evaluation of the equations per iteration (the state and its finite-difference
 neighbours at once), 5-6 iterations from the contact state (the pump pressure given: at that
-pressure; and on the later pads in turn, see :func:`fast_hold`). Neither path answers above the free finger's pressure at its largest bend, where
-``grasp_state`` has no state. Units: mm, N, MPa, rad.
+pressure, and on the later pads in turn, see :func:`fast_hold`). Neither path answers above
+the free finger's pressure at its largest bend, where ``grasp_state`` has no state. Units:
+mm, N, MPa, rad.
 """
 from __future__ import annotations
 
