@@ -212,6 +212,17 @@ def slow_hold(design: HandDesign, diameter_mm: float, mass_kg: float, target: st
         return cond(s.q, P, s.F_v)
 
     lo = float(hand.finger_pressure(theta_c, design)) + 1e-9
+    if target == "P_pump" and value > lo:
+        # the reservoir's pressure is not negative, so the cavity pressure of the answer is at
+        # least the pump's: if one pad no longer holds the object alone there, it does not
+        # hold it alone at the answer either (a pump limit beyond where a second pad touches:
+        # one equilibrium instead of a bracket halving down to that edge)
+        try:
+            state(float(value))
+        except InputError:
+            raise InputError(target, value, f"not reached by the finger on one pad: a second pad "
+                                            f"touches below the cavity pressure {value:.4g} MPa, "
+                                            "the least the pump pressure needs") from None
     f_lo, step, grow = f(lo), 0.05, 2.0
     hi, f_hi = lo, f_lo
     for _ in range(60):  # the first sign change above the contact pressure: steps 0.05, 0.1, ... MPa

@@ -168,3 +168,25 @@ def test_a_pump_pressure_that_presses_a_later_pad_is_found_on_it(monkeypatch):
         assert a == pytest.approx(b, rel=1e-10, abs=1e-12)
     force = grasp_hold.slow_hold(PAPER, 180.0, 1.0, "F_v", held.F_v)
     assert force.link == 3 and grasp_hold.fast_hold(PAPER, 180.0, 1.0, "F_v", held.F_v) is None
+
+
+def test_a_pump_pressure_beyond_the_one_pad_region_is_refused_at_once(monkeypatch):
+    """The paper's hand at a 4 MPa pump on 180 mm: a second pad touches near 3 MPa. The answer's
+    cavity pressure is at least the pump's (the reservoir's pressure is not negative), where one
+    pad no longer holds the object alone: refused after that one equilibrium (the bracket
+    halved down to the edge, ~0.5 s). A scan of the one-pad states confirms: none reaches 4 MPa."""
+    from softhand.reduced.errors import InputError
+
+    calls, state = [], grasp_fem.grasp_state
+    monkeypatch.setattr(grasp_fem, "grasp_state", lambda *a, **k: calls.append(a) or state(*a, **k))
+    with pytest.raises(InputError, match="second pad touches below the cavity pressure 4 MPa"):
+        grasp_hold.slow_hold(PAPER, 180.0, 1.0, "P_pump", 4.0)
+    assert len(calls) == 1
+    reached = []
+    for P in np.arange(0.4, 4.0, 0.05):
+        try:
+            s = state(PAPER, 180.0, P, 1.0)
+        except InputError:
+            break
+        reached.append(P - float(grasp_hold.reservoir_pressure(s.theta, PAPER)))
+    assert 1.5 < len(reached) * 0.05 and max(reached) < 4.0
