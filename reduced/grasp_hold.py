@@ -144,7 +144,7 @@ def fast_hold(design: HandDesign, diameter_mm: float, mass_kg: float, target: st
         max(P_c + 0.1, float(value) + float(reservoir_pressure(theta_c, design, reservoir)))
     for k in range(first, first + 1 if target == "F_v" else design.n_s + 1):
         held = _hold_on_pad(k, design, diameter_mm, depth, mass_kg, target, value, reservoir, theta_c, P0)
-        if held is None:
+        if held is None or not held.P_cavity <= _largest_pressure(design):  # grasp_state has no state there
             continue
         if k == first:
             return held
@@ -168,7 +168,7 @@ def _hold_on_pad(k: int, design: HandDesign, diameter_mm: float, depth: float, m
         z = _newton(fun, z0, np.concatenate([np.full(m, 0.01), [1.0, 0.1]]))
     except InputError:  # an iterate beyond the models' range (e.g. more oil than the reservoir holds)
         return None
-    if z is None or not z[m + 1] <= _largest_pressure(design):  # grasp_state has no state there
+    if z is None:
         return None
     res, F_v = fun(z[None])
     q = np.concatenate([z[:k], np.full(n_s - k, z[k])])
@@ -214,16 +214,18 @@ def slow_hold(design: HandDesign, diameter_mm: float, mass_kg: float, target: st
     lo = float(hand.finger_pressure(theta_c, design)) + 1e-9
     if target == "P_pump" and value > lo:
         # the reservoir's pressure is not negative, so the cavity pressure of the answer is at
-        # least the pump's: if one pad no longer holds the object alone there, it does not
-        # hold it alone at the answer either (a pump limit beyond where a second pad touches:
-        # one equilibrium instead of a bracket halving down to that edge)
+        # least the pump's: the bracket starts there (no root below it); and if one pad no longer
+        # holds the object alone there, it does not at the answer either (a pump limit beyond
+        # where a second pad touches: one equilibrium instead of a bracket halving to that edge)
         try:
-            state(float(value))
+            lo, f_lo = float(value), f(float(value))
         except InputError:
             raise InputError(target, value, f"not reached by the finger on one pad: a second pad "
                                             f"touches below the cavity pressure {value:.4g} MPa, "
                                             "the least the pump pressure needs") from None
-    f_lo, step, grow = f(lo), 0.05, 2.0
+    else:
+        f_lo = f(lo)
+    step, grow = 0.05, 2.0
     hi, f_hi = lo, f_lo
     for _ in range(60):  # the first sign change above the contact pressure: steps 0.05, 0.1, ... MPa
         hi = min(lo + step, P_max)

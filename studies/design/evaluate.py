@@ -23,9 +23,10 @@ fits its links (a + b < d), walls (b >= min wall, t > 0), the reservoir keeps oi
 and sits below the first pressure maximum of its model p_r(V) (limit point), peak stretch,
 pump pressure (at most the pump's limit), the open hand passes the object and at rest (pump
 off) does not reach into the object's place (the free hand's pump pressure at the grasp angle,
-P_contact >= 0, so P_grasp >= 0 too: the pump pushes oil into the fingers), the sheet is thin enough for the membrane models of the
-reservoir (t/R <= :data:`reduced.reservoir.MAX_THICKNESS_RATIO`), and the finger model's
-calibrated range when it has one. The whole model's P(theta) and theta(P) are those of
+P_contact >= 0, so P_grasp >= 0 too: the pump pushes oil into the fingers), the sheet is thin
+enough for the membrane models of the reservoir (t/R <=
+:data:`reduced.reservoir.MAX_THICKNESS_RATIO`), and the finger model's calibrated range when
+it has one. The whole model's P(theta) and theta(P) are those of
 ``design.finger_model``/``design.reservoir_model`` through :mod:`reduced.hand`, so another
 finger model changes the answer by a design key alone.
 """
