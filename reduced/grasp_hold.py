@@ -51,6 +51,14 @@ class Hold(NamedTuple):
     theta: float      #: the finger's bend, sum of the hinge angles [rad]
     link: int         #: the touching pad
     fast: bool        #: found by the one-solve path (False: the slow path)
+    edge: str = ""    #: :func:`at_pump` only: why the grasp stops below the pump pressure asked ("": it does not)
+
+
+#: :attr:`Hold.edge`: one pad no longer holds the object alone above this state (a second pad touches it)
+ONE_PAD_END = "one pad no longer holds the object alone (a second pad touches it)"
+#: :attr:`Hold.edge`: the cavity pressure reaches the calibrated finger's highest (the free finger's at its
+#: largest bend), above which the finger model has no state
+LARGEST_BEND = "the cavity pressure reaches the calibrated finger's highest (the free finger's at its largest bend)"
 
 
 def reservoir_pressure(theta, design: HandDesign, reservoir: bool = True):
@@ -87,6 +95,8 @@ def _residuals(Z, k: int, depth: float, radius: float, weight: float, target: st
         cond = F_v - value
     elif target == "P_pump":
         cond = P - reservoir_pressure(q.sum(axis=1), design, reservoir) - value
+    elif target == "gap":  # pad ``value`` just touches the object: where one pad stops holding it alone
+        cond = contact.pad_gaps(q, C, radius, design)[:, int(value)]
     else:
         raise ValueError(target)
     # hinges 1..k held; hinge k+1 (as every distal one) free: M_{k+1} = 0
@@ -143,7 +153,9 @@ def fast_hold(design: HandDesign, diameter_mm: float, mass_kg: float, target: st
     P0 = P_c + 0.1 if target == "F_v" else \
         max(P_c + 0.1, float(value) + float(reservoir_pressure(theta_c, design, reservoir)))
     for k in range(first, first + 1 if target == "F_v" else design.n_s + 1):
-        held = _hold_on_pad(k, design, diameter_mm, depth, mass_kg, target, value, reservoir, theta_c, P0)
+        m = k + (k < design.n_s)  # the held hinges, and one unknown for the distal ones if there are any
+        z0 = np.concatenate([np.full(m, theta_c / design.n_s), [max(float(value), 1.0) if target == "F_v" else 1.0, P0]])
+        held = _hold_on_pad(k, design, diameter_mm, depth, mass_kg, target, value, reservoir, z0)
         if held is None or not held.P_cavity <= _largest_pressure(design):  # grasp_state has no state there
             continue
         if k == first:
@@ -155,15 +167,30 @@ def fast_hold(design: HandDesign, diameter_mm: float, mass_kg: float, target: st
 
 
 def _hold_on_pad(k: int, design: HandDesign, diameter_mm: float, depth: float, mass_kg: float, target: str,
-                 value: float, reservoir: bool, theta_c: float, P0: float) -> Hold | None:
-    """:func:`fast_hold`'s Newton solve with pad k touching, from hinges at theta_c / n_s and
-    cavity pressure P0; None if it fails or its state is not acceptable (N < 0, another pad in
-    the object, a residual left)."""
+                 value: float, reservoir: bool, z0) -> Hold | None:
+    """:func:`fast_hold`'s Newton solve with pad k touching, from z0 = (held hinges, distal
+    hinges, N, cavity pressure); None if it fails or its state is not acceptable (N < 0, another
+    pad in the object -- but pad ``value`` for ``target="gap"`` --, a residual left)."""
+    solved = _solve_on_pad(k, design, diameter_mm, depth, mass_kg, target, value, reservoir, z0)
+    if solved is None:
+        return None
+    z, gaps, F_v = solved
+    if target == "gap":
+        gaps[int(value)] = np.inf
+    if z[-2] < 0.0 or np.min(gaps) < -grasp_fem._PENETRATION:
+        return None
+    q = _hinges(z, k, design.n_s)
+    theta, P = float(np.sum(q)), float(z[-1])
+    return Hold(P, float(P - reservoir_pressure(theta, design, reservoir)), F_v, theta, k, True)
+
+
+def _solve_on_pad(k: int, design: HandDesign, diameter_mm: float, depth: float, mass_kg: float, target: str,
+                  value: float, reservoir: bool, z0):
+    """The Newton solve of :func:`_hold_on_pad`, unchecked: (z, the gaps of the pads but k, F_v),
+    or None if it fails or leaves a residual."""
     radius, weight = 0.5 * float(diameter_mm), float(mass_kg) * design.g / design.n
-    n_s = design.n_s
-    m = k + (k < n_s)  # the held hinges, and one unknown for the distal ones if there are any
+    m = len(z0) - 2
     fun = lambda Z: _residuals(Z, k, depth, radius, weight, target, value, design, reservoir)  # noqa: E731
-    z0 = np.concatenate([np.full(m, theta_c / n_s), [max(float(value), 1.0) if target == "F_v" else 1.0, P0]])
     try:
         z = _newton(fun, z0, np.concatenate([np.full(m, 0.01), [1.0, 0.1]]))
     except InputError:  # an iterate beyond the models' range (e.g. more oil than the reservoir holds)
@@ -171,13 +198,16 @@ def _hold_on_pad(k: int, design: HandDesign, diameter_mm: float, depth: float, m
     if z is None:
         return None
     res, F_v = fun(z[None])
-    q = np.concatenate([z[:k], np.full(n_s - k, z[k])])
-    gaps = contact.pad_gaps(q, (0.0, depth), radius, design)
-    gaps[k] = np.inf
-    if z[m] < 0.0 or np.min(gaps) < -grasp_fem._PENETRATION or np.max(np.abs(res)) > 1e-8:
+    if np.max(np.abs(res)) > 1e-8:
         return None
-    theta, P = float(np.sum(q)), float(z[m + 1])
-    return Hold(P, float(P - reservoir_pressure(theta, design, reservoir)), float(F_v[0]), theta, k, True)
+    gaps = contact.pad_gaps(_hinges(z, k, design.n_s), (0.0, depth), radius, design)
+    gaps[k] = np.inf
+    return z, gaps, float(F_v[0])
+
+
+def _hinges(z, k: int, n_s: int) -> np.ndarray:
+    """The hinge angles (n_s,) of the unknowns z: k held, the distal ones at z[k]."""
+    return np.concatenate([z[:k], np.full(n_s - k, z[k] if k < n_s else 0.0)])
 
 
 def _largest_pressure(design: HandDesign) -> float:
@@ -257,3 +287,133 @@ def hold(design: HandDesign, diameter_mm: float, mass_kg: float, target: str, va
     fast = fast_hold(design, diameter_mm, mass_kg, target, value, reservoir=reservoir)
     return fast if fast is not None else slow_hold(design, diameter_mm, mass_kg, target, value,
                                                    reservoir=reservoir)
+
+
+def at_pump(design: HandDesign, diameter_mm: float, mass_kg: float, P_pump: float, *,
+            reservoir: bool = True) -> Hold:
+    """The grasp at pump pressure P_pump [MPa] (:func:`hold`) -- or, where the one-pad model
+    ends at a lower pump pressure, the grasp at that end (:func:`one_pad_end`): a second pad
+    touches the object, or the finger reaches its largest bend. ``Hold.edge`` then says which,
+    and its ``P_pump`` is below the one asked. What a task's margin is measured at: the force
+    the hand gives at the pump limit, or at the highest pump pressure this model answers for."""
+    try:
+        return hold(design, diameter_mm, mass_kg, "P_pump", P_pump, reservoir=reservoir)
+    except InputError as refused:
+        try:
+            end = one_pad_end(design, diameter_mm, mass_kg, reservoir=reservoir, beyond=P_pump)
+        except InputError:  # no one-pad state from the contact on
+            end = None
+        if end is None or not end.P_pump < P_pump:
+            raise refused
+        return end
+
+
+#: how far above the one-pad model's end [MPa] :func:`one_pad_end` checks that it has no state
+END_PROBE = 1e-4
+
+
+def one_pad_end(design: HandDesign, diameter_mm: float, mass_kg: float, *, reservoir: bool = True,
+                beyond: float | None = None) -> Hold | None:
+    """The grasp at the highest cavity pressure up to which one pad holds the object alone, from
+    the contact on (``Hold.edge``: :data:`ONE_PAD_END`, or :data:`LARGEST_BEND` if that is
+    where it ends); None if the finger does not touch the object.
+
+    The end is a state where pad k holds the object and another pad j just touches it: one
+    Newton solve of the module's equations with the condition gap_j = 0 (the cavity pressure
+    unknown) gives it, from a state near it. ``beyond`` (a pump pressure the one-pad model does
+    not reach): the start is the state of pad k at that pump pressure (as :func:`fast_hold`)
+    in which pad j is inside the object, for the pads k in turn; the end is kept if it is
+    :func:`reduced.grasp_fem.grasp_state`'s state at its pressure and ``grasp_state`` has none
+    :data:`END_PROBE` above it (a pad change is not an end). Otherwise ``grasp_state`` is
+    stepped up in cavity pressure (0.05, 0.1, 0.2 ... MPa) until it has no state, the end
+    bisected to :data:`BRACKET_RESOLUTION` and solved for from there (kept if ``grasp_state``'s
+    state), or, failing that, bisected to 1e-13 MPa."""
+    design = grasp_fem.fem_finger(design)
+    P_top = _largest_pressure(design)
+    depth = contact.object_depth(diameter_mm, design)
+    theta_c, first = contact.contact_angle(diameter_mm, design, depth=depth)
+    if first == 0:
+        return None
+    state = lambda P: grasp_fem.grasp_state(design, diameter_mm, P, mass_kg)  # noqa: E731
+    lo = float(hand.finger_pressure(theta_c, design)) + 1e-9
+    if beyond is not None:
+        # a state of pad k at that pump pressure (or at 0.9 of the largest cavity pressure, if
+        # lower: beyond it the free finger has no pressure), the object inside other pads or not
+        P_start = min(float(beyond), 0.9 * P_top)
+        P0 = max(lo + 0.1, P_start + float(reservoir_pressure(theta_c, design, reservoir)))
+        for k in range(first, design.n_s + 1):
+            z0 = np.concatenate([np.full(k + (k < design.n_s), theta_c / design.n_s), [1.0, P0]])
+            solved = _solve_on_pad(k, design, diameter_mm, depth, mass_kg, "P_pump", P_start, reservoir, z0)
+            if solved is None or solved[0][-2] < 0.0:
+                continue
+            end = _end_on_pad(k, _nearest_pad(k, solved[1]), solved[0], design, diameter_mm, depth,
+                              mass_kg, reservoir, P_top)
+            if end is not None:
+                return end
+    s_lo, hi, step = state(lo), None, 0.05
+    while hi is None and lo < P_top:
+        P = min(lo + step, P_top)
+        try:
+            s_lo, lo, step = state(P), P, 2.0 * step
+        except InputError:
+            hi = P
+    if hi is None:
+        return _hold_of(s_lo, design, reservoir, LARGEST_BEND)
+    s_lo, hi = _bisect_end(state, s_lo, hi, BRACKET_RESOLUTION)
+    k = s_lo.link
+    if k >= 1:
+        gaps = contact.pad_gaps(s_lo.q, (0.0, depth), 0.5 * float(diameter_mm), design)
+        gaps[k] = np.inf
+        z0 = np.concatenate([s_lo.q[:k], s_lo.q[k:k + 1] if k < design.n_s else [], [s_lo.N, s_lo.P]])
+        end = _end_on_pad(k, _nearest_pad(k, gaps), z0, design, diameter_mm, depth, mass_kg, reservoir, hi)
+        if end is not None and end.P_cavity >= s_lo.P - 1e-9:
+            return end
+    return _hold_of(_bisect_end(state, s_lo, hi, _PTOL)[0], design, reservoir, ONE_PAD_END)
+
+
+def _bisect_end(state, s_lo: grasp_fem.GraspState, hi: float, tol: float):
+    """(the last state, the first pressure without one) to tol [MPa], bisecting from s_lo (a
+    state) and hi (a cavity pressure with none)."""
+    while hi - s_lo.P > tol:
+        mid = 0.5 * (s_lo.P + hi)
+        try:
+            s_lo = state(mid)
+        except InputError:
+            hi = mid
+    return s_lo, hi
+
+
+def _nearest_pad(k: int, gaps) -> int:
+    """The pad but k (gaps[k] = inf) nearest the object, or inside it the most: the one that
+    touches it where the one-pad state of pad k ends; pad k+1 only if it does more than
+    share pad k's far end (a corner contact: both at gap 0)."""
+    gaps = np.array(gaps, float)
+    if k + 1 < len(gaps) and abs(gaps[k + 1]) <= grasp_fem._PENETRATION:
+        gaps[k + 1] = np.inf
+    return int(np.argmin(gaps))
+
+
+def _end_on_pad(k: int, j: int, z0, design: HandDesign, diameter_mm: float, depth: float, mass_kg: float,
+                reservoir: bool, P_top: float) -> Hold | None:
+    """:func:`one_pad_end`'s Newton solve from z0: pad k holds the object, pad j just touches it,
+    at a cavity pressure up to P_top. None if it fails, or if it is not ``grasp_state``'s state
+    at its pressure, or ``grasp_state`` has a state :data:`END_PROBE` above it."""
+    end = _hold_on_pad(k, design, diameter_mm, depth, mass_kg, "gap", j, reservoir, z0)
+    if end is None or not end.P_cavity <= P_top:
+        return None
+    check = grasp_fem.grasp_state(design, diameter_mm, end.P_cavity, mass_kg)
+    if check.link != k or abs(check.theta - end.theta) > 1e-9 * max(1.0, abs(end.theta)):
+        return None
+    if abs(j - k) > 1:  # a pad beyond the next one on the object: two contacts, not a pad change
+        return end._replace(edge=ONE_PAD_END)
+    try:
+        grasp_fem.grasp_state(design, diameter_mm, end.P_cavity + END_PROBE, mass_kg)
+    except InputError:
+        return end._replace(edge=ONE_PAD_END)
+    return None
+
+
+def _hold_of(s: grasp_fem.GraspState, design: HandDesign, reservoir: bool, edge: str) -> Hold:
+    """The Hold of grasp state s (found by stepping ``grasp_state``: the slow path's)."""
+    return Hold(s.P, float(s.P - reservoir_pressure(s.theta, design, reservoir)), s.F_v, s.theta, s.link,
+                False, edge)

@@ -458,3 +458,27 @@ def test_an_object_wider_than_the_open_hand_names_its_widest_span():
     widest = 2.0 * (base.base_offset + base.l0 * math.sin(base.theta0))
     assert design_opt.open_span(base) == pytest.approx(widest, rel=1e-12)
     assert f"straight, its tips span {widest:.4g} mm" in design_opt.infeasible_report(task, opt)
+
+
+def test_a_margin_beyond_the_one_pad_grasp_is_measured_where_it_ends():
+    """A 4 MPa pump on the paper's object at 1 kg: a second pad touches it near 2.8 MPa, where the
+    FEM-informed grasp ends. The margin is F_v there (reduced.grasp_hold.at_pump), flagged, not
+    -inf (every such design was infeasible), and F_v at the pump limit is not claimed."""
+    from softhand.reduced import grasp_hold
+
+    task = task_from_dict({**CI_TASK, "object": {"diameter_mm": 180.0, "mass_kg": 1.0},
+                           "grasp": {"force_factor": 2.0, "objective": "margin"},
+                           "pump": {"max_pressure_MPa": 4.0}})
+    ev = design_opt.evaluate(task.base, task)
+    end = grasp_hold.at_pump(task.base, 180.0, 1.0, 4.0)
+    assert end.edge == grasp_hold.ONE_PAD_END and 2.0 < end.P_pump < 4.0
+    assert (ev.margin_edge, ev.P_margin, ev.F_v_at_limit) == (end.edge, end.P_pump, end.F_v)
+    predicted = json.loads(json.dumps(ev.predicted()))
+    assert predicted["F_v_at_pump_limit_N"] is None
+    assert predicted["margin_N"] == pytest.approx(end.F_v - task.required_F_v(), rel=1e-12)
+    assert predicted["margin_at_pump_pressure_MPa"] == end.P_pump
+    force = [c for c in ev.constraints if c.name.startswith("F_v at the pump limit")]
+    assert len(force) == 1 and force[0].value == end.F_v and force[0].satisfied
+    assert ev.feasible
+    report = design_opt.infeasible_report(task, design_opt.Optimum(np.array([task.base.d, task.base.V0]), ev, 0, 0.0, 0, ""))
+    assert f"at {end.P_pump:.4g} MPa, below the pump limit 4 MPa, where one pad no longer holds" in report

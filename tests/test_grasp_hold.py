@@ -190,3 +190,56 @@ def test_a_pump_pressure_beyond_the_one_pad_region_is_refused_at_once(monkeypatc
             break
         reached.append(P - float(grasp_hold.reservoir_pressure(s.theta, PAPER)))
     assert 1.5 < len(reached) * 0.05 and max(reached) < 4.0
+
+
+def _existence_edge(design, diameter, mass, lo, hi, tol=1e-8):
+    """The cavity pressure where grasp_state stops having a state, by plain bisection on whether it
+    has one (lo: it has, hi: it has not)."""
+    from softhand.reduced.errors import InputError
+
+    while hi - lo > tol:
+        mid = 0.5 * (lo + hi)
+        try:
+            grasp_fem.grasp_state(design, diameter, mid, mass)
+            lo = mid
+        except InputError:
+            hi = mid
+    return lo
+
+
+def test_the_one_pad_model_ends_where_a_second_pad_touches(monkeypatch):
+    """The paper's hand at a 4 MPa pump on 180 mm (refused above): at_pump gives the grasp where
+    one pad stops holding the object alone, the state grasp_state has there, with another pad
+    just touching the object, at the pressure a bisection on grasp_state's having a state finds;
+    the scan-and-bisect route (the fast route's solve switched off) gives the same end."""
+    held = grasp_hold.at_pump(PAPER, 180.0, 1.0, 4.0)
+    assert held.edge == grasp_hold.ONE_PAD_END and held.P_pump < 4.0 and held.fast
+    # grasp_state admits 1e-6 mm of another pad in the object: ~1e-7 MPa past the exact end
+    edge = _existence_edge(PAPER, 180.0, 1.0, 2.0, 4.0)
+    assert held.P_cavity == pytest.approx(edge, abs=2e-7)
+    s = grasp_fem.grasp_state(PAPER, 180.0, held.P_cavity, 1.0)
+    assert s.link == held.link and s.F_v == pytest.approx(held.F_v, rel=1e-9)
+    gaps = grasp_hold.contact.pad_gaps(s.q, (0.0, s.depth), 90.0, grasp_fem.fem_finger(PAPER))
+    gaps[s.link] = np.inf
+    assert np.min(np.abs(gaps)) < 1e-8  # the second pad, at the object
+    assert held.P_pump == pytest.approx(held.P_cavity - float(grasp_hold.reservoir_pressure(s.theta, PAPER)))
+    slow = grasp_hold.one_pad_end(PAPER, 180.0, 1.0)  # no pump pressure to start from: the scan
+    assert slow.edge == held.edge and slow.P_cavity == pytest.approx(held.P_cavity, abs=1e-12)
+    monkeypatch.setattr(grasp_hold, "_end_on_pad", lambda *a, **k: None)
+    bisected = grasp_hold.at_pump(PAPER, 180.0, 1.0, 4.0)
+    assert not bisected.fast and bisected.P_cavity == pytest.approx(edge, abs=1e-8)
+    assert bisected.F_v == pytest.approx(held.F_v, rel=1e-6)
+
+
+def test_the_one_pad_model_ends_at_the_calibrated_fingers_highest_pressure():
+    """A big object held at the tip: one pad holds it up to the free finger's pressure at its
+    largest bend (the finger model's highest), below the 4.5 MPa asked: the grasp there."""
+    top = grasp_hold._largest_pressure(TIP_HOLD)
+    held = grasp_hold.at_pump(TIP_HOLD, 230.0, 3.5, 4.5)
+    assert held.edge == grasp_hold.LARGEST_BEND and held.P_cavity == top and held.P_pump < 4.5
+    assert held.F_v == grasp_fem.grasp_state(TIP_HOLD, 230.0, top, 3.5).F_v
+
+
+def test_at_pump_is_hold_where_the_one_pad_model_reaches_the_pump_pressure():
+    held = grasp_hold.at_pump(PAPER, 180.0, 1.0, 2.0)
+    assert held.edge == "" and held == grasp_hold.hold(PAPER, 180.0, 1.0, "P_pump", 2.0)

@@ -8,7 +8,9 @@ that keeps that pad on the object (:func:`reduced.contact.rolling_weights`). The
 
 * ``P_grasp``: the pump pressure at which each finger presses with the required F_v;
 * ``P_contact``: the free hand's pump pressure at theta_g (eq. (27)), where the fingers touch;
-* ``F_v`` at the pump limit, and the margin over the requirement;
+* ``F_v`` at the pump limit, and the margin over the requirement (for the FEM-informed grasp
+  at the highest pump pressure it answers for, if that is below the limit: where a second
+  pad touches the object);
 
 for ``finger_model = "fem"`` by the FEM-informed grasp (:mod:`reduced.grasp_hold`: the
 calibrated finger in equilibrium hinge by hinge against the object, the reservoir's pressure
@@ -85,11 +87,13 @@ class Evaluation:
     P_grasp: float             #: pump pressure holding the object with the required F_v [MPa]
     P_contact: float           #: free hand's pump pressure at theta_g (27) [MPa]
     F_v: float                 #: required normal force per finger [N]
-    F_v_at_limit: float        #: F_v at the pump limit [N]
+    F_v_at_limit: float        #: F_v at the pump limit, or at P_margin below it (see margin_edge) [N]
     stretch: float             #: the tube's peak principal stretch, eq. (8) x stretch_factor, at theta_hold
     sheet_stretch: float       #: the reservoir sheet's stretch at V0, eq. (16)
     constraints: tuple[Constraint, ...]
     theta_hold: float = math.nan  #: the finger's bend when it presses with the required F_v [rad]
+    P_margin: float = math.nan    #: the pump pressure F_v_at_limit is at: the limit, or lower (margin_edge) [MPa]
+    margin_edge: str = ""         #: why F_v_at_limit is below the pump limit (the FEM-informed grasp's end), or ""
 
     @property
     def rubber_stretch(self) -> float:
@@ -104,8 +108,10 @@ class Evaluation:
         return {"P_grasp_MPa": self.P_grasp, "P_contact_MPa": self.P_contact,
                 "theta_grasp_deg": math.degrees(self.theta_hold), "F_v_N": self.F_v,
                 "theta_contact_deg": math.degrees(self.theta_grasp),
-                "F_v_at_pump_limit_N": _number(self.F_v_at_limit),
+                "F_v_at_pump_limit_N": None if self.margin_edge else _number(self.F_v_at_limit),
                 "margin_N": _number(self.F_v_at_limit - self.F_v),
+                **({"margin_at_pump_pressure_MPa": self.P_margin, "margin_below_pump_limit": self.margin_edge}
+                   if self.margin_edge else {}),
                 "w": self.w.tolist(), "touching_link": self.link, "depth_mm": self.depth,
                 "max_principal_stretch": self.stretch, "sheet_stretch": self.sheet_stretch,
                 **self.contact_parts()}
@@ -169,8 +175,10 @@ def evaluate(design: HandDesign, task: Task, *, exact: bool = True) -> Evaluatio
     (``exact=False``: the kinematics interpolated in l0, see :func:`grasp_geometry`)."""
     depth, theta, link, w, theta_open = grasp_geometry(design, task, exact=exact)
     F_req = task.required_F_v()
+    P_margin, edge = task.max_pressure, ""
     try:
-        P_grasp, P_contact, P_open, F_lim, theta_hold = grasp_relation(design, task, theta, w, theta_open)
+        P_grasp, P_contact, P_open, F_lim, theta_hold, P_margin, edge = grasp_relation(design, task, theta, w,
+                                                                                       theta_open)
     except InputError:  # e.g. V0 too small for the oil, a design outside the calibrated range
         F_lim = -math.inf if asks_force_at_limit(design, task) else math.nan
         P_grasp, P_contact, P_open, theta_hold = math.inf, math.inf, -math.inf, theta
@@ -183,7 +191,7 @@ def evaluate(design: HandDesign, task: Task, *, exact: bool = True) -> Evaluatio
     sheet = float(reservoir.stretch(design.V0, design))
     cons = _constraints(design, task, oil, stretch, sheet, P_grasp, P_contact, F_lim, P_open)
     return Evaluation(design, depth, theta, link, w, P_grasp, P_contact, F_req, F_lim, stretch, sheet,
-                      tuple(cons), theta_hold)
+                      tuple(cons), theta_hold, P_margin, edge)
 
 
 def _constraints(design: HandDesign, task: Task, oil, stretch, sheet, P_grasp, P_contact, F_lim, P_open) -> list:
@@ -200,7 +208,9 @@ def _constraints(design: HandDesign, task: Task, oil, stretch, sheet, P_grasp, P
         Constraint("contact: P(theta_g), the free hand's pump pressure where a pad touches the object "
                    "[MPa] (the hand at rest must not reach into the object's place)", P_contact, 0.0, ">=",
                    task.max_pressure),
-        *([Constraint("F_v at the pump limit [N]", F_lim, task.required_F_v(), ">=")]
+        *([Constraint("F_v at the pump limit [N]" if design.finger_model != "fem" else
+                      "F_v at the pump limit, or where one pad stops holding the object alone below it [N]",
+                      F_lim, task.required_F_v(), ">=")]
           if asks_force_at_limit(design, task) else []),
         Constraint("opening: P(theta_open), the free hand's pump pressure where the tips "
                    f"span {task.opening_mm:g} mm [MPa]", P_open, 0.0, ">=", task.max_pressure),
@@ -225,8 +235,10 @@ class GraspRelation(NamedTuple):
     P_grasp: float     #: pump pressure at which each finger presses with the required F_v [MPa]
     P_contact: float   #: free hand's pump pressure at the grasp angle (27) [MPa]
     P_open: float      #: free hand's pump pressure where the tips span the opening [MPa]; -inf: never
-    F_at_limit: float  #: F_v at the pump limit [N]; nan: not asked (see grasp_relation)
+    F_at_limit: float  #: F_v at the pump limit (or at P_margin, see edge) [N]; nan: not asked (see grasp_relation)
     theta_hold: float  #: the finger's bend when it presses with the required F_v [rad]
+    P_margin: float    #: the pump pressure of F_at_limit: the limit, or where the FEM-informed grasp ends [MPa]
+    edge: str = ""     #: why P_margin is below the limit (:attr:`reduced.grasp_hold.Hold.edge`), or ""
 
 
 def asks_force_at_limit(design: HandDesign, task: Task) -> bool:
@@ -251,24 +263,29 @@ def grasp_relation(design: HandDesign, task: Task, theta: float, w, theta_open: 
         F_v=np.array([0.0, 1.0, F_req, 0.0, 0.0])))
     F_lim = (task.max_pressure - P0) / (P1 - P0)  # [N]: F_v at P0 is 0, at P1 1 N
     return GraspRelation(P_grasp, P_contact, P_open if math.isfinite(theta_open) else -math.inf, F_lim,
-                         theta)
+                         theta, task.max_pressure)
 
 
 def _fem_relation(design: HandDesign, task: Task, theta: float, theta_open: float) -> GraspRelation:
     """The FEM-informed grasp: P_grasp from the equilibrium with F_v = F_req; F_v at the pump
     limit only for the "margin" objective (for "pressure" the pump-pressure constraint on
-    P_grasp is the same condition, F_v growing with the pump pressure: nan)."""
+    P_grasp is the same condition, F_v growing with the pump pressure: nan). Where the
+    FEM-informed grasp ends below the pump limit (a second pad touches the object, the finger
+    reaches its largest bend: :func:`reduced.grasp_hold.at_pump`) F_v is the one there, at the
+    highest pump pressure the model answers for, and ``edge`` says why."""
     P_contact = float(hand.pressure(theta, design))
     P_open = float(hand.pressure(theta_open, design)) if math.isfinite(theta_open) else -math.inf
     F_req = task.required_F_v()
     # F_v = 0 (a massless object, no margin): the fingers only touch it, at the contact pressure
     held = grasp_hold.hold(design, task.diameter, task.mass, "F_v", F_req) if F_req > 0.0 else \
         grasp_hold.Hold(math.nan, P_contact, 0.0, theta, -1, True)
-    F_lim = math.nan
+    F_lim, P_margin, edge = math.nan, task.max_pressure, ""
     if asks_force_at_limit(design, task):
-        F_lim = 0.0 if task.max_pressure <= P_contact else \
-            grasp_hold.hold(design, task.diameter, task.mass, "P_pump", task.max_pressure).F_v
-    return GraspRelation(held.P_pump, P_contact, P_open, F_lim, held.theta)
+        at = grasp_hold.Hold(math.nan, task.max_pressure, 0.0, theta, -1, True) \
+            if task.max_pressure <= P_contact else \
+            grasp_hold.at_pump(design, task.diameter, task.mass, task.max_pressure)
+        F_lim, P_margin, edge = at.F_v, at.P_pump, at.edge
+    return GraspRelation(held.P_pump, P_contact, P_open, F_lim, held.theta, P_margin, edge)
 
 
 def calibrated_range(design: HandDesign) -> list[Constraint]:

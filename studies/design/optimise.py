@@ -164,4 +164,7 @@ def infeasible_report(task: Task, opt: Optimum) -> str:
             f"it touches the object at {math.degrees(ev.theta_grasp):.2f} deg and would need {ev.P_grasp:.4g} MPa "
             f"(bent to {math.degrees(ev.theta_hold):.2f} deg) for F_v = {ev.F_v:.4g} N"
             + (f", and presses with {ev.F_v_at_limit:.4g} N at the pump limit {task.max_pressure:.4g} MPa."
-               if math.isfinite(ev.F_v_at_limit) else f" against the pump limit {task.max_pressure:.4g} MPa."))
+               if math.isfinite(ev.F_v_at_limit) and not ev.margin_edge else
+               f", and presses with {ev.F_v_at_limit:.4g} N at {ev.P_margin:.4g} MPa, below the pump limit "
+               f"{task.max_pressure:.4g} MPa, where {ev.margin_edge}." if math.isfinite(ev.F_v_at_limit) else
+               f" against the pump limit {task.max_pressure:.4g} MPa."))

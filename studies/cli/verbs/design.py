@@ -219,13 +219,18 @@ def _print(result: dict, task, opt) -> None:
     rows = [{"constraint": c["name"], "value": c["value"], "sense": c["sense"], "limit": c["limit"],
              "satisfied": c["satisfied"]} for c in result["constraints"]]
     print_table(rows)
-    keys = ("P_grasp_MPa", "P_contact_MPa", "theta_grasp_deg", "F_v_N", "max_principal_stretch", "w")
+    keys = ("P_grasp_MPa", "P_contact_MPa", "theta_grasp_deg", "F_v_N", "max_principal_stretch", "w") + \
+        (("F_v_at_pump_limit_N", "margin_N") if task.objective == "margin" else ())
     fem = result.get("fem") or {}
     base = result["base_design"]["predicted"]
     table = [{"quantity": k, "base design": base.get(k), "predicted": result["predicted"].get(k),
               "FEM": fem.get(k), "FEM / predicted - 1": _rel(fem.get(k), result["predicted"].get(k))}
              for k in keys]
     print_table(table)
+    predicted = result["predicted"]
+    if predicted.get("margin_below_pump_limit"):
+        print(f"# margin_N: F_v at {predicted['margin_at_pump_pressure_MPa']:.4g} MPa, below the pump limit, less "
+              f"the required F_v; the FEM-informed grasp ends there: {predicted['margin_below_pump_limit']}")
     if fem.get("constraints"):
         print_table(fem["constraints"])
     if fem.get("wall_seconds"):
