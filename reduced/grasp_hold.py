@@ -217,11 +217,11 @@ def _largest_pressure(design: HandDesign) -> float:
 
 
 def _condition(target: str, value: float, design: HandDesign, reservoir: bool):
-    """c(q, P, F_v) of the module docstring: F_v - value [N], or P - p_r - value [MPa]."""
+    """c(theta, P, F_v) of the module docstring: F_v - value [N], or P - p_r(theta) - value [MPa]."""
     if target == "F_v":
-        return lambda q, P, F_v: F_v - value
+        return lambda theta, P, F_v: F_v - value
     if target == "P_pump":
-        return lambda q, P, F_v: P - float(reservoir_pressure(float(np.sum(q)), design, reservoir)) - value
+        return lambda theta, P, F_v: P - float(reservoir_pressure(theta, design, reservoir)) - value
     raise ValueError(target)
 
 
@@ -229,7 +229,9 @@ def slow_hold(design: HandDesign, diameter_mm: float, mass_kg: float, target: st
               reservoir: bool = True) -> Hold:
     """The same grasp as :func:`fast_hold`, by brentq on the cavity pressure around
     :func:`reduced.grasp_fem.grasp_state` (from the contact pressure up to the free finger's
-    pressure at its largest bend)."""
+    pressure at its largest bend). Where one pad stops holding the object alone before the
+    condition is met, the end is solved for (:func:`one_pad_end`'s way) and the refusal
+    names it: its cavity and pump pressures and F_v."""
     design = grasp_fem.fem_finger(design)
     P_max = _largest_pressure(design)
     depth = contact.object_depth(diameter_mm, design)
@@ -239,41 +241,43 @@ def slow_hold(design: HandDesign, diameter_mm: float, mass_kg: float, target: st
 
     def f(P):
         s = state(P)
-        return cond(s.q, P, s.F_v)
+        return cond(s.theta, P, s.F_v)
 
     lo = float(hand.finger_pressure(theta_c, design)) + 1e-9
     if target == "P_pump" and value > lo:
         # the reservoir's pressure is not negative, so the cavity pressure of the answer is at
         # least the pump's: the bracket starts there (no root below it); and if one pad no longer
         # holds the object alone there, it does not at the answer either (a pump limit beyond
-        # where a second pad touches: one equilibrium instead of a bracket halving to that edge)
+        # where a second pad touches: one equilibrium instead of a search for that end)
         try:
-            lo, f_lo = float(value), f(float(value))
+            lo, s_lo = float(value), state(float(value))
         except InputError:
             raise InputError(target, value, f"not reached by the finger on one pad: a second pad "
                                             f"touches below the cavity pressure {value:.4g} MPa, "
                                             "the least the pump pressure needs") from None
     else:
-        f_lo = f(lo)
-    step, grow = 0.05, 2.0
-    hi, f_hi = lo, f_lo
-    for _ in range(60):  # the first sign change above the contact pressure: steps 0.05, 0.1, ... MPa
+        s_lo = state(lo)
+    f_lo, step = cond(s_lo.theta, lo, s_lo.F_v), 0.05
+    while True:  # the first sign change above the contact pressure: steps 0.05, 0.1, ... MPa
         hi = min(lo + step, P_max)
         try:
-            f_hi = f(hi)
-        except InputError:  # e.g. several pads on the object: closer, down to BRACKET_RESOLUTION
-            hi, f_hi, step, grow = lo, f_lo, 0.5 * step, 1.0
-            if step < BRACKET_RESOLUTION:
-                break
-            continue
+            s_hi = state(hi)
+        except InputError:  # one pad no longer holds the object alone below hi: up to its end
+            end = _end_between(state, s_lo, hi, design, diameter_mm, mass_kg, reservoir)
+            hi, f_hi = end.P_cavity, cond(end.theta, end.P_cavity, end.F_v)
+            if not f_lo * f_hi <= 0.0:
+                raise InputError(target, value, f"not reached by the finger on one pad, which holds the "
+                                                f"object alone up to the cavity pressure {hi:.6g} MPa (pump "
+                                                f"{end.P_pump:.4g} MPa, F_v {end.F_v:.4g} N): above, "
+                                                "a second pad touches it") from None
+            break
+        f_hi = cond(s_hi.theta, hi, s_hi.F_v)
         if f_lo * f_hi <= 0.0:
             break
         if hi == P_max:
-            break
-        lo, f_lo, step = hi, f_hi, grow * step
-    if not f_lo * f_hi <= 0.0:
-        raise InputError(target, value, f"not reached by the finger on one pad between its contact "
-                                        f"pressure and {hi:.4g} MPa")
+            raise InputError(target, value, f"not reached by the finger on one pad up to the cavity pressure "
+                                            f"{hi:.6g} MPa (F_v {s_hi.F_v:.4g} N), where {LARGEST_BEND}")
+        lo, s_lo, f_lo, step = hi, s_hi, f_hi, 2.0 * step
     P = brentq(f, lo, hi, xtol=_PTOL, rtol=4 * np.finfo(float).eps)
     s = state(P)
     return Hold(float(P), float(P - reservoir_pressure(s.theta, design, reservoir)), s.F_v, s.theta,
@@ -359,13 +363,23 @@ def one_pad_end(design: HandDesign, diameter_mm: float, mass_kg: float, *, reser
             hi = P
     if hi is None:
         return _hold_of(s_lo, design, reservoir, LARGEST_BEND)
-    s_lo, hi = _bisect_end(state, s_lo, hi, BRACKET_RESOLUTION)
-    k = s_lo.link
-    if k >= 1:
-        gaps = contact.pad_gaps(s_lo.q, (0.0, depth), 0.5 * float(diameter_mm), design)
+    return _end_between(state, s_lo, hi, design, diameter_mm, mass_kg, reservoir)
+
+
+def _end_between(state, s_lo: grasp_fem.GraspState, hi: float, design: HandDesign, diameter_mm: float,
+                 mass_kg: float, reservoir: bool) -> Hold:
+    """The one-pad grasp's end between the state s_lo and the cavity pressure hi (no state there):
+    bisected to 0.05 MPa and solved for from there (:func:`_end_on_pad`); failing that, bisected
+    to :data:`BRACKET_RESOLUTION` and solved for; failing that, bisected to 1e-13 MPa."""
+    for tol in (0.05, BRACKET_RESOLUTION):
+        s_lo, hi = _bisect_end(state, s_lo, hi, tol)
+        k = s_lo.link
+        if k < 1:
+            continue
+        gaps = contact.pad_gaps(s_lo.q, (0.0, s_lo.depth), 0.5 * float(diameter_mm), design)
         gaps[k] = np.inf
         z0 = np.concatenate([s_lo.q[:k], s_lo.q[k:k + 1] if k < design.n_s else [], [s_lo.N, s_lo.P]])
-        end = _end_on_pad(k, _nearest_pad(k, gaps), z0, design, diameter_mm, depth, mass_kg, reservoir, hi)
+        end = _end_on_pad(k, _nearest_pad(k, gaps), z0, design, diameter_mm, s_lo.depth, mass_kg, reservoir, hi)
         if end is not None and end.P_cavity >= s_lo.P - 1e-9:
             return end
     return _hold_of(_bisect_end(state, s_lo, hi, _PTOL)[0], design, reservoir, ONE_PAD_END)

@@ -482,3 +482,22 @@ def test_a_margin_beyond_the_one_pad_grasp_is_measured_where_it_ends():
     assert ev.feasible
     report = design_opt.infeasible_report(task, design_opt.Optimum(np.array([task.base.d, task.base.V0]), ev, 0, 0.0, 0, ""))
     assert f"at {end.P_pump:.4g} MPa, below the pump limit 4 MPa, where one pad no longer holds" in report
+
+
+def test_a_force_one_pad_cannot_give_leaves_the_rest_of_the_evaluation_standing():
+    """20 kg on the paper's hand: F_v = 98 N is more than one pad gives before a second one
+    touches (~83 N). P_grasp has no value, and says why; the free hand's pressures (the contact
+    and opening constraints) are still the design's, not "inf" as for a design the model has
+    no answer for (the report named them and an opening no bend reaches)."""
+    task = task_from_dict({**CI_TASK, "object": {"diameter_mm": 180.0, "mass_kg": 20.0},
+                           "pump": {"max_pressure_MPa": 4.0}})
+    ev = design_opt.evaluate(task.base, task)
+    assert ev.P_grasp == math.inf and "not reached by the finger on one pad" in ev.no_grasp
+    assert ev.P_contact == pytest.approx(float(hand.pressure(ev.theta_grasp, task.base)), rel=1e-12)
+    failed = [c.name.split(" ")[0] for c in ev.constraints if not c.satisfied]
+    assert failed == ["pump_pressure"]
+    assert json.loads(json.dumps(ev.predicted()["no_P_grasp"])) == ev.no_grasp
+    report = design_opt.infeasible_report(task, design_opt.Optimum(np.array([task.base.d, task.base.V0]), ev, 0,
+                                                                   0.0, 0, ""))
+    assert f"has no pump pressure for F_v = {ev.F_v:.4g} N (the pump limit 4 MPa): not reached" in report
+    assert "no bend opens" not in report

@@ -77,12 +77,12 @@ def test_the_equations_at_a_batch_are_those_of_each_state():
     assert math.isfinite(F[0])
 
 
-def test_a_force_one_pad_cannot_give_is_refused_at_the_edge_of_one_pad(monkeypatch):
+def test_a_force_one_pad_cannot_give_is_refused_at_the_end_of_one_pad(monkeypatch):
     """20 kg on the paper's hand: F_v = 2 m g / n = 98 N is more than pad 3 gives before a second
-    pad touches (~75 N at ~2.9 MPa). The bracket used to halve its step 60 times at that edge
-    (82 equilibria, each evaluated twice per trial pressure); now it stops at BRACKET_RESOLUTION
-    and names the edge, where one pad holds with less than the force asked and just above which
-    it no longer holds alone."""
+    pad touches (~75 N at ~2.9 MPa). The bracket halved its step at that end, evaluating the
+    same failing pressures again (21 equilibria); now the end is solved for, and the refusal
+    names it: the cavity pressure where grasp_state stops having a state (bisection on that; to
+    the message's six digits), and F_v there."""
     from softhand.reduced.errors import InputError
 
     calls = []
@@ -90,12 +90,13 @@ def test_a_force_one_pad_cannot_give_is_refused_at_the_edge_of_one_pad(monkeypat
     monkeypatch.setattr(grasp_fem, "grasp_state", lambda *a: calls.append(a) or state(*a))
     with pytest.raises(InputError, match="not reached by the finger on one pad") as info:
         grasp_hold.slow_hold(PAPER, 180.0, 20.0, "F_v", 98.0665)
-    assert len(calls) <= 30
-    edge = float(str(info.value).split(" and ")[-1].split(" MPa")[0])
-    below = state(PAPER, 180.0, edge - 2 * grasp_hold.BRACKET_RESOLUTION, 20.0)
-    assert below.F_v < 98.0665
-    with pytest.raises(InputError):
-        state(PAPER, 180.0, edge + 2 * grasp_hold.BRACKET_RESOLUTION, 20.0)
+    assert len(calls) <= 15
+    message = str(info.value)
+    end = float(message.split("up to the cavity pressure ")[1].split(" MPa")[0])
+    edge = _existence_edge(PAPER, 180.0, 20.0, 2.0, 4.0)
+    assert end == pytest.approx(edge, abs=1e-5)
+    F_v = state(PAPER, 180.0, edge, 20.0).F_v
+    assert F_v < 98.0665 and f"F_v {F_v:.4g} N" in message
 
 
 #: a big object held at the tip of a short, stiff finger with a small reservoir: the pump's 3.5 MPa

@@ -94,6 +94,7 @@ class Evaluation:
     theta_hold: float = math.nan  #: the finger's bend when it presses with the required F_v [rad]
     P_margin: float = math.nan    #: the pump pressure F_v_at_limit is at: the limit, or lower (margin_edge) [MPa]
     margin_edge: str = ""         #: why F_v_at_limit is below the pump limit (the FEM-informed grasp's end), or ""
+    no_grasp: str = ""            #: why there is no P_grasp (the required F_v not reached), or ""
 
     @property
     def rubber_stretch(self) -> float:
@@ -112,6 +113,7 @@ class Evaluation:
                 "margin_N": _number(self.F_v_at_limit - self.F_v),
                 **({"margin_at_pump_pressure_MPa": self.P_margin, "margin_below_pump_limit": self.margin_edge}
                    if self.margin_edge else {}),
+                **({"no_P_grasp": self.no_grasp} if self.no_grasp else {}),
                 "w": self.w.tolist(), "touching_link": self.link, "depth_mm": self.depth,
                 "max_principal_stretch": self.stretch, "sheet_stretch": self.sheet_stretch,
                 **self.contact_parts()}
@@ -175,10 +177,10 @@ def evaluate(design: HandDesign, task: Task, *, exact: bool = True) -> Evaluatio
     (``exact=False``: the kinematics interpolated in l0, see :func:`grasp_geometry`)."""
     depth, theta, link, w, theta_open = grasp_geometry(design, task, exact=exact)
     F_req = task.required_F_v()
-    P_margin, edge = task.max_pressure, ""
+    P_margin, edge, no_grasp = task.max_pressure, "", ""
     try:
-        P_grasp, P_contact, P_open, F_lim, theta_hold, P_margin, edge = grasp_relation(design, task, theta, w,
-                                                                                       theta_open)
+        P_grasp, P_contact, P_open, F_lim, theta_hold, P_margin, edge, no_grasp = \
+            grasp_relation(design, task, theta, w, theta_open)
     except InputError:  # e.g. V0 too small for the oil, a design outside the calibrated range
         F_lim = -math.inf if asks_force_at_limit(design, task) else math.nan
         P_grasp, P_contact, P_open, theta_hold = math.inf, math.inf, -math.inf, theta
@@ -191,7 +193,7 @@ def evaluate(design: HandDesign, task: Task, *, exact: bool = True) -> Evaluatio
     sheet = float(reservoir.stretch(design.V0, design))
     cons = _constraints(design, task, oil, stretch, sheet, P_grasp, P_contact, F_lim, P_open)
     return Evaluation(design, depth, theta, link, w, P_grasp, P_contact, F_req, F_lim, stretch, sheet,
-                      tuple(cons), theta_hold, P_margin, edge)
+                      tuple(cons), theta_hold, P_margin, edge, no_grasp)
 
 
 def _constraints(design: HandDesign, task: Task, oil, stretch, sheet, P_grasp, P_contact, F_lim, P_open) -> list:
@@ -239,6 +241,7 @@ class GraspRelation(NamedTuple):
     theta_hold: float  #: the finger's bend when it presses with the required F_v [rad]
     P_margin: float    #: the pump pressure of F_at_limit: the limit, or where the FEM-informed grasp ends [MPa]
     edge: str = ""     #: why P_margin is below the limit (:attr:`reduced.grasp_hold.Hold.edge`), or ""
+    no_grasp: str = ""  #: why P_grasp is inf (the required F_v not reached by the FEM-informed grasp), or ""
 
 
 def asks_force_at_limit(design: HandDesign, task: Task) -> bool:
@@ -277,15 +280,19 @@ def _fem_relation(design: HandDesign, task: Task, theta: float, theta_open: floa
     P_open = float(hand.pressure(theta_open, design)) if math.isfinite(theta_open) else -math.inf
     F_req = task.required_F_v()
     # F_v = 0 (a massless object, no margin): the fingers only touch it, at the contact pressure
-    held = grasp_hold.hold(design, task.diameter, task.mass, "F_v", F_req) if F_req > 0.0 else \
-        grasp_hold.Hold(math.nan, P_contact, 0.0, theta, -1, True)
+    no_grasp = ""
+    try:
+        held = grasp_hold.hold(design, task.diameter, task.mass, "F_v", F_req) if F_req > 0.0 else \
+            grasp_hold.Hold(math.nan, P_contact, 0.0, theta, -1, True)
+    except InputError as refused:  # F_req beyond what the finger gives: no P_grasp, the rest stands
+        held, no_grasp = grasp_hold.Hold(math.nan, math.inf, math.nan, theta, -1, False), refused.allowed
     F_lim, P_margin, edge = math.nan, task.max_pressure, ""
     if asks_force_at_limit(design, task):
         at = grasp_hold.Hold(math.nan, task.max_pressure, 0.0, theta, -1, True) \
             if task.max_pressure <= P_contact else \
             grasp_hold.at_pump(design, task.diameter, task.mass, task.max_pressure)
         F_lim, P_margin, edge = at.F_v, at.P_pump, at.edge
-    return GraspRelation(held.P_pump, P_contact, P_open, F_lim, held.theta, P_margin, edge)
+    return GraspRelation(held.P_pump, P_contact, P_open, F_lim, held.theta, P_margin, edge, no_grasp)
 
 
 def calibrated_range(design: HandDesign) -> list[Constraint]:

@@ -159,12 +159,19 @@ def infeasible_report(task: Task, opt: Optimum) -> str:
     if any(c.name.startswith("opening") and not math.isfinite(c.value) for c in worst):
         names += (f" (no bend opens the hand that wide: straight, its tips span "
                   f"{open_span(ev.design):.4g} mm; l0_mm, theta0_deg and base_offset_mm set that span)")
+    if ev.no_grasp:
+        force = (f"has no pump pressure for F_v = {ev.F_v:.4g} N (the pump limit {task.max_pressure:.4g} MPa): "
+                 f"{ev.no_grasp}.")
+    else:
+        force = (f"would need {ev.P_grasp:.4g} MPa (bent to {math.degrees(ev.theta_hold):.2f} deg) for F_v = "
+                 f"{ev.F_v:.4g} N")
+        if not math.isfinite(ev.F_v_at_limit):
+            force += f" against the pump limit {task.max_pressure:.4g} MPa."
+        elif ev.margin_edge:
+            force += (f", and presses with {ev.F_v_at_limit:.4g} N at {ev.P_margin:.4g} MPa, below the pump "
+                      f"limit {task.max_pressure:.4g} MPa, where {ev.margin_edge}.")
+        else:
+            force += f", and presses with {ev.F_v_at_limit:.4g} N at the pump limit {task.max_pressure:.4g} MPa."
     return (f"The task cannot be met within the free bounds: the binding constraint is {names}. "
             f"The nearest design (least constraint violation found by the optimiser) has {free}: "
-            f"it touches the object at {math.degrees(ev.theta_grasp):.2f} deg and would need {ev.P_grasp:.4g} MPa "
-            f"(bent to {math.degrees(ev.theta_hold):.2f} deg) for F_v = {ev.F_v:.4g} N"
-            + (f", and presses with {ev.F_v_at_limit:.4g} N at the pump limit {task.max_pressure:.4g} MPa."
-               if math.isfinite(ev.F_v_at_limit) and not ev.margin_edge else
-               f", and presses with {ev.F_v_at_limit:.4g} N at {ev.P_margin:.4g} MPa, below the pump limit "
-               f"{task.max_pressure:.4g} MPa, where {ev.margin_edge}." if math.isfinite(ev.F_v_at_limit) else
-               f" against the pump limit {task.max_pressure:.4g} MPa."))
+            f"it touches the object at {math.degrees(ev.theta_grasp):.2f} deg and {force}")
