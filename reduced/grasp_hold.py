@@ -69,10 +69,11 @@ def reservoir_pressure(theta, design: HandDesign, reservoir: bool = True):
 
 
 def _residuals(Z, k: int, depth: float, radius: float, weight: float, target: str, value: float,
-               design: HandDesign, reservoir: bool):
+               design: HandDesign, reservoir: bool, corner: bool = False):
     """The module's equations at a batch of unknowns Z (B, m + 2), m = k held hinges (+ 1 for the
     distal ones) -> (residuals (B, m + 2), F_v (B,)); :func:`reduced.grasp_fem.grasp_state`'s
-    equilibrium with pad k touching, written for many states at once."""
+    equilibrium with pad k touching (``corner``: with its far end, the hinge it shares with pad
+    k+1), written for many states at once."""
     n_s, m = design.n_s, Z.shape[1] - 2
     q = np.concatenate([Z[:, :k], np.repeat(Z[:, k:k + 1], n_s - k, axis=1)], axis=1)
     N, P = Z[:, m], Z[:, m + 1]
@@ -80,7 +81,8 @@ def _residuals(Z, k: int, depth: float, radius: float, weight: float, target: st
     alpha = kinematics.link_angles(q, design)                       # (B, n_s + 1)
     C = np.array([0.0, depth])
     A, AB = p[:, k], p[:, k + 1] - p[:, k]
-    tau = np.clip(np.einsum("bi,bi->b", C - A, AB) / np.einsum("bi,bi->b", AB, AB), 0.0, 1.0)
+    tau = np.ones(len(Z)) if corner else \
+        np.clip(np.einsum("bi,bi->b", C - A, AB) / np.einsum("bi,bi->b", AB, AB), 0.0, 1.0)
     xs = A + tau[:, None] * AB                                      # closest point of pad k
     rho = np.linalg.norm(C - xs, axis=1)
     nu = (C - xs) / rho[:, None]
@@ -136,9 +138,11 @@ def fast_hold(design: HandDesign, diameter_mm: float, mass_kg: float, target: st
     module doc).
 
     A pump pressure well above contact often presses a later pad than the one that touched
-    first (the paper's hand at 2 MPa on 180 mm: pad 3, touching with pad 2): the later pads are
-    tried in turn, and such an answer is kept only if ``grasp_state`` at its pressure is the
-    same state (one equilibrium, against a dozen for the slow path). The pump pressure grows
+    first (the paper's hand at 2 MPa on 180 mm: pad 3, touching with pad 2), or a pad's far end
+    (the hinge it shares with the next pad: ``grasp_state``'s corner contact): each pad with
+    its face, then with its far end, is tried in turn, and an answer other than the first
+    pad's face is kept only if ``grasp_state`` at its pressure is the same state (one
+    equilibrium, against a dozen for the slow path). The pump pressure grows
     with the cavity's, so its answer is the only one; F_v need not (it drops where the
     touching pad changes), so for F_v only the first pad is tried: a later pad's answer
     could be a second root."""
@@ -152,13 +156,16 @@ def fast_hold(design: HandDesign, diameter_mm: float, mass_kg: float, target: st
     # pressure plus the reservoir's at contact: a start 3 MPa below the answer often failed
     P0 = P_c + 0.1 if target == "F_v" else \
         max(P_c + 0.1, float(value) + float(reservoir_pressure(theta_c, design, reservoir)))
-    for k in range(first, first + 1 if target == "F_v" else design.n_s + 1):
+    # each pad with its face, then with its far end (a corner, as grasp_state's)
+    pads = [(first, False)] if target == "F_v" else \
+        [(k, corner) for k in range(first, design.n_s + 1) for corner in (False, True)[:1 + (k < design.n_s)]]
+    for k, corner in pads:
         m = k + (k < design.n_s)  # the held hinges, and one unknown for the distal ones if there are any
         z0 = np.concatenate([np.full(m, theta_c / design.n_s), [max(float(value), 1.0) if target == "F_v" else 1.0, P0]])
-        held = _hold_on_pad(k, design, diameter_mm, depth, mass_kg, target, value, reservoir, z0)
+        held = _hold_on_pad(k, design, diameter_mm, depth, mass_kg, target, value, reservoir, z0, corner=corner)
         if held is None or not held.P_cavity <= _largest_pressure(design):  # grasp_state has no state there
             continue
-        if k == first:
+        if (k, corner) == (first, False):
             return held
         state = grasp_fem.grasp_state(design, diameter_mm, held.P_cavity, mass_kg)
         if state.link == k and abs(state.theta - held.theta) <= 1e-9 * max(1.0, abs(held.theta)):
@@ -167,11 +174,12 @@ def fast_hold(design: HandDesign, diameter_mm: float, mass_kg: float, target: st
 
 
 def _hold_on_pad(k: int, design: HandDesign, diameter_mm: float, depth: float, mass_kg: float, target: str,
-                 value: float, reservoir: bool, z0) -> Hold | None:
-    """:func:`fast_hold`'s Newton solve with pad k touching, from z0 = (held hinges, distal
-    hinges, N, cavity pressure); None if it fails or its state is not acceptable (N < 0, another
-    pad in the object -- but pad ``value`` for ``target="gap"`` --, a residual left)."""
-    solved = _solve_on_pad(k, design, diameter_mm, depth, mass_kg, target, value, reservoir, z0)
+                 value: float, reservoir: bool, z0, corner: bool = False) -> Hold | None:
+    """:func:`fast_hold`'s Newton solve with pad k touching (``corner``: with its far end), from
+    z0 = (held hinges, distal hinges, N, cavity pressure); None if it fails or its state is not
+    acceptable (N < 0, another pad in the object -- but pad ``value`` for ``target="gap"`` --,
+    a residual left)."""
+    solved = _solve_on_pad(k, design, diameter_mm, depth, mass_kg, target, value, reservoir, z0, corner)
     if solved is None:
         return None
     z, gaps, F_v = solved
@@ -185,12 +193,12 @@ def _hold_on_pad(k: int, design: HandDesign, diameter_mm: float, depth: float, m
 
 
 def _solve_on_pad(k: int, design: HandDesign, diameter_mm: float, depth: float, mass_kg: float, target: str,
-                  value: float, reservoir: bool, z0):
-    """The Newton solve of :func:`_hold_on_pad`, unchecked: (z, the gaps of the pads but k, F_v),
-    or None if it fails or leaves a residual."""
+                  value: float, reservoir: bool, z0, corner: bool = False):
+    """The Newton solve of :func:`_hold_on_pad`, unchecked: (z, the gaps of the pads but k (and
+    k+1 for a corner), F_v), or None if it fails or leaves a residual."""
     radius, weight = 0.5 * float(diameter_mm), float(mass_kg) * design.g / design.n
     m = len(z0) - 2
-    fun = lambda Z: _residuals(Z, k, depth, radius, weight, target, value, design, reservoir)  # noqa: E731
+    fun = lambda Z: _residuals(Z, k, depth, radius, weight, target, value, design, reservoir, corner)  # noqa: E731
     try:
         z = _newton(fun, z0, np.concatenate([np.full(m, 0.01), [1.0, 0.1]]))
     except InputError:  # an iterate beyond the models' range (e.g. more oil than the reservoir holds)
@@ -201,7 +209,7 @@ def _solve_on_pad(k: int, design: HandDesign, diameter_mm: float, depth: float, 
     if np.max(np.abs(res)) > 1e-8:
         return None
     gaps = contact.pad_gaps(_hinges(z, k, design.n_s), (0.0, depth), radius, design)
-    gaps[k] = np.inf
+    gaps[k:k + 1 + corner] = np.inf
     return z, gaps, float(F_v[0])
 
 
@@ -243,7 +251,8 @@ def slow_hold(design: HandDesign, diameter_mm: float, mass_kg: float, target: st
         s = state(P)
         return cond(s.theta, P, s.F_v)
 
-    lo = float(hand.finger_pressure(theta_c, design)) + 1e-9
+    P_contact = float(hand.finger_pressure(theta_c, design)) + 1e-9
+    lo, s_lo = P_contact, None
     if target == "P_pump" and value > lo:
         # the reservoir's pressure is not negative, so the cavity pressure of the answer is at
         # least the pump's: the bracket starts there (no root below it); and if one pad no longer
@@ -255,8 +264,9 @@ def slow_hold(design: HandDesign, diameter_mm: float, mass_kg: float, target: st
             raise InputError(target, value, f"not reached by the finger on one pad: a second pad "
                                             f"touches below the cavity pressure {value:.4g} MPa, "
                                             "the least the pump pressure needs") from None
-    else:
-        s_lo = state(lo)
+        if cond(s_lo.theta, lo, s_lo.F_v) > 0.0:  # p_r < 0 there (a tabulated model's round-off at
+            lo, s_lo = P_contact, None           # a tiny reservoir): the answer lies below, from contact
+    s_lo = state(lo) if s_lo is None else s_lo
     f_lo, step = cond(s_lo.theta, lo, s_lo.F_v), 0.05
     while True:  # the first sign change above the contact pressure: steps 0.05, 0.1, ... MPa
         hi = min(lo + step, P_max)

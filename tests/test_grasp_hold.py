@@ -19,6 +19,19 @@ CASES = [
     (PAPER.replace(a=4.5, b=5.69, d=18.0, R=29.3, V0=30000.0), 240.0, 3.0, 14.709975, 1.0),
 ]
 
+def _same_hold(a, b):
+    """Two Holds of the same state: P_cavity, P_pump, F_v, theta to Newton's / brentq's 1e-13."""
+    for x, y in zip(a[:4], b[:4]):
+        assert x == pytest.approx(y, rel=1e-10, abs=1e-12)
+
+
+def _count_states(monkeypatch) -> list:
+    """The calls of grasp_fem.grasp_state from now on (the list grows as they come)."""
+    calls, state = [], grasp_fem.grasp_state
+    monkeypatch.setattr(grasp_fem, "grasp_state", lambda *a, **k: calls.append(a) or state(*a, **k))
+    return calls
+
+
 @pytest.mark.parametrize("design, diameter, mass, F_v, P_pump", CASES)
 @pytest.mark.parametrize("target", ["F_v", "P_pump"])
 def test_fast_path_equals_the_slow_path(design, diameter, mass, F_v, P_pump, target):
@@ -28,8 +41,7 @@ def test_fast_path_equals_the_slow_path(design, diameter, mass, F_v, P_pump, tar
     assert fast is not None and fast.fast and not slow.fast
     assert fast.link == slow.link
     # both solve the same equations: Newton to 1e-13 of the unknowns, brentq to 1e-13 MPa
-    for a, b in zip(fast[:4], slow[:4]):
-        assert a == pytest.approx(b, rel=1e-10, abs=1e-12)
+    _same_hold(fast, slow)
 
 
 @pytest.mark.parametrize("design, diameter, mass, F_v, P_pump", CASES)
@@ -85,9 +97,8 @@ def test_a_force_one_pad_cannot_give_is_refused_at_the_end_of_one_pad(monkeypatc
     the message's six digits), and F_v there."""
     from softhand.reduced.errors import InputError
 
-    calls = []
     state = grasp_fem.grasp_state
-    monkeypatch.setattr(grasp_fem, "grasp_state", lambda *a: calls.append(a) or state(*a))
+    calls = _count_states(monkeypatch)
     with pytest.raises(InputError, match="not reached by the finger on one pad") as info:
         grasp_hold.slow_hold(PAPER, 180.0, 20.0, "F_v", 98.0665)
     assert len(calls) <= 15
@@ -112,8 +123,7 @@ def test_a_pump_pressure_far_above_contact_is_found_by_the_fast_path():
     fast = grasp_hold.fast_hold(TIP_HOLD, 230.0, 3.5, "P_pump", 3.5)
     slow = grasp_hold.slow_hold(TIP_HOLD, 230.0, 3.5, "P_pump", 3.5)
     assert fast is not None and fast.link == slow.link == 5
-    for a, b in zip(fast[:4], slow[:4]):
-        assert a == pytest.approx(b, rel=1e-10, abs=1e-12)
+    _same_hold(fast, slow)
 
 
 def test_both_paths_stop_where_the_free_finger_has_no_pressure():
@@ -151,8 +161,17 @@ def test_a_fast_iterate_outside_the_models_does_not_end_the_hold(monkeypatch):
     held = grasp_hold.fast_hold(design, 230.0, 3.5, "P_pump", 3.5)
     assert raised and held is not None and held.link == 5
     slow = grasp_hold.slow_hold(design, 230.0, 3.5, "P_pump", 3.5)
-    for a, b in zip(held[:4], slow[:4]):
-        assert a == pytest.approx(b, rel=1e-10, abs=1e-12)
+    _same_hold(held, slow)
+
+
+def _found_on_a_later_pad(monkeypatch, design, diameter, mass, P_pump, link):
+    """fast_hold's answer at P_pump on pad ``link`` (not the first face): checked by one
+    grasp_state, and the slow path's state."""
+    calls = _count_states(monkeypatch)
+    held = grasp_hold.fast_hold(design, diameter, mass, "P_pump", P_pump)
+    assert held is not None and held.link == link and len(calls) == 1
+    _same_hold(held, grasp_hold.slow_hold(design, diameter, mass, "P_pump", P_pump))
+    return held
 
 
 def test_a_pump_pressure_that_presses_a_later_pad_is_found_on_it(monkeypatch):
@@ -160,13 +179,7 @@ def test_a_pump_pressure_that_presses_a_later_pad_is_found_on_it(monkeypatch):
     first pad's solve fails, pad 3's is checked by one grasp_state (the slow path's 190 ms were
     spent on every such design of a margin task) and is the slow path's answer. F_v is solved
     on the first pad only (a later pad's root may not be the first)."""
-    calls, state = [], grasp_fem.grasp_state
-    monkeypatch.setattr(grasp_fem, "grasp_state", lambda *a, **k: calls.append(a) or state(*a, **k))
-    held = grasp_hold.fast_hold(PAPER, 180.0, 1.0, "P_pump", 2.0)
-    assert held is not None and held.link == 3 and len(calls) == 1
-    slow = grasp_hold.slow_hold(PAPER, 180.0, 1.0, "P_pump", 2.0)
-    for a, b in zip(held[:4], slow[:4]):
-        assert a == pytest.approx(b, rel=1e-10, abs=1e-12)
+    held = _found_on_a_later_pad(monkeypatch, PAPER, 180.0, 1.0, 2.0, link=3)
     force = grasp_hold.slow_hold(PAPER, 180.0, 1.0, "F_v", held.F_v)
     assert force.link == 3 and grasp_hold.fast_hold(PAPER, 180.0, 1.0, "F_v", held.F_v) is None
 
@@ -178,8 +191,8 @@ def test_a_pump_pressure_beyond_the_one_pad_region_is_refused_at_once(monkeypatc
     halved down to the edge, ~0.5 s). A scan of the one-pad states confirms: none reaches 4 MPa."""
     from softhand.reduced.errors import InputError
 
-    calls, state = [], grasp_fem.grasp_state
-    monkeypatch.setattr(grasp_fem, "grasp_state", lambda *a, **k: calls.append(a) or state(*a, **k))
+    state = grasp_fem.grasp_state
+    calls = _count_states(monkeypatch)
     with pytest.raises(InputError, match="second pad touches below the cavity pressure 4 MPa"):
         grasp_hold.slow_hold(PAPER, 180.0, 1.0, "P_pump", 4.0)
     assert len(calls) == 1
@@ -244,3 +257,31 @@ def test_the_one_pad_model_ends_at_the_calibrated_fingers_highest_pressure():
 def test_at_pump_is_hold_where_the_one_pad_model_reaches_the_pump_pressure():
     held = grasp_hold.at_pump(PAPER, 180.0, 1.0, 2.0)
     assert held.edge == "" and held == grasp_hold.hold(PAPER, 180.0, 1.0, "P_pump", 2.0)
+
+
+def test_a_pump_pressure_held_at_a_pads_far_end_is_found_by_the_fast_path(monkeypatch):
+    """A wide tube on short links (150 mm, 1 kg, a held-out-style margin task near its optimum):
+    at 1.5 MPa pad 3 holds the object with its far end, the hinge it shares with pad 4 (both
+    pads' faces cut the circle there, as in grasp_state's corner contact). The face solves put
+    pad 4 into the object, so every such design went to the slow path (114 ms); the corner's
+    solve, checked by one grasp_state, is the slow path's state."""
+    design = PAPER.replace(a=6.0, d=13.61, l0=161.32, hinge_s=tuple(s * 161.32 / PAPER.l0 for s in PAPER.hinge_s))
+    state = grasp_fem.grasp_state
+    held = _found_on_a_later_pad(monkeypatch, design, 150.0, 1.0, 1.5, link=3)
+    s = state(design, 150.0, held.P_cavity, 1.0)
+    gaps = grasp_hold.contact.pad_gaps(s.q, (0.0, s.depth), 75.0, design)
+    assert gaps[3] < -0.1 and gaps[4] < -0.1  # the corner: both faces inside, the hinge on the circle
+    assert np.linalg.norm(s.point - grasp_hold.kinematics.joint_positions(s.q, design)[4]) < 1e-12
+
+
+def test_a_reservoir_pressure_below_zero_does_not_hide_the_pump_pressure():
+    """A tiny reservoir (V0 = 2000 mm^3) whose tabulated model gives p_r = -4e-6 MPa: the cavity
+    pressure of the answer is just below the pump's, where the slow path's bracket started (it
+    refused the pump pressure, "not reached up to 8.5 MPa"). It now starts from contact there,
+    and finds the fast path's state."""
+    design = PAPER.replace(a=4.1956, b=7.0, d=13.3817, R=40.0, t=0.89407, V0=2000.0, tie_width=13.7794,
+                           l0=155.3523, hinge_s=tuple(s * 155.3523 / PAPER.l0 for s in PAPER.hinge_s))
+    slow = grasp_hold.slow_hold(design, 230.0, 3.5, "P_pump", 3.5)
+    assert slow.P_cavity < 3.5 and slow.P_pump == pytest.approx(3.5, abs=1e-12)
+    fast = grasp_hold.fast_hold(design, 230.0, 3.5, "P_pump", 3.5)
+    _same_hold(fast, slow)
