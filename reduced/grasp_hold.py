@@ -159,18 +159,55 @@ def fast_hold(design: HandDesign, diameter_mm: float, mass_kg: float, target: st
     # each pad with its face, then with its far end (a corner, as grasp_state's)
     pads = [(first, False)] if target == "F_v" else \
         [(k, corner) for k in range(first, design.n_s + 1) for corner in (False, True)[:1 + (k < design.n_s)]]
+    into = []  # the solves that put another pad into the object: a snap may lie below them
     for k, corner in pads:
         m = k + (k < design.n_s)  # the held hinges, and one unknown for the distal ones if there are any
         z0 = np.concatenate([np.full(m, theta_c / design.n_s), [max(float(value), 1.0) if target == "F_v" else 1.0, P0]])
-        held = _hold_on_pad(k, design, diameter_mm, depth, mass_kg, target, value, reservoir, z0, corner=corner)
+        solved = _solve_on_pad(k, design, diameter_mm, depth, mass_kg, target, value, reservoir, z0, corner)
+        held = None if solved is None else _held(k, solved, design, reservoir)
+        if held is None and solved is not None and solved[0][-2] >= 0.0:
+            into.append((k, corner, solved))
         if held is None or not held.P_cavity <= _largest_pressure(design):  # grasp_state has no state there
             continue
-        if (k, corner) == (first, False):
+        if (k, corner) == (first, False) or _is_state(held, design, diameter_mm, mass_kg):
             return held
-        state = grasp_fem.grasp_state(design, diameter_mm, held.P_cavity, mass_kg)
-        if state.link == k and abs(state.theta - held.theta) <= 1e-9 * max(1.0, abs(held.theta)):
-            return held
+    if target == "P_pump":
+        for k, corner, (z, gaps, _) in into:
+            snap = _snap_below(k, corner, z, _nearest_pad(k, gaps), design, diameter_mm, depth, mass_kg, value,
+                               reservoir)
+            if snap is not None:
+                return snap
     return None
+
+
+#: how far above a pad's end [MPa] :func:`_snap_below` looks for the state the finger snaps to
+SNAP_PROBE = 1e-6
+
+
+def _snap_below(k: int, corner: bool, z0, j: int, design: HandDesign, diameter_mm: float, depth: float,
+                mass_kg: float, value: float, reservoir: bool) -> Hold | None:
+    """The state just below a snap of the grasp past the pump pressure ``value``: where pad j
+    touches the object while pad k (its far end if ``corner``) holds it, grasp_state's finger
+    moves to another state at once (its bend jumps), and the pump pressure with it, from below
+    ``value`` to above it. No equilibrium has that pump pressure: the state before the snap is
+    the answer (its pump pressure a little below ``value``), as the slow path's root finder,
+    which closes on the jump, finds too. None if there is no such snap."""
+    end = _hold_on_pad(k, design, diameter_mm, depth, mass_kg, "gap", j, reservoir, z0, corner=corner)
+    if end is None or not end.P_pump < value or not end.P_cavity <= _largest_pressure(design) \
+            or not _is_state(end, design, diameter_mm, mass_kg):
+        return None
+    try:
+        above = grasp_fem.grasp_state(design, diameter_mm, end.P_cavity + SNAP_PROBE, mass_kg)
+    except InputError:
+        return None
+    P_pump = above.P - float(reservoir_pressure(above.theta, design, reservoir))
+    return end if P_pump > value and abs(above.theta - end.theta) > 1e3 * SNAP_PROBE else None
+
+
+def _is_state(held: Hold, design: HandDesign, diameter_mm: float, mass_kg: float) -> bool:
+    """Whether ``grasp_state`` at held's cavity pressure is held's state (pad, bend)."""
+    state = grasp_fem.grasp_state(design, diameter_mm, held.P_cavity, mass_kg)
+    return state.link == held.link and abs(state.theta - held.theta) <= 1e-9 * max(1.0, abs(held.theta))
 
 
 def _hold_on_pad(k: int, design: HandDesign, diameter_mm: float, depth: float, mass_kg: float, target: str,
@@ -182,9 +219,15 @@ def _hold_on_pad(k: int, design: HandDesign, diameter_mm: float, depth: float, m
     solved = _solve_on_pad(k, design, diameter_mm, depth, mass_kg, target, value, reservoir, z0, corner)
     if solved is None:
         return None
-    z, gaps, F_v = solved
     if target == "gap":
-        gaps[int(value)] = np.inf
+        solved[1][int(value)] = np.inf
+    return _held(k, solved, design, reservoir)
+
+
+def _held(k: int, solved, design: HandDesign, reservoir: bool) -> Hold | None:
+    """The Hold of :func:`_solve_on_pad`'s solution with pad k touching, None if it is not
+    acceptable (N < 0, another pad in the object)."""
+    z, gaps, F_v = solved
     if z[-2] < 0.0 or np.min(gaps) < -grasp_fem._PENETRATION:
         return None
     q = _hinges(z, k, design.n_s)
@@ -290,6 +333,20 @@ def slow_hold(design: HandDesign, diameter_mm: float, mass_kg: float, target: st
         lo, s_lo, f_lo, step = hi, s_hi, f_hi, 2.0 * step
     P = brentq(f, lo, hi, xtol=_PTOL, rtol=4 * np.finfo(float).eps)
     s = state(P)
+    c = cond(s.theta, P, s.F_v)
+    if abs(c) > 1e-8 * max(1.0, abs(value)) and (c > 0.0) == (target == "P_pump"):
+        # a snap, not a root (the state, and the condition, jump): the state below it for the
+        # pump pressure (the last one the pump reaches, as fast_hold's), above it for F_v (the
+        # first that presses with F_v); brentq's P may lie on either side of the jump
+        step = _PTOL if target == "F_v" else -_PTOL
+        for _ in range(20):
+            s = state(P + step)
+            if (cond(s.theta, s.P, s.F_v) > 0.0) != (target == "P_pump"):
+                P = P + step
+                break
+            step *= 2.0
+        else:
+            s = state(P)
     return Hold(float(P), float(P - reservoir_pressure(s.theta, design, reservoir)), s.F_v, s.theta,
                 s.link, False)
 
@@ -425,8 +482,7 @@ def _end_on_pad(k: int, j: int, z0, design: HandDesign, diameter_mm: float, dept
     end = _hold_on_pad(k, design, diameter_mm, depth, mass_kg, "gap", j, reservoir, z0)
     if end is None or not end.P_cavity <= P_top:
         return None
-    check = grasp_fem.grasp_state(design, diameter_mm, end.P_cavity, mass_kg)
-    if check.link != k or abs(check.theta - end.theta) > 1e-9 * max(1.0, abs(end.theta)):
+    if not _is_state(end, design, diameter_mm, mass_kg):
         return None
     if abs(j - k) > 1:  # a pad beyond the next one on the object: two contacts, not a pad change
         return end._replace(edge=ONE_PAD_END)

@@ -285,3 +285,26 @@ def test_a_reservoir_pressure_below_zero_does_not_hide_the_pump_pressure():
     assert slow.P_cavity < 3.5 and slow.P_pump == pytest.approx(3.5, abs=1e-12)
     fast = grasp_hold.fast_hold(design, 230.0, 3.5, "P_pump", 3.5)
     _same_hold(fast, slow)
+
+
+@pytest.mark.parametrize("a, d, l0", [(6.0, 13.59, 162.49), (5.99558128, 13.5871418, 162.41546091)])
+def test_a_pump_pressure_at_a_snap_is_the_state_just_below_it(monkeypatch, a, d, l0):
+    """Near a held-out-style margin task's optimum (150 mm, 1 kg, 1.5 MPa): where pad 4 touches
+    the object held by pad 3's far end, the finger snaps to another state and the pump
+    pressure jumps past 1.5 MPa (by 1.2e-4 MPa): no equilibrium has it. The slow path's root
+    finder closed on the jump (37 equilibria: the design optimiser's polish spent 0.45 s a
+    design there); the fast path solves for the snap (pad 4's gap 0) and checks it with two
+    states: the same state, to grasp_state's 1e-6 mm tolerance on a second pad. The root finder
+    lands on either side of the jump (F_v 14.3 N above it, 16.2 N below, the second design): it
+    takes the state below, as the fast path."""
+    design = PAPER.replace(a=a, d=d, l0=l0, hinge_s=tuple(s * l0 / PAPER.l0 for s in PAPER.hinge_s))
+    state = grasp_fem.grasp_state
+    calls = _count_states(monkeypatch)
+    held = grasp_hold.fast_hold(design, 150.0, 1.0, "P_pump", 1.5)
+    assert held is not None and held.link == 3 and len(calls) <= 4
+    assert 1.5 - 2e-4 < held.P_pump < 1.5
+    above = state(design, 150.0, held.P_cavity + 1e-6, 1.0)
+    assert above.P - float(grasp_hold.reservoir_pressure(above.theta, design)) > 1.5
+    slow = grasp_hold.slow_hold(design, 150.0, 1.0, "P_pump", 1.5)
+    assert slow.P_cavity == pytest.approx(held.P_cavity, abs=1e-6)
+    assert slow.F_v == pytest.approx(held.F_v, rel=1e-5)
