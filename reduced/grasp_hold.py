@@ -20,9 +20,12 @@ otherwise, or if the solve fails, the same numbers come from a bracketing root f
 ``grasp_state`` (the slow path, :func:`slow_hold`). The solve is Newton's method with one
 batched evaluation of the equations per iteration (the state and its finite-difference
 neighbours at once), 5-6 iterations from the contact state (the pump pressure given: at that
-pressure, and on the later pads in turn, see :func:`fast_hold`). Neither path answers above
-the free finger's pressure at its largest bend, where ``grasp_state`` has no state. Units:
-mm, N, MPa, rad.
+pressure, and on the later pads and their far ends in turn, see :func:`fast_hold`). Neither
+path answers above the free finger's pressure at its largest bend, where ``grasp_state`` has
+no state. Where a second pad touches the object, the one-pad model ends (the same equations
+with that pad's gap = 0 give the end, :func:`one_pad_end`; a task's margin is measured there
+if the pump limit lies beyond, :func:`at_pump`) or the state snaps to another pad (the state
+below the snap answers a pump pressure inside the jump). Units: mm, N, MPa, rad.
 """
 from __future__ import annotations
 
