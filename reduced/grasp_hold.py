@@ -159,14 +159,14 @@ def fast_hold(design: HandDesign, diameter_mm: float, mass_kg: float, target: st
     # pressure plus the reservoir's at contact: a start 3 MPa below the answer often failed
     P0 = P_c + 0.1 if target == "F_v" else \
         max(P_c + 0.1, float(value) + float(reservoir_pressure(theta_c, design, reservoir)))
-    # each pad with its face, then with its far end (a corner, as grasp_state's)
-    pads = [(first, False)] if target == "F_v" else \
-        [(k, corner) for k in range(first, design.n_s + 1) for corner in (False, True)[:1 + (k < design.n_s)]]
+    # each pad with its face, then, if that put the next pad into the object, with its far end
+    # (a corner, as grasp_state's)
+    pads = [(first, False)] if target == "F_v" else _pads(first, design.n_s)
     into = []  # the solves that put another pad into the object: a snap may lie below them
-    for k, corner in pads:
-        m = k + (k < design.n_s)  # the held hinges, and one unknown for the distal ones if there are any
-        z0 = np.concatenate([np.full(m, theta_c / design.n_s), [max(float(value), 1.0) if target == "F_v" else 1.0, P0]])
-        solved = _solve_on_pad(k, design, diameter_mm, depth, mass_kg, target, value, reservoir, z0, corner)
+    N0 = max(float(value), 1.0) if target == "F_v" else 1.0
+    solve = lambda k, corner: _solve_on_pad(k, design, diameter_mm, depth, mass_kg, target, value, reservoir,  # noqa: E731
+                                            _start(k, design.n_s, theta_c, N0, P0), corner)
+    for k, corner, solved in _pad_solves(pads, design.n_s, solve):
         held = None if solved is None else _held(k, solved, design, reservoir)
         if held is None and solved is not None and solved[0][-2] >= 0.0:
             into.append((k, corner, solved))
@@ -174,13 +174,41 @@ def fast_hold(design: HandDesign, diameter_mm: float, mass_kg: float, target: st
             continue
         if (k, corner) == (first, False) or _is_state(held, design, diameter_mm, mass_kg):
             return held
-    if target == "P_pump":
-        for k, corner, (z, gaps, _) in into:
-            snap = _snap_below(k, corner, z, _nearest_pad(k, gaps), design, diameter_mm, depth, mass_kg, value,
-                               reservoir)
+    for k, corner, (z, gaps, _) in into if target == "P_pump" else ():
+        j = _nearest_pad(k, gaps)
+        if _next_to(j, k, corner):  # the contact moves on to a neighbour (a pad beyond: two contacts)
+            snap = _snap_below(k, corner, z, j, design, diameter_mm, depth, mass_kg, value, reservoir)
             if snap is not None:
                 return snap
     return None
+
+
+def _next_to(j: int, k: int, corner: bool) -> bool:
+    """Whether pad j is next to the contact of pad k (its far end, the hinge with pad k+1, if
+    ``corner``): touching it may move the contact there; a pad beyond makes two contacts."""
+    return k - 1 <= j <= k + 1 + corner
+
+
+def _start(k: int, n_s: int, theta_c: float, N0: float, P0: float) -> np.ndarray:
+    """The Newton start on pad k: every hinge at the contact's theta_c / n_s, N0, P0."""
+    return np.concatenate([np.full(k + (k < n_s), theta_c / n_s), [N0, P0]])
+
+
+def _pad_solves(pads, n_s: int, solve):
+    """(k, corner, solve(k, corner)) for the (pad, corner) pairs in turn; a pad's far end only if
+    its face's solve put the next pad into the object (else the corner cannot be the contact)."""
+    next_in = False
+    for k, corner in pads:
+        if corner and not next_in:
+            continue
+        solved = solve(k, corner)
+        next_in = solved is not None and k < n_s and solved[1][k + 1] < -grasp_fem._PENETRATION
+        yield k, corner, solved
+
+
+def _pads(first: int, n_s: int) -> list[tuple[int, bool]]:
+    """(pad, corner) from pad ``first`` on: each pad's face, then its far end (but the tip's)."""
+    return [(k, corner) for k in range(first, n_s + 1) for corner in (False, True)[:1 + (k < n_s)]]
 
 
 #: how far above a pad's end [MPa] :func:`_snap_below` looks for the state the finger snaps to
@@ -204,7 +232,8 @@ def _snap_below(k: int, corner: bool, z0, j: int, design: HandDesign, diameter_m
     except InputError:
         return None
     P_pump = above.P - float(reservoir_pressure(above.theta, design, reservoir))
-    return end if P_pump > value and abs(above.theta - end.theta) > 1e3 * SNAP_PROBE else None
+    # a snap: the bend jumps (a continuous change of pad moves it by ~1e-6 rad over SNAP_PROBE)
+    return end if P_pump > value and abs(above.theta - end.theta) > 1e2 * SNAP_PROBE else None
 
 
 def _is_state(held: Hold, design: HandDesign, diameter_mm: float, mass_kg: float) -> bool:
@@ -395,13 +424,13 @@ def one_pad_end(design: HandDesign, diameter_mm: float, mass_kg: float, *, reser
     The end is a state where pad k holds the object and another pad j just touches it: one
     Newton solve of the module's equations with the condition gap_j = 0 (the cavity pressure
     unknown) gives it, from a state near it. ``beyond`` (a pump pressure the one-pad model does
-    not reach): the start is the state of pad k at that pump pressure (as :func:`fast_hold`)
-    in which pad j is inside the object, for the pads k in turn; the end is kept if it is
+    not reach): the start is the state of pad k (its face, then its far end) at that pump
+    pressure (as :func:`fast_hold`) in which pad j is inside the object, for the pads k in
+    turn; the end is kept if it is
     :func:`reduced.grasp_fem.grasp_state`'s state at its pressure and ``grasp_state`` has none
     :data:`END_PROBE` above it (a pad change is not an end). Otherwise ``grasp_state`` is
-    stepped up in cavity pressure (0.05, 0.1, 0.2 ... MPa) until it has no state, the end
-    bisected to :data:`BRACKET_RESOLUTION` and solved for from there (kept if ``grasp_state``'s
-    state), or, failing that, bisected to 1e-13 MPa."""
+    stepped up in cavity pressure (0.05, 0.1, 0.2 ... MPa) until it has no state and the end
+    found between (:func:`_end_between`)."""
     design = grasp_fem.fem_finger(design)
     P_top = _largest_pressure(design)
     depth = contact.object_depth(diameter_mm, design)
@@ -415,13 +444,13 @@ def one_pad_end(design: HandDesign, diameter_mm: float, mass_kg: float, *, reser
         # lower: beyond it the free finger has no pressure), the object inside other pads or not
         P_start = min(float(beyond), 0.9 * P_top)
         P0 = max(lo + 0.1, P_start + float(reservoir_pressure(theta_c, design, reservoir)))
-        for k in range(first, design.n_s + 1):
-            z0 = np.concatenate([np.full(k + (k < design.n_s), theta_c / design.n_s), [1.0, P0]])
-            solved = _solve_on_pad(k, design, diameter_mm, depth, mass_kg, "P_pump", P_start, reservoir, z0)
+        solve = lambda k, corner: _solve_on_pad(k, design, diameter_mm, depth, mass_kg, "P_pump", P_start,  # noqa: E731
+                                                reservoir, _start(k, design.n_s, theta_c, 1.0, P0), corner)
+        for k, corner, solved in _pad_solves(_pads(first, design.n_s), design.n_s, solve):
             if solved is None or solved[0][-2] < 0.0:
                 continue
             end = _end_on_pad(k, _nearest_pad(k, solved[1]), solved[0], design, diameter_mm, depth,
-                              mass_kg, reservoir, P_top)
+                              mass_kg, reservoir, P_top, corner)
             if end is not None:
                 return end
     s_lo, hi, step = state(lo), None, 0.05
@@ -478,16 +507,17 @@ def _nearest_pad(k: int, gaps) -> int:
 
 
 def _end_on_pad(k: int, j: int, z0, design: HandDesign, diameter_mm: float, depth: float, mass_kg: float,
-                reservoir: bool, P_top: float) -> Hold | None:
-    """:func:`one_pad_end`'s Newton solve from z0: pad k holds the object, pad j just touches it,
-    at a cavity pressure up to P_top. None if it fails, or if it is not ``grasp_state``'s state
-    at its pressure, or ``grasp_state`` has a state :data:`END_PROBE` above it."""
-    end = _hold_on_pad(k, design, diameter_mm, depth, mass_kg, "gap", j, reservoir, z0)
+                reservoir: bool, P_top: float, corner: bool = False) -> Hold | None:
+    """:func:`one_pad_end`'s Newton solve from z0: pad k (its far end if ``corner``) holds the
+    object, pad j just touches it, at a cavity pressure up to P_top. None if it fails, or if it
+    is not ``grasp_state``'s state at its pressure, or (j next to the contact: perhaps a change
+    of pad) ``grasp_state`` has a state :data:`END_PROBE` above it."""
+    end = _hold_on_pad(k, design, diameter_mm, depth, mass_kg, "gap", j, reservoir, z0, corner=corner)
     if end is None or not end.P_cavity <= P_top:
         return None
     if not _is_state(end, design, diameter_mm, mass_kg):
         return None
-    if abs(j - k) > 1:  # a pad beyond the next one on the object: two contacts, not a pad change
+    if not _next_to(j, k, corner):  # a pad beyond the next one on the object: two contacts
         return end._replace(edge=ONE_PAD_END)
     try:
         grasp_fem.grasp_state(design, diameter_mm, end.P_cavity + END_PROBE, mass_kg)
