@@ -40,8 +40,8 @@ from .errors import InputError
 
 #: tolerance of the fast solve (Newton step, relative on the unknowns) and of the slow path's brentq [MPa]
 _XTOL, _PTOL = 1e-13, 1e-13
-#: the slow path's bracket: the least pressure step [MPa] towards where one pad stops holding
-#: the object alone (a heavy object: the condition is not met before; without it, 60 halvings)
+#: where one pad stops holding the object alone, the end is bisected to this [MPa] (after 0.05 MPa)
+#: before the second Newton solve for it from there (:func:`_end_between`)
 BRACKET_RESOLUTION = 1e-3
 
 

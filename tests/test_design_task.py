@@ -501,3 +501,18 @@ def test_a_force_one_pad_cannot_give_leaves_the_rest_of_the_evaluation_standing(
                                                                    0.0, 0, ""))
     assert f"has no pump pressure for F_v = {ev.F_v:.4g} N (the pump limit 4 MPa): not reached" in report
     assert "no bend opens" not in report
+
+
+def test_only_a_force_not_reached_is_reported_as_no_grasp(monkeypatch):
+    """An error of another model inside the grasp (here: more oil than the reservoir holds) is
+    not "F_v not reached": the design has no answer at all, as before (every pressure inf)."""
+    from softhand.reduced import grasp_hold
+
+    task = task_from_dict(CI_TASK)
+
+    def too_much_oil(*args, **kwargs):
+        raise InputError("V_mm3", -1.0, "reservoir volume must be positive")
+
+    monkeypatch.setattr(grasp_hold, "hold", too_much_oil)
+    ev = design_opt.evaluate(task.base, task)
+    assert ev.no_grasp == "" and ev.P_grasp == math.inf and ev.P_contact == math.inf

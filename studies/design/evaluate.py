@@ -285,6 +285,8 @@ def _fem_relation(design: HandDesign, task: Task, theta: float, theta_open: floa
         held = grasp_hold.hold(design, task.diameter, task.mass, "F_v", F_req) if F_req > 0.0 else \
             grasp_hold.Hold(math.nan, P_contact, 0.0, theta, -1, True)
     except InputError as refused:  # F_req beyond what the finger gives: no P_grasp, the rest stands
+        if refused.field != "F_v":  # another model's range (e.g. more oil than the reservoir holds)
+            raise
         held, no_grasp = grasp_hold.Hold(math.nan, math.inf, math.nan, theta, -1, False), refused.allowed
     F_lim, P_margin, edge = math.nan, task.max_pressure, ""
     if asks_force_at_limit(design, task):
