@@ -145,10 +145,10 @@ def fast_hold(design: HandDesign, diameter_mm: float, mass_kg: float, target: st
     (the hinge it shares with the next pad: ``grasp_state``'s corner contact): each pad with
     its face, then with its far end, is tried in turn, and an answer other than the first
     pad's face is kept only if ``grasp_state`` at its pressure is the same state (one
-    equilibrium, against a dozen for the slow path). The pump pressure grows
-    with the cavity's, so its answer is the only one; F_v need not (it drops where the
-    touching pad changes), so for F_v only the first pad is tried: a later pad's answer
-    could be a second root."""
+    equilibrium, against a dozen for the slow path). The pump pressure grows with the
+    cavity's, so its answer is the only one; F_v need not (it drops where the touching pad
+    changes): a later pad's F_v is kept only if it is the root the slow path finds, the one
+    in the first interval of its grid (:func:`_first_on_the_grid`)."""
     design = grasp_fem.fem_finger(design)
     depth = contact.object_depth(diameter_mm, design)
     theta_c, first = contact.contact_angle(diameter_mm, design, depth=depth)
@@ -161,7 +161,7 @@ def fast_hold(design: HandDesign, diameter_mm: float, mass_kg: float, target: st
         max(P_c + 0.1, float(value) + float(reservoir_pressure(theta_c, design, reservoir)))
     # each pad with its face, then, if that put the next pad into the object, with its far end
     # (a corner, as grasp_state's)
-    pads = [(first, False)] if target == "F_v" else _pads(first, design.n_s)
+    pads = _pads(first, design.n_s)
     into = []  # the solves that put another pad into the object: a snap may lie below them
     N0 = max(float(value), 1.0) if target == "F_v" else 1.0
     solve = lambda k, corner: _solve_on_pad(k, design, diameter_mm, depth, mass_kg, target, value, reservoir,  # noqa: E731
@@ -172,7 +172,8 @@ def fast_hold(design: HandDesign, diameter_mm: float, mass_kg: float, target: st
             into.append((k, corner, solved))
         if held is None or not held.P_cavity <= _largest_pressure(design):  # grasp_state has no state there
             continue
-        if (k, corner) == (first, False) or _is_state(held, design, diameter_mm, mass_kg):
+        if (k, corner) == (first, False) or _is_state(held, design, diameter_mm, mass_kg) and \
+                (target == "P_pump" or _first_on_the_grid(held, P_c, design, diameter_mm, mass_kg, value)):
             return held
     for k, corner, (z, gaps, _) in into if target == "P_pump" else ():
         j = _nearest_pad(k, gaps)
@@ -181,6 +182,28 @@ def fast_hold(design: HandDesign, diameter_mm: float, mass_kg: float, target: st
             if snap is not None:
                 return snap
     return None
+
+
+#: the slow path's bracket: its first step above the contact pressure [MPa]; each next one twice as long
+GRID_STEP = 0.05
+
+
+def _first_on_the_grid(held: Hold, P_contact: float, design: HandDesign, diameter_mm: float, mass_kg: float,
+                       F_v: float) -> bool:
+    """Whether F_v at held (on a later pad than the first) is the root :func:`slow_hold` finds:
+    F_v below the asked one at every point of its grid (the contact pressure, then steps of
+    GRID_STEP, twice that, ...) below held's pressure, so that held lies in the grid's first
+    interval where F_v reaches it. A few states at pressures of one pad, against the slow
+    path's bracket and brentq."""
+    P, step = P_contact + 1e-9, GRID_STEP
+    while P < held.P_cavity:
+        try:
+            if grasp_fem.grasp_state(design, diameter_mm, P, mass_kg).F_v >= F_v:
+                return False
+        except InputError:
+            return False
+        P, step = P + step, 2.0 * step
+    return True
 
 
 def _next_to(j: int, k: int, corner: bool) -> bool:
@@ -342,7 +365,7 @@ def slow_hold(design: HandDesign, diameter_mm: float, mass_kg: float, target: st
         if cond(s_lo.theta, lo, s_lo.F_v) > 0.0:  # p_r < 0 there (a tabulated model's round-off at
             lo, s_lo = P_contact, None           # a tiny reservoir): the answer lies below, from contact
     s_lo = state(lo) if s_lo is None else s_lo
-    f_lo, step = cond(s_lo.theta, lo, s_lo.F_v), 0.05
+    f_lo, step = cond(s_lo.theta, lo, s_lo.F_v), GRID_STEP
     while True:  # the first sign change above the contact pressure: steps 0.05, 0.1, ... MPa
         hi = min(lo + step, P_max)
         try:

@@ -177,11 +177,23 @@ def _found_on_a_later_pad(monkeypatch, design, diameter, mass, P_pump, link):
 def test_a_pump_pressure_that_presses_a_later_pad_is_found_on_it(monkeypatch):
     """The paper's hand touches the 180 mm object with pad 2 and holds it with pad 3 at 2 MPa: the
     first pad's solve fails, pad 3's is checked by one grasp_state (the slow path's 190 ms were
-    spent on every such design of a margin task) and is the slow path's answer. F_v is solved
-    on the first pad only (a later pad's root may not be the first)."""
+    spent on every such design of a margin task) and is the slow path's answer."""
     held = _found_on_a_later_pad(monkeypatch, PAPER, 180.0, 1.0, 2.0, link=3)
-    force = grasp_hold.slow_hold(PAPER, 180.0, 1.0, "F_v", held.F_v)
-    assert force.link == 3 and grasp_hold.fast_hold(PAPER, 180.0, 1.0, "F_v", held.F_v) is None
+    assert held.P_pump == pytest.approx(2.0, rel=1e-12)
+
+
+def test_a_force_on_a_later_pad_is_the_slow_paths_root(monkeypatch):
+    """F_v = 30 N on the paper's hand at 180 mm, 1 kg: pad 3 presses with it, pad 2 touched
+    first. F_v drops where the touching pad changes and may be reached twice, so a later pad's
+    root is kept only if F_v is below 30 N at every point of the slow path's grid below it
+    (here 5 states, then its check): the slow path's state, 60 states fewer."""
+    calls = _count_states(monkeypatch)
+    fast = grasp_hold.fast_hold(PAPER, 180.0, 1.0, "F_v", 30.0)
+    assert fast is not None and fast.link == 3 and len(calls) <= 8
+    slow = grasp_hold.slow_hold(PAPER, 180.0, 1.0, "F_v", 30.0)
+    assert slow.link == 3 and len(calls) > 20
+    _same_hold(fast, slow)
+
 
 
 def test_a_pump_pressure_beyond_the_one_pad_region_is_refused_at_once(monkeypatch):
@@ -308,3 +320,21 @@ def test_a_pump_pressure_at_a_snap_is_the_state_just_below_it(monkeypatch, a, d,
     slow = grasp_hold.slow_hold(design, 150.0, 1.0, "P_pump", 1.5)
     assert slow.P_cavity == pytest.approx(held.P_cavity, abs=1e-6)
     assert slow.F_v == pytest.approx(held.F_v, rel=1e-5)
+
+
+def test_a_later_pads_force_is_the_first_root_where_the_root_finder_took_a_second():
+    """A held-out-style task's design (200 mm, 3 kg, F_v 17.35 N): on pad 3 F_v rises to 17.35 N
+    at 0.970 MPa, drops by 2 N at 0.975 MPa (the contact moves to the pad's far end) and
+    reaches 17.35 N again at 1.079 MPa. The root finder's bracket held both roots and gave the
+    second; the fast path's pad-3 solve, checked on the root finder's grid, gives the first:
+    F_v stays below the asked force on a fine scan up to it."""
+    design = PAPER.replace(b=3.13164975, V0=15384.3122, R=20.0, mu_sf=1.5, mu_sr=1.5)
+    F_v = 17.3549875
+    fast = grasp_hold.fast_hold(design, 200.0, 3.0, "F_v", F_v)
+    slow = grasp_hold.slow_hold(design, 200.0, 3.0, "F_v", F_v)
+    assert fast is not None and fast.link == slow.link == 3
+    assert fast.P_cavity == pytest.approx(0.9701, abs=1e-3) and slow.P_cavity == pytest.approx(1.0788, abs=1e-3)
+    theta_c, _ = grasp_hold.contact.contact_angle(200.0, grasp_fem.fem_finger(design))
+    P_c = float(grasp_hold.hand.finger_pressure(theta_c, grasp_fem.fem_finger(design)))
+    below = [grasp_fem.grasp_state(design, 200.0, P, 3.0).F_v for P in np.arange(P_c + 1e-6, fast.P_cavity, 0.005)]
+    assert max(below) < F_v
