@@ -64,6 +64,16 @@ ONE_PAD_END = "one pad no longer holds the object alone (a second pad touches it
 LARGEST_BEND = "the cavity pressure reaches the calibrated finger's highest (the free finger's at its largest bend)"
 
 
+class NotReached(InputError):
+    """The force or pump pressure asked is not reached on one pad; ``reached`` is the grasp
+    where one pad stops holding the object alone (or at the calibrated finger's highest
+    pressure): how far it comes."""
+
+    def __init__(self, target: str, value: float, allowed: str, reached: Hold):
+        super().__init__(target, value, allowed)
+        self.reached = reached
+
+
 def reservoir_pressure(theta, design: HandDesign, reservoir: bool = True):
     """p_r [MPa] at the oil the n fingers take at bend theta [rad] (0 without the reservoir)."""
     if not reservoir:
@@ -374,17 +384,18 @@ def slow_hold(design: HandDesign, diameter_mm: float, mass_kg: float, target: st
             end = _end_between(state, s_lo, hi, design, diameter_mm, mass_kg, reservoir)
             hi, f_hi = end.P_cavity, cond(end.theta, end.P_cavity, end.F_v)
             if not f_lo * f_hi <= 0.0:
-                raise InputError(target, value, f"not reached by the finger on one pad, which holds the "
+                raise NotReached(target, value, f"not reached by the finger on one pad, which holds the "
                                                 f"object alone up to the cavity pressure {hi:.6g} MPa (pump "
                                                 f"{end.P_pump:.4g} MPa, F_v {end.F_v:.4g} N): above, "
-                                                "a second pad touches it") from None
+                                                "a second pad touches it", end) from None
             break
         f_hi = cond(s_hi.theta, hi, s_hi.F_v)
         if f_lo * f_hi <= 0.0:
             break
         if hi == P_max:
-            raise InputError(target, value, f"not reached by the finger on one pad up to the cavity pressure "
-                                            f"{hi:.6g} MPa (F_v {s_hi.F_v:.4g} N), where {LARGEST_BEND}")
+            raise NotReached(target, value, f"not reached by the finger on one pad up to the cavity pressure "
+                                            f"{hi:.6g} MPa (F_v {s_hi.F_v:.4g} N), where {LARGEST_BEND}",
+                             _hold_of(s_hi, design, reservoir, LARGEST_BEND))
         lo, s_lo, f_lo, step = hi, s_hi, f_hi, 2.0 * step
     P = brentq(f, lo, hi, xtol=_PTOL, rtol=4 * np.finfo(float).eps)
     s = state(P)

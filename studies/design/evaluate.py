@@ -54,12 +54,15 @@ class Constraint:
     limit: float
     sense: str  #: "<=" or ">="
     scale: float | None = None  #: of the normalised slack; None: |limit|
+    #: a value with no number (inf): how far the design is from having one, in (0, 1] (None: no measure)
+    shortfall: float | None = None
 
     @property
     def slack(self) -> float:
-        """Normalised distance to the limit, >= 0 when met."""
+        """Normalised distance to the limit, >= 0 when met; -1 - shortfall for a value with no number
+        but a measure of how far it is from one, else -1e3."""
         if not math.isfinite(self.value):
-            return -1e3
+            return -1.0 - self.shortfall if self.shortfall is not None else -1e3
         if not math.isfinite(self.limit):  # no limit (e.g. no limit point): met, by far
             return 1e3
         gap = self.limit - self.value if self.sense == "<=" else self.value - self.limit
@@ -177,9 +180,9 @@ def evaluate(design: HandDesign, task: Task, *, exact: bool = True) -> Evaluatio
     (``exact=False``: the kinematics interpolated in l0, see :func:`grasp_geometry`)."""
     depth, theta, link, w, theta_open = grasp_geometry(design, task, exact=exact)
     F_req = task.required_F_v()
-    P_margin, edge, no_grasp = task.max_pressure, "", ""
+    P_margin, edge, no_grasp, F_reached = task.max_pressure, "", "", math.nan
     try:
-        P_grasp, P_contact, P_open, F_lim, theta_hold, P_margin, edge, no_grasp = \
+        P_grasp, P_contact, P_open, F_lim, theta_hold, P_margin, edge, no_grasp, F_reached = \
             grasp_relation(design, task, theta, w, theta_open)
     except InputError:  # e.g. V0 too small for the oil, a design outside the calibrated range
         F_lim = -math.inf if asks_force_at_limit(design, task) else math.nan
@@ -192,6 +195,9 @@ def evaluate(design: HandDesign, task: Task, *, exact: bool = True) -> Evaluatio
     stretch = 1.0 + task.stretch_factor * (peak_stretch(theta_hold, design) - 1.0)
     sheet = float(reservoir.stretch(design.V0, design))
     cons = _constraints(design, task, oil, stretch, sheet, P_grasp, P_contact, F_lim, P_open)
+    if no_grasp and F_reached < F_req:  # no P_grasp: how far short of F_req the finger comes, for the optimiser
+        cons = [replace(c, shortfall=min(1.0, 1.0 - max(F_reached, 0.0) / F_req)) if c.name.startswith("pump_pressure")
+                else c for c in cons]
     return Evaluation(design, depth, theta, link, w, P_grasp, P_contact, F_req, F_lim, stretch, sheet,
                       tuple(cons), theta_hold, P_margin, edge, no_grasp)
 
@@ -242,6 +248,7 @@ class GraspRelation(NamedTuple):
     P_margin: float    #: the pump pressure of F_at_limit: the limit, or where the FEM-informed grasp ends [MPa]
     edge: str = ""     #: why P_margin is below the limit (:attr:`reduced.grasp_hold.Hold.edge`), or ""
     no_grasp: str = ""  #: why P_grasp is inf (the required F_v not reached by the FEM-informed grasp), or ""
+    F_reached: float = math.nan  #: with no_grasp: F_v where the FEM-informed grasp ends (how far it comes) [N]
 
 
 def asks_force_at_limit(design: HandDesign, task: Task) -> bool:
@@ -280,21 +287,20 @@ def _fem_relation(design: HandDesign, task: Task, theta: float, theta_open: floa
     P_open = float(hand.pressure(theta_open, design)) if math.isfinite(theta_open) else -math.inf
     F_req = task.required_F_v()
     # F_v = 0 (a massless object, no margin): the fingers only touch it, at the contact pressure
-    no_grasp = ""
+    no_grasp, F_reached = "", math.nan
     try:
         held = grasp_hold.hold(design, task.diameter, task.mass, "F_v", F_req) if F_req > 0.0 else \
             grasp_hold.Hold(math.nan, P_contact, 0.0, theta, -1, True)
-    except InputError as refused:  # F_req beyond what the finger gives: no P_grasp, the rest stands
-        if refused.field != "F_v":  # another model's range (e.g. more oil than the reservoir holds)
-            raise
+    except grasp_hold.NotReached as refused:  # F_req beyond what the finger gives: no P_grasp, the rest stands
         held, no_grasp = grasp_hold.Hold(math.nan, math.inf, math.nan, theta, -1, False), refused.allowed
+        F_reached = refused.reached.F_v
     F_lim, P_margin, edge = math.nan, task.max_pressure, ""
     if asks_force_at_limit(design, task):
         at = grasp_hold.Hold(math.nan, task.max_pressure, 0.0, theta, -1, True) \
             if task.max_pressure <= P_contact else \
             grasp_hold.at_pump(design, task.diameter, task.mass, task.max_pressure)
         F_lim, P_margin, edge = at.F_v, at.P_pump, at.edge
-    return GraspRelation(held.P_pump, P_contact, P_open, F_lim, held.theta, P_margin, edge, no_grasp)
+    return GraspRelation(held.P_pump, P_contact, P_open, F_lim, held.theta, P_margin, edge, no_grasp, F_reached)
 
 
 def calibrated_range(design: HandDesign) -> list[Constraint]:
