@@ -19,6 +19,7 @@ from softhand.reduced.errors import InputError
 from softhand.reduced.paper import FIG8
 from softhand.studies.cli.args import MOST_FEM_POINTS, add_design_option, add_json_option, \
     add_max_cases_option, add_progress_option, design_from_args, max_cases, parse_values, print_json, print_table
+from softhand.studies.design.task import UPPER
 from softhand.studies.io.files import kept_if_unwritable
 
 HELP = "hinge weight vectors w for an object diameter from the grasp FEM; F_v vs eq. (25)"
@@ -53,8 +54,10 @@ def configure(parser) -> None:
     add_progress_option(parser)
 
 
-#: option -> (lowest, highest) allowed, in the option's unit
-LIMITS = {"--diameter-mm": (60.0, 500.0), "--mass-kg": (0.0, 20.0), "--pressure-mpa": (0.01, 3.0),
+#: option -> (lowest, highest) allowed, in the option's unit; the cavity pressure up to the pump
+#: limit design tasks allow, so that a design's grasp can be checked at its pump's limit
+LIMITS = {"--diameter-mm": (60.0, 500.0), "--mass-kg": (0.0, 20.0),
+          "--pressure-mpa": (0.01, UPPER["max_pressure_MPa"]),
           "--dp-mpa": (0.001, 0.5), "--mesh-size-mm": (2.0, 12.0), "--depth-mm": (-1000.0, 1000.0),
           "--check-mm": (60.0, 500.0), "--fig8": (0.01, 3.0)}
 #: most diameters of one sweep and pressures of one --fig8 (one grasp FEM each)
