@@ -29,6 +29,7 @@ below the snap answers a pump pressure inside the jump). Units: mm, N, MPa, rad.
 """
 from __future__ import annotations
 
+import itertools
 from typing import NamedTuple
 
 import numpy as np
@@ -176,19 +177,20 @@ def fast_hold(design: HandDesign, diameter_mm: float, mass_kg: float, target: st
     N0 = max(float(value), 1.0) if target == "F_v" else 1.0
     solve = lambda k, corner: _solve_on_pad(k, design, diameter_mm, depth, mass_kg, target, value, reservoir,  # noqa: E731
                                             _start(k, design.n_s, theta_c, N0, P0), corner)
+    P_top = _largest_pressure(design)
     for k, corner, solved in _pad_solves(pads, design.n_s, solve):
         held = None if solved is None else _held(k, solved, design, reservoir)
-        if held is None and solved is not None and solved[0][-2] >= 0.0:
+        if held is None and target == "P_pump" and solved is not None and solved[0][-2] >= 0.0:
             into.append((k, corner, solved))
-        if held is None or not held.P_cavity <= _largest_pressure(design):  # grasp_state has no state there
+        if held is None or not held.P_cavity <= P_top:  # grasp_state has no state there
             continue
         if (k, corner) == (first, False) or _is_state(held, design, diameter_mm, mass_kg) and \
                 (target == "P_pump" or _first_on_the_grid(held, P_c, design, diameter_mm, mass_kg, value)):
             return held
-    for k, corner, (z, gaps, _) in into if target == "P_pump" else ():
+    for k, corner, (z, gaps, _) in into:
         j = _nearest_pad(k, gaps)
         if _next_to(j, k, corner):  # the contact moves on to a neighbour (a pad beyond: two contacts)
-            snap = _snap_below(k, corner, z, j, design, diameter_mm, depth, mass_kg, value, reservoir)
+            snap = _snap_below(k, corner, z, j, design, diameter_mm, depth, mass_kg, value, reservoir, P_top)
             if snap is not None:
                 return snap
     return None
@@ -198,21 +200,30 @@ def fast_hold(design: HandDesign, diameter_mm: float, mass_kg: float, target: st
 GRID_STEP = 0.05
 
 
+def _grid(P0: float, top: float):
+    """The cavity pressures [MPa] the slow path steps through: P0, then P0 + GRID_STEP, each step
+    twice the last, up to top (the last one)."""
+    P, step = P0, GRID_STEP
+    yield P
+    while P < top:
+        P, step = min(P + step, top), 2.0 * step
+        yield P
+
+
 def _first_on_the_grid(held: Hold, P_contact: float, design: HandDesign, diameter_mm: float, mass_kg: float,
                        F_v: float) -> bool:
     """Whether F_v at held (on a later pad than the first) is the root :func:`slow_hold` finds:
-    F_v below the asked one at every point of its grid (the contact pressure, then steps of
-    GRID_STEP, twice that, ...) below held's pressure, so that held lies in the grid's first
-    interval where F_v reaches it. A few states at pressures of one pad, against the slow
-    path's bracket and brentq."""
-    P, step = P_contact + 1e-9, GRID_STEP
-    while P < held.P_cavity:
+    F_v below the asked one at every point of its grid (:func:`_grid` from the contact
+    pressure) below held's pressure, so that held lies in the grid's first interval where F_v
+    reaches it. A few states at pressures of one pad, against the slow path's bracket and brentq."""
+    for P in _grid(P_contact + 1e-9, held.P_cavity):
+        if P >= held.P_cavity:
+            break
         try:
             if grasp_fem.grasp_state(design, diameter_mm, P, mass_kg).F_v >= F_v:
                 return False
         except InputError:
             return False
-        P, step = P + step, 2.0 * step
     return True
 
 
@@ -249,7 +260,7 @@ SNAP_PROBE = 1e-6
 
 
 def _snap_below(k: int, corner: bool, z0, j: int, design: HandDesign, diameter_mm: float, depth: float,
-                mass_kg: float, value: float, reservoir: bool) -> Hold | None:
+                mass_kg: float, value: float, reservoir: bool, P_top: float) -> Hold | None:
     """The state just below a snap of the grasp past the pump pressure ``value``: where pad j
     touches the object while pad k (its far end if ``corner``) holds it, grasp_state's finger
     moves to another state at once (its bend jumps), and the pump pressure with it, from below
@@ -257,7 +268,7 @@ def _snap_below(k: int, corner: bool, z0, j: int, design: HandDesign, diameter_m
     the answer (its pump pressure a little below ``value``), as the slow path's root finder,
     which closes on the jump, finds too. None if there is no such snap."""
     end = _hold_on_pad(k, design, diameter_mm, depth, mass_kg, "gap", j, reservoir, z0, corner=corner)
-    if end is None or not end.P_pump < value or not end.P_cavity <= _largest_pressure(design) \
+    if end is None or not end.P_pump < value or not end.P_cavity <= P_top \
             or not _is_state(end, design, diameter_mm, mass_kg):
         return None
     try:
@@ -375,9 +386,8 @@ def slow_hold(design: HandDesign, diameter_mm: float, mass_kg: float, target: st
         if cond(s_lo.theta, lo, s_lo.F_v) > 0.0:  # p_r < 0 there (a tabulated model's round-off at
             lo, s_lo = P_contact, None           # a tiny reservoir): the answer lies below, from contact
     s_lo = state(lo) if s_lo is None else s_lo
-    f_lo, step = cond(s_lo.theta, lo, s_lo.F_v), GRID_STEP
-    while True:  # the first sign change above the contact pressure: steps 0.05, 0.1, ... MPa
-        hi = min(lo + step, P_max)
+    f_lo = cond(s_lo.theta, lo, s_lo.F_v)
+    for hi in itertools.islice(_grid(lo, P_max), 1, None):  # the first sign change above lo
         try:
             s_hi = state(hi)
         except InputError:  # one pad no longer holds the object alone below hi: up to its end
@@ -396,7 +406,11 @@ def slow_hold(design: HandDesign, diameter_mm: float, mass_kg: float, target: st
             raise NotReached(target, value, f"not reached by the finger on one pad up to the cavity pressure "
                                             f"{hi:.6g} MPa (F_v {s_hi.F_v:.4g} N), where {LARGEST_BEND}",
                              _hold_of(s_hi, design, reservoir, LARGEST_BEND))
-        lo, s_lo, f_lo, step = hi, s_hi, f_hi, 2.0 * step
+        lo, s_lo, f_lo = hi, s_hi, f_hi
+    else:  # lo is the largest pressure already: no step above it
+        raise NotReached(target, value, f"not reached by the finger on one pad up to the cavity pressure "
+                                        f"{lo:.6g} MPa (F_v {s_lo.F_v:.4g} N), where {LARGEST_BEND}",
+                         _hold_of(s_lo, design, reservoir, LARGEST_BEND))
     P = brentq(f, lo, hi, xtol=_PTOL, rtol=4 * np.finfo(float).eps)
     s = state(P)
     c = cond(s.theta, P, s.F_v)
@@ -463,7 +477,7 @@ def one_pad_end(design: HandDesign, diameter_mm: float, mass_kg: float, *, reser
     turn; the end is kept if it is
     :func:`reduced.grasp_fem.grasp_state`'s state at its pressure and ``grasp_state`` has none
     :data:`END_PROBE` above it (a pad change is not an end). Otherwise ``grasp_state`` is
-    stepped up in cavity pressure (0.05, 0.1, 0.2 ... MPa) until it has no state and the end
+    stepped up through the slow path's grid (:func:`_grid`) until it has no state and the end
     found between (:func:`_end_between`)."""
     design = grasp_fem.fem_finger(design)
     P_top = _largest_pressure(design)
@@ -487,16 +501,13 @@ def one_pad_end(design: HandDesign, diameter_mm: float, mass_kg: float, *, reser
                               mass_kg, reservoir, P_top, corner)
             if end is not None:
                 return end
-    s_lo, hi, step = state(lo), None, 0.05
-    while hi is None and lo < P_top:
-        P = min(lo + step, P_top)
+    s_lo = state(lo)
+    for P in itertools.islice(_grid(lo, P_top), 1, None):
         try:
-            s_lo, lo, step = state(P), P, 2.0 * step
+            s_lo = state(P)
         except InputError:
-            hi = P
-    if hi is None:
-        return _hold_of(s_lo, design, reservoir, LARGEST_BEND)
-    return _end_between(state, s_lo, hi, design, diameter_mm, mass_kg, reservoir)
+            return _end_between(state, s_lo, P, design, diameter_mm, mass_kg, reservoir)
+    return _hold_of(s_lo, design, reservoir, LARGEST_BEND)
 
 
 def _end_between(state, s_lo: grasp_fem.GraspState, hi: float, design: HandDesign, diameter_mm: float,

@@ -269,6 +269,7 @@ def test_the_one_pad_model_ends_at_the_calibrated_fingers_highest_pressure():
 def test_at_pump_is_hold_where_the_one_pad_model_reaches_the_pump_pressure():
     held = grasp_hold.at_pump(PAPER, 180.0, 1.0, 2.0)
     assert held.edge == "" and held == grasp_hold.hold(PAPER, 180.0, 1.0, "P_pump", 2.0)
+    assert held.P_pump == pytest.approx(2.0, rel=1e-12)  # the pump pressure asked, reached
 
 
 def test_a_pump_pressure_held_at_a_pads_far_end_is_found_by_the_fast_path(monkeypatch):
