@@ -1,20 +1,22 @@
 """The FEM proof of a design on CI-sized meshes (finger 10 mm, sheet 12 elements): its three
 models agree with each other where they must, and with the calibrated models the design uses."""
 import math
+from dataclasses import replace
 
 import pytest
 
-from softhand.reduced import hand
+from softhand.reduced import grasp_hold, hand
 from softhand.studies.design import optimise as design_opt
 from softhand.studies.design.proof import ProofOptions, prove
-from softhand.studies.design.task import task_from_dict
+from softhand.studies.design.task import load_task, task_from_dict
 
-TASK = task_from_dict({
+TASK_DICT = {
     "object": {"diameter_mm": 180.0, "mass_kg": 2.0},
     "grasp": {"force_factor": 2.0},
     "pump": {"max_pressure_MPa": 2.0},
     "free": {"V0_mm3": [12000.0, 30000.0]},
-})
+}
+TASK = task_from_dict(TASK_DICT)
 CI = ProofOptions(mesh_size_mm=10.0, edge_ratio=1.0, sheet={"n_radial": 12}, max_secant=1)
 
 
@@ -39,3 +41,55 @@ def test_fem_proof_of_the_paper_design(tmp_path):
     # the grasp's w sums to 1 (eq. (23)) and the touching link is link 2, as predicted
     assert sum(fem["w"]) == pytest.approx(1.0, abs=1e-9)
     assert max(range(6), key=lambda k: fem["contact_force_N"][k]) == ev.link
+
+
+@pytest.mark.slow
+def test_the_margin_is_proven_by_the_grasp_fem_at_the_pump_limit():
+    """The "margin" objective: the proof takes the grasp FEM on from the verified grasp to the
+    pump limit, where the state's pump pressure (cavity less the reservoir's at the oil left) is
+    the limit. Checked against a sheet FEM solved at that state's oil (not the path it was
+    interpolated on), and the FEM's margin against the calibrated model's."""
+    from softhand.fem.hand.reservoir import SheetModel, inflate
+
+    task = load_task("studies/designs/tasks/low_pressure.toml")
+    # the task's optimum (a 4.5, b 4.5, d 18, t 2 mm, V0 26 312 mm^3): one pad holds it to 0.4 MPa
+    design = replace(task.base, a=4.5, b=4.5, d=18.0, t=2.0, V0=26311.5)
+    ev = design_opt.evaluate(design, task)
+    assert ev.margin_edge == "" and ev.P_margin == task.max_pressure
+    fem = prove(ev, task, CI)
+    m = fem["margin"]
+    assert m["pump_pressure_MPa"] == pytest.approx(task.max_pressure, abs=CI.pump_tol_mpa)
+    p_r = inflate(SheetModel.from_design(design, **CI.sheet), [m["oil_left_mm3"]]).states[0].pressure
+    assert m["cavity_pressure_MPa"] - p_r == pytest.approx(task.max_pressure, abs=2 * CI.pump_tol_mpa)
+    assert fem["F_v_at_pump_limit_N"] == m["F_v_N"]
+    assert fem["margin_N"] == pytest.approx(m["F_v_N"] - task.required_F_v(), rel=1e-12)
+    # the pump limit lies above the verified grasp: the finger presses harder there, on the same pad
+    assert fem["P_grasp_MPa"] < task.max_pressure and m["F_v_N"] > fem["F_v_at_P_grasp_N"]
+    assert m["links_in_contact"] == [ev.link]
+    # the calibrated model's F_v at the pump limit (on the default mesh) against this coarse mesh
+    assert m["F_v_N"] == pytest.approx(ev.F_v_at_limit, rel=0.1)
+
+
+@pytest.mark.slow
+def test_a_margin_below_the_pump_limit_is_proven_there_and_the_fem_goes_on_to_the_limit():
+    """Where the reduced model's one-pad grasp ends below the pump limit (the paper's hand on
+    180 mm: the tip pad touches near 2.8 MPa), the FEM's margin is taken at that pump pressure,
+    where one pad holds the object in the FEM too, and the FEM goes on to the pump limit with
+    the tip pad on the object as well (the grasp FEM's stored states: it touches from 2.9 MPa)."""
+    task = task_from_dict({**TASK_DICT, "object": {"diameter_mm": 180.0, "mass_kg": 1.0},
+                           "grasp": {"force_factor": 6.0, "objective": "margin"},
+                           "pump": {"max_pressure_MPa": 3.2}})
+    ev = design_opt.evaluate(task.base, task)
+    assert ev.margin_edge and ev.P_margin < task.max_pressure
+    fem = prove(ev, task, CI)
+    m, limit = fem["margin"], fem["at_pump_limit"]
+    assert m["pump_pressure_MPa"] == pytest.approx(ev.P_margin, abs=CI.pump_tol_mpa)
+    # the pad the reduced model holds with there (the hold has rolled on from the first pad, ev.link)
+    end = grasp_hold.at_pump(task.base, task.diameter, task.mass, task.max_pressure)
+    assert (end.P_pump, end.F_v) == (ev.P_margin, ev.F_v_at_limit)
+    assert m["links_in_contact"] == [end.link]
+    assert m["F_v_N"] == pytest.approx(ev.F_v_at_limit, rel=0.1)
+    assert fem["margin_N"] == pytest.approx(m["F_v_N"] - task.required_F_v(), rel=1e-12)
+    assert limit["pump_pressure_MPa"] == pytest.approx(task.max_pressure, abs=CI.pump_tol_mpa)
+    assert limit["links_in_contact"] == [end.link, ev.design.n_s]  # and the tip pad
+    assert fem["F_v_at_pump_limit_N"] == limit["F_v_N"] > m["F_v_N"]

@@ -175,3 +175,105 @@ def test_a_proof_that_fails_on_every_mesh_is_not_a_proven_design(tmp_path, monke
     result = json.loads(capsys.readouterr().out)
     assert result["fem_report"].startswith("The FEM proof could not be completed (finger mesh 10 mm")
     assert "Newton failed at 0.2 MPa" in result["fem_report"] and "rejected" not in result
+
+
+def test_the_fem_margin_is_printed_with_the_pads_on_the_object(capsys):
+    """The text output's lines for the FEM's margin, at the pump limit beyond the one-pad grasp,
+    and where the FEM did not reach the limit."""
+    from types import SimpleNamespace
+
+    from softhand.studies.cli.verbs.design import _print_margin
+
+    at = {"F_v_N": 40.19, "pump_pressure_MPa": 2.8143, "cavity_pressure_MPa": 2.861,
+          "links_in_contact": [3], "predicted_F_v_N": 38.13}
+    limit = {"F_v_N": 43.16, "margin_N": 28.45, "links_in_contact": [3, 5]}
+    _print_margin({"margin": at, "at_pump_limit": limit}, SimpleNamespace(max_pressure=3.2))
+    out = capsys.readouterr().out.splitlines()
+    assert out == ["# FEM margin: F_v 40.19 N at the pump pressure 2.814 MPa (cavity 2.861 MPa, on the "
+                   "object: link 3 (0 = base)), predicted 38.13 N",
+                   "# FEM at the pump limit 3.2 MPa, beyond the reduced model's one-pad grasp: F_v 43.16 N, "
+                   "margin 28.45 N (on the object: links 3, 5 (0 = base))"]
+    _print_margin({"margin": at, "at_pump_limit": {"error": "Newton stopped at P = 3.1 MPa"}},
+                  SimpleNamespace(max_pressure=3.2))
+    assert capsys.readouterr().out.splitlines()[1] == \
+        "# FEM at the pump limit 3.2 MPa: not reached (Newton stopped at P = 3.1 MPa)"
+
+
+class _LinearGrasp:
+    """A stand-in for the grasp FEM (fem.hand.grasp.GraspModel) with closed-form states: the
+    fingers take dQ = 2000 P mm^3 each, F_v = 30 P N; Newton fails above ``fails_above`` MPa."""
+
+    def __init__(self, fails_above=float("inf")):
+        from types import SimpleNamespace
+
+        self.design = SimpleNamespace(V0=20000.0, n=4)
+        self.finger = SimpleNamespace(dQ=lambda y: 2000.0 * y)
+        self.fails_above, self.solves = fails_above, []
+
+    def solve(self, P, start=None):
+        from types import SimpleNamespace
+
+        import numpy as np
+        from softhand.fem.newton import NotConverged
+
+        self.solves.append(P)
+        if P > self.fails_above:
+            raise NotConverged(f"Newton stopped at P = {self.fails_above:g} MPa on the way to {P:.4g} MPa",
+                               [1.0], None)
+        return SimpleNamespace(P=P, y=P, F_v=30.0 * P, theta=0.5, N=np.array([0.0, 0.0, 30.0 * P]))
+
+
+def test_the_margin_state_is_the_pump_pressure_asked():
+    """grasp_at_pump against the closed form of the stand-in: the reservoir's p_r(V) = 1e-5 V MPa
+    at the oil left V = V0 - n dQ(P), so the cavity pressure P of pump pressure p solves
+    P - 1e-5 (20000 - 8000 P) = p: P = (p + 0.2) / 1.08."""
+    from types import SimpleNamespace
+
+    import numpy as np
+    from softhand.studies.design.proof import ProofOptions, margin
+
+    model, options = _LinearGrasp(), ProofOptions(pump_tol_mpa=1e-9)
+    sheet = SimpleNamespace(path_volume=np.array([0.0, 30000.0]), path_pressure=np.array([0.0, 0.3]))
+    ev = SimpleNamespace(P_margin=1.5, margin_edge="", F_v_at_limit=50.0)
+    task = SimpleNamespace(required_F_v=lambda: 10.0, max_pressure=1.5)
+    best = model.solve(0.5)
+    out = margin(model, sheet, best, ev, task, options)
+    P = (1.5 + 0.2) / 1.08
+    assert out["margin"]["cavity_pressure_MPa"] == pytest.approx(P, abs=1e-9)
+    assert out["margin"]["pump_pressure_MPa"] == pytest.approx(1.5, abs=1e-9)
+    assert out["margin_N"] == pytest.approx(30.0 * P - 10.0, abs=1e-7) and out["F_v_at_pump_limit_N"] == out["margin"]["F_v_N"]
+    assert max(np.diff(model.solves[1:6])) <= options.max_step_mpa + 1e-12  # continued in steps
+    # below the pump limit (a second pad touches in the reduced model) the FEM goes on to the limit
+    model = _LinearGrasp()
+    out = margin(model, sheet, model.solve(0.5), SimpleNamespace(P_margin=1.2, margin_edge="a second pad",
+                 F_v_at_limit=40.0), task, options)
+    assert out["margin"]["pump_pressure_MPa"] == pytest.approx(1.2, abs=1e-9)
+    assert out["at_pump_limit"]["cavity_pressure_MPa"] == pytest.approx(P, abs=1e-9)
+    assert out["F_v_at_pump_limit_N"] == pytest.approx(30.0 * P, abs=1e-7)
+
+
+def test_a_margin_the_grasp_fem_does_not_reach_is_reported_not_raised(capsys):
+    """The margin is the objective, met already by the verified grasp: a grasp FEM that fails on
+    the way to it is one line in the result, and the proof stands."""
+    from types import SimpleNamespace
+
+    import numpy as np
+    from softhand.studies.cli.verbs.design import _print_margin
+    from softhand.studies.design.proof import ProofOptions, margin
+
+    sheet = SimpleNamespace(path_volume=np.array([0.0, 30000.0]), path_pressure=np.array([0.0, 0.3]))
+    task = SimpleNamespace(required_F_v=lambda: 10.0, max_pressure=1.5)
+    model = _LinearGrasp(fails_above=1.0)
+    out = margin(model, sheet, model.solve(0.5), SimpleNamespace(P_margin=1.5, margin_edge="", F_v_at_limit=50.0),
+                 task, ProofOptions())
+    assert out == {"margin": {"error": "Newton stopped at P = 1 MPa on the way to 1.08 MPa",
+                              "predicted_F_v_N": 50.0, "below_pump_limit": ""}}
+    _print_margin(out, task)
+    assert capsys.readouterr().out == ("# FEM margin: not computed (Newton stopped at P = 1 MPa on the way to "
+                                       "1.08 MPa); predicted F_v 50 N\n")
+    # past the reduced margin, on the way to the pump limit: the margin stands, the limit is reported
+    model = _LinearGrasp(fails_above=1.45)
+    out = margin(model, sheet, model.solve(0.5), SimpleNamespace(P_margin=1.2, margin_edge="a second pad",
+                 F_v_at_limit=40.0), task, ProofOptions())
+    assert out["margin"]["pump_pressure_MPa"] == pytest.approx(1.2, abs=1e-3)
+    assert out["F_v_at_pump_limit_N"] is None and "error" in out["at_pump_limit"]

@@ -16,6 +16,14 @@ Three FEM models check the reduced model's answer (:class:`studies.design_opt.Ev
    reservoir (F_v there is the FEM's answer to the prediction), then secant steps in the
    cavity pressure until the FEM's F_v is the required one within ``rtol``: that state is the
    verified grasp (its pump pressure P_grasp, bend, w, peak stretch, VTK).
+4. **Margin** (the "margin" objective only): the grasp FEM continued from the verified grasp
+   to the pump pressure of the reduced model's margin (the pump limit, or where the reduced
+   model's one-pad grasp ends below it), in cavity-pressure steps of at most ``max_step_mpa``,
+   then secant corrections of the cavity pressure until the state's pump pressure,
+   cavity pressure less p_r at the oil left, is that pressure within ``pump_tol_mpa``: its
+   F_v less the required one is the FEM's margin. Where the reduced margin ends below the pump
+   limit, the FEM goes on to the limit (it has no one-pad restriction: the margin the task
+   asks for, which the reduced model does not reach).
 
 The finger mesh is the grasp FEM's (:func:`studies.weights.finger_options`) for both finger
 runs, so that the free bend and the grasp share one discretisation.
@@ -44,6 +52,8 @@ class ProofOptions:
     edge_ratio: float = 0.5     #: finger mesh grading at the ring edges (1: uniform)
     sheet: dict = field(default_factory=dict)  #: sheet FEM mesh keywords (fem.reservoir.SheetModel)
     bend_factors: tuple = (1.0, 1.25, 1.5, 1.75, 2.0, 2.5, 3.0, 4.0)  #: free bend: x eq. (28)'s pressure
+    pump_tol_mpa: float = 1e-3  #: margin: the state's pump pressure within this of the margin's [MPa]
+    max_corrections: int = 4    #: margin: secant corrections of the cavity pressure at most
 
 
 class _Past(Exception):
@@ -124,6 +134,88 @@ def grasp_secant(model, ladder, F_req: float, options: ProofOptions, say=None) -
     w = weight_vector(*sorted((best, near), key=lambda s: s.P))
     return {"first": first, "best": best, "w": w, "states": pair, "secant_steps": steps,
             "seconds": time.perf_counter() - t0}
+
+
+def grasp_at_pump(model, pump, start, P_pump: float, options: ProofOptions, say=None):
+    """The grasp FEM state whose pump pressure ``pump(state)`` [MPa] is ``P_pump``: continued
+    from the converged state ``start`` in cavity steps of at most ``max_step_mpa`` to P_pump
+    plus the reservoir's pressure at ``start``, then secant corrections of the cavity pressure
+    on the last two states (the pump pressure grows with the cavity's, at a slope near 1: the
+    reservoir's pressure changes little with the oil the fingers take). RuntimeError if the
+    pump pressure is not within ``pump_tol_mpa`` after ``max_corrections``."""
+    t0 = time.perf_counter()
+    states = [start]
+
+    def solve(P):
+        near = min(states, key=lambda s: abs(s.P - P))  # the nearest converged state
+        state = model.solve(P, start=near)
+        states.append(state)
+        if say is not None:
+            say(f"  grasp state: cavity {state.P:.4g} MPa, pump {pump(state):.4g} MPa, "
+                f"F_v {state.F_v:.4g} N ({time.perf_counter() - t0:.0f} s)")
+        return state
+
+    target = P_pump + start.P - pump(start)  # the reservoir's pressure as at start
+    steps = max(1, math.ceil(abs(target - start.P) / options.max_step_mpa - 1e-9))
+    prev, state = None, start
+    for P in np.linspace(start.P, target, steps + 1)[1:]:
+        prev, state = state, solve(P)
+    for _ in range(options.max_corrections):
+        miss = pump(state) - P_pump
+        if abs(miss) <= options.pump_tol_mpa:
+            return state
+        slope = (pump(state) - pump(prev)) / (state.P - prev.P) if state.P != prev.P else 1.0
+        prev, state = state, solve(state.P - miss / (slope if slope > 0.5 else 1.0))
+    if abs(pump(state) - P_pump) > options.pump_tol_mpa:
+        raise RuntimeError(f"grasp FEM: the pump pressure {P_pump:.4g} MPa not reached within "
+                           f"{options.pump_tol_mpa:g} MPa after {options.max_corrections} corrections "
+                           f"(last {pump(state):.6g} MPa)")
+    return state
+
+
+def margin(model, sheet, best, ev: Evaluation, task: Task, options: ProofOptions, say=None) -> dict:
+    """The FEM's margin (see the module doc, 4.) from the verified grasp ``best``: the grasp at
+    the reduced margin's pump pressure ev.P_margin, and at the pump limit if that is above it.
+    A grasp FEM that fails on the way is reported (``"error"``), not raised: the margin is the
+    task's objective, which the verified grasp has already met (its F_v at P_grasp)."""
+    from softhand.fem.newton import NotConverged
+
+    finger, design = model.finger, model.design
+
+    def oil_left(state):
+        V = design.V0 - design.n * finger.dQ(state.y)
+        if not V > 0:
+            raise RuntimeError(f"grasp FEM: the fingers take all the oil (V0 = {design.V0:.0f} mm^3) "
+                               f"at the cavity pressure {state.P:.4g} MPa")
+        return V
+
+    def pump(state):  # the hand's pump pressure: the cavity's less the reservoir's at the oil left
+        return state.P - float(np.interp(oil_left(state), sheet.path_volume, sheet.path_pressure))
+
+    def row(state):
+        return {"pump_pressure_MPa": pump(state), "cavity_pressure_MPa": state.P, "F_v_N": state.F_v,
+                "oil_left_mm3": oil_left(state),
+                "theta_deg": math.degrees(state.theta),
+                "links_in_contact": [int(k) for k in np.flatnonzero(state.N > 0)],
+                "contact_force_N": state.N.tolist()}
+
+    F_req = task.required_F_v()
+    try:
+        at = grasp_at_pump(model, pump, best, ev.P_margin, options, say)
+    except (NotConverged, RuntimeError) as exc:  # the margin is the objective, not a limit: reported
+        return {"margin": {"error": str(exc).split(";")[0], "predicted_F_v_N": ev.F_v_at_limit,
+                           "below_pump_limit": ev.margin_edge}}
+    out = {"margin_N": at.F_v - F_req, "F_v_at_pump_limit_N": None if ev.margin_edge else at.F_v,
+           "margin": {**row(at), "predicted_F_v_N": ev.F_v_at_limit, "below_pump_limit": ev.margin_edge}}
+    if ev.margin_edge:  # the FEM goes on to the pump limit, where the reduced model does not reach
+        try:
+            limit = grasp_at_pump(model, pump, at, task.max_pressure, options, say)
+        except (NotConverged, RuntimeError) as exc:
+            out["at_pump_limit"] = {"error": str(exc).split(";")[0]}
+        else:
+            out["F_v_at_pump_limit_N"] = limit.F_v
+            out["at_pump_limit"] = {**row(limit), "margin_N": limit.F_v - F_req}
+    return out
 
 
 def _touch(bend: dict, ev: Evaluation, task: Task) -> float | None:
@@ -270,5 +362,9 @@ def prove(ev: Evaluation, task: Task, options: ProofOptions = ProofOptions(), *,
         "mesh_size_mm": options.mesh_size_mm,
         "wall_seconds": time.perf_counter() - t0,
     }
+    if task.objective == "margin" and math.isfinite(ev.F_v_at_limit):
+        say(f"grasp FEM at the margin's pump pressure {ev.P_margin:.4g} MPa")
+        fem.update(margin(model, sheet, best, ev, task, options, say))
+        fem["wall_seconds"] = time.perf_counter() - t0
     fem["constraints"] = fem_constraints(fem, task)
     return fem

@@ -231,6 +231,8 @@ def _print(result: dict, task, opt) -> None:
     if predicted.get("margin_below_pump_limit"):
         print(f"# margin_N: F_v at {predicted['margin_at_pump_pressure_MPa']:.4g} MPa, below the pump limit, less "
               f"the required F_v; the FEM-informed grasp ends there: {predicted['margin_below_pump_limit']}")
+    if fem.get("margin"):
+        _print_margin(fem, task)
     if fem.get("constraints"):
         print_table(fem["constraints"])
     if fem.get("wall_seconds"):
@@ -247,6 +249,26 @@ def _print(result: dict, task, opt) -> None:
                   f"{knee['fem']['P_grasp_MPa']:.4g} MPa FEM; F_v {knee['predicted']['F_v_N']:.4g} N "
                   f"predicted, {knee['fem']['F_v_N']:.4g} N FEM; design {knee['design_file']}")
     print(f"design: {result['design_file'] or 'none written (the task cannot be met)'}")
+
+
+def _print_margin(fem: dict, task) -> None:
+    """The FEM's grasp at the margin's pump pressure, and at the pump limit if it went on to it."""
+    def on(row):
+        links = row["links_in_contact"]
+        return f"on the object: link{'s' if len(links) > 1 else ''} {', '.join(map(str, links)) or 'none'} (0 = base)"
+
+    m = fem["margin"]
+    if "error" in m:
+        print(f"# FEM margin: not computed ({m['error']}); predicted F_v {m['predicted_F_v_N']:.4g} N")
+        return
+    print(f"# FEM margin: F_v {m['F_v_N']:.4g} N at the pump pressure {m['pump_pressure_MPa']:.4g} MPa "
+          f"(cavity {m['cavity_pressure_MPa']:.4g} MPa, {on(m)}), predicted {m['predicted_F_v_N']:.4g} N")
+    limit = fem.get("at_pump_limit")
+    if limit and "error" in limit:
+        print(f"# FEM at the pump limit {task.max_pressure:g} MPa: not reached ({limit['error']})")
+    elif limit:
+        print(f"# FEM at the pump limit {task.max_pressure:g} MPa, beyond the reduced model's one-pad grasp: "
+              f"F_v {limit['F_v_N']:.4g} N, margin {limit['margin_N']:.4g} N ({on(limit)})")
 
 
 def _rel(a, b):
