@@ -1,6 +1,7 @@
 """The FEM proof of a design on CI-sized meshes (finger 10 mm, sheet 12 elements): its three
 models agree with each other where they must, and with the calibrated models the design uses."""
 import math
+import xml.etree.ElementTree as ET
 from dataclasses import replace
 
 import pytest
@@ -17,6 +18,11 @@ TASK_DICT = {
     "free": {"V0_mm3": [12000.0, 30000.0]},
 }
 TASK = task_from_dict(TASK_DICT)
+def _pvd_times(path):
+    """The time steps a ParaView collection file lists."""
+    return [float(e.get("timestep")) for e in ET.parse(path).iter("DataSet")]
+
+
 CI = ProofOptions(mesh_size_mm=10.0, edge_ratio=1.0, sheet={"n_radial": 12}, max_secant=1)
 
 
@@ -71,7 +77,7 @@ def test_the_margin_is_proven_by_the_grasp_fem_at_the_pump_limit():
 
 
 @pytest.mark.slow
-def test_a_margin_below_the_pump_limit_is_proven_there_and_the_fem_goes_on_to_the_limit():
+def test_a_margin_below_the_pump_limit_is_proven_there_and_the_fem_goes_on_to_the_limit(tmp_path):
     """Where the reduced model's one-pad grasp ends below the pump limit (the paper's hand on
     180 mm: the tip pad touches near 2.8 MPa), the FEM's margin is taken at that pump pressure,
     where one pad holds the object in the FEM too, and the FEM goes on to the pump limit with
@@ -81,7 +87,7 @@ def test_a_margin_below_the_pump_limit_is_proven_there_and_the_fem_goes_on_to_th
                            "pump": {"max_pressure_MPa": 3.2}})
     ev = design_opt.evaluate(task.base, task)
     assert ev.margin_edge and ev.P_margin < task.max_pressure
-    fem = prove(ev, task, CI)
+    fem = prove(ev, task, CI, out=tmp_path)
     m, limit = fem["margin"], fem["at_pump_limit"]
     assert m["pump_pressure_MPa"] == pytest.approx(ev.P_margin, abs=CI.pump_tol_mpa)
     # the pad the reduced model holds with there (the hold has rolled on from the first pad, ev.link)
@@ -93,3 +99,7 @@ def test_a_margin_below_the_pump_limit_is_proven_there_and_the_fem_goes_on_to_th
     assert limit["pump_pressure_MPa"] == pytest.approx(task.max_pressure, abs=CI.pump_tol_mpa)
     assert limit["links_in_contact"] == [end.link, ev.design.n_s]  # and the tip pad
     assert fem["F_v_at_pump_limit_N"] == limit["F_v_N"] > m["F_v_N"]
+    # the VTK series: the verified grasp, the margin's state and the pump limit's, by cavity pressure
+    steps = _pvd_times(tmp_path / "grasp.pvd")
+    assert steps == pytest.approx([fem["cavity_pressure_MPa"], m["cavity_pressure_MPa"],
+                                   limit["cavity_pressure_MPa"]], rel=1e-6)

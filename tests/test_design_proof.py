@@ -237,7 +237,8 @@ def test_the_margin_state_is_the_pump_pressure_asked():
     ev = SimpleNamespace(P_margin=1.5, margin_edge="", F_v_at_limit=50.0)
     task = SimpleNamespace(required_F_v=lambda: 10.0, max_pressure=1.5)
     best = model.solve(0.5)
-    out = margin(model, sheet, best, ev, task, options)
+    out, states = margin(model, sheet, best, ev, task, options)
+    assert [s.P for s in states] == [out["margin"]["cavity_pressure_MPa"]]
     P = (1.5 + 0.2) / 1.08
     assert out["margin"]["cavity_pressure_MPa"] == pytest.approx(P, abs=1e-9)
     assert out["margin"]["pump_pressure_MPa"] == pytest.approx(1.5, abs=1e-9)
@@ -245,8 +246,9 @@ def test_the_margin_state_is_the_pump_pressure_asked():
     assert max(np.diff(model.solves[1:6])) <= options.max_step_mpa + 1e-12  # continued in steps
     # below the pump limit (a second pad touches in the reduced model) the FEM goes on to the limit
     model = _LinearGrasp()
-    out = margin(model, sheet, model.solve(0.5), SimpleNamespace(P_margin=1.2, margin_edge="a second pad",
-                 F_v_at_limit=40.0), task, options)
+    out, states = margin(model, sheet, model.solve(0.5), SimpleNamespace(P_margin=1.2, margin_edge="a second pad",
+                         F_v_at_limit=40.0), task, options)
+    assert len(states) == 2 and states[1].P == out["at_pump_limit"]["cavity_pressure_MPa"]
     assert out["margin"]["pump_pressure_MPa"] == pytest.approx(1.2, abs=1e-9)
     assert out["at_pump_limit"]["cavity_pressure_MPa"] == pytest.approx(P, abs=1e-9)
     assert out["F_v_at_pump_limit_N"] == pytest.approx(30.0 * P, abs=1e-7)
@@ -264,16 +266,16 @@ def test_a_margin_the_grasp_fem_does_not_reach_is_reported_not_raised(capsys):
     sheet = SimpleNamespace(path_volume=np.array([0.0, 30000.0]), path_pressure=np.array([0.0, 0.3]))
     task = SimpleNamespace(required_F_v=lambda: 10.0, max_pressure=1.5)
     model = _LinearGrasp(fails_above=1.0)
-    out = margin(model, sheet, model.solve(0.5), SimpleNamespace(P_margin=1.5, margin_edge="", F_v_at_limit=50.0),
-                 task, ProofOptions())
-    assert out == {"margin": {"error": "Newton stopped at P = 1 MPa on the way to 1.08 MPa",
+    out, states = margin(model, sheet, model.solve(0.5), SimpleNamespace(P_margin=1.5, margin_edge="",
+                         F_v_at_limit=50.0), task, ProofOptions())
+    assert states == [] and out == {"margin": {"error": "Newton stopped at P = 1 MPa on the way to 1.08 MPa",
                               "predicted_F_v_N": 50.0, "below_pump_limit": ""}}
     _print_margin(out, task)
     assert capsys.readouterr().out == ("# FEM margin: not computed (Newton stopped at P = 1 MPa on the way to "
                                        "1.08 MPa); predicted F_v 50 N\n")
     # past the reduced margin, on the way to the pump limit: the margin stands, the limit is reported
     model = _LinearGrasp(fails_above=1.45)
-    out = margin(model, sheet, model.solve(0.5), SimpleNamespace(P_margin=1.2, margin_edge="a second pad",
-                 F_v_at_limit=40.0), task, ProofOptions())
-    assert out["margin"]["pump_pressure_MPa"] == pytest.approx(1.2, abs=1e-3)
+    out, states = margin(model, sheet, model.solve(0.5), SimpleNamespace(P_margin=1.2, margin_edge="a second pad",
+                         F_v_at_limit=40.0), task, ProofOptions())
+    assert len(states) == 1 and out["margin"]["pump_pressure_MPa"] == pytest.approx(1.2, abs=1e-3)
     assert out["F_v_at_pump_limit_N"] is None and "error" in out["at_pump_limit"]

@@ -173,11 +173,12 @@ def grasp_at_pump(model, pump, start, P_pump: float, options: ProofOptions, say=
     return state
 
 
-def margin(model, sheet, best, ev: Evaluation, task: Task, options: ProofOptions, say=None) -> dict:
+def margin(model, sheet, best, ev: Evaluation, task: Task, options: ProofOptions, say=None) -> tuple[dict, list]:
     """The FEM's margin (see the module doc, 4.) from the verified grasp ``best``: the grasp at
-    the reduced margin's pump pressure ev.P_margin, and at the pump limit if that is above it.
-    A grasp FEM that fails on the way is reported (``"error"``), not raised: the margin is the
-    task's objective, which the verified grasp has already met (its F_v at P_grasp)."""
+    the reduced margin's pump pressure ev.P_margin, and at the pump limit if that is above it;
+    (the record, those states). A grasp FEM that fails on the way is reported (``"error"``),
+    not raised: the margin is the task's objective, which the verified grasp has already met
+    (its F_v at P_grasp)."""
     from softhand.fem.newton import NotConverged
 
     finger, design = model.finger, model.design
@@ -204,18 +205,19 @@ def margin(model, sheet, best, ev: Evaluation, task: Task, options: ProofOptions
         at = grasp_at_pump(model, pump, best, ev.P_margin, options, say)
     except (NotConverged, RuntimeError) as exc:  # the margin is the objective, not a limit: reported
         return {"margin": {"error": str(exc).split(";")[0], "predicted_F_v_N": ev.F_v_at_limit,
-                           "below_pump_limit": ev.margin_edge}}
+                           "below_pump_limit": ev.margin_edge}}, []
     out = {"margin_N": at.F_v - F_req, "F_v_at_pump_limit_N": None if ev.margin_edge else at.F_v,
            "margin": {**row(at), "predicted_F_v_N": ev.F_v_at_limit, "below_pump_limit": ev.margin_edge}}
-    if ev.margin_edge:  # the FEM goes on to the pump limit, where the reduced model does not reach
-        try:
-            limit = grasp_at_pump(model, pump, at, task.max_pressure, options, say)
-        except (NotConverged, RuntimeError) as exc:
-            out["at_pump_limit"] = {"error": str(exc).split(";")[0]}
-        else:
-            out["F_v_at_pump_limit_N"] = limit.F_v
-            out["at_pump_limit"] = {**row(limit), "margin_N": limit.F_v - F_req}
-    return out
+    if not ev.margin_edge:
+        return out, [at]
+    try:  # the FEM goes on to the pump limit, where the reduced model does not reach
+        limit = grasp_at_pump(model, pump, at, task.max_pressure, options, say)
+    except (NotConverged, RuntimeError) as exc:
+        out["at_pump_limit"] = {"error": str(exc).split(";")[0]}
+        return out, [at]
+    out["F_v_at_pump_limit_N"] = limit.F_v
+    out["at_pump_limit"] = {**row(limit), "margin_N": limit.F_v - F_req}
+    return out, [at, limit]
 
 
 def _touch(bend: dict, ev: Evaluation, task: Task) -> float | None:
@@ -332,8 +334,6 @@ def prove(ev: Evaluation, task: Task, options: ProofOptions = ProofOptions(), *,
     V_grasp = design.V0 - design.n * fs.dQ
     # the sheet's path from flat to V0 passes V_grasp (steps <= R^2 t / 2): interpolated
     p_grasp = float(np.interp(V_grasp, sheet.path_volume, sheet.path_pressure))
-    if out is not None:
-        write_vtk(out, model, (best,))
     first = g["first"]
     fem = {
         "P_grasp_MPa": best.P - p_grasp,
@@ -362,9 +362,14 @@ def prove(ev: Evaluation, task: Task, options: ProofOptions = ProofOptions(), *,
         "mesh_size_mm": options.mesh_size_mm,
         "wall_seconds": time.perf_counter() - t0,
     }
+    states = [best]
     if task.objective == "margin" and math.isfinite(ev.F_v_at_limit):
         say(f"grasp FEM at the margin's pump pressure {ev.P_margin:.4g} MPa")
-        fem.update(margin(model, sheet, best, ev, task, options, say))
+        record, more = margin(model, sheet, best, ev, task, options, say)
+        fem.update(record)
+        states += more
         fem["wall_seconds"] = time.perf_counter() - t0
+    if out is not None:  # the verified grasp, then the margin's states (by cavity pressure)
+        write_vtk(out, model, sorted(states, key=lambda s: s.P))
     fem["constraints"] = fem_constraints(fem, task)
     return fem
