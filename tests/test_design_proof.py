@@ -279,3 +279,14 @@ def test_a_margin_the_grasp_fem_does_not_reach_is_reported_not_raised(capsys):
                          F_v_at_limit=40.0), task, ProofOptions())
     assert len(states) == 1 and out["margin"]["pump_pressure_MPa"] == pytest.approx(1.2, abs=1e-3)
     assert out["F_v_at_pump_limit_N"] is None and "error" in out["at_pump_limit"]
+
+
+def test_the_knee_line_gives_the_fem_margin_where_the_proof_has_one():
+    from softhand.studies.cli.verbs.design import _knee_line
+
+    knee = {"predicted": {"P_grasp_MPa": 0.52, "F_v_N": 9.81, "margin_N": 4.13},
+            "fem": {"P_grasp_MPa": 0.53, "F_v_N": 9.41}, "design_file": "knee/design.toml"}
+    assert _knee_line(knee) == ("knee: P_grasp 0.52 MPa predicted, 0.53 MPa FEM; F_v 9.81 N predicted, "
+                                "9.41 N FEM; design knee/design.toml")
+    knee["fem"]["margin_N"] = 3.68
+    assert "9.41 N FEM; margin 4.13 N predicted, 3.68 N FEM; design knee/design.toml" in _knee_line(knee)

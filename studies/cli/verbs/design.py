@@ -245,10 +245,18 @@ def _print(result: dict, task, opt) -> None:
               f"{result['pareto']['rows'][k]['max_principal_stretch']:.4g}; plot {result['pareto']['plot']}")
         knee = result["pareto"].get("knee_proof")
         if knee and "P_grasp_MPa" in knee["fem"]:
-            print(f"knee: P_grasp {knee['predicted']['P_grasp_MPa']:.4g} MPa predicted, "
-                  f"{knee['fem']['P_grasp_MPa']:.4g} MPa FEM; F_v {knee['predicted']['F_v_N']:.4g} N "
-                  f"predicted, {knee['fem']['F_v_N']:.4g} N FEM; design {knee['design_file']}")
+            print(_knee_line(knee))
     print(f"design: {result['design_file'] or 'none written (the task cannot be met)'}")
+
+
+def _knee_line(knee: dict) -> str:
+    """The Pareto knee's prediction beside its FEM proof (and the margin, if the proof has one)."""
+    predicted, fem = knee["predicted"], knee["fem"]
+    margin = "" if fem.get("margin_N") is None else \
+        f"margin {predicted['margin_N']:.4g} N predicted, {fem['margin_N']:.4g} N FEM; "
+    return (f"knee: P_grasp {predicted['P_grasp_MPa']:.4g} MPa predicted, {fem['P_grasp_MPa']:.4g} MPa FEM; "
+            f"F_v {predicted['F_v_N']:.4g} N predicted, {fem['F_v_N']:.4g} N FEM; {margin}"
+            f"design {knee['design_file']}")
 
 
 def _print_margin(fem: dict, task) -> None:
