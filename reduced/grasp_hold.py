@@ -402,12 +402,8 @@ def slow_hold(design: HandDesign, diameter_mm: float, mass_kg: float, target: st
         f_hi = cond(s_hi.theta, hi, s_hi.F_v)
         if f_lo * f_hi <= 0.0:
             break
-        if hi == P_max:
-            raise NotReached(target, value, f"not reached by the finger on one pad up to the cavity pressure "
-                                            f"{hi:.6g} MPa (F_v {s_hi.F_v:.4g} N), where {LARGEST_BEND}",
-                             _hold_of(s_hi, design, reservoir, LARGEST_BEND))
         lo, s_lo, f_lo = hi, s_hi, f_hi
-    else:  # lo is the largest pressure already: no step above it
+    else:  # no sign change up to the largest pressure (or lo is that pressure already)
         raise NotReached(target, value, f"not reached by the finger on one pad up to the cavity pressure "
                                         f"{lo:.6g} MPa (F_v {s_lo.F_v:.4g} N), where {LARGEST_BEND}",
                          _hold_of(s_lo, design, reservoir, LARGEST_BEND))

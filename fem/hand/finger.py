@@ -175,7 +175,10 @@ class FingerModel:
 
     def dQ(self, y) -> float:
         """Cavity volume change of the whole finger [mm^3] at the reduced state y."""
-        return 2.0 * (self.cavity.volume(self.constraint.expand(y)) - self.V0)
+        return self._dQ(self.constraint.expand(y))
+
+    def _dQ(self, u) -> float:
+        return 2.0 * (self.cavity.volume(u) - self.V0)  # the half model's cavity, twice
 
     def state(self, y, P: float, iterations: int = 0) -> FingerState:
         """Outputs of the converged reduced state y at pressure P."""
@@ -190,7 +193,7 @@ class FingerModel:
         share = np.cumsum(self.windings.W[self.wall].ravel()[order])
         return FingerState(
             P=float(P), q=np.array(self.constraint.q(y)),
-            dQ=self.dQ(y),
+            dQ=self._dQ(u),
             radial_stretch_max=float(lam_f.max()),
             radial_stretch_q99=float(lam_f.ravel()[order][np.searchsorted(share, 0.99 * share[-1])]),
             max_principal_stretch=float(np.sqrt(eig.max())),

@@ -194,16 +194,17 @@ def evaluate(design: HandDesign, task: Task, *, exact: bool = True) -> Evaluatio
         oil = math.inf
     stretch = 1.0 + task.stretch_factor * (peak_stretch(theta_hold, design) - 1.0)
     sheet = float(reservoir.stretch(design.V0, design))
-    cons = _constraints(design, task, oil, stretch, sheet, P_grasp, P_contact, F_lim, P_open)
-    if no_grasp and F_reached < F_req:  # no P_grasp: how far short of F_req the finger comes, for the optimiser
-        cons = [replace(c, shortfall=min(1.0, 1.0 - max(F_reached, 0.0) / F_req)) if c.name.startswith("pump_pressure")
-                else c for c in cons]
+    # no P_grasp: how far short of F_req the finger comes (for the optimiser)
+    shortfall = min(1.0, 1.0 - max(F_reached, 0.0) / F_req) if no_grasp and F_reached < F_req else None
+    cons = _constraints(design, task, oil, stretch, sheet, P_grasp, P_contact, F_lim, P_open, shortfall)
     return Evaluation(design, depth, theta, link, w, P_grasp, P_contact, F_req, F_lim, stretch, sheet,
                       tuple(cons), theta_hold, P_margin, edge, no_grasp)
 
 
-def _constraints(design: HandDesign, task: Task, oil, stretch, sheet, P_grasp, P_contact, F_lim, P_open) -> list:
-    """Every constraint of a design; how many depends on the task and the finger model alone."""
+def _constraints(design: HandDesign, task: Task, oil, stretch, sheet, P_grasp, P_contact, F_lim, P_open,
+                 grasp_shortfall: float | None = None) -> list:
+    """Every constraint of a design; how many depends on the task and the finger model alone.
+    ``grasp_shortfall``: the pump pressure's :attr:`Constraint.shortfall` (no P_grasp)."""
     return [
         Constraint("tube_fits_links (a + b < d) [mm]", design.a + design.b, design.d, "<="),
         Constraint("tube_wall b [mm]", design.b, task.min_wall, ">="),
@@ -212,7 +213,7 @@ def _constraints(design: HandDesign, task: Task, oil, stretch, sheet, P_grasp, P
         Constraint("reservoir_below_limit_point V0 [mm^3]", design.V0, limit_point_volume(design), "<="),
         Constraint("max_principal_stretch", stretch, task.max_stretch, "<="),
         Constraint("sheet_stretch at V0, eq. (16)", sheet, task.max_stretch, "<="),
-        Constraint("pump_pressure at the grasp [MPa]", P_grasp, task.max_pressure, "<="),
+        Constraint("pump_pressure at the grasp [MPa]", P_grasp, task.max_pressure, "<=", shortfall=grasp_shortfall),
         Constraint("contact: P(theta_g), the free hand's pump pressure where a pad touches the object "
                    "[MPa] (the hand at rest must not reach into the object's place)", P_contact, 0.0, ">=",
                    task.max_pressure),

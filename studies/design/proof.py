@@ -183,8 +183,12 @@ def margin(model, sheet, best, ev: Evaluation, task: Task, options: ProofOptions
 
     finger, design = model.finger, model.design
 
+    oil = {}  # id(state) -> (state, V): the cavity's volume integral once a state (the state kept: its id stays its own)
+
     def oil_left(state):
-        V = design.V0 - design.n * finger.dQ(state.y)
+        if id(state) not in oil:
+            oil[id(state)] = (state, design.V0 - design.n * finger.dQ(state.y))
+        V = oil[id(state)][1]
         if not V > 0:
             raise RuntimeError(f"grasp FEM: the fingers take all the oil (V0 = {design.V0:.0f} mm^3) "
                                f"at the cavity pressure {state.P:.4g} MPa")
