@@ -94,6 +94,23 @@ def test_bad_input_is_one_line_exit_2(argv, field, capsys):
     assert err.count("\n") == 1 and field in err
 
 
+GRASP = ["grasp", "--theta-deg", "50", "--mass-kg", "2"]
+
+
+@pytest.mark.parametrize("argv, allowed", [
+    (["curve", "--theta-deg", "1,,2"], "start:stop:step (step > 0, stop >= start) or a comma-separated list"),
+    ([*GRASP, "--pressure-mpa", "1e309", "--weights", "paper180"], "must be one number in [-5, 5]"),
+    ([*GRASP, "--pressure-mpa", "0:1:-1", "--weights", "paper180"], "must be one number in [-5, 5]"),
+    ([*GRASP, "--pressure-mpa", "1", "--weights=1,,2"],
+     "must be a comma-separated list of finite numbers, or one of paper180, paper240"),
+    (["weights", "--diameter-mm", "180", "--pressure-mpa", "x"], "must be a number in [0.01, 5]"),
+])
+def test_a_bad_value_is_told_what_its_field_takes(argv, allowed, capsys):
+    """A field of one number is not told it may be a range; --weights is told the paper's names."""
+    assert main(argv) == 2
+    assert allowed in capsys.readouterr().err
+
+
 @pytest.mark.parametrize("text, argv, field", [
     ("V0_mm3 = 3000.0\n", ["curve", "--theta-deg", "0:90:10"], "V0_mm3"),  # 4737 mm^3 needed at 90 deg
     ("bogus = 1\n", ["curve", "--theta-deg", "0:90:10"], "bogus"),

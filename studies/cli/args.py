@@ -20,17 +20,21 @@ MOST_POINTS, MOST_FEM_POINTS = 1_000_000, 10_000
 #: longest range or list text read [characters]
 MAX_TEXT = 100_000
 _FORMS = "start:stop:step (step > 0, stop >= start) or a comma-separated list of finite numbers"
+#: what a field of one value or of a vector (no range) takes
+ONE_NUMBER, NUMBER_LIST = "one finite number", "a comma-separated list of finite numbers"
 
 
 _NUMBER = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?|[+-]?(?:nan|inf|infinity)",
                      re.IGNORECASE | re.ASCII)
 
 
-def parse_values(text: str, field: str, max_count: int = MAX_POINTS) -> np.ndarray:
+def parse_values(text: str, field: str, max_count: int = MAX_POINTS, forms: str | None = None) -> np.ndarray:
     """``'0:90:10'`` (start:stop:step, stop included) or ``'1,2.5,3'`` -> float array.
 
-    Every value finite; at most ``max_count`` of them (InputError otherwise).
+    Every value finite; at most ``max_count`` of them (InputError otherwise). ``forms``: what
+    the field takes, for the message (default: a range or list; one number if max_count is 1).
     """
+    forms = forms or (ONE_NUMBER if max_count == 1 else _FORMS)
     if len(text) > MAX_TEXT:
         raise InputError(field, text, f"is longer than {MAX_TEXT} characters")
     parts = [x.strip() for x in (text.split(":") if ":" in text else text.split(","))]
@@ -39,7 +43,7 @@ def parse_values(text: str, field: str, max_count: int = MAX_POINTS) -> np.ndarr
     if ":" in text:
         if len(numbers) != 3 or not all(map(math.isfinite, numbers)) or not numbers[2] > 0 \
                 or numbers[1] < numbers[0]:
-            raise InputError(field, text, f"must be {_FORMS}")
+            raise InputError(field, text, f"must be {forms}")
         start, stop, step = numbers
         count = (stop - start) / step + 1
         if not count <= max_count:
@@ -50,7 +54,7 @@ def parse_values(text: str, field: str, max_count: int = MAX_POINTS) -> np.ndarr
         if values.size > max_count:
             raise InputError(field, text, _too_many(values.size, max_count))
     if values.size == 0 or not np.all(np.isfinite(values)):
-        raise InputError(field, text, f"must be {_FORMS}")
+        raise InputError(field, text, f"must be {forms}")
     return values
 
 

@@ -102,7 +102,8 @@ def check_writable(path, kind: str, field: str) -> None:
         suffix = p.suffix if kind in EXACT_SUFFIX else p.suffix.lower()
         if suffixes and suffix not in suffixes:
             case = " (lower case)" if kind in EXACT_SUFFIX else ""
-            raise InputError(field, text, f"must end in one of {', '.join(suffixes)}{case}")
+            ends = f"one of {', '.join(suffixes)}" if len(suffixes) > 1 else suffixes[0]
+            raise InputError(field, text, f"must end in {ends}{case}")
         folder = p.parent
     _probe(folder, field, text)
 

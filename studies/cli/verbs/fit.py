@@ -13,7 +13,8 @@ from __future__ import annotations
 
 import sys
 
-from softhand.studies.cli.args import add_design_option, add_json_option, design_from_args, parse_values, print_json
+from softhand.studies.cli.args import NUMBER_LIST, add_design_option, add_json_option, design_from_args, parse_values, \
+    print_json
 
 HELP = "calibrate design parameters (V0, mu, ...) to measured bend angles or grasp forces"
 
@@ -124,7 +125,7 @@ def _weights(args, design, data):
         except InputError as exc:
             raise exc.renamed("--diameter-mm") from None
     if args.weights is not None:
-        return parse_values(args.weights, "--weights")
+        return parse_values(args.weights, "--weights", forms=NUMBER_LIST)
     return None
 
 

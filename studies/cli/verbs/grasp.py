@@ -23,12 +23,13 @@ import numpy as np
 from softhand.fem.newton import NotConverged
 from softhand.reduced import grasp
 from softhand.reduced.errors import InputError
-from softhand.studies.cli.args import add_design_option, add_json_option, design_from_args, parse_values, \
-    print_json, require_finite
+from softhand.studies.cli.args import NUMBER_LIST, add_design_option, add_json_option, design_from_args, \
+    parse_values, print_json, require_finite
 from softhand.studies.grasp import state, state_fem
 
 #: the paper's weight vectors by name (--weights paper180)
 PAPER_NAMES = {f"paper{D:g}": D for D in grasp.PAPER_WEIGHTS}
+_WEIGHT_FORMS = f"{NUMBER_LIST}, or one of {', '.join(PAPER_NAMES)}"
 
 HELP = "grasping forces F_x, F_y, F_v at a pressure, bend angle and mass (eqs. 24, 25, 29)"
 #: --model: eq. (25) as printed, or the FEM-informed estimate (reduced.grasp_fem)
@@ -60,10 +61,11 @@ LIMITS = {"--pressure-mpa": (-5.0, 5.0), "--theta-deg": (-90.0, 180.0), "--mass-
 
 
 def _scalar(text: str, field: str) -> float:
-    values = parse_values(text, field, max_count=1)
     lo, hi = LIMITS[field]
+    allowed = f"one number in [{lo:g}, {hi:g}]"
+    values = parse_values(text, field, 1, allowed)
     if not lo <= values[0] <= hi:
-        raise InputError(field, text, f"must be one number in [{lo:g}, {hi:g}]")
+        raise InputError(field, text, f"must be {allowed}")
     return float(values[0])
 
 
@@ -86,7 +88,7 @@ def _weights(args, design, mass: float) -> tuple[np.ndarray, str, list[str]]:
         D = PAPER_NAMES[args.weights.strip()]
         w, source = grasp.weights_for_diameter(D, design), f"paper, {D:g} mm (section III-C)"
     elif args.weights is not None:
-        w, source = parse_values(args.weights, "--weights"), "given"
+        w, source = parse_values(args.weights, "--weights", forms=_WEIGHT_FORMS), "given"
     else:
         w, source = _fem_weights(_scalar(args.diameter_mm, "--diameter-mm"), mass, design)
     with warnings.catch_warnings(record=True) as caught:
@@ -119,7 +121,7 @@ def run(args) -> int:
         try:
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore", grasp.WeightSumWarning)
-                grasp.check_weights(parse_values(args.weights, "--weights", max_count=1000), design)
+                grasp.check_weights(parse_values(args.weights, "--weights", 1000, _WEIGHT_FORMS), design)
         except InputError as exc:
             raise exc.renamed("--weights") from None
     try:
