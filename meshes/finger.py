@@ -167,6 +167,32 @@ def _halve(v: np.ndarray, times: int) -> np.ndarray:
     return v
 
 
+def _layered_grid(tube: FingerTube, n_phi: int, layer_first: float, layer_ratio: float, axial_size: float,
+                  core_rings: int, refine: int) -> tuple[np.ndarray, np.ndarray, int]:
+    """The layered mesh's planes x, radii (core rings, then the wall's) and sectors."""
+    if not (n_phi >= 2 and core_rings >= 1 and layer_first > 0 and layer_ratio >= 1 and axial_size > 0):
+        raise ValueError("need n_phi >= 2, core_rings >= 1, layer_first > 0, layer_ratio >= 1, "
+                         f"axial_size > 0; got {n_phi}, {core_rings}, {layer_first}, {layer_ratio}, {axial_size}")
+    wall = _halve(layered_radii(tube.a, tube.b, layer_first, layer_ratio), refine)
+    rings = np.concatenate((_halve(np.linspace(0.0, tube.a, core_rings + 1), refine)[1:-1], wall))
+    cuts = tube.cuts()
+    x = np.concatenate([cuts[:1]] + [np.linspace(c0, c1, int(np.ceil((c1 - c0) / axial_size - 1e-9)) + 1)[1:]
+                                     for c0, c1 in zip(cuts[:-1], cuts[1:])])
+    return _halve(x, refine), rings, n_phi * 2 ** refine
+
+
+def layered_tets(tube: FingerTube, *, n_phi: int, layer_first: float, layer_ratio: float,
+                 axial_size: float, core_rings: int = 1, refine: int = 0) -> int:
+    """The number of tetrahedra :func:`layered_tube_mesh` makes with these arguments, counted
+    from its grid alone (no mesh built): three a prism, the wall's prisms in every slice and
+    the core's in the end cap's."""
+    x, rings, n_phi = _layered_grid(tube, n_phi, layer_first, layer_ratio, axial_size, core_rings, refine)
+    wall = 2 * n_phi * int(np.sum(rings[1:] > tube.a + 1e-12))  # triangles outside the cavity
+    everything = n_phi * (2 * len(rings) - 1)
+    in_cap = int(np.sum(x[:-1] >= tube.length - tube.cap - 1e-9))
+    return 3 * ((len(x) - 1 - in_cap) * wall + in_cap * everything)
+
+
 def layered_tube_mesh(tube: FingerTube, *, n_phi: int, layer_first: float, layer_ratio: float,
                       axial_size: float, core_rings: int = 1, refine: int = 0) -> skfem.MeshTet2:
     """A structured, layered quadratic tetrahedral mesh of ``tube`` (no gmsh).
@@ -186,18 +212,9 @@ def layered_tube_mesh(tube: FingerTube, *, n_phi: int, layer_first: float, layer
     convergence); an unstructured mesh refines all three directions together.
     Boundaries as in :func:`finger_geometry`.
     """
-    if not (n_phi >= 2 and core_rings >= 1 and layer_first > 0 and layer_ratio >= 1 and axial_size > 0):
-        raise ValueError("need n_phi >= 2, core_rings >= 1, layer_first > 0, layer_ratio >= 1, "
-                         f"axial_size > 0; got {n_phi}, {core_rings}, {layer_first}, {layer_ratio}, {axial_size}")
     a, b, length = tube.a, tube.b, tube.length
     x_end = length - tube.cap
-    wall = _halve(layered_radii(a, b, layer_first, layer_ratio), refine)
-    rings = np.concatenate((_halve(np.linspace(0.0, a, core_rings + 1), refine)[1:-1], wall))
-    n_phi *= 2 ** refine
-    cuts = tube.cuts()
-    x = np.concatenate([cuts[:1]] + [np.linspace(c0, c1, int(np.ceil((c1 - c0) / axial_size - 1e-9)) + 1)[1:]
-                                     for c0, c1 in zip(cuts[:-1], cuts[1:])])
-    x = _halve(x, refine)
+    x, rings, n_phi = _layered_grid(tube, n_phi, layer_first, layer_ratio, axial_size, core_rings, refine)
 
     # the half cross-section: node 0 on the axis, node 1 + i (n_phi + 1) + j on ring i, angle j
     na = n_phi + 1

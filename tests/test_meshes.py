@@ -223,3 +223,107 @@ def test_a_finger_mesh_with_folded_elements_is_refused_before_its_fem():
         FingerModel(HandDesign(), FingerOptions(mesher="gmsh", mesh_size=10.0, edge_ratio=0.5, mesh_refine=0))
     assert info.value.field == "mesh" and isinstance(info.value, MeshRejected)
     FingerModel(HandDesign(), FingerOptions(mesher="gmsh", mesh_size=4.0, edge_ratio=1.0, mesh_refine=0))
+
+
+@pytest.mark.parametrize("kw", [{}, {"refine": 1}, {"n_phi": 3, "axial_size": 5.0},
+                                {"layer_first": 1.0, "layer_ratio": 1.0, "core_rings": 2}])
+def test_layered_tets_counts_the_layered_mesh_without_building_it(kw):
+    from softhand.meshes.finger import layered_tets, layered_tube_mesh
+
+    tube, _ = layered(0)
+    args = {"n_phi": 4, "layer_first": 0.2, "layer_ratio": 2.0, "axial_size": 2.5, **kw}
+    assert layered_tets(tube, **args) == layered_tube_mesh(tube, **args).t.shape[1]
+
+
+def _thin_walled():
+    from softhand.reduced.design import HandDesign
+
+    return HandDesign(a=6.0, b=3.0, d=10.0, l0=200.0)
+
+
+@pytest.mark.parametrize("design, options", [
+    ("paper", {}),
+    ("paper", {"mesher": "gmsh", "mesh_size": 4.0}),
+    ("thin", {"mesher": "gmsh", "mesh_size": 4.0}),
+    ("thin", {"n_phi": 3, "axial_size": 5.0}),
+])
+def test_least_unknowns_is_a_lower_bound_of_the_finger_fem(design, options):
+    """The size check's estimate, taken before meshing, never exceeds the FEM's unknowns (it
+    refuses only meshes at least that large); the layered one is within 25 %."""
+    from softhand.fem.hand.finger import FingerModel, FingerOptions
+    from softhand.fem.hand.finger_options import least_unknowns
+    from softhand.reduced.design import HandDesign
+
+    design = HandDesign() if design == "paper" else _thin_walled()
+    model = FingerModel(design, FingerOptions(**options))
+    least = least_unknowns(model.tube, model.options)
+    assert least <= model.ndofs
+    if model.options.mesher == "layered":
+        assert model.ndofs <= 1.25 * least
+
+
+def test_a_mesh_too_large_for_the_memory_is_refused_before_meshing(monkeypatch):
+    """By the measured peak memory (14.9 GB at 553 820 unknowns, growing as n^(4/3)): 1 GB holds
+    about 73 000 unknowns, so the 2 mm gmsh finger (>= 46 000) passes and one refinement of the
+    layered mesh (>= 277 000) does not; nothing is meshed (gmsh is not called)."""
+    from softhand.fem.hand import finger_options as fo
+    from softhand.fem.hand.finger import FingerModel, FingerOptions, finger_tube
+    from softhand.reduced.design import HandDesign
+    from softhand.reduced.errors import MeshRejected
+
+    assert fo.most_unknowns(fo.MEASURED_PEAK_BYTES) == fo.MEASURED_UNKNOWNS
+    assert fo.most_unknowns(1e9) == pytest.approx(553_820 / 14.9 ** 0.75, abs=1)
+    design = HandDesign()
+    small, large = FingerOptions(mesher="gmsh", mesh_size=2.0), FingerOptions(mesh_refine=1)
+    fo.check_size(finger_tube(design, small), small, memory=1e9)
+    with pytest.raises(MeshRejected, match="at least 277,632 unknowns; 1 GiB of memory"):
+        fo.check_size(finger_tube(design, large), large, memory=1e9)
+    monkeypatch.setattr(fo, "memory_bytes", lambda: 1e9)
+    monkeypatch.setattr(fo, "build_mesh", lambda *a: pytest.fail("meshed"))
+    with pytest.raises(MeshRejected, match="choose a coarser mesh"):
+        FingerModel(design, large)
+
+
+@pytest.mark.parametrize("files, argv, field", [
+    ({"t.toml": "[object]\ndiameter_mm = 180.0\nmass_kg = 2.0\n[pump]\nmax_pressure_MPa = 2.0\n"
+                "[free]\na_mm = [3.5, 4.5]\n[fem]\nmesh_size_mm = 0.6\n"},
+     ["design", "--task", "t.toml", "--no-progress"], "fem.mesh_size_mm = 0.6"),
+    ({"t.toml": "[object]\ndiameter_mm = 180.0\nmass_kg = 2.0\n[pump]\nmax_pressure_MPa = 2.0\n"
+                "[free]\na_mm = [3.5, 4.5]\n"},
+     ["design", "--task", "t.toml", "--no-progress", "--mesh-size-mm", "0.5"], "--mesh-size-mm = 0.5"),
+    ({"s.toml": "lhs = 2\nmesh_size_mm = 0.5\n[space]\na_mm = [3.0, 6.0]\nb_mm = [3.0, 7.0]\n"
+                "d_mm = [10.0, 20.0]\nl0_mm = [120.0, 200.0]\ntie_width_mm = [5.0, 15.0]\n"},
+     ["calibrate", "finger", "--space", "s.toml", "--out", "t.csv", "--no-progress"], "s.toml: mesh_size_mm = 0.5"),
+    ({"o/result.json": "{}"},  # the last run's result, kept
+     ["bend", "--mesh-size-mm", "0.6", "--out", "o"], "mesh = 'gmsh mesh_size=0.6"),
+])
+def test_a_run_whose_mesh_exceeds_the_memory_is_one_line_before_any_work(files, argv, field, tmp_path,
+                                                                        monkeypatch, capsys):
+    """On a 24 GiB machine: the design task's proof mesh (checked on the box's smallest finger
+    before the optimiser runs), a design space's mesh and a bend mesh: exit 2, one line naming
+    the field (no progress bar drawn first), nothing written or cleared."""
+    from softhand.fem.hand import finger_options as fo
+    from softhand.studies.cli.main import main
+
+    monkeypatch.setattr(fo, "memory_bytes", lambda: 24 * 2 ** 30)
+    monkeypatch.chdir(tmp_path)
+    for name, text in files.items():
+        (tmp_path / name).parent.mkdir(exist_ok=True)
+        (tmp_path / name).write_text(text)
+    assert main(argv) == 2
+    out, err = capsys.readouterr()
+    assert err.startswith("softhand ") and err.count("\n") == 1 and field in err and "coarser mesh" in err
+    assert out == ""
+    assert sorted(str(p.relative_to(tmp_path)) for p in tmp_path.rglob("*") if p.is_file()) == sorted(files)
+
+
+def test_the_memory_is_the_containers_limit_where_it_is_lower(tmp_path, monkeypatch):
+    from softhand.fem.hand import finger_options as fo
+
+    machine = fo.memory_bytes()
+    (tmp_path / "v2").write_text("max\n")
+    (tmp_path / "v1").write_text(f"{2 ** 30}\n")
+    monkeypatch.setattr(fo, "CGROUP_LIMITS", (str(tmp_path / "v2"), str(tmp_path / "missing")))
+    assert fo.memory_bytes() == machine  # no limit
+    monkeypatch.setattr(fo, "CGROUP_LIMITS", (str(tmp_path / "v2"), str(tmp_path / "v1")))
+    assert fo.memory_bytes() == min(machine, 2 ** 30)

@@ -43,7 +43,7 @@ from skfem import Basis, ElementTetP2, ElementVector
 
 from softhand.fem import kinematics as kin
 from softhand.fem.constraints import ChainConstraint, PlanarChain
-from softhand.fem.hand.finger_options import FingerOptions, build_mesh, describe_mesh, ring_width, tie_bands
+from softhand.fem.hand.finger_options import FingerOptions, build_mesh, check_size, describe_mesh, ring_width, tie_bands
 from softhand.fem.hand.finger_sweep import SweepStats, solve_pressures
 from softhand.fem.hand.frame import to_hand_frame
 from softhand.fem.hand.windings import Windings, WindingFibers, hoop_directions
@@ -80,14 +80,21 @@ class FingerState:
         return float(np.sum(self.q))
 
 
+def finger_tube(design: HandDesign, options: FingerOptions) -> FingerTube:
+    """The half tube the finger FEM meshes: the design's radii and length, the options' end cap
+    (default: the wall b) and tie bands."""
+    cap = options.cap if options.cap is not None else design.b
+    return FingerTube(design.a, design.b, design.l0, cap, tie_bands(design, options),
+                      options.edge_ratio, options.edge_reach)
+
+
 class FingerModel:
     """The built finger FEM: mesh, solid, shell constraint and pressure load."""
 
     def __init__(self, design: HandDesign, options: FingerOptions = FingerOptions()):
         self.design, self.options = design, options
-        cap = options.cap if options.cap is not None else design.b
-        self.tube = FingerTube(design.a, design.b, design.l0, cap, tie_bands(design, options),
-                               options.edge_ratio, options.edge_reach)
+        self.tube = finger_tube(design, options)
+        check_size(self.tube, options)
         self.mesh = build_mesh(self.tube, options)
         mu = design.mu_sf
         rubber = rubber_law(design.finger_rubber, options.kappa_ratio * mu)
@@ -111,7 +118,7 @@ class FingerModel:
         self.law = rubber + self.fibers
         self.cavity = _cavity(self.solid, self.mesh, options)
         #: elements of the tube wall (not the end cap): where the windings are
-        self.wall = self.mesh.p[0, self.mesh.t[:4]].mean(axis=0) < design.l0 - cap
+        self.wall = self.mesh.p[0, self.mesh.t[:4]].mean(axis=0) < design.l0 - self.tube.cap
         self.chain = PlanarChain(np.c_[design.hinge_s, np.full(design.n_s, design.d)])
         self.constraint = self._tie()
         self.V0 = self.cavity.volume(np.zeros(self.solid.ndofs))

@@ -1,15 +1,16 @@
 """The finger FEM's discretisation and modelling options, the tie bands and the mesh they give."""
 from __future__ import annotations
 
+import os
 from dataclasses import dataclass
 
 import numpy as np
 from skfem.quadrature import get_quadrature
 from skfem.refdom import RefTet
 
-from softhand.meshes.finger import FingerTube, finger_tube_mesh, layered_tube_mesh
+from softhand.meshes.finger import FingerTube, finger_tube_mesh, layered_tets, layered_tube_mesh
 from softhand.reduced.design import HandDesign
-from softhand.reduced.errors import InputError
+from softhand.reduced.errors import InputError, MeshRejected
 
 TIES = ("ring", "full")
 MESHERS = ("layered", "gmsh")
@@ -84,6 +85,71 @@ def tie_bands(design: HandDesign, options: FingerOptions) -> tuple[tuple[float, 
     start[0], end[-1] = 0.0, design.l0
     return tuple((float(a), float(b)) for a, b in zip(start, end))
 
+
+
+#: the finger FEM's peak memory, measured: 14.9 GB at 553 820 unknowns (gmsh level 2,
+#: docs/finger.md); a sparse factor's fill in 3D grows about as unknowns^(4/3)
+MEASURED_UNKNOWNS, MEASURED_PEAK_BYTES, FILL_EXPONENT = 553_820, 14.9e9, 4 / 3
+#: unknowns per tetrahedron, at least (P2, after the links' reduction: 4.2-4.7 measured on
+#: layered and gmsh meshes of 2 000-130 000 tetrahedra)
+UNKNOWNS_PER_TET = 4
+#: a gmsh tetrahedron of size h is at most this times h^3 in volume on average (1.15 mm^3 at
+#: h = 2 mm, 0.14-0.22 h^3 measured; thin walls make them smaller)
+TET_VOLUME_PER_H3 = 0.2
+
+
+def least_unknowns(tube: FingerTube, options: FingerOptions) -> int:
+    """A lower bound of the finger FEM's unknowns on this mesh, without meshing: the layered
+    mesh's tetrahedra counted exactly; gmsh's from the half tube's volume over the largest
+    average tetrahedron of its size (grading only adds elements)."""
+    if options.mesher == "layered":
+        tets = layered_tets(tube, n_phi=options.n_phi, layer_first=options.layer_first,
+                            layer_ratio=options.layer_ratio, axial_size=options.axial_size,
+                            refine=options.mesh_refine)
+    else:
+        outer, inner = (tube.a + tube.b) ** 2, tube.a ** 2
+        volume = 0.5 * np.pi * (outer * tube.length - inner * (tube.length - tube.cap))
+        tets = 8 ** options.mesh_refine * volume / (TET_VOLUME_PER_H3 * options.mesh_size ** 3)
+    return int(UNKNOWNS_PER_TET * tets)
+
+
+#: a container's memory limit (cgroup v2, v1), where it is lower than the machine's
+CGROUP_LIMITS = ("/sys/fs/cgroup/memory.max", "/sys/fs/cgroup/memory/memory.limit_in_bytes")
+
+
+def memory_bytes() -> float | None:
+    """The memory this process may use [bytes]: the machine's, or its container's limit where
+    lower; None where the system does not say."""
+    try:
+        memory = float(os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES"))
+    except (AttributeError, ValueError, OSError):
+        return None
+    for path in CGROUP_LIMITS:
+        try:
+            with open(path) as f:
+                memory = min(memory, float(f.read().split()[0]))  # "max": no limit
+        except (OSError, ValueError, IndexError):
+            pass
+    return memory
+
+
+def most_unknowns(memory: float) -> int:
+    """About the most unknowns whose finger FEM fits in ``memory`` bytes (see MEASURED_*)."""
+    return int(MEASURED_UNKNOWNS * (memory / MEASURED_PEAK_BYTES) ** (1 / FILL_EXPONENT))
+
+
+def check_size(tube: FingerTube, options: FingerOptions, memory: float | None = None) -> None:
+    """Refuse, before meshing, a mesh whose FEM cannot fit in this machine's memory (a mesh
+    size of 0.5 mm would mesh for minutes, then fill the memory and be killed)."""
+    memory = memory_bytes() if memory is None else memory
+    if memory is None:
+        return
+    least, most = least_unknowns(tube, options), most_unknowns(memory)
+    if least > most:
+        raise MeshRejected(describe_mesh(options),
+                           f"has at least {least:,} unknowns; {memory / 2 ** 30:.0f} GiB of memory hold "
+                           f"the finger FEM of about {most:,} (measured: {MEASURED_PEAK_BYTES / 1e9:g} GB "
+                           f"at {MEASURED_UNKNOWNS:,}); choose a coarser mesh")
 
 
 def build_mesh(tube: FingerTube, options: FingerOptions):

@@ -18,6 +18,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from softhand.reduced.design import HandDesign
+from softhand.reduced.errors import InputError, MeshRejected
 from softhand.studies.batch.studyfile import Study
 from softhand.studies.calibration.space import _PATH_KEYS, VARIABLES, DesignSpace, finger_design
 
@@ -48,6 +49,35 @@ def space_params(space: DesignSpace) -> dict:
     if space.axial_size_mm is not None:
         params["axial_size_mm"] = space.axial_size_mm
     return params
+
+
+def case_options(params: dict):
+    """The finger FEM's mesh of one case: the default, a uniform gmsh mesh (``mesh_size_mm``) or
+    the layered mesh with longer slices (``axial_size_mm``)."""
+    from softhand.fem.hand.finger import FingerOptions
+
+    if "axial_size_mm" in params:
+        return FingerOptions(axial_size=float(params["axial_size_mm"]))
+    if "mesh_size_mm" in params:
+        return FingerOptions(mesher="gmsh", mesh_size=float(params["mesh_size_mm"]))
+    return FingerOptions()
+
+
+def check_memory(space: DesignSpace, src: str) -> None:
+    """Refuse a space whose mesh (``mesh_size_mm`` or ``axial_size_mm``) is too large for this
+    machine's memory on one of its designs, when it is read, not as failed cases."""
+    key = "mesh_size_mm" if space.mesh_size_mm is not None else "axial_size_mm"
+    if getattr(space, key) is None:
+        return
+    from softhand.fem.hand.finger import finger_tube
+    from softhand.fem.hand.finger_options import check_size
+
+    options = case_options(space_params(space))
+    try:
+        for design in space.designs():
+            check_size(finger_tube(design, options), options)
+    except MeshRejected as exc:
+        raise InputError(f"{src}: {key}", getattr(space, key), exc.allowed) from None
 
 
 #: the space's longer slices (``axial_size_mm``) are used only where they put at least this many
@@ -109,13 +139,9 @@ def bend_case(params: dict, design: HandDesign, outdir: Path) -> dict:
     ``axial_size_mm`` (optional): the default (layered) mesh with slices of at most that length.
     Returns P_MPa, theta_deg, dQ_mm3 (whole finger) per converged pressure.
     """
-    from softhand.fem.hand.finger import FingerModel, FingerOptions, solve_pressures
+    from softhand.fem.hand.finger import FingerModel, solve_pressures
 
-    options = FingerOptions() if "mesh_size_mm" not in params else \
-        FingerOptions(mesher="gmsh", mesh_size=float(params["mesh_size_mm"]))
-    if "axial_size_mm" in params:  # the layered mesh with longer slices
-        options = FingerOptions(axial_size=float(params["axial_size_mm"]))
-    model = FingerModel(design, options)
+    model = FingerModel(design, case_options(params))
     states, stats = solve_pressures(model, params["pressures_mpa"])
     more = load_path(states[-1].theta, params)
     its, facs, wall = stats.newton_iterations, stats.factorizations, stats.wall_seconds

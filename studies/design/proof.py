@@ -38,6 +38,7 @@ import numpy as np
 from scipy.interpolate import PchipInterpolator
 
 from softhand.reduced import hand
+from softhand.studies.design.evaluate import design_at
 from softhand.studies.design.optimise import Evaluation
 from softhand.studies.design.task import Task
 
@@ -259,6 +260,19 @@ def proof_mesh(design, mesh_size_mm: float) -> float:
     """The finger element size [mm] of the proof for this design: ``mesh_size_mm``, at most
     PROOF_MESH_THICK_WALL for a wall b above THICK_WALL_MM."""
     return min(mesh_size_mm, PROOF_MESH_THICK_WALL) if design.b > THICK_WALL_MM else mesh_size_mm
+
+
+def check_proof_size(task: Task, mesh_size_mm: float) -> None:
+    """Refuse (MeshRejected) a proof mesh too large for this machine's memory whatever the design:
+    checked on the task's smallest finger (its free keys at their lower bounds), before the
+    optimiser runs, not after it."""
+    from softhand.fem.hand.finger import finger_tube
+    from softhand.fem.hand.finger_options import check_size
+    from softhand.studies.weights import finger_options
+
+    smallest = design_at(task, [lo for _, lo, _ in task.free])
+    options = replace(finger_options(min(proof_meshes(smallest, mesh_size_mm))), edge_ratio=task.edge_ratio)
+    check_size(finger_tube(smallest, options), options)
 
 
 def fem_constraints(fem: dict, task: Task) -> list[dict]:

@@ -126,6 +126,13 @@ def _options(args):
     return FingerOptions(tie=args.tie, **{k: v for k, v in given.items() if v is not None})
 
 
+def _check_size(study) -> None:
+    from softhand.fem.hand.finger import finger_tube
+    from softhand.fem.hand.finger_options import check_size
+
+    check_size(finger_tube(study.design, study.options), study.options)
+
+
 def run(args) -> int:
     from tqdm import tqdm
 
@@ -145,6 +152,7 @@ def run(args) -> int:
     study = BendingStudy(design, pressures, _options(args),
                          peak_mpa=_peak(args.peak_mpa, pressures),
                          hand=args.hand)
+    _check_size(study)  # before the last run's outputs are cleared or a progress bar drawn
     out = Path(args.out)
     clear_outputs(out)
     n_steps = len(pressures) + (1 if study.peak_mpa else 0)

@@ -67,8 +67,8 @@ def run(args) -> int:
         raise InputError("--out", args.out, "not with --check, which compares a table with the "
                                             "FEM and writes none")
     if args.check is not None:
-        return _check(fc.load_space(args.check), args)
-    space = fc.load_space(args.space) if args.space else fc.single_design_space(args.design)
+        return _check(_load_space(args.check), args)
+    space = _load_space(args.space) if args.space else fc.single_design_space(args.design)
     results = _run(space, args)
     if results is None:
         return 1
@@ -130,6 +130,18 @@ def _finished_only(space, results):
                                               "mesh_pair cases; run without --finished")
     return (dataclasses.replace(space, points=tuple(space.points[i] for i in keep)),
             [results[i] for i in keep] + results[n:])
+
+
+def _load_space(path):
+    """The design space, refused now if its mesh is too large for this machine's memory."""
+    from pathlib import Path
+
+    from softhand.studies.calibration import space as fc
+    from softhand.studies.calibration.finger import check_memory
+
+    space = fc.load_space(path)
+    check_memory(space, Path(path).name)
+    return space
 
 
 def _check(space, args) -> int:

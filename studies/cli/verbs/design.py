@@ -60,6 +60,8 @@ def run(args) -> int:
             if value is not None:
                 raise InputError(option, value, "sets the FEM proof, which --no-fem skips")
     task = load_task(args.task)
+    if not args.no_fem:
+        _check_proof_size(task, args)
     say = (lambda text: print(f"softhand design: {text}", file=sys.stderr)) if args.json else print
     options = design_opt.OptimiserOptions(seed=args.seed)
     opt = _optimise(task, options, args)
@@ -161,6 +163,18 @@ def _prove_knee(pareto: dict, task, args, out, say) -> dict | None:
     return {"design_file": str(write_atomic(out / "knee" / "design.toml", ev.design.to_toml())),
             "stretch_limit": row["stretch_limit"], "predicted": ev.predicted(),
             "fem": _prove(ev, sub, args, out / "knee", say)}
+
+
+def _check_proof_size(task, args) -> None:
+    """A proof mesh too large for this machine: one line now, not after the optimiser's minutes."""
+    from softhand.studies.design.proof import check_proof_size
+
+    given = args.mesh_size_mm is not None
+    size = args.mesh_size_mm if given else task.mesh_size
+    try:
+        check_proof_size(task, size)
+    except MeshRejected as exc:
+        raise InputError("--mesh-size-mm" if given else "fem.mesh_size_mm", size, exc.allowed) from None
 
 
 def _prove(ev, task, args, out, say) -> dict:
