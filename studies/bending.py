@@ -113,10 +113,11 @@ def row(state: FingerState, design: HandDesign) -> dict:
     }
 
 
-def run(study: BendingStudy, *, on_state=None) -> BendingResult:
-    """Run the bending study; ``on_state(model, state)`` after each converged pressure."""
+def run(study: BendingStudy, *, on_state=None, model: FingerModel | None = None) -> BendingResult:
+    """Run the bending study; ``on_state(model, state)`` after each converged pressure.
+    ``model``: the study's finger FEM if already built (its mesh checked before outputs are touched)."""
     t0 = time.perf_counter()
-    model = FingerModel(study.design, study.options)
+    model = FingerModel(study.design, study.options) if model is None else model
     build = time.perf_counter() - t0
     callback = None if on_state is None else (lambda s: on_state(model, s))
     states, stats = solve_pressures(model, study.pressures_mpa, callback=callback)
