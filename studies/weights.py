@@ -155,11 +155,37 @@ def weights(case: WeightsCase, *, cache: bool = True, out=None) -> dict:
     if out is None and cache:
         entry = read_entry(path, case.key())
         if entry is not None:
-            return {**entry, "cached": True}
+            return _untouched_said(case, {**entry, "cached": True})
     result = compute(case) if out is None else compute(case, out)
     if cache:
         write_entry(path, case.key(), result)
-    return {**result, "cached": False}
+    return _untouched_said(case, {**result, "cached": False})
+
+
+def _untouched_said(case: WeightsCase, result: dict) -> dict:
+    """A warning where the finger does not touch the object at the case's pressure (no contact
+    force): its w is then the free finger's bend, not the grasp's."""
+    forces = result.get("contact_force_N")
+    if forces is not None and not any(f > 0.0 for f in forces):
+        print(f"softhand: warning: the finger does not touch the {case.diameter_mm:g} mm object at "
+              f"{case.pressure_mpa:g} MPa (theta {result['theta_deg']:.3g} deg, no contact force): its w "
+              f"is the free finger's bend, not a grasp's{_reduced_contact(case, result.get('depth_mm'))}",
+              file=sys.stderr)
+    return result
+
+
+def _reduced_contact(case: WeightsCase, depth: float | None) -> str:
+    """Where the reduced model's free finger touches the object, as a hint (or nothing)."""
+    from softhand.reduced import contact, hand
+    from softhand.reduced.errors import InputError
+
+    try:
+        theta, _ = contact.contact_angle(case.diameter_mm, case.design, depth=depth)
+        P = float(hand.finger_pressure(theta, case.design))
+    except (InputError, ValueError):
+        return ""
+    return (f"; the reduced model's finger touches it at theta {math.degrees(theta):.3g} deg "
+            f"(cavity pressure {P:.3g} MPa)")
 
 
 @dataclass(frozen=True)

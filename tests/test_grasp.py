@@ -204,3 +204,26 @@ def test_grasp_cli_takes_w_from_the_fem_or_the_paper_by_name(tmp_path, monkeypat
     assert main(base + ["--weights", "paper240"]) == 0
     out = json.loads(capsys.readouterr().out)
     assert out["w"] == pytest.approx([-0.2, 0.0, 0.1, 0.3, 0.8]) and out["w_source"].startswith("paper")
+
+
+@pytest.mark.parametrize("forces, warned", [([0.0] * 6, True), ([0.0, 0.0, 0.0, 0.0, 0.0, 1.5], False)])
+def test_w_of_a_finger_that_does_not_touch_the_object_is_said_to_be_no_grasps(forces, warned, tmp_path,
+                                                                             monkeypatch, capsys):
+    """The 60 mm object at 0.8 MPa: the grasp FEM's finger bends 20.5 deg and touches nothing (its
+    w is the free bend's); the reduced model's finger reaches it only at 167 deg, 3.59 MPa (the
+    paper's finger, eqs. (28) and the pad geometry): the warning says both."""
+    import softhand.studies.weights as sw
+
+    def fake_compute(case):
+        return {"diameter_mm": case.diameter_mm, "depth_mm": 40.0, "w": [0.2] * 5, "w_sum": 1.0,
+                "theta_deg": 20.54, "F_v_fem_N": 0.0, "contact_force_N": forces,
+                "mesh_size_mm": case.mesh_size_mm, "ndofs": 10}
+
+    monkeypatch.setenv("SOFTHAND_CACHE", str(tmp_path))
+    monkeypatch.setattr(sw, "compute", fake_compute)
+    assert main(["weights", "--diameter-mm", "60", "--json"]) == 0
+    err = capsys.readouterr().err
+    said = "softhand: warning: the finger does not touch the 60 mm object at 0.8 MPa (theta 20.5 deg"
+    assert (said in err) == warned
+    if warned:
+        assert "touches it at theta 167 deg (cavity pressure 3.59 MPa)" in err
