@@ -41,3 +41,7 @@ class MeshRejected(InputError):
 
     def __init__(self, mesh: str, allowed: str):
         super().__init__("mesh", mesh, allowed)
+
+
+class MeshTooLarge(MeshRejected):
+    """A mesh whose FEM would not fit in the machine's memory (refused before meshing)."""

@@ -84,6 +84,49 @@ def test_a_failed_proof_mesh_is_retried_on_the_next_finer_one(monkeypatch):
         verb._prove(ev, task, SimpleNamespace(mesh_size_mm=None), None, lambda text: None)
 
 
+def test_a_proof_mesh_too_large_for_the_optimum_is_not_retried_finer(monkeypatch):
+    """The box's smallest finger fitted the memory, the optimum's does not: no finer mesh is
+    tried (it would be larger still) and the report asks for a coarser one."""
+    from types import SimpleNamespace
+
+    from softhand.reduced.errors import MeshTooLarge
+    from softhand.studies.cli.verbs import design as verb
+    from softhand.studies.design import proof
+
+    tried = []
+
+    def prove(ev, task, options, out=None, progress=None):
+        tried.append(options.mesh_size_mm)
+        raise MeshTooLarge("gmsh mesh_size=10", "has at least 900,000 unknowns; choose a coarser mesh")
+
+    monkeypatch.setattr(proof, "prove", prove)
+    task = task_from_dict({**CI_TASK, "fem": {"mesh_size_mm": 10.0}})
+    ev = design_opt.evaluate(task.base, task)
+    fem = verb._prove(ev, task, SimpleNamespace(mesh_size_mm=None), None, lambda text: None)
+    assert tried == [10.0] and fem["too_large"]
+    assert "try --mesh-size-mm with a coarser mesh" in proof.fem_report(fem, ev)
+
+
+def test_the_proof_mesh_is_bounded_on_the_boxs_thinnest_shortest_tube(monkeypatch):
+    """check_proof_size takes a, b, l0 at their lower bounds (free) or the base's, whether or
+    not that corner is a valid design (d below a + b there), and the finest mesh the proof may
+    try: the bound of a uniform gmsh tube of that size."""
+    from softhand.fem.hand import finger_options as fo
+    from softhand.reduced.errors import MeshTooLarge
+    from softhand.studies.design import proof
+
+    seen = []
+    monkeypatch.setattr(fo, "check_unknowns", lambda least, mesh, memory=None: seen.append((least, mesh)))
+    task = task_from_dict({**CI_TASK, "design": {"a_mm": 5.0, "b_mm": 5.0},
+                           "free": {"d_mm": [10.0, 18.0], "l0_mm": [150.0, 200.0]}})
+    proof.check_proof_size(task, 10.0)
+    assert seen == [(int(4 * fo.gmsh_least_tets(5.0, 5.0, 150.0, 5.0, 4.0)), "gmsh mesh_size=4 (the proof's)")]
+    monkeypatch.undo()
+    monkeypatch.setattr(fo, "memory_bytes", lambda: 24 * 2 ** 30)
+    with pytest.raises(MeshTooLarge, match="at least 2,8"):  # ~2.9 million unknowns
+        proof.check_proof_size(task, 0.5)
+
+
 def test_a_fem_stretch_above_the_limit_reoptimises_with_the_fems_factor(tmp_path, monkeypatch, capsys):
     """The proof's peak stretch 1.41 breaks the limit 1.4: the verb optimises again with eq. (8)'s
     strain scaled by (1.41 - 1) / (lambda_pred - 1), proves that design (here: the FEM stand-in

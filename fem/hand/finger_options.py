@@ -10,7 +10,7 @@ from skfem.refdom import RefTet
 
 from softhand.meshes.finger import FingerTube, finger_tube_mesh, layered_tets, layered_tube_mesh
 from softhand.reduced.design import HandDesign
-from softhand.reduced.errors import InputError, MeshRejected
+from softhand.reduced.errors import InputError, MeshTooLarge
 
 TIES = ("ring", "full")
 MESHERS = ("layered", "gmsh")
@@ -107,10 +107,15 @@ def least_unknowns(tube: FingerTube, options: FingerOptions) -> int:
                             layer_ratio=options.layer_ratio, axial_size=options.axial_size,
                             refine=options.mesh_refine)
     else:
-        outer, inner = (tube.a + tube.b) ** 2, tube.a ** 2
-        volume = 0.5 * np.pi * (outer * tube.length - inner * (tube.length - tube.cap))
-        tets = 8 ** options.mesh_refine * volume / (TET_VOLUME_PER_H3 * options.mesh_size ** 3)
+        tets = gmsh_least_tets(tube.a, tube.b, tube.length, tube.cap, options.mesh_size, options.mesh_refine)
     return int(UNKNOWNS_PER_TET * tets)
+
+
+def gmsh_least_tets(a: float, b: float, length: float, cap: float, size: float, refine: int = 0) -> float:
+    """At least the tetrahedra of gmsh's half tube of element size ``size`` [mm], refined
+    ``refine`` times: its volume over the largest average tetrahedron of that size."""
+    volume = 0.5 * np.pi * ((a + b) ** 2 * length - a ** 2 * (length - cap))
+    return 8 ** refine * volume / (TET_VOLUME_PER_H3 * size ** 3)
 
 
 #: a container's memory limit (cgroup v2, v1), where it is lower than the machine's
@@ -139,17 +144,22 @@ def most_unknowns(memory: float) -> int:
 
 
 def check_size(tube: FingerTube, options: FingerOptions, memory: float | None = None) -> None:
-    """Refuse, before meshing, a mesh whose FEM cannot fit in this machine's memory (a mesh
-    size of 0.5 mm would mesh for minutes, then fill the memory and be killed)."""
+    """Refuse (MeshTooLarge), before meshing, a mesh whose FEM cannot fit in this machine's
+    memory (a mesh size of 0.5 mm would mesh for minutes, then fill the memory and be killed)."""
+    check_unknowns(least_unknowns(tube, options), describe_mesh(options), memory)
+
+
+def check_unknowns(least: int, mesh: str, memory: float | None = None) -> None:
+    """MeshTooLarge if ``least`` unknowns (a lower bound) exceed what ``memory`` (default: this
+    machine's) holds; ``mesh`` names the mesh in the message."""
     memory = memory_bytes() if memory is None else memory
     if memory is None:
         return
-    least, most = least_unknowns(tube, options), most_unknowns(memory)
+    most = most_unknowns(memory)
     if least > most:
-        raise MeshRejected(describe_mesh(options),
-                           f"has at least {least:,} unknowns; {memory / 2 ** 30:.0f} GiB of memory hold "
-                           f"the finger FEM of about {most:,} (measured: {MEASURED_PEAK_BYTES / 1e9:g} GB "
-                           f"at {MEASURED_UNKNOWNS:,}); choose a coarser mesh")
+        raise MeshTooLarge(mesh, f"has at least {least:,} unknowns; {memory / 2 ** 30:.0f} GiB of memory hold "
+                                 f"the finger FEM of about {most:,} (measured: {MEASURED_PEAK_BYTES / 1e9:g} GB "
+                                 f"at {MEASURED_UNKNOWNS:,}); choose a coarser mesh")
 
 
 def build_mesh(tube: FingerTube, options: FingerOptions):

@@ -38,7 +38,6 @@ import numpy as np
 from scipy.interpolate import PchipInterpolator
 
 from softhand.reduced import hand
-from softhand.studies.design.evaluate import design_at
 from softhand.studies.design.optimise import Evaluation
 from softhand.studies.design.task import Task
 
@@ -263,16 +262,16 @@ def proof_mesh(design, mesh_size_mm: float) -> float:
 
 
 def check_proof_size(task: Task, mesh_size_mm: float) -> None:
-    """Refuse (MeshRejected) a proof mesh too large for this machine's memory whatever the design:
-    checked on the task's smallest finger (its free keys at their lower bounds), before the
-    optimiser runs, not after it."""
-    from softhand.fem.hand.finger import finger_tube
-    from softhand.fem.hand.finger_options import check_size
-    from softhand.studies.weights import finger_options
+    """Refuse (MeshTooLarge) a proof mesh too large for this machine's memory whatever the design:
+    bounded on the task's thinnest, shortest tube (a, b, l0 at their lower bounds where free) and
+    the finest mesh the proof may try, before the optimiser runs, not after it."""
+    from softhand.fem.hand.finger_options import UNKNOWNS_PER_TET, check_unknowns, gmsh_least_tets
 
-    smallest = design_at(task, [lo for _, lo, _ in task.free])
-    options = replace(finger_options(min(proof_meshes(smallest, mesh_size_mm))), edge_ratio=task.edge_ratio)
-    check_size(finger_tube(smallest, options), options)
+    low = {key: lo for key, lo, _ in task.free}
+    a, b, l0 = (low.get(key, default) for key, default in
+                (("a_mm", task.base.a), ("b_mm", task.base.b), ("l0_mm", task.base.l0)))
+    h = min(mesh_size_mm, PROOF_MESH_FINEST)
+    check_unknowns(int(UNKNOWNS_PER_TET * gmsh_least_tets(a, b, l0, b, h)), f"gmsh mesh_size={h:g} (the proof's)")
 
 
 def fem_constraints(fem: dict, task: Task) -> list[dict]:
@@ -290,8 +289,9 @@ def fem_report(fem: dict, ev: Evaluation) -> str | None:
     grasp breaks a limit of the task, else None."""
     if "error" in fem:
         meshes = ", ".join(f"{m['mesh_size_mm']:g} mm" for m in fem.get("failed_meshes", ()))
+        finer = "a coarser" if fem.get("too_large") else "a finer"
         return (f"The FEM proof could not be completed (finger mesh {meshes}): {fem['error']}. "
-                "The design is not proven; try --mesh-size-mm with a finer mesh.")
+                f"The design is not proven; try --mesh-size-mm with {finer} mesh.")
     broken = [c for c in fem.get("constraints", ()) if not c["satisfied"]]
     if not broken:
         return None

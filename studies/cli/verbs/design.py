@@ -18,7 +18,7 @@ from pathlib import Path
 
 import numpy as np
 
-from softhand.reduced.errors import InputError, MeshRejected
+from softhand.reduced.errors import InputError, MeshRejected, MeshTooLarge
 from softhand.studies.cli.args import add_json_option, add_progress_option, print_json, print_table
 
 HELP = "size finger and reservoir for an object (reduced model, optimiser) and prove it with the FEM"
@@ -190,6 +190,8 @@ def _prove(ev, task, args, out, say) -> dict:
         except (NotConverged, RuntimeError, MeshRejected) as exc:
             say(f"the FEM proof on the {size:g} mm finger mesh failed: {str(exc)[:300]}")  # e.g. folded
             failed.append({"mesh_size_mm": size, "error": str(exc)[:300]})
+            if isinstance(exc, MeshTooLarge):  # a finer mesh would be larger still
+                return {"error": failed[-1]["error"], "failed_meshes": failed, "too_large": True}
     return {"error": failed[-1]["error"], "failed_meshes": failed}
 
 
