@@ -216,7 +216,7 @@ def test_bend_failure_is_one_line_with_the_pressure_and_out_never_mixes_runs(tmp
     (out / "finger").mkdir()
     (out / "finger" / "finger_0003.vtm").write_text("an earlier run")
 
-    def failing(study, on_state=None):
+    def failing(study, on_state=None, model=None):
         error = NotConverged("Newton did not converge above P = 0.03 MPa on the way to 0.1 MPa",
                              [1.0], None, None)
         error.pressure = 0.03
