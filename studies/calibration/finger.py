@@ -18,7 +18,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from softhand.reduced.design import HandDesign
-from softhand.reduced.errors import InputError, MeshRejected
+from softhand.reduced.errors import InputError, MeshTooLarge
 from softhand.studies.batch.studyfile import Study
 from softhand.studies.calibration.space import _PATH_KEYS, VARIABLES, DesignSpace, finger_design
 
@@ -76,7 +76,7 @@ def check_memory(space: DesignSpace, src: str) -> None:
     try:
         for design in space.designs():
             check_size(finger_tube(design, options), options)
-    except MeshRejected as exc:
+    except MeshTooLarge as exc:
         raise InputError(f"{src}: {key}", getattr(space, key), exc.allowed) from None
 
 

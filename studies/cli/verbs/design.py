@@ -173,7 +173,7 @@ def _check_proof_size(task, args) -> None:
     size = args.mesh_size_mm if given else task.mesh_size
     try:
         check_proof_size(task, size)
-    except MeshRejected as exc:
+    except MeshTooLarge as exc:
         raise InputError("--mesh-size-mm" if given else "fem.mesh_size_mm", size, exc.allowed) from None
 
 

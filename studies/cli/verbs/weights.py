@@ -66,10 +66,10 @@ MAX_DIAMETERS, MAX_FIG8 = 50, 20
 
 def _values(text, field: str, max_count: int = 1):
     lo, hi = LIMITS[field]
-    one = f"a number in [{lo:g}, {hi:g}]"
-    values = parse_values(str(text), field, max_count, one if max_count == 1 else None)
+    allowed = f"{'a number' if max_count == 1 else 'numbers'} in [{lo:g}, {hi:g}]"
+    values = parse_values(str(text), field, max_count, allowed if max_count == 1 else None)
     if values.min() < lo or values.max() > hi:
-        raise InputError(field, text, f"must be {one if max_count == 1 else f'numbers in [{lo:g}, {hi:g}]'}")
+        raise InputError(field, text, f"must be {allowed}")
     return values
 
 
