@@ -136,13 +136,56 @@ def test_active_constraint_is_the_stretch_of_the_sheet():
     assert P[1] <= min(P[0], P[2])  # a minimum in d, not a bound
 
 
-def test_infeasible_task_names_the_binding_constraint():
+def test_infeasible_task_names_the_binding_constraint_and_stops_once_its_violation_stalls():
+    """SciPy's DE never converges while a member breaks a constraint: the 0.05 MPa pump's task,
+    whose least violation does not move, stops after the stall window, not after 60 generations."""
     task = task_from_dict({**CI_TASK, "pump": {"max_pressure_MPa": 0.05}})
     opt = design_opt.optimise(task, FAST)
     assert not opt.evaluation.feasible
+    assert opt.generations == FAST.stall + 1 < FAST.maxiter
+    assert opt.message.endswith("stopped") and "no design met the constraints" in opt.message
     text = design_opt.infeasible_report(task, opt)
     assert "pump_pressure" in text or "F_v at the pump limit" in text
     assert "d_mm = " in text and "\n" not in text
+
+
+def test_the_stall_rule_judges_the_pace_of_the_least_violation():
+    """Stopped only when the pace of the last ``window`` generations would leave a violation at
+    the last generation; a generation with a feasible member starts the count again."""
+    flat = design_opt.Stall(window=3, maxiter=60)
+    assert [flat(g, 1.0) for g in range(1, 6)] == [False, False, False, True, True]
+    falling = design_opt.Stall(window=3, maxiter=11)  # 0.1 a generation from 1.0 reaches 0 at 11
+    assert not any(falling(g, 1.0 - 0.1 * (g - 1)) for g in range(1, 11))
+    short = design_opt.Stall(window=3, maxiter=10)    # ... one generation too few
+    assert [short(g, 1.0 - 0.1 * (g - 1)) for g in range(1, 5)] == [False, False, False, True]
+    met = design_opt.Stall(window=3, maxiter=60)
+    assert not any(met(g, v) for g, v in enumerate([1.0, 1.0, 1.0, 0.0, 1.0, 1.0, 1.0], 1))
+    assert met(8, 1.0) and "in 8 generations" in met.message(8)
+
+
+def test_a_sliver_of_feasible_designs_is_found_not_called_infeasible():
+    """A pump limit a hair above the optimum's pressure leaves a sliver of the box feasible:
+    DE's first generations meet no constraint, but their violation falls fast (by orders of
+    magnitude), so the stall rule lets DE go on to the sliver."""
+    best = design_opt.optimise(task_from_dict(CI_TASK), FAST).evaluation.P_grasp
+    for factor in (1.00001, 1.001):
+        task = task_from_dict({**CI_TASK, "pump": {"max_pressure_MPa": best * factor}})
+        opt = design_opt.optimise(task, design_opt.OptimiserOptions(seed=1))
+        assert opt.evaluation.feasible and "stopped" not in opt.message
+        assert opt.evaluation.P_grasp == pytest.approx(best, rel=1e-6)
+    # a hair below: no design meets it, and the stall rule ends DE before its last generation
+    task = task_from_dict({**CI_TASK, "pump": {"max_pressure_MPa": best * 0.99999}})
+    opt = design_opt.optimise(task, design_opt.OptimiserOptions(seed=1))
+    assert not opt.evaluation.feasible and opt.generations < 60
+
+
+def test_slsqp_is_tried_from_the_least_violating_design_when_de_meets_nothing():
+    """Two generations find no design in the sliver; SLSQP from the least-violating one does."""
+    best = design_opt.optimise(task_from_dict(CI_TASK), FAST).evaluation.P_grasp
+    task = task_from_dict({**CI_TASK, "pump": {"max_pressure_MPa": best * 1.001}})
+    opt = design_opt.optimise(task, design_opt.OptimiserOptions(seed=1, maxiter=2))
+    assert opt.evaluation.feasible and opt.message.endswith("SLSQP from the least-violating design met the constraints")
+    assert opt.evaluation.P_grasp == pytest.approx(best, rel=1e-6)
 
 
 def test_l0_scales_the_hinges():

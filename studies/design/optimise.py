@@ -5,6 +5,13 @@ forces, constraints). Optimiser: :func:`scipy.optimize.differential_evolution` (
 worker: deterministic) with the constraints as a :class:`~scipy.optimize.NonlinearConstraint`
 (feasibility rules: a task that cannot be met ends at the least-violating design), then an
 SLSQP polish from its best point. ``benchmarks/bench_design.py`` measures it against SLSQP alone.
+
+SciPy's DE never converges while a member of its population breaks a constraint, so a task
+no design meets would run every generation: :class:`Stall` stops it once no member has met the
+constraints for ``OptimiserOptions.stall`` generations and the least violation, at the pace it
+fell over them, would still be above zero at the last generation. Whenever DE ends with no
+feasible member, SLSQP is tried from the least-violating design before the task is called
+infeasible.
 """
 from __future__ import annotations
 
@@ -20,7 +27,7 @@ from softhand.studies.design.evaluate import Constraint, Evaluation, design_at, 
 from softhand.studies.design.task import Task
 
 __all__ = ["Constraint", "Evaluation", "design_at", "evaluate", "objective", "Problem", "OptimiserOptions",
-           "Optimum", "optimise", "on_bounds", "polish", "binding", "infeasible_report", "open_span"]
+           "Optimum", "Stall", "optimise", "on_bounds", "polish", "binding", "infeasible_report", "open_span"]
 
 
 def objective(ev: Evaluation, task: Task) -> float:
@@ -58,6 +65,10 @@ class Problem:
     def slacks(self, x) -> np.ndarray:
         return np.array([c.slack for c in self.evaluation(x).constraints])
 
+    def violation(self, x) -> float:
+        """The total constraint violation at x (0 when every constraint is met), as SciPy sums it."""
+        return float(np.sum(np.maximum(-self.slacks(x), 0.0)))
+
     @property
     def bounds(self):
         return [(lo, hi) for _, lo, hi in self.task.free]
@@ -70,6 +81,7 @@ class OptimiserOptions:
     maxiter: int = 60         #: DE generations at most
     tol: float = 1e-2         #: DE relative tolerance on the population's objective spread
     polish: bool = True       #: SLSQP from the DE optimum
+    stall: int = 10           #: generations with no feasible member over which :class:`Stall` judges the pace
 
 
 @dataclass(frozen=True)
@@ -83,22 +95,57 @@ class Optimum:
     cpu_seconds: float = 0.0  #: the process's CPU time (the wall time of a loaded machine is a multiple)
 
 
+class Stall:
+    """Whether DE should stop on a task it is not meeting: no design in the population has met
+    the constraints for ``window`` generations, and the least total violation, falling at the
+    pace of those generations, would still be above zero after the last of ``maxiter``."""
+
+    def __init__(self, window: int, maxiter: int):
+        self.window, self.maxiter = window, maxiter
+        self.least: list[float] = []  #: the least violation of each generation since one met them all
+        self.stopped = False
+
+    def __call__(self, generation: int, violation: float) -> bool:
+        if violation <= 0.0:
+            self.least.clear()
+            return False
+        self.least.append(violation)
+        if len(self.least) <= self.window:
+            return False
+        pace = (self.least[-1 - self.window] - violation) / self.window  # fall per generation
+        self.stopped = violation - pace * (self.maxiter - generation) > 0.0
+        return self.stopped
+
+    def message(self, generations: int) -> str:
+        return (f"no design met the constraints in {generations} generations, and the least violation "
+                f"({self.least[-1]:.4g}) fell too slowly over the last {self.window} to reach zero "
+                f"within {self.maxiter}: stopped")
+
+
 def optimise(task: Task, options: OptimiserOptions = OptimiserOptions(), *, progress=None) -> Optimum:
     """Differential evolution (seeded) + SLSQP polish on the reduced model. ``progress``: called
     after each generation with the model evaluations so far (at most ``options.maxiter`` calls)."""
     t0, cpu = time.perf_counter(), time.process_time()
     problem = Problem(task)
     cons = NonlinearConstraint(problem.slacks, 0.0, np.inf)
+    stall = Stall(options.stall, options.maxiter)
 
     def generation(intermediate_result):  # scipy's callback: this name is its new-style signature
         if progress is not None:
             progress(problem.evaluations)
+        if stall(intermediate_result.nit, problem.violation(intermediate_result.x)):
+            raise StopIteration
 
     res = differential_evolution(problem.f, problem.bounds, constraints=cons, seed=options.seed,
                                  popsize=options.popsize, maxiter=options.maxiter, tol=options.tol,
                                  polish=False, init="sobol", updating="immediate", workers=1,
                                  callback=generation)
     x = np.asarray(res.x, dtype=float)
+    message = stall.message(int(res.nit)) if stall.stopped else str(res.message)
+    if options.polish and not problem.evaluation(x).feasible:  # SLSQP may step where DE's population did not
+        x = polish(problem, x, require_better=False, maxiter=options.stall)
+        if problem.evaluation(x).feasible:
+            message += "; SLSQP from the least-violating design met the constraints"
     if options.polish and problem.evaluation(x).feasible:
         x = polish(problem, x)
     x = on_bounds(x, problem.bounds)
@@ -108,7 +155,7 @@ def optimise(task: Task, options: OptimiserOptions = OptimiserOptions(), *, prog
         bounds = {key: [lo, hi] for key, lo, hi in task.free}
         raise InputError("free", bounds, f"no design within these bounds is one the model can answer "
                                          f"for this task; the optimiser's best try: {exc}") from None
-    return Optimum(x, ev, problem.evaluations, time.perf_counter() - t0, int(res.nit), str(res.message),
+    return Optimum(x, ev, problem.evaluations, time.perf_counter() - t0, int(res.nit), message,
                    time.process_time() - cpu)
 
 
@@ -122,13 +169,14 @@ def on_bounds(x, bounds, rtol: float = 1e-9) -> np.ndarray:
     return np.where(np.abs(x - lo) < tol, lo, np.where(np.abs(x - hi) < tol, hi, x))
 
 
-def polish(problem: Problem, x0, *, require_better: bool = True) -> np.ndarray:
-    """SLSQP (finite-difference gradients) from x0 in variables scaled to [0, 1]; the result
-    is kept if feasible (and, with ``require_better``, no worse than x0), else x0."""
+def polish(problem: Problem, x0, *, require_better: bool = True, maxiter: int = 200) -> np.ndarray:
+    """SLSQP (finite-difference gradients, at most ``maxiter`` iterations) from x0 in variables
+    scaled to [0, 1]; the result is kept if feasible (and, with ``require_better``, no worse
+    than x0), else x0."""
     lo, hi = np.array(problem.bounds).T
     to_x = lambda z: lo + z * (hi - lo)  # noqa: E731
     res = minimize(lambda z: problem.f(to_x(z)), (x0 - lo) / (hi - lo), method="SLSQP",
-                   bounds=[(0.0, 1.0)] * len(lo), options={"ftol": 1e-12, "maxiter": 200},
+                   bounds=[(0.0, 1.0)] * len(lo), options={"ftol": 1e-12, "maxiter": maxiter},
                    constraints=[{"type": "ineq", "fun": lambda z: problem.slacks(to_x(z))}])
     x = np.clip(to_x(res.x), lo, hi)
     better = problem.f(x) <= problem.f(x0) or not require_better
