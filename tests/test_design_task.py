@@ -271,6 +271,8 @@ def test_cli_infeasible_task_is_one_paragraph_exit_1(tmp_path):
     proc = _cli("design", "--task", str(task), "--no-fem", "--out", str(tmp_path / "out"))
     assert proc.returncode == 1, proc.stderr
     assert "The task cannot be met" in proc.stdout
+    # the SLSQP try after DE found nothing is said, not waited through in silence
+    assert "softhand design: no design met the constraints after 11 generations" in proc.stderr
 
 
 def test_a_task_designs_on_the_fem_calibrated_models():

@@ -122,9 +122,11 @@ class Stall:
                 f"within {self.maxiter}: stopped")
 
 
-def optimise(task: Task, options: OptimiserOptions = OptimiserOptions(), *, progress=None) -> Optimum:
+def optimise(task: Task, options: OptimiserOptions = OptimiserOptions(), *, progress=None,
+             say=None) -> Optimum:
     """Differential evolution (seeded) + SLSQP polish on the reduced model. ``progress``: called
-    after each generation with the model evaluations so far (at most ``options.maxiter`` calls)."""
+    after each generation with the model evaluations so far (at most ``options.maxiter`` calls);
+    ``say``: told in one line when DE ends with no feasible design and SLSQP is tried."""
     t0, cpu = time.perf_counter(), time.process_time()
     problem = Problem(task)
     cons = NonlinearConstraint(problem.slacks, 0.0, np.inf)
@@ -143,6 +145,9 @@ def optimise(task: Task, options: OptimiserOptions = OptimiserOptions(), *, prog
     x = np.asarray(res.x, dtype=float)
     message = stall.message(int(res.nit)) if stall.stopped else str(res.message)
     if options.polish and not problem.evaluation(x).feasible:  # SLSQP may step where DE's population did not
+        if say is not None:
+            say(f"no design met the constraints after {int(res.nit)} generations ({problem.evaluations} "
+                f"evaluations): trying SLSQP from the least-violating one")
         x = polish(problem, x, require_better=False, maxiter=options.stall)
         if problem.evaluation(x).feasible:
             message += "; SLSQP from the least-violating design met the constraints"

@@ -110,7 +110,8 @@ def _optimise(task, options, args):
             bar.set_postfix_str(f"{evaluations} evaluations", refresh=False)
             bar.update()
 
-        return design_opt.optimise(task, options, progress=step)
+        return design_opt.optimise(task, options, progress=step,
+                                   say=lambda text: bar.write(f"softhand design: {text}", file=sys.stderr))
 
 
 def _prove_and_correct(result, task, opt, base, args, out, say, options) -> dict:
