@@ -161,6 +161,8 @@ def test_the_stall_rule_judges_the_pace_of_the_least_violation():
     met = design_opt.Stall(window=3, maxiter=60)
     assert not any(met(g, v) for g, v in enumerate([1.0, 1.0, 1.0, 0.0, 1.0, 1.0, 1.0], 1))
     assert met(8, 1.0) and "in 8 generations" in met.message(8)
+    unbounded = design_opt.Stall(window=2, maxiter=60)  # inf - inf is no pace at all
+    assert [unbounded(g, math.inf) for g in range(1, 4)] == [False, False, True]
 
 
 def test_a_sliver_of_feasible_designs_is_found_not_called_infeasible():

@@ -321,6 +321,27 @@ def test_a_refused_mesh_is_one_line_before_any_work_and_touches_no_output(files,
     assert sorted(str(p) for p in written if p.parts[0] != "cache") == sorted(files)
 
 
+def test_a_study_whose_finger_mesh_does_not_fit_is_refused_when_read(tmp_path, monkeypatch, capsys):
+    """A finger_bend study on 0.25 mm slices (347k unknowns at least for the paper's finger) on a
+    4 GiB machine: one line naming the case's field, exit 2, before any case runs; on 24 GiB the
+    same study loads."""
+    from softhand.fem.hand import finger_options as fo
+    from softhand.studies.batch.studyfile import load_study
+    from softhand.studies.cli.main import main
+
+    study = tmp_path / "s.toml"
+    study.write_text('kind = "finger_bend"\n[params]\ntheta_target_deg = 64.0\np_max_mpa = 2.0\n'
+                     'p_step_mpa = 0.5\npressures_mpa = [0.2]\naxial_size_mm = 0.25\n[sweep]\na_mm = [4.0]\n')
+    monkeypatch.setattr(fo, "memory_bytes", lambda: 24 * 2 ** 30)
+    load_study(study)
+    monkeypatch.setattr(fo, "memory_bytes", lambda: 4 * 2 ** 30)
+    monkeypatch.chdir(tmp_path)
+    assert main(["study", "run", str(study), "--no-progress"]) == 2
+    out, err = capsys.readouterr()
+    assert err.count("\n") == 1 and "axial_size_mm = 0.25" in err and "at least 346,560 unknowns" in err
+    assert sorted(p.name for p in tmp_path.rglob("*")) == ["s.toml"]
+
+
 def test_the_memory_is_the_containers_limit_where_it_is_lower(tmp_path, monkeypatch):
     from softhand.fem.hand import finger_options as fo
 

@@ -113,6 +113,7 @@ class Stall:
         if len(self.least) <= self.window:
             return False
         pace = (self.least[-1 - self.window] - violation) / self.window  # fall per generation
+        pace = 0.0 if math.isnan(pace) else pace  # an infinite violation that stays infinite
         self.stopped = violation - pace * (self.maxiter - generation) > 0.0
         return self.stopped
 
