@@ -62,7 +62,7 @@ _PENETRATION = 1e-6
 #: the finger FEM's locked-hinge volume rates A_j(theta) (written by ``python -m softhand.studies.calibration.hinges``)
 HINGE_TABLE = Path(__file__).resolve().parent / "data" / "grasp_hinges.csv"
 #: the equilibrium's tolerance (scipy hybr, relative on the unknowns)
-_XTOL = 1e-12
+_XTOL = 1e-10
 
 
 class GraspState(NamedTuple):
