@@ -74,6 +74,12 @@ class Problem:
         return [(lo, hi) for _, lo, hi in self.task.free]
 
 
+#: SLSQP iterations from the least-violating design when DE ends with none feasible (each
+#: iteration a finite-difference gradient: about 1 + free keys evaluations; a sliver of
+#: feasible designs next to it took 6-8)
+RESCUE_ITERATIONS = 10
+
+
 @dataclass(frozen=True)
 class OptimiserOptions:
     seed: int = 1
@@ -149,7 +155,7 @@ def optimise(task: Task, options: OptimiserOptions = OptimiserOptions(), *, prog
         if say is not None:
             say(f"no design met the constraints after {int(res.nit)} generations ({problem.evaluations} "
                 f"evaluations): trying SLSQP from the least-violating one")
-        x = polish(problem, x, require_better=False, maxiter=options.stall)
+        x = polish(problem, x, require_better=False, maxiter=RESCUE_ITERATIONS)
         if problem.evaluation(x).feasible:
             message += "; SLSQP from the least-violating design met the constraints"
     if options.polish and problem.evaluation(x).feasible:
