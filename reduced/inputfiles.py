@@ -2,6 +2,7 @@
 else is one :class:`reduced.errors.InputError` line naming the option."""
 from __future__ import annotations
 
+import re
 import tomllib
 from pathlib import Path
 
@@ -14,6 +15,14 @@ __all__ = ["MAX_FILE_BYTES", "MAX_NESTING", "nesting_depth", "read_input_file", 
 MAX_FILE_BYTES = 1_000_000
 #: deepest nesting of tables and arrays in an input file (the files' own need at most 4)
 MAX_NESTING = 16
+#: a key of more than MAX_NESTING dotted parts (opening a line, a table header or a key of an
+#: inline table), its strings emptied: refused before parsing, since tomllib takes time
+#: quadratic in a dotted key's parts (20 000: 1-8 s)
+_DEEP_KEY = re.compile(r'(?:^|[{,])[ \t]*\[{0,2}[ \t]*(?:(?:[A-Za-z0-9_-]+|"")[ \t]*\.[ \t]*){%d,}' % MAX_NESTING,
+                       re.MULTILINE)
+#: TOML's strings (multi-line first), and its comments once the strings are gone
+_STRINGS = re.compile(r'"""[\s\S]*?"""|\'\'\'[\s\S]*?\'\'\'|"(?:[^"\\\n]|\\.)*"|\'[^\'\n]*\'')
+_COMMENT = re.compile(r"#[^\n]*")
 
 
 def read_input_file(path: str | Path, field: str, what: str) -> bytes:
@@ -41,16 +50,19 @@ def read_input_file(path: str | Path, field: str, what: str) -> bytes:
 def read_toml(path: str | Path, field: str, what: str) -> dict:
     """A small TOML file as a dict; InputError (one line) if unreadable or not TOML."""
     data = read_input_file(path, field, what)
+    deep = InputError(field, str(path), f"nests tables or arrays more than {MAX_NESTING} deep; give {what}")
     try:
-        table = tomllib.loads(data.decode("utf-8"))
+        text = data.decode("utf-8")
+        if _DEEP_KEY.search(_COMMENT.sub("", _STRINGS.sub('""', text))):
+            raise deep
+        table = tomllib.loads(text)
     except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
         raise InputError(field, str(path), f"is not valid TOML ({exc})") from None
     except RecursionError:  # arrays nested thousands deep
         raise InputError(field, str(path), f"nests arrays or tables more than the parser's "
                          f"limit; give {what}") from None
     if nesting_depth(table, MAX_NESTING + 1) > MAX_NESTING:  # dotted keys nest without recursion
-        raise InputError(field, str(path), f"nests tables or arrays more than {MAX_NESTING} "
-                         f"deep; give {what}")
+        raise deep
     return table
 
 

@@ -399,3 +399,38 @@ def test_every_number_of_a_design_has_bounds():
     assert set(numeric) <= set(BOUNDS)
     for key, (lo, hi) in BOUNDS.items():
         assert math.isfinite(lo) and math.isfinite(hi) and lo < hi, key
+
+
+@pytest.mark.parametrize("text", [
+    "a_mm" + ".x" * 400_000 + " = 1\n",                 # a dotted key: parsing it took an hour
+    "[a" + ".x" * 400_000 + "]\n",                       # a table header
+    "[[a" + ".x" * 400_000 + "]]\n",                     # an array of tables
+    "x = {y = 1, a" + ".x" * 400_000 + " = 1}\n",        # a key of an inline table
+    "a" + '."x"' * 200_000 + " = 1\n",                   # quoted parts
+])
+def test_a_deeply_dotted_key_is_refused_before_the_parser_reads_it(text, tmp_path, monkeypatch):
+    """tomllib takes time quadratic in a dotted key's parts (20 000 parts: 1-8 s, 400 000 in a
+    1 MB file: about an hour); such a key is refused by a scan of the text, without parsing."""
+    from softhand.reduced import inputfiles
+    from softhand.reduced.errors import InputError
+
+    path = tmp_path / "d.toml"
+    path.write_text(text)
+    monkeypatch.setattr(inputfiles.tomllib, "loads", lambda s: pytest.fail("parsed"))
+    with pytest.raises(InputError, match="more than 16 deep"):
+        inputfiles.read_toml(path, "--design", "a design TOML file")
+
+
+def test_dotted_keys_within_the_nesting_limit_are_read(tmp_path):
+    """Sixteen parts (the limit) in a key and a header's inner key; dots after commas inside
+    strings and comments are not keys."""
+    from softhand.reduced import inputfiles
+
+    key = ".".join(f"k{i}" for i in range(16))
+    path = tmp_path / "d.toml"
+    dots = ",b.c.d.e.f.g.h.i.j.k.l.m.n.o.p.q.r.s.t"
+    path.write_text(f'{key} = 1\ndescription = "a{dots}"\nnote = \'\'\'\n{dots}\'\'\'  # {dots}\n'
+                    f'["q.{key}"]\nz = {{ {".".join(f"p{i}" for i in range(13))} = 2 }}\n')
+    table = inputfiles.read_toml(path, "--design", "a design TOML file")
+    assert inputfiles.nesting_depth(table) == 16  # the top level holds k0 .. k15 = 1: 16 tables
+    assert table[f"q.{key}"]["z"]["p0"]["p1"]["p2"]["p3"]["p4"]["p5"]["p6"]["p7"]["p8"]["p9"]["p10"]["p11"]["p12"] == 2
