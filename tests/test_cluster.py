@@ -71,3 +71,27 @@ def test_roomy_malloc_keeps_megabyte_blocks_off_mmap():
         pytest.skip("the C library has no mallinfo2 (not glibc >= 2.33)")
     assert run.returncode == 0, run.stderr
     assert run.stdout.split() == ["1", "True", "0", "1"]
+
+
+def test_an_unreachable_scheduler_is_told_at_once_and_a_live_one_is_joined():
+    """An unknown host and a port nobody listens on are one line without Dask's 15 s of retries;
+    the probe does not stand in the way of a scheduler that is there."""
+    pytest.importorskip("distributed")
+    import socket
+
+    from dask.distributed import LocalCluster
+
+    from softhand.reduced.errors import InputError
+    from softhand.studies.batch.cluster import close_cluster, open_cluster
+
+    with pytest.raises(InputError, match="no host 'nowhere.invalid'"):
+        open_cluster("tcp://nowhere.invalid:8786", 1)
+    with socket.socket() as s:  # a port that was free a moment ago
+        s.bind(("127.0.0.1", 0))
+        port = s.getsockname()[1]
+    with pytest.raises(InputError, match=f"nothing listens on port {port} of 127.0.0.1"):
+        open_cluster(f"127.0.0.1:{port}", 1)
+    with LocalCluster(n_workers=1, processes=False, dashboard_address=None) as cluster:
+        client, own = open_cluster(cluster.scheduler_address, 1)
+        assert own is None and client.submit(lambda x: x + 1, 1).result() == 2
+        close_cluster(client, own)

@@ -13,6 +13,7 @@ from __future__ import annotations
 import ctypes
 import logging
 import os
+import socket
 import traceback
 
 from softhand.reduced.errors import InputError
@@ -98,7 +99,30 @@ def roomy_malloc() -> bool:
     return True
 
 
+def _probe(address: str) -> None:
+    """Refuse at once a TCP address whose host does not resolve or whose port refuses the
+    connection: Dask retries both until its 15 s timeout. Other schemes (tls, ucx, ...), and a
+    host that does not answer at all, are left to Dask's own connection."""
+    from distributed.comm.addressing import parse_address, parse_host_port
+
+    try:
+        scheme, location = parse_address(address)
+        if scheme != "tcp":
+            return
+        host, port = parse_host_port(location, default_port=8786)
+        socket.create_connection((host, port), timeout=5.0).close()
+    except socket.gaierror as exc:
+        raise InputError("--scheduler", address, f"cannot reach a Dask scheduler: no host {host!r} "
+                         f"({exc.strerror})") from None
+    except ConnectionRefusedError:
+        raise InputError("--scheduler", address, f"cannot reach a Dask scheduler: nothing listens on "
+                         f"port {port} of {host}") from None
+    except (OSError, ValueError):  # a timeout, an address Dask may still read: Dask says
+        return
+
+
 def _connect(Client, address: str):
+    _probe(address)
     quiet = logging.getLogger("distributed")
     level, quiet.level = quiet.level, logging.CRITICAL  # the one error line says it all
     try:
