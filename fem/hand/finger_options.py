@@ -64,6 +64,16 @@ class FingerOptions:
                 raise InputError(name, getattr(self, name), "must be a positive number")
 
 
+def mesh_options(mesh_size: float | None = None, axial_size: float | None = None) -> FingerOptions:
+    """The options of a mesh asked by its size: the layered mesh with slices of at most
+    ``axial_size`` [mm], else a uniform gmsh mesh of ``mesh_size`` [mm], else the default."""
+    if axial_size is not None:
+        return FingerOptions(axial_size=float(axial_size))
+    if mesh_size is not None:
+        return FingerOptions(mesher="gmsh", mesh_size=float(mesh_size))
+    return FingerOptions()
+
+
 def ring_width(design: HandDesign, options: FingerOptions) -> float:
     """Width of each link's tied ring [mm]: the options' if given, else the design's tie_width."""
     return design.tie_width if options.tie_width is None else options.tie_width

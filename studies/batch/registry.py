@@ -85,11 +85,10 @@ def _finger_mesh_fits(params: dict, design: HandDesign, src: str) -> None:
     """The case's finger mesh fits this machine's memory (a lower bound on its unknowns, counted
     without meshing): one line when the study is read, not a case failing after the others ran."""
     from softhand.fem.hand.finger import finger_tube
-    from softhand.fem.hand.finger_options import check_size
+    from softhand.fem.hand.finger_options import check_size, mesh_options
     from softhand.reduced.errors import MeshTooLarge
-    from softhand.studies.calibration.finger import case_options
 
-    options = case_options(params)
+    options = mesh_options(params.get("mesh_size_mm"), params.get("axial_size_mm"))
     try:
         check_size(finger_tube(design, options), options)
     except MeshTooLarge as exc:

@@ -54,13 +54,9 @@ def space_params(space: DesignSpace) -> dict:
 def case_options(params: dict):
     """The finger FEM's mesh of one case: the default, a uniform gmsh mesh (``mesh_size_mm``) or
     the layered mesh with longer slices (``axial_size_mm``)."""
-    from softhand.fem.hand.finger import FingerOptions
+    from softhand.fem.hand.finger_options import mesh_options
 
-    if "axial_size_mm" in params:
-        return FingerOptions(axial_size=float(params["axial_size_mm"]))
-    if "mesh_size_mm" in params:
-        return FingerOptions(mesher="gmsh", mesh_size=float(params["mesh_size_mm"]))
-    return FingerOptions()
+    return mesh_options(params.get("mesh_size_mm"), params.get("axial_size_mm"))
 
 
 def check_memory(space: DesignSpace, src: str) -> None:
