@@ -275,6 +275,7 @@ def test_cli_infeasible_task_is_one_paragraph_exit_1(tmp_path):
     assert "The task cannot be met" in proc.stdout
     # the SLSQP try after DE found nothing is said, not waited through in silence
     assert "softhand design: no design met the constraints after 11 generations" in proc.stderr
+    assert "# the search: no design met the constraints in 11 generations" in proc.stdout
 
 
 def test_a_task_designs_on_the_fem_calibrated_models():

@@ -125,8 +125,7 @@ class Stall:
 
     def message(self, generations: int) -> str:
         return (f"no design met the constraints in {generations} generations, and the least violation "
-                f"({self.least[-1]:.4g}) fell too slowly over the last {self.window} to reach zero "
-                f"within {self.maxiter}: stopped")
+                f"fell too slowly over the last {self.window} to reach zero within {self.maxiter}: stopped")
 
 
 def optimise(task: Task, options: OptimiserOptions = OptimiserOptions(), *, progress=None,

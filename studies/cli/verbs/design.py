@@ -223,6 +223,8 @@ def _print(result: dict, task, opt) -> None:
           f"per finger, pump <= {task.max_pressure:g} MPa; objective: {task.objective}")
     print(f"optimum: {free}  ({opt.evaluations} model evaluations, {opt.seconds:.1f} s wall, "
           f"{opt.cpu_seconds:.1f} s CPU)")
+    if not opt.evaluation.feasible:  # why the search ended where it did
+        print(f"# the search: {opt.message}")
     for key, lo, hi in task.clipped:
         print(f"# free {key} = [{lo:g}, {hi:g}] clipped to {result['free_bounds'][key]}: the space "
               f"finger_model \"fem\" is calibrated on")
