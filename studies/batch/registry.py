@@ -81,7 +81,7 @@ def _one_mesh(params: dict, design: HandDesign, src: str) -> None:
                          "applies to the layered mesh; remove mesh_size_mm (a uniform gmsh mesh)")
 
 
-def _finger_mesh_fits(params: dict, design: HandDesign, src: str) -> None:
+def finger_mesh_fits(params: dict, design: HandDesign, src: str) -> None:
     """The case's finger mesh fits this machine's memory (a lower bound on its unknowns, counted
     without meshing): one line when the study is read, not a case failing after the others ran."""
     from softhand.fem.hand.finger import finger_tube
@@ -165,7 +165,7 @@ KINDS: dict[str, Kind] = {
                         {"pressures_mpa": NumList(200, 0.0, 5.0, increasing=True, above_lo=True),
                          "theta_target_deg": Num(1.0, 180.0), "p_max_mpa": Num(0.01, 5.0),
                          "p_step_mpa": Num(0.01, 5.0), "axial_size_mm": Num(0.25, 20.0)},
-                        fem=True, mesh=Num(2.0, 12.0), checks=(_one_mesh, _finger_mesh_fits),
+                        fem=True, mesh=Num(2.0, 12.0), checks=(_one_mesh, finger_mesh_fits),
                         required=("pressures_mpa", "theta_target_deg", "p_max_mpa", "p_step_mpa")),
 }
 #: the entry-point group where installed packages declare more kinds

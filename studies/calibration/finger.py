@@ -18,7 +18,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from softhand.reduced.design import HandDesign
-from softhand.reduced.errors import InputError, MeshTooLarge
+from softhand.reduced.errors import InputError
 from softhand.studies.batch.studyfile import Study
 from softhand.studies.calibration.space import _PATH_KEYS, VARIABLES, DesignSpace, finger_design
 
@@ -62,18 +62,13 @@ def case_options(params: dict):
 def check_memory(space: DesignSpace, src: str) -> None:
     """Refuse a space whose mesh (``mesh_size_mm`` or ``axial_size_mm``) is too large for this
     machine's memory on one of its designs, when it is read, not as failed cases."""
-    key = "mesh_size_mm" if space.mesh_size_mm is not None else "axial_size_mm"
-    if getattr(space, key) is None:
+    if space.mesh_size_mm is None and space.axial_size_mm is None:
         return
-    from softhand.fem.hand.finger import finger_tube
-    from softhand.fem.hand.finger_options import check_size
+    from softhand.studies.batch.registry import finger_mesh_fits
 
-    options = case_options(space_params(space))
-    try:
-        for design in space.designs():
-            check_size(finger_tube(design, options), options)
-    except MeshTooLarge as exc:
-        raise InputError(f"{src}: {key}", getattr(space, key), exc.allowed) from None
+    params = space_params(space)
+    for design in space.designs():
+        finger_mesh_fits(params, design, src)
 
 
 #: the space's longer slices (``axial_size_mm``) are used only where they put at least this many
