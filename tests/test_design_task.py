@@ -122,6 +122,22 @@ def test_optimum_beats_a_grid_search_and_is_deterministic():
     assert opt.evaluation.P_grasp < base.P_grasp
 
 
+def test_the_pareto_fronts_end_is_the_least_stretch_of_a_grid_search():
+    """The front's far end: no feasible design on a grid over the free keys stretches the rubber
+    less than the least stretch found, and the design found is feasible with that stretch."""
+    from softhand.studies.design import pareto
+
+    task = task_from_dict(CI_TASK)
+    x, lam = pareto.least_stretch(task, FAST)
+    ev = design_opt.evaluate(design_opt.design_at(task, x), task)
+    assert ev.feasible and ev.rubber_stretch == pytest.approx(lam, rel=1e-12)
+    grid = [design_opt.evaluate(design_opt.design_at(task, p), task)
+            for p in zip(*(a.ravel() for a in np.meshgrid(np.linspace(10, 20, 11), np.linspace(12000, 30000, 11))))]
+    best = min(g.rubber_stretch for g in grid if g.feasible)
+    assert lam <= best + 1e-12
+    assert lam > best - 0.05  # the grid's spacing (1 mm, 1 800 mm^3) bounds how far above it can be
+
+
 def test_active_constraint_is_the_stretch_of_the_sheet():
     """With d and V0 free and nothing else in the way, the pressure falls with V0 (a fuller
     sheet pushes harder) until the sheet's stretch (16) reaches the limit; in d the calibrated

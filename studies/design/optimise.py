@@ -18,6 +18,7 @@ from __future__ import annotations
 import math
 import time
 from dataclasses import dataclass, field
+from typing import Callable
 
 import numpy as np
 from scipy.optimize import NonlinearConstraint, differential_evolution, minimize
@@ -43,6 +44,8 @@ class Problem:
     """The optimisation problem on the task's free keys, with one evaluation per x (memo)."""
 
     task: Task
+    #: what is minimised (default: the task's :func:`objective`); the Pareto front's end minimises the stretch
+    measure: Callable[[Evaluation], float] | None = None
     evaluations: int = 0
     _memo: dict = field(default_factory=dict, repr=False)
 
@@ -60,7 +63,8 @@ class Problem:
         return self._memo[k]
 
     def f(self, x) -> float:
-        return objective(self.evaluation(x), self.task)
+        ev = self.evaluation(x)
+        return objective(ev, self.task) if self.measure is None else self.measure(ev)
 
     def slacks(self, x) -> np.ndarray:
         return np.array([c.slack for c in self.evaluation(x).constraints])
