@@ -23,6 +23,7 @@ from pathlib import Path
 import numpy as np
 
 from .errors import InputError
+from .inputfiles import plain_float
 
 #: column -> what it holds (unit in the name)
 COLUMNS = {
@@ -131,7 +132,7 @@ def _parse_columns(name: str, header: list[str], rows) -> dict[str, np.ndarray]:
 
 def _number(name: str, line: int, col: str, text: str) -> float:
     try:
-        value = float(text)
+        value = plain_float(text)
     except ValueError:
         value = math.nan
     if not math.isfinite(value):

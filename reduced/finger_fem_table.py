@@ -18,6 +18,7 @@ import numpy as np
 
 from .errors import InputError
 from .finger_fem_terms import check_terms, legacy_terms
+from .inputfiles import plain_float, read_input_file
 
 TABLE_FILE = Path(__file__).resolve().parent / "data" / "finger_fem.csv"
 #: the nondimensional groups, in table column order
@@ -56,8 +57,6 @@ ROW_LIMITS = {"theta": (1e-6, 2 * math.pi), "p_tilde": (1e-9, 1e6), "q_tilde": (
 
 def read_table(path: str | Path = TABLE_FILE) -> Table:
     """Read a finger calibration CSV; InputError naming the file on any problem."""
-    from softhand.reduced.design import read_input_file
-
     path = Path(path)
     data = read_input_file(path, "finger_table", "a CSV written by softhand calibrate finger")
     try:
@@ -69,7 +68,7 @@ def read_table(path: str | Path = TABLE_FILE) -> Table:
     if not lines or tuple(c.strip() for c in lines[0].split(",")) != COLUMNS:
         raise _bad(path, f"needs the header {','.join(COLUMNS)}")
     try:
-        values = np.array([[float(x) for x in line.split(",")] for line in lines[1:]], ndmin=2)
+        values = np.array([[plain_float(x) for x in line.split(",")] for line in lines[1:]], ndmin=2)
     except ValueError:
         raise _bad(path, "has a cell that is not a number") from None
     if values.shape[0] == 0 or values.shape[1] != len(COLUMNS) or not np.all(np.isfinite(values)):
@@ -130,7 +129,7 @@ def _header(comments: list[str], path) -> tuple[dict, dict, str]:
                     key, _, value = item.strip().partition("=")
                     spec[key.strip()] = value.strip()
     try:
-        ranges = {g: tuple(float(v) for v in spec[g].split(":")) for g in GROUPS}
+        ranges = {g: tuple(plain_float(v) for v in spec[g].split(":")) for g in GROUPS}
     except (KeyError, ValueError):
         raise _bad(path, "needs the lines '# range: b_a=lo:hi, d_a=..., link_a=..., tie_link=...' "
                          "and '# fit: p_terms=..., q_terms=...' (or design_degree=D, "

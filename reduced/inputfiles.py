@@ -3,12 +3,13 @@ else is one :class:`reduced.errors.InputError` line naming the option."""
 from __future__ import annotations
 
 import re
+import stat
 import tomllib
 from pathlib import Path
 
 from .errors import InputError
 
-__all__ = ["MAX_FILE_BYTES", "MAX_NESTING", "nesting_depth", "read_input_file", "read_toml"]
+__all__ = ["MAX_FILE_BYTES", "MAX_NESTING", "nesting_depth", "plain_float", "read_input_file", "read_toml"]
 
 
 #: largest design / study / data file read [bytes]; a bigger one (or /dev/zero) is refused
@@ -23,6 +24,19 @@ _DEEP_KEY = re.compile(r'(?:^|[{,])[ \t]*\[{0,2}[ \t]*(?:(?:[A-Za-z0-9_-]+|"")[ 
 #: TOML's strings (multi-line first), and its comments once the strings are gone
 _STRINGS = re.compile(r'"""[\s\S]*?"""|\'\'\'[\s\S]*?\'\'\'|"(?:[^"\\\n]|\\.)*"|\'[^\'\n]*\'')
 _COMMENT = re.compile(r"#[^\n]*")
+#: a number as a data file or a command line writes it: ASCII decimal, optional exponent, or
+#: nan / inf (refused as not finite by whoever reads it)
+_NUMBER = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?|[+-]?(?:nan|inf|infinity)",
+                     re.IGNORECASE | re.ASCII)
+
+
+def plain_float(text: str) -> float:
+    """float() of a plain ASCII number (spaces around it allowed); ValueError for what float()
+    would also take but no data file or command line means: '1_0' (read as 10), other
+    scripts' digits ('٥', '２')."""
+    if not _NUMBER.fullmatch(text.strip()):
+        raise ValueError(f"not a plain number: {text!r}")
+    return float(text)
 
 
 def read_input_file(path: str | Path, field: str, what: str) -> bytes:
@@ -31,9 +45,12 @@ def read_input_file(path: str | Path, field: str, what: str) -> bytes:
         raise InputError(field, str(path), f"is empty; give {what}")
     path = Path(path)
     try:
+        mode = path.stat().st_mode  # before opening: a FIFO's open waits for a writer
+        if stat.S_ISDIR(mode):
+            raise IsADirectoryError
+        if not stat.S_ISREG(mode):
+            raise InputError(field, str(path), f"is not a regular file; give {what}")
         with open(path, "rb") as f:
-            if not path.is_file():
-                raise InputError(field, str(path), f"is not a regular file; give {what}")
             data = f.read(MAX_FILE_BYTES + 1)
     except FileNotFoundError:
         raise InputError(field, str(path), f"no such file; give {what}") from None

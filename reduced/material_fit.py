@@ -44,6 +44,7 @@ from scipy.optimize import least_squares
 from . import rubber
 from .csvdata import _read_rows
 from .errors import InputError
+from .inputfiles import plain_float
 from .lsq import FitOptions, diagnose, jacobian
 
 #: ``--model`` -> (rubber model, Ogden terms)
@@ -162,7 +163,7 @@ def _cell(data, i, col):
 
 def _number(name, line, col, text, positive=False):
     try:
-        value = float(text)
+        value = plain_float(text)
     except ValueError:
         value = math.nan
     if not math.isfinite(value) or (positive and not value > 0):

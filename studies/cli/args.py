@@ -3,13 +3,13 @@ from __future__ import annotations
 
 import argparse
 import math
-import re
 import sys
 
 import numpy as np
 
 from softhand.reduced.design import HandDesign, load_design
 from softhand.reduced.errors import InputError
+from softhand.reduced.inputfiles import plain_float
 from softhand.studies.io.files import json_text
 
 
@@ -24,10 +24,6 @@ _FORMS = "start:stop:step (step > 0, stop >= start) or a comma-separated list of
 ONE_NUMBER, NUMBER_LIST = "one finite number", "a comma-separated list of finite numbers"
 
 
-_NUMBER = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?|[+-]?(?:nan|inf|infinity)",
-                     re.IGNORECASE | re.ASCII)
-
-
 def parse_values(text: str, field: str, max_count: int = MAX_POINTS, forms: str | None = None) -> np.ndarray:
     """``'0:90:10'`` (start:stop:step, stop included) or ``'1,2.5,3'`` -> float array.
 
@@ -38,8 +34,10 @@ def parse_values(text: str, field: str, max_count: int = MAX_POINTS, forms: str 
     if len(text) > MAX_TEXT:
         raise InputError(field, text, f"is longer than {MAX_TEXT} characters")
     parts = [x.strip() for x in (text.split(":") if ":" in text else text.split(","))]
-    # plain ASCII decimals only: float() would also take '1_0' and other scripts' digits
-    numbers = [float(x) for x in parts] if all(map(_NUMBER.fullmatch, parts)) else []
+    try:
+        numbers = [plain_float(x) for x in parts]
+    except ValueError:
+        numbers = []
     if ":" in text:
         if len(numbers) != 3 or not all(map(math.isfinite, numbers)) or not numbers[2] > 0 \
                 or numbers[1] < numbers[0]:

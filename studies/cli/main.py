@@ -16,11 +16,13 @@ from __future__ import annotations
 import argparse
 import importlib
 import os
+import re
 import signal
 import sys
 import warnings
 
 from softhand.reduced.errors import InputError, short
+from softhand.reduced.inputfiles import plain_float
 from softhand.reduced.versions import package_version
 
 #: verb -> module under studies.commands; the order is the order of ``--help``.
@@ -32,10 +34,34 @@ VERBS = (
 
 
 class ArgumentParser(argparse.ArgumentParser):
-    """argparse, but a usage error is one line and exit code 2."""
+    """argparse, but a usage error is one line and exit code 2; ``type=float`` and ``type=int``
+    take plain ASCII numbers only (float() would read '1_0' as 10 and other scripts' digits)."""
+
+    def __init__(self, *args, **kwargs):
+        super().__init__(*args, **kwargs)
+        self.register("type", float, plain_float)
+        self.register("type", int, _plain_int)
+
+    def parse_known_args(self, args=None, namespace=None):
+        # Python 3.11's argparse turns '--option=--' into the value [] (not a string), past
+        # every check that expects one
+        for token in sys.argv[1:] if args is None else args:
+            if token == "--":
+                break
+            name, equals, value = token.partition("=")
+            if name.startswith("--") and equals and value == "--":
+                self.error(f"{name} = '--': must be a value ('--' ends the options)")
+        return super().parse_known_args(args, namespace)
 
     def error(self, message):
         self.exit(2, f"{self.prog}: error: {short(message, 400)}\n")
+
+
+def _plain_int(text: str) -> int:
+    """int() of ASCII digits with an optional sign (spaces around allowed); ValueError otherwise."""
+    if not re.fullmatch(r"[+-]?[0-9]+", text.strip()):
+        raise ValueError(f"not a plain whole number: {text!r}")
+    return int(text)
 
 
 def _verb_module(verb: str):

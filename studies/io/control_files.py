@@ -13,6 +13,7 @@ from pathlib import Path
 import numpy as np
 
 from softhand.reduced.errors import InputError
+from softhand.reduced.inputfiles import plain_float
 from softhand.studies.io.files import save_figure
 
 DISTURBANCE_HEADER = ("t_s", "force_N")
@@ -62,7 +63,7 @@ def _row(path: Path, number: int, cells: list[str]) -> tuple[float, float]:
     if len(cells) != 2:
         raise InputError(where, ",".join(cells), "must be two numbers: t_s,force_N")
     try:
-        t, force = float(cells[0]), float(cells[1])
+        t, force = plain_float(cells[0]), plain_float(cells[1])
     except ValueError:
         raise InputError(where, ",".join(cells), "must be two numbers: t_s,force_N") from None
     if not (math.isfinite(t) and math.isfinite(force)):

@@ -137,12 +137,13 @@ def _parse_bounds(text):
 
     from softhand.reduced.design import BOUNDS
     from softhand.reduced.errors import InputError
+    from softhand.reduced.inputfiles import plain_float
 
     bounds = {}
     for item in text.split(","):
         key, _, rng = item.partition("=")
         try:
-            lo, hi = (float(x) for x in rng.split(":"))
+            lo, hi = (plain_float(x) for x in rng.split(":"))
         except ValueError:
             raise InputError("--bounds", item, "must be KEY=LOW:HIGH, e.g. V0_mm3=1e4:3e4") from None
         limits = BOUNDS.get(key.strip(), (-math.inf, math.inf))

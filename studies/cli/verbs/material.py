@@ -17,6 +17,7 @@ import sys
 import numpy as np
 
 from softhand.reduced.errors import InputError
+from softhand.reduced.inputfiles import plain_float
 from softhand.studies.cli.args import add_json_option, print_json, print_table
 
 HELP = "rubber models: fit Mooney-Rivlin, Yeoh, Gent, Ogden, Neo-Hookean to test data"
@@ -78,7 +79,7 @@ def _stretch_range(text, data) -> tuple[float, float]:
         top = float(np.max(np.maximum(data.stretch, 1.0 / data.stretch)))
         return 1.0 / top, top
     try:
-        lo, hi = (float(x) for x in text.split(":"))
+        lo, hi = (plain_float(x) for x in text.split(":"))
     except ValueError:
         lo = hi = float("nan")
     low, high = STRETCH_LIMITS
