@@ -298,7 +298,11 @@ def design_from_dict(values: dict, base: HandDesign | None = None, *, source: st
     for part in PARTS:
         if part in values:
             changes.update(_material_changes(part, values[part], source, values))
-    return dataclasses.replace(base, **changes)
+    design = dataclasses.replace(base, **changes)
+    if changes.get("finger_table") and design.finger_model != "fem":  # the table would be unused
+        raise InputError(f"{source}: finger_table", values["finger_table"], f"is the table of "
+                         f"finger_model = 'fem'; this design's finger_model is {design.finger_model!r}")
+    return design
 
 
 def load_design(path: str | Path | None = None) -> HandDesign:
@@ -308,8 +312,4 @@ def load_design(path: str | Path | None = None) -> HandDesign:
     table = values.get("finger_table")
     if isinstance(table, str) and table and not Path(table).is_absolute():
         values["finger_table"] = str((path.parent / table).resolve())  # relative to the file
-    design = design_from_dict(values, source=path.name)
-    if design.finger_table and design.finger_model != "fem":  # a file's table would be unused
-        raise InputError(f"{path.name}: finger_table", table, f"is the table of finger_model = "
-                         f"'fem'; this design's finger_model is {design.finger_model!r}")
-    return design
+    return design_from_dict(values, source=path.name)

@@ -107,6 +107,7 @@ EXTRA_FILES = {
     "t_material.toml": _task("[material]\nmu_sf_MPa = -1.0\n"),
     "t_design_key.toml": _task("[design]\ncolour = 1\n"),
     "t_design_bad.toml": _task("[design]\nb_mm = 30.0\n"),
+    "t_table_unused.toml": _task('[design]\nfinger_model = "paper"\nfinger_table = "nope.csv"\n'),
     "t_fem_mesh.toml": _task("[fem]\nmesh_size_mm = 1e-9\n"),
     "t_fem_ratio.toml": _task("[fem]\nedge_ratio = 50.0\n"),
     "t_fem_dp.toml": _task("[fem]\ndP_MPa = 0.0\n"),
@@ -127,6 +128,25 @@ EXTRA_FILES = {
     "bad.pvd": "<VTKFile type='Collection'><Collection><DataSet file='nope.vtu'/></Collection></VTKFile>",
     "trunc.vtm": "<VTKFile type='vtkMultiBlockDataSet'",
     "x.obj": "v 0 0 0\n",
+    # numbers float() reads but no data file means: '1_5' is 15, other scripts' digits
+    "m_underscore.csv": GOOD_MATERIAL.replace("uniaxial,1.5,", "uniaxial,1_5,"),
+    "m_fullwidth.csv": GOOD_MATERIAL.replace("uniaxial,1.5,", "uniaxial,\uff11.\uff15,"),
+    "fit_underscore.csv": "P_MPa,theta_deg\n0.2,10\n0.4,2_5\n0.6,40\n0.8,55\n",
+    "fit_arabic.csv": "P_MPa,theta_deg\n0.2,10\n0.4,25\n0.6,\u0664\u0660\n0.8,55\n",
+    "push_underscore.csv": "t_s,force_N\n0,0\n5,1_0\n",
+    # output folders holding an entry of the wrong kind where a run writes (a '/keep' file
+    # makes its parent a folder)
+    "kind/root_file/good_study": "a file where the study's folder goes",
+    "kind/index_dir/good_study/index.csv/keep": "",
+    "kind/claims_file/good_study/.claims": "a file where the claims' folder goes",
+    "kind/design_json/result.json/keep": "",
+    "kind/knee_file/knee": "a file where the Pareto knee's folder goes",
+    "kind/rep/fig7_reduced": "a file where a section's folder goes",
+    "kind/rep2/report.md/keep": "",
+    "kind/ctl/summary.json/keep": "",
+    # a finger table the design's model would not use (finger_model = "paper")
+    "st_table_unused.toml": 'kind = "curve"\n[design]\nfinger_table = "nope.csv"\n[sweep]\ntheta_deg = [10]\n',
+    "st_table_swept.toml": 'kind = "curve"\n[sweep]\ntheta_deg = [10]\nfinger_table = ["nope.csv"]\n',
 }
 
 GOOD_TASK, GOOD_SPACE = "good_task.toml", "good_space.toml"
@@ -238,4 +258,37 @@ def replay_cases() -> list[tuple[str, list[str]]]:
         ["weights", "--diameter-mm", "180", "--fig8", "0.5", "--check-mm", "180"],
     ]
     cases += [("range", r) for r in ranges]
+    control = ["control", "--theta-ref-deg", "50", "--mass-kg", "1"]
+    forms = [  # numbers as float() and int() read them but nobody means them
+        ["material", "fit", "--data", "m_underscore.csv", "--model", "yeoh"],
+        ["material", "fit", "--data", "m_fullwidth.csv", "--model", "yeoh"],
+        ["material", "fit", "--data", "good_material.csv", "--model", "yeoh", "--stability-range", "0.2:1_0"],
+        ["fit", "--data", "fit_underscore.csv", "--params", "V0_mm3"],
+        ["fit", "--data", "fit_arabic.csv", "--params", "V0_mm3"],
+        ["fit", "--data", "good.csv", "--params", "V0_mm3", "--bounds", "V0_mm3=1_000:40_000"],
+        [*control, "--disturbance", "push_underscore.csv"], [*control, "--seed", "1_0"],
+        ["control", "--theta-ref-deg", "5_0", "--mass-kg", "1"],
+        ["control", "--theta-ref-deg", "\u0665\u0660", "--mass-kg", "1"],
+        ["design", "--task", GOOD_TASK, "--seed", "1_0"], ["reservoir", "--n-radial", "1_0"],
+        ["inspect", "good.vtu", "--step", "0_0"], ["curve", "--theta-deg", "10", "--max-cases", "\uff11\uff10"],
+    ]
+    forms += [  # '--option=--': Python 3.11's argparse gives the option [], not a string
+        ["curve", "--theta-deg=--"], ["bend", "--mesher=--"], ["bend", "--out=--"],
+        ["study", "run", "good_study.toml", "--scheduler=--"], [*control, "--mode=--"], [*control, "--out=--"],
+        ["design", "--task", GOOD_TASK, "--no-fem", "--out=--"], ["reservoir", "--out=--"],
+        ["weights", "--diameter-mm", "180", "--out=--"], ["material", "fit", "--data=--", "--model", "yeoh"],
+        ["calibrate", "finger", "--space", GOOD_SPACE, "--out", "t.csv", "--scheduler=--"],
+        ["grasp", "--weights=--"], ["inspect", "good.vtu", "--field=--"], ["verify", "--case=--"],
+        ["reproduce", "--only=--"], ["fit", "--data", "good.csv", "--params=--"],
+    ]
+    cases += [("form", f) for f in forms]
+    kinds = [["study", "run", "good_study.toml", "--workers", "1", "--results", f"kind/{r}"]
+             for r in ("root_file", "index_dir", "claims_file")]
+    kinds += [["study", "report", "good_study.toml", "--results", "kind/index_dir"],
+              ["design", "--task", GOOD_TASK, "--no-fem", "--out", "kind/design_json"],
+              ["design", "--task", GOOD_TASK, "--no-fem", "--pareto", "--out", "kind/knee_file"],
+              ["reproduce", "--only", "fig7_reduced", "--out", "kind/rep"],
+              ["reproduce", "--only", "fig7_reduced", "--out", "kind/rep2"], [*control, "--out", "kind/ctl"]]
+    cases += [("kind", k) for k in kinds]
+    cases += [("study", ["study", "run", s, "--workers", "1"]) for s in ("st_table_unused.toml", "st_table_swept.toml")]
     return [(f"{name}-{k}-{' '.join(argv[1:])[:40]}", argv) for k, (name, argv) in enumerate(cases)]

@@ -354,6 +354,7 @@ CASES = _cases()
 def scratch(tmp_path, monkeypatch):
     for name, text in {**FILES, **_design_files(), **STUDIES, **EXTRA_FILES}.items():
         path = tmp_path / name
+        path.parent.mkdir(parents=True, exist_ok=True)
         path.write_bytes(text if isinstance(text, bytes) else text.encode())
     (tmp_path / "adir").mkdir()
     monkeypatch.chdir(tmp_path)
@@ -434,3 +435,33 @@ def test_dotted_keys_within_the_nesting_limit_are_read(tmp_path):
     table = inputfiles.read_toml(path, "--design", "a design TOML file")
     assert inputfiles.nesting_depth(table) == 16  # the top level holds k0 .. k15 = 1: 16 tables
     assert table[f"q.{key}"]["z"]["p0"]["p1"]["p2"]["p3"]["p4"]["p5"]["p6"]["p7"]["p8"]["p9"]["p10"]["p11"]["p12"] == 2
+
+
+@pytest.mark.parametrize("argv", [["curve", "--theta-deg", "10", "--design", "pipe"],
+                                  ["material", "fit", "--data", "pipe", "--model", "yeoh"]])
+def test_a_named_pipe_is_refused_not_waited_on(argv, tmp_path):
+    """Opening a FIFO waits for a writer: it is refused before it is opened. In a subprocess,
+    so that a regression fails on the timeout instead of hanging the suite."""
+    import os
+    import subprocess
+    import sys
+
+    os.mkfifo(tmp_path / "pipe")
+    proc = subprocess.run([sys.executable, "-m", "softhand.studies.cli", *argv], cwd=tmp_path,
+                          capture_output=True, text=True, timeout=60,
+                          env={**os.environ, "SOFTHAND_CACHE": str(tmp_path / "cache")})
+    assert proc.returncode == 2 and proc.stderr.count("\n") == 1, proc.stderr
+    assert "pipe = 'pipe': is not a regular file" in proc.stderr or "= 'pipe': is not a regular file" in proc.stderr
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["pipe"]
+
+
+@pytest.mark.parametrize("argv", [["control", "--theta-ref-deg", "50", "--mass-kg", "1", "--out", "link"],
+                                  ["bend", "--out", "link"], ["reservoir", "--out", "link"]])
+def test_a_broken_link_as_an_output_folder_is_refused_before_the_work(argv, tmp_path, monkeypatch, capsys):
+    (tmp_path / "link").symlink_to(tmp_path / "nowhere" / "x")
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setenv("SOFTHAND_CACHE", str(tmp_path / "cache"))
+    assert _run(argv) == 2
+    out, err = capsys.readouterr()
+    assert out == "" and err.count("\n") == 1 and "'link': is a broken symbolic link" in err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["link"]

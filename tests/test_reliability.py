@@ -124,6 +124,24 @@ def test_corrupt_case_files_are_reported_and_recomputed(quick_study, tmp_path, c
     _check_results(study, root)
 
 
+def test_a_file_where_a_case_folder_goes_is_refused_before_any_case_runs(quick_study, tmp_path, capsys):
+    """A case's folder is committed by a rename after it is computed: a file in its place
+    would fail then; it is one error line before the first case instead."""
+    root = tmp_path / "res"
+    study = load_study(quick_study)
+    sdir = study_dir(study, root)
+    sdir.mkdir(parents=True)
+    blocker = sdir / plan(study)[5].key
+    blocker.write_text("not a case folder")
+    argv = ["study", "run", str(quick_study), "--workers", "1", "--results", str(root), "--no-progress"]
+    assert main(argv) == 2
+    out, err = capsys.readouterr()
+    assert out == "" and err.count("\n") == 1 and f"'{blocker}': is not a folder" in err
+    assert not (tmp_path / "log").exists() and sorted(p.name for p in sdir.iterdir()) == [blocker.name]
+    blocker.unlink()
+    assert main(argv) == 0
+
+
 def test_sigterm_stops_a_run_like_ctrl_c(logged_study, tmp_path):
     root = tmp_path / "res"
     proc = subprocess.Popen(_cli("study", "run", str(logged_study), "--workers", "2",

@@ -41,6 +41,7 @@ from softhand.studies.batch.cases import (FAILED, RESULT, Case, case_key, case_s
 from softhand.studies.batch.claims import Claims
 from softhand.studies.batch.index import index_rows, other_sources, status, write_index  # noqa: F401
 from softhand.studies.batch.studyfile import Study
+from softhand.studies.io.files import check_output_tree
 
 
 @dataclass
@@ -70,6 +71,7 @@ def run_study(study: Study, *, results_root: str | Path = "results", workers: in
     """
     sdir = own_study_dir(study, results_root, write=False)
     cases = plan(study)
+    check_output_tree(sdir, "--results", folders=[c.key for c in cases])
     states = {c.key: case_state(sdir, c) for c in cases}
     todo = [c for c in cases if fresh or states[c.key] != "done"]
     summary = RunSummary(total=len(cases), reused=len(cases) - len(todo), not_run=len(todo),

@@ -92,6 +92,8 @@ def check_writable(path, kind: str, field: str) -> None:
     p = Path(text)
     _check_name_lengths(p, field, text)
     if kind == "dir":
+        if p.is_symlink() and not p.exists():
+            raise InputError(field, text, "is a broken symbolic link; give a folder")
         if p.exists() and not p.is_dir():
             raise InputError(field, text, "exists and is not a folder; give a folder")
         folder = p

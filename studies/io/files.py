@@ -94,6 +94,32 @@ def jsonable(value):
     raise TypeError(f"not JSON serialisable: {type(value).__name__}")
 
 
+def check_output_tree(folder: str | Path, field: str, *, files=(), folders=()) -> None:
+    """Before any work: the output ``folder`` and the named ``files`` and ``folders`` in it
+    that a run writes are each of their kind or not there yet (a file where a folder goes
+    fails its first write after the computation, a folder where a file goes its last); the
+    folder's ancestors are folders. InputError naming ``field`` and the path otherwise."""
+    from softhand.reduced.errors import InputError
+
+    folder = Path(folder)
+    for ancestor in (folder, *folder.parents):
+        if ancestor.exists() and not ancestor.is_dir():
+            raise InputError(field, str(ancestor), "is a file where the output folder goes; move it "
+                                                   "away or give another folder")
+        if ancestor.is_symlink() and not ancestor.exists():
+            raise InputError(field, str(ancestor), "is a broken symbolic link where the output "
+                                                   "folder goes")
+    for name in folders:
+        path = folder / name
+        if (path.exists() or path.is_symlink()) and not path.is_dir():
+            raise InputError(field, str(path), "is not a folder, and the run writes a folder there; "
+                                               "move it away or give another folder")
+    for name in files:
+        if (folder / name).is_dir():
+            raise InputError(field, str(folder / name), "is a folder, and the run writes a file "
+                                                        "there; move it away or give another folder")
+
+
 @contextmanager
 def removed_unless_finished(folder: str | Path):
     """The files written under ``folder`` in this block (new, or rewritten: another inode, size

@@ -141,9 +141,12 @@ def study_from_args(args):
 
 
 def run(args) -> int:
-    from softhand.studies.control import run as run_study
+    from softhand.studies.control import FILES, run as run_study
+    from softhand.studies.io.files import check_output_tree
 
     study = study_from_args(args)
+    if args.out:
+        check_output_tree(args.out, "--out", files=FILES)
     result = run_study(study)
     if args.out:
         with kept_if_unwritable(Path(args.out), "control"):

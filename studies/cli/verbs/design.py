@@ -46,7 +46,7 @@ def run(args) -> int:
     from softhand.studies.design import optimise as design_opt
     from softhand.studies.design.task import load_task
     from softhand.studies.design.task import LOWER, UPPER
-    from softhand.studies.io.files import removed_unless_finished, write_atomic, write_json
+    from softhand.studies.io.files import check_output_tree, removed_unless_finished, write_atomic, write_json
 
     lo, hi = LOWER["mesh_size_mm"], UPPER["mesh_size_mm"]
     if args.mesh_size_mm is not None and not lo <= args.mesh_size_mm <= hi:
@@ -60,6 +60,9 @@ def run(args) -> int:
             if value is not None:
                 raise InputError(option, value, "sets the FEM proof, which --no-fem skips")
     task = load_task(args.task)
+    out = Path(args.out) if args.out else Path("results") / "design" / task.name
+    check_output_tree(out, "--out", files=("result.json", "design.toml", "rejected_design.toml", "pareto.png",
+                                           "grasp.pvd"), folders=("knee", "grasp"))
     if not args.no_fem:
         _check_proof_size(task, args)
     say = (lambda text: print(f"softhand design: {text}", file=sys.stderr)) if args.json else print
@@ -71,7 +74,6 @@ def run(args) -> int:
         result = {**_result(task, opt, base, None, args.seed), "report": design_opt.infeasible_report(task, opt)}
         print_json(result) if args.json else _print(result, task, opt)
         return 1
-    out = Path(args.out) if args.out else Path("results") / "design" / task.name
     out.mkdir(parents=True, exist_ok=True)
     (out / "result.json").unlink(missing_ok=True)  # the record of an earlier run, which this one replaces
     with removed_unless_finished(out):  # a run stopped mid-proof leaves none of its files

@@ -21,6 +21,7 @@ def configure(parser) -> None:
 
 def run(args) -> int:
     from softhand.studies.cli.checks import check_choices
+    from softhand.studies.io.files import check_output_tree
     from softhand.studies.reproduce.core import exit_code, reproduce, sections
 
     keys = [s.key for s in sections()]
@@ -28,6 +29,7 @@ def run(args) -> int:
     if args.only is not None:
         only = tuple(k.strip() for k in args.only.split(","))
         check_choices("--only", only, keys, "section", shown=args.only)
+    check_output_tree(args.out, "--out", files=("report.md", "summary.csv"), folders=keys)
     outcomes = reproduce(args.out, quick=args.quick, design=design_from_args(args), only=only,
                          fresh=args.fresh, progress=not args.no_progress)
     width = max(len(o.section.key) for o in outcomes)
