@@ -107,6 +107,9 @@ EXTRA_FILES = {
     "t_material.toml": _task("[material]\nmu_sf_MPa = -1.0\n"),
     "t_design_key.toml": _task("[design]\ncolour = 1\n"),
     "t_design_bad.toml": _task("[design]\nb_mm = 30.0\n"),
+    "task_tiny_object.toml": TASK.replace("diameter_mm = 180.0", "diameter_mm = 1e-300"),
+    "t_free_breaks_rules.toml": TASK.replace("a_mm = [3.5, 4.5]", "t_mm = [40.0, 50.0]"),
+    "t_material_twice.toml": _task("[material]\nmu_sf_MPa = 2.0\n[design]\nmu_sf_MPa = 1.0\n"),
     "t_table_unused.toml": _task('[design]\nfinger_model = "paper"\nfinger_table = "nope.csv"\n'),
     "t_fem_mesh.toml": _task("[fem]\nmesh_size_mm = 1e-9\n"),
     "t_fem_ratio.toml": _task("[fem]\nedge_ratio = 50.0\n"),
@@ -144,6 +147,9 @@ EXTRA_FILES = {
     "kind/rep/fig7_reduced": "a file where a section's folder goes",
     "kind/rep2/report.md/keep": "",
     "kind/ctl/summary.json/keep": "",
+    # designs a section of the report cannot run: the fingers' oil at 90 deg, the paper's w
+    "rep_small_reservoir.toml": "V0_mm3 = 100.0\n",
+    "rep_three_hinges.toml": "n_s = 3\nhinge_s_mm = [40.0, 80.0, 120.0]\n",
     # a finger table the design's model would not use (finger_model = "paper")
     "st_table_unused.toml": 'kind = "curve"\n[design]\nfinger_table = "nope.csv"\n[sweep]\ntheta_deg = [10]\n',
     "st_table_swept.toml": 'kind = "curve"\n[sweep]\ntheta_deg = [10]\nfinger_table = ["nope.csv"]\n',
@@ -181,6 +187,8 @@ def replay_cases() -> list[tuple[str, list[str]]]:
         ["--mesh-size-mm", "nan"], ["--mesh-size-mm", "1e-9"], ["--mesh-size-mm", "1e9"],
         ["--out", "a_file"], ["--out", "/proc/d"], ["--plot", "p.txt"], ["--plot", "a_file/p.png"],
         ["--plot", "adir"])] + [[]]
+    # every design the optimiser's first generation tries has no answer: one line after it
+    design += [["--task", "task_tiny_object.toml", "--no-fem", "--no-progress"]]
     cases += [("design", ["design", *d]) for d in design]
     material = [["--data", d, "--model", "yeoh"] for d in sorted(EXTRA_FILES) if d.startswith("m_")]
     material += [["--data", d, "--model", "yeoh"] for d in ("missing.csv", ".", "/dev/zero",
@@ -212,7 +220,9 @@ def replay_cases() -> list[tuple[str, list[str]]]:
     cases += [("verify", ["verify", *v]) for v in (["--case", ""], ["--case", "x" * 5000], ["--quick", "--case", "nope"])]
     cases += [("reproduce", ["reproduce", *r]) for r in (
         ["--only", ""], ["--only", "x" * 5000], ["--out", "/proc/r"], ["--out", "a_file/r"],
-        ["--design", "missing.toml"], ["--design", "/dev/zero"], ["--design", "d_sheet_thick.toml"])]
+        ["--design", "missing.toml"], ["--design", "/dev/zero"], ["--design", "d_sheet_thick.toml"],
+        ["--design", "rep_small_reservoir.toml", "--only", "fig7_reduced"],
+        ["--design", "rep_three_hinges.toml", "--only", "table2_reduced"])]
     cases += [("study", ["study", *s]) for s in (
         ["run", "good_study.toml", "--max-cases", "-1"], ["run", "good_study.toml", "--max-cases", "x"],
         ["run", "good_study.toml", "--max-cases", "1"], ["status", "good_study.toml", "--max-cases", "1"],

@@ -50,6 +50,9 @@ def test_task_file_reads_the_paper_task():
     ({"colour": "red"}, "colour"),
     ({"base_design": "nowhere.toml"}, "base_design"),
     ({"design": {"b_mm": -5.0}}, "b_mm"),
+    ({"free": {"t_mm": [40.0, 50.0]}}, "free"),                       # every t >= R = 24 mm
+    ({"free": {"a_mm": [5.5, 6.0], "b_mm": [5.0, 7.0], "d_mm": [10.0, 10.4]}}, "free"),  # a + b >= d everywhere
+    ({"design": {"mu_sf_MPa": 1.0}, "material": {"mu_sf_MPa": 2.0}}, "design.mu_sf_MPa"),
 ])
 def test_bad_task_files_name_the_field(change, field):
     with pytest.raises(InputError) as info:
@@ -163,6 +166,17 @@ def test_infeasible_task_names_the_binding_constraint_and_stops_once_its_violati
     text = design_opt.infeasible_report(task, opt)
     assert "pump_pressure" in text or "F_v at the pump limit" in text
     assert "d_mm = " in text and "\n" not in text
+
+
+def test_a_task_no_design_can_answer_is_refused_without_a_rescue():
+    """An object the fingers reach in no design of the box: one InputError naming [free] and
+    the model's reason, without SLSQP from a point that has no answer."""
+    task = task_from_dict({**CI_TASK, "object": {"diameter_mm": 1e-3, "mass_kg": 2.0}})
+    said, generations = [], []
+    with pytest.raises(InputError) as info:
+        design_opt.optimise(task, FAST, say=said.append, progress=generations.append)
+    assert info.value.field == "free" and "does not reach the object" in str(info.value)
+    assert said == [] and len(generations) <= 11
 
 
 def test_the_stall_rule_judges_the_pace_of_the_least_violation():

@@ -47,6 +47,8 @@ class Problem:
     #: what is minimised (default: the task's :func:`objective`); the Pareto front's end minimises the stretch
     measure: Callable[[Evaluation], float] | None = None
     evaluations: int = 0
+    answered: int = 0  #: evaluations the model had an answer for
+    refusal: InputError | None = field(default=None, repr=False)  #: the first it had none for
     _memo: dict = field(default_factory=dict, repr=False)
 
     def evaluation(self, x) -> Evaluation:
@@ -58,8 +60,10 @@ class Problem:
             exact = "l0_mm" not in (key for key, _, _ in self.task.free)
             try:
                 self._memo[k] = evaluate(design_at(self.task, x), self.task, exact=exact)
-            except InputError:  # no such design (a + b >= d, t >= R, ...) or no answer (no contact)
+                self.answered += 1
+            except InputError as exc:  # no such design (a + b >= d, t >= R, ...) or no answer (no contact)
                 self._memo[k] = unanswered(self.task)
+                self.refusal = self.refusal or exc
         return self._memo[k]
 
     def f(self, x) -> float:
@@ -153,6 +157,8 @@ def optimise(task: Task, options: OptimiserOptions = OptimiserOptions(), *, prog
                                  polish=False, init="sobol", updating="immediate", workers=1,
                                  callback=generation)
     x = np.asarray(res.x, dtype=float)
+    if not problem.answered:  # nothing to rescue from: every point DE tried has no answer
+        raise _unanswerable(task, problem.refusal)
     message = stall.message(int(res.nit)) if stall.stopped else str(res.message)
     if options.polish and not problem.evaluation(x).feasible:  # SLSQP may step where DE's population did not
         if say is not None:
@@ -166,12 +172,16 @@ def optimise(task: Task, options: OptimiserOptions = OptimiserOptions(), *, prog
     x = on_bounds(x, problem.bounds)
     try:
         ev = evaluate(design_at(task, x), task)  # exact kinematics
-    except InputError as exc:  # not one point the optimiser tried has an answer
-        bounds = {key: [lo, hi] for key, lo, hi in task.free}
-        raise InputError("free", bounds, f"no design within these bounds is one the model can answer "
-                                         f"for this task; the optimiser's best try: {exc}") from None
+    except InputError as exc:  # the point SLSQP ended at has none
+        raise _unanswerable(task, exc) from None
     return Optimum(x, ev, problem.evaluations, time.perf_counter() - t0, int(res.nit), message,
                    time.process_time() - cpu)
+
+
+def _unanswerable(task: Task, exc: InputError) -> InputError:
+    bounds = {key: [lo, hi] for key, lo, hi in task.free}
+    return InputError("free", bounds, f"no design within these bounds is one the model can answer "
+                                      f"for this task; the optimiser's try: {exc}")
 
 
 def on_bounds(x, bounds, rtol: float = 1e-9) -> np.ndarray:

@@ -130,9 +130,13 @@ def task_from_dict(data: dict, *, folder: Path = Path("."), name: str = "task") 
         if key in tables["free"]:
             raise InputError(f"design.{key}", tables["design"][key],
                              "is also in [free]; give a fixed value in [design] or bounds in [free], not both")
+        if key in tables["material"]:
+            raise InputError(f"design.{key}", tables["design"][key],
+                             "is also in [material]; give it in one of them")
     base = _base_design(data.get("base_design"), folder)
     base = design_from_dict({**MODELS, **tables["design"], **tables["material"]}, base, source="design")
     free, clipped = _calibrated(_free(tables["free"], base), base)
+    _some_design_keeps_the_rules(free, base)
     obj, grasp, pump, limits, fem = (tables[s] for s in ("object", "grasp", "pump", "limits", "fem"))
     if "force_factor" in grasp and "margin_N" in grasp:
         raise InputError("grasp.margin_N", grasp["margin_N"], "give force_factor or margin_N, not both")
@@ -216,6 +220,23 @@ def _free(table: dict, base: HandDesign) -> tuple[tuple[str, float, float], ...]
             raise InputError(f"free.{key}", bounds, f"must lie within [{lo:g}, {hi:g}]")
         out.append((key, float(bounds[0]), float(bounds[1])))
     return tuple(out)
+
+
+#: free keys whose smaller values the design rules favour (a + b < d, t < R, ties shorter than
+#: the links); the others' larger values (V0 is in no rule)
+_RULES_FAVOUR_LOW = ("a_mm", "b_mm", "t_mm", "tie_width_mm")
+
+
+def _some_design_keeps_the_rules(free, base: HandDesign) -> None:
+    """InputError if no design within the free bounds passes the design rules: each rule is
+    monotone in each key, so the box's most favourable corner decides (before any search)."""
+    corner = {key: lo if key in _RULES_FAVOUR_LOW else hi for key, lo, hi in free}
+    try:
+        design_from_dict(corner, base, source="free")
+    except InputError as exc:
+        raise InputError("free", {key: [lo, hi] for key, lo, hi in free},
+                         f"no design within these bounds keeps the design rules; at their most "
+                         f"favourable corner, {exc}") from None
 
 
 def _calibrated(free, base: HandDesign):

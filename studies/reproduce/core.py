@@ -20,18 +20,23 @@ from __future__ import annotations
 import hashlib
 import importlib
 import json
+import math
 import re
 import sys
 from dataclasses import dataclass
 from datetime import datetime, timezone
 from pathlib import Path
 
+from softhand.reduced import paper
 from softhand.reduced.design import HandDesign
+from softhand.reduced.errors import InputError
 from softhand.studies.io.files import write_atomic, write_csv
 from softhand.studies.reproduce.section import Context, Section
 from softhand.studies.batch.runner import FAILED, RESULT, code_version, commit, execute_case, outcome_record
 
 SECTION_MD = "section.md"
+#: the largest bend the report's sections ask of the hand (Figs. 7 and 8: 0-90 deg)
+THETA_MAX_DEG = 90.0
 _ACTIVE: dict = {}  #: the sections of the current reproduce() call, by key
 _SHOW: dict = {"progress": True}  #: whether the current reproduce() call shows progress
 
@@ -81,6 +86,17 @@ def run_section(params: dict, design: HandDesign, outdir: Path) -> dict:
                                               progress=_SHOW["progress"]), outdir)
     (outdir / SECTION_MD).write_text(markdown.strip() + "\n")
     return numbers
+
+
+def check_design(design: HandDesign) -> None:
+    """InputError naming the design's key if a section could not run for ``design``: its
+    reservoir supplies the fingers up to THETA_MAX_DEG, and it has a hinge for each weight of
+    the paper's weight vectors w, which the Table II and Fig. 8 sections use."""
+    design.check_volume(math.radians(THETA_MAX_DEG))
+    hinges = len(paper.WEIGHTS[180.0])
+    if design.n_s != hinges:
+        raise InputError("n_s", design.n_s, f"must be {hinges}: the report's Table II and Fig. 8 sections "
+                                            f"use the paper's weight vectors w, one weight per hinge")
 
 
 def reproduce(out: str | Path = "results/reproduce", *, quick: bool = False,

@@ -22,7 +22,7 @@ def configure(parser) -> None:
 def run(args) -> int:
     from softhand.studies.cli.checks import check_choices
     from softhand.studies.io.files import check_output_tree
-    from softhand.studies.reproduce.core import exit_code, reproduce, sections
+    from softhand.studies.reproduce.core import check_design, exit_code, reproduce, sections
 
     keys = [s.key for s in sections()]
     only = None
@@ -30,7 +30,9 @@ def run(args) -> int:
         only = tuple(k.strip() for k in args.only.split(","))
         check_choices("--only", only, keys, "section", shown=args.only)
     check_output_tree(args.out, "--out", files=("report.md", "summary.csv"), folders=keys)
-    outcomes = reproduce(args.out, quick=args.quick, design=design_from_args(args), only=only,
+    design = design_from_args(args)
+    check_design(design)
+    outcomes = reproduce(args.out, quick=args.quick, design=design, only=only,
                          fresh=args.fresh, progress=not args.no_progress)
     width = max(len(o.section.key) for o in outcomes)
     for o in outcomes:
