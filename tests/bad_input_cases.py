@@ -131,6 +131,8 @@ EXTRA_FILES = {
     "bad.pvd": "<VTKFile type='Collection'><Collection><DataSet file='nope.vtu'/></Collection></VTKFile>",
     "trunc.vtm": "<VTKFile type='vtkMultiBlockDataSet'",
     "x.obj": "v 0 0 0\n",
+    "self.pvd": "<VTKFile type='Collection'><Collection><DataSet file='self.pvd'/></Collection></VTKFile>",
+    "empty_series.pvd": "<VTKFile type='Collection'><Collection></Collection></VTKFile>",
     # numbers float() reads but no data file means: '1_5' is 15, other scripts' digits
     "m_underscore.csv": GOOD_MATERIAL.replace("uniaxial,1.5,", "uniaxial,1_5,"),
     "m_fullwidth.csv": GOOD_MATERIAL.replace("uniaxial,1.5,", "uniaxial,\uff11.\uff15,"),
@@ -208,7 +210,7 @@ def replay_cases() -> list[tuple[str, list[str]]]:
     material += [["--data", "m_all_same.csv", "--model", m] for m in ("mooney-rivlin", "gent", "ogden2")]
     cases += [("material", ["material", "fit", *m]) for m in material]
     cases += [("material", ["material"]), ("material", ["material", "unfit"])]
-    inspect = [[f] for f in ("bad.vtu", "bad.pvd", "trunc.vtm", "x.obj", "a_file/x.vtu", "adir",
+    inspect = [[f] for f in ("bad.vtu", "bad.pvd", "self.pvd", "empty_series.pvd", "trunc.vtm", "x.obj", "a_file/x.vtu", "adir",
                              "binary.toml", "empty.csv")]
     inspect += [["good.vtu", *extra] for extra in (
         ["--field", "colour"], ["--field", "displacement_mm[9]"], ["--field", "displacement_mm[x]"],

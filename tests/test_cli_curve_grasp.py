@@ -56,6 +56,16 @@ def test_curve_plot(tmp_path, capsys):
     assert path.read_bytes()[:4] == b"\x89PNG"
 
 
+@pytest.mark.parametrize("suffix, magic", [(".eps", b"%!PS-Adobe-3.0 EPSF"), (".ps", b"%!PS-Adobe-3.0")])
+def test_curve_plot_in_postscript_says_nothing_on_stderr(tmp_path, capfd, caplog, suffix, magic):
+    """PostScript has no translucency: matplotlib's backend logs (to stderr, outside pytest)
+    that it draws it opaque; the plot is read the same, so the line is not shown."""
+    path = tmp_path / f"fig7{suffix}"
+    assert main(["curve", "--pressure-mpa", "0:0.8:0.1", "--plot", str(path)]) == 0
+    assert path.read_bytes().startswith(magic)
+    assert capfd.readouterr().err == "" and not caplog.records
+
+
 def test_grasp_json(capsys):
     out = run_json(capsys, "grasp", "--pressure-mpa", "0.89", "--theta-deg", "50", "--mass-kg", "2",
                    "--weights", "paper180", "--normalise")

@@ -4,6 +4,7 @@ from __future__ import annotations
 import csv
 import io
 import json
+import logging
 import math
 import sys
 from contextlib import contextmanager
@@ -73,7 +74,15 @@ def save_figure(fig, path: str | Path, *, dpi: int = 150) -> Path:
 
     path = Path(path)
     buf = io.BytesIO()
-    fig.savefig(buf, format=path.suffix.lstrip(".") or "png", dpi=dpi, bbox_inches="tight")
+    # PostScript draws the grids' and bands' translucency opaque, and matplotlib's backend logs
+    # a line saying so on stderr, not in the verb's own format: the plot is read the same
+    ps_log = logging.getLogger("matplotlib.backends.backend_ps")
+    level = ps_log.level
+    ps_log.setLevel(logging.ERROR)
+    try:
+        fig.savefig(buf, format=path.suffix.lstrip(".") or "png", dpi=dpi, bbox_inches="tight")
+    finally:
+        ps_log.setLevel(level)
     plt.close(fig)
     return write_atomic(path, buf.getvalue())
 

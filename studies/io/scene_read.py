@@ -39,6 +39,9 @@ def load_scene(path: str | Path, step: int | None = None) -> tuple[pv.MultiBlock
             data = reader.read()
         except InputError:
             raise
+        except RecursionError:
+            raise InputError("file", str(path), "must be a VTK file that does not name itself "
+                                                "(directly or through the files it names)") from None
         except Exception as exc:  # VTK reports bad files through many exception types
             raise InputError("file", str(path), f"must be a readable VTK file: {_first_line(exc)}") from None
     scene = _flatten(data, path.stem)
@@ -68,6 +71,9 @@ def _check_sizes(path: Path, depth: int = 0) -> None:
         if int(count) > MAX_ENTITIES:
             raise InputError("file", str(path), f"declares {key.decode()} = {int(count)}; "
                              f"at most {MAX_ENTITIES} (not a result of this toolkit?)")
+    if path.suffix == ".pvd" and depth == 0 and not re.search(rb"<DataSet\b", head):
+        raise InputError("file", str(path), "must be a VTK series with at least one step (this .pvd "
+                                            "names no DataSet)")
     if path.suffix in (".pvd", ".vtm") and depth < 2:
         for name in dict.fromkeys(re.findall(rb'file\s*=\s*"([^"]+)"', head)):
             child = path.parent / name.decode("utf-8", "replace")
