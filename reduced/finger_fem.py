@@ -153,6 +153,10 @@ def _fit(path: str) -> tuple[Table, object, float]:
     else:
         try:
             fit = KernelFit(table.rows, y, ln_kappa, table.kernel, table.features)
+        except np.linalg.LinAlgError as error:  # designs at one point of the features
+            raise _bad(path, f"has designs that coincide in its '# fit:' features "
+                             f"({' '.join(table.features)}), so the kernel interpolant cannot be built "
+                             f"({error}); name features that tell the designs apart") from None
         except ValueError as error:
             raise _bad(path, f"has {error}") from None
     return table, fit, float(table.rows["theta"].max())

@@ -81,6 +81,7 @@ def read_table(path: str | Path = TABLE_FILE) -> Table:
         if bad.size:
             raise _bad(path, f"has {column} = {rows[column][bad[0]]:g} in data row {bad[0] + 1}; a "
                              f"finger's FEM gives {lo:g} to {hi:g}")
+    _check_designs(rows, path)
     ranges, spec, prior = _header(comments, path)
     for g in GROUPS:
         lo, hi = ranges[g]
@@ -97,6 +98,25 @@ def read_table(path: str | Path = TABLE_FILE) -> Table:
                      kernel=spec["kernel"], features=features)
     terms = _terms(spec, ranges, path)
     return Table(path.name, rows, ranges, *terms, prior=prior, header=tuple(comments))
+
+
+def _check_designs(rows: dict, path) -> None:
+    """Each design (a whole-number id) one point of the groups, each of its angles once: a
+    design's rows are one FEM curve."""
+    ids = rows["design"]
+    if np.any(ids < 0) or np.any(ids != np.round(ids)):
+        bad = int(np.flatnonzero((ids < 0) | (ids != np.round(ids)))[0])
+        raise _bad(path, f"has design = {ids[bad]:g} in data row {bad + 1}; design ids are whole numbers >= 0")
+    for i in np.unique(ids):
+        at = np.flatnonzero(ids == i)
+        for g in GROUPS:
+            if np.ptp(rows[g][at]) > 1e-9 * np.max(np.abs(rows[g][at])):
+                raise _bad(path, f"has design {i:g} at more than one {LABELS[g]} ({rows[g][at].min():g} to "
+                                 f"{rows[g][at].max():g}); a design's rows are one FEM curve of one design")
+        theta, count = np.unique(rows["theta"][at], return_counts=True)
+        if np.any(count > 1):
+            raise _bad(path, f"has design {i:g} at theta = {theta[count > 1][0]:g} rad more than once; "
+                             f"a design's rows are one FEM curve")
 
 
 def _terms(spec: dict, ranges: dict, path) -> tuple[tuple[str, ...], tuple[str, ...]]:

@@ -153,10 +153,24 @@ def test_missing_table_and_too_few_designs(tmp_path):
         hand.pressure(0.5, designs[0].replace(finger_model="fem", finger_table=str(path)))
 
 
+def _rows(text: str) -> list[str]:
+    return [line for line in text.splitlines() if line and not line.startswith(("#", "design"))]
+
+
+def _edit_row(text: str, k: int, change) -> str:
+    """The table text with data row k (from 0) replaced by change(its cells)."""
+    row = _rows(text)[k]
+    return text.replace(row + "\n", ",".join(change(row.split(","))) + "\n", 1)
+
+
 @pytest.mark.parametrize("edit, match", [
     (lambda text: text.replace("b_a=0.5:2.333333333", "b_a=0.5:inf"), "hi < inf"),  # extrapolated silently
     (lambda text: text.replace(",2.812647618\n", ",1e300\n", 1), "q_tilde = 1e\\+300 in data row 1"),
     (lambda text: text.replace(",0.1606386471,", ",1e-300,", 1), "theta = 1e-300 in data row 1"),
+    (lambda text: text.replace("\n0,", "\n0.5,", 1), "design = 0.5 in data row 1; design ids are whole"),
+    (lambda text: _edit_row(text, 1, lambda c: [c[0], str(1.1 * float(c[1])), *c[2:]]),
+     "design 0 at more than one b/a"),
+    (lambda text: text + "".join(line + "\n" for line in _rows(text)[:3]), "design 0 at theta = 0.160639 rad more than once"),
 ])
 def test_a_table_out_of_any_fem_is_refused_naming_it(tmp_path, edit, match):
     path = tmp_path / "t.csv"
@@ -164,6 +178,16 @@ def test_a_table_out_of_any_fem_is_refused_naming_it(tmp_path, edit, match):
     assert path.read_text() != finger_fem.TABLE_FILE.read_text()
     with pytest.raises(InputError, match=match) as info:
         finger_fem.read_table(path)
+    assert info.value.field == "finger_table"
+
+
+def test_a_kernel_table_whose_features_do_not_tell_its_designs_apart_is_named(tmp_path):
+    """In b/a alone the package table's 41 designs coincide (5 values of b/a): the interpolant's
+    matrix is singular, said as such, not as numpy's bare 'Singular matrix.'."""
+    path = tmp_path / "t.csv"
+    path.write_text(finger_fem.TABLE_FILE.read_text().replace("features=lb ld lL lt s2", "features=lb"))
+    with pytest.raises(InputError, match="coincide in its '# fit:' features \\(lb\\)") as info:
+        hand.pressure(0.5, HandDesign(finger_model="fem", finger_table=str(path)))
     assert info.value.field == "finger_table"
 
 
