@@ -11,6 +11,7 @@ gmsh is imported only inside ``meshes/``; callers use :mod:`meshes.cache`.
 """
 from __future__ import annotations
 
+import signal
 from pathlib import Path
 from typing import Any, Callable
 
@@ -36,7 +37,9 @@ def generate_msh(geometry: Geometry, params, path: str | Path, *, size: float,
                          f"got size={size}, order={order}, refine={refine}")
     started_here = not gmsh.isInitialized()
     if started_here:
+        handlers = _signal_handlers()
         gmsh.initialize(readConfigFiles=False, interruptible=False)
+        _restore(handlers)
     try:
         gmsh.model.add(getattr(geometry, "__name__", "geometry"))
         _set_options(size)
@@ -56,6 +59,26 @@ def generate_msh(geometry: Geometry, params, path: str | Path, *, size: float,
         gmsh.model.remove()
         if started_here:
             gmsh.finalize()
+            _restore(handlers)
+
+
+#: the signals whose Python handlers gmsh's C++ library replaces at the C level (a SIGTERM then
+#: killed the process outright, skipping the CLI's clean-up of a stopped run)
+_SIGNALS = (signal.SIGINT, signal.SIGTERM)
+
+
+def _signal_handlers() -> dict:
+    return {s: signal.getsignal(s) for s in _SIGNALS}
+
+
+def _restore(handlers: dict) -> None:
+    """Install the Python handlers again (at the C level too); only the main thread can."""
+    for sig, handler in handlers.items():
+        if handler is not None:
+            try:
+                signal.signal(sig, handler)
+            except ValueError:  # not the main thread: nothing was installed from here either
+                return
 
 
 def _set_options(size: float) -> None:

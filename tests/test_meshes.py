@@ -1,4 +1,6 @@
 """Meshes: gmsh geometry -> .msh -> scikit-fem with named groups; the cache; bad files."""
+from pathlib import Path
+
 import numpy as np
 import pytest
 import skfem
@@ -82,6 +84,29 @@ def test_2d_geometry_gives_triangles_with_named_edges(order, kind):
     assert measure(mesh) == pytest.approx(3.0, rel=1e-12)  # straight edges: exact
     assert measure(mesh, mesh.boundaries["bottom"]) == pytest.approx(3.0, rel=1e-12)
     assert np.allclose(mesh.p[0, mesh.facets[:, mesh.boundaries["axis"]]], 0.0)
+
+
+def test_python_signal_handlers_still_run_after_gmsh_meshed(tmp_path):
+    """gmsh's library installs its own C-level handlers: a SIGTERM after meshing killed the
+    process instead of running the CLI's handler (the clean-up of a stopped run)."""
+    import subprocess
+    import sys
+
+    code = (
+        "import os, signal, sys\n"
+        "sys.path.insert(0, {tests!r})\n"
+        "from test_meshes import rectangle\n"
+        "from softhand.meshes.gmsh_io import generate_msh\n"
+        "hits = []\n"
+        "signal.signal(signal.SIGTERM, lambda *a: hits.append('TERM'))\n"
+        "signal.signal(signal.SIGINT, lambda *a: hits.append('INT'))\n"
+        "generate_msh(rectangle, {{'width': 3.0, 'height': 1.0}}, 'r.msh', size=1.0)\n"
+        "os.kill(os.getpid(), signal.SIGTERM)\n"
+        "os.kill(os.getpid(), signal.SIGINT)\n"
+        "print(','.join(hits))\n"
+    ).format(tests=str(Path(__file__).parent))
+    proc = subprocess.run([sys.executable, "-c", code], cwd=tmp_path, capture_output=True, text=True, timeout=120)
+    assert proc.returncode == 0 and proc.stdout.strip() == "TERM,INT", (proc.returncode, proc.stderr)
 
 
 def test_cache_generates_each_mesh_once(monkeypatch):
