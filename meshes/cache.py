@@ -28,8 +28,17 @@ FORMAT = 2  # 2: element size no longer capped by gmsh's default point sizes
 
 
 def cache_dir() -> Path:
-    """The mesh cache folder: ``$SOFTHAND_CACHE/meshes`` or ``~/.cache/softhand/meshes``."""
-    root = os.environ.get("SOFTHAND_CACHE") or Path.home() / ".cache" / "softhand"
+    """The mesh cache folder: ``$SOFTHAND_CACHE/meshes`` or ``~/.cache/softhand/meshes``; with
+    no home folder (HOME unset or empty, and a user id the password file does not know, as in
+    a container run as another user) ``<temp>/softhand-<uid>/meshes``."""
+    root = os.environ.get("SOFTHAND_CACHE")
+    if not root:
+        try:
+            home = Path.home() if os.environ.get("HOME", None) != "" else None
+        except RuntimeError:  # "Could not determine home directory"
+            home = None
+        root = home / ".cache" / "softhand" if home is not None else \
+            Path(tempfile.gettempdir()) / f"softhand-{os.getuid() if hasattr(os, 'getuid') else 'user'}"
     return Path(root) / "meshes"
 
 

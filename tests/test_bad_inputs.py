@@ -465,3 +465,28 @@ def test_a_broken_link_as_an_output_folder_is_refused_before_the_work(argv, tmp_
     out, err = capsys.readouterr()
     assert out == "" and err.count("\n") == 1 and "'link': is a broken symbolic link" in err
     assert sorted(p.name for p in tmp_path.iterdir()) == ["link"]
+
+
+def test_a_current_folder_that_was_removed_is_one_line(tmp_path, monkeypatch, capsys):
+    gone = tmp_path / "gone"
+    gone.mkdir()
+    monkeypatch.chdir(gone)
+    gone.rmdir()
+    assert _run(["curve", "--theta-deg", "10", "--plot", "p.png"]) == 2
+    out, err = capsys.readouterr()
+    assert out == "" and err == "softhand curve: error: the current folder no longer exists; change to one that does\n"
+
+
+def test_designs_default_output_folder_is_checked_before_the_optimiser(tmp_path, monkeypatch, capsys):
+    """Without --out the design goes to results/design/TASK: a file named results is refused
+    before the search, as a given --out is."""
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setenv("SOFTHAND_CACHE", str(tmp_path / "cache"))
+    (tmp_path / "results").write_text("a file")
+    (tmp_path / "task.toml").write_text(EXTRA_FILES["good_task.toml"])
+    import softhand.studies.design.optimise as design_opt
+
+    monkeypatch.setattr(design_opt, "optimise", lambda *a, **k: pytest.fail("the optimiser ran"))
+    assert _run(["design", "--task", "task.toml", "--no-fem"]) == 2
+    out, err = capsys.readouterr()
+    assert out == "" and err.count("\n") == 1 and "--out = 'results/design/task': cannot be created" in err

@@ -377,3 +377,22 @@ def test_the_memory_is_the_containers_limit_where_it_is_lower(tmp_path, monkeypa
     assert fo.memory_bytes() == machine  # no limit
     monkeypatch.setattr(fo, "CGROUP_LIMITS", (str(tmp_path / "v2"), str(tmp_path / "v1")))
     assert fo.memory_bytes() == min(machine, 2 ** 30)
+
+
+def test_without_a_home_folder_the_cache_goes_to_the_temporary_folder(monkeypatch):
+    """HOME unset and a user id the password file does not know (a container run as another
+    user): Path.home() raises; HOME set empty would put the cache at the root's /.cache."""
+    import tempfile
+
+    monkeypatch.delenv("SOFTHAND_CACHE", raising=False)
+    monkeypatch.delenv("HOME", raising=False)
+
+    def no_home():
+        raise RuntimeError("Could not determine home directory.")
+
+    monkeypatch.setattr(Path, "home", staticmethod(no_home))
+    assert cache.cache_dir().parent.parent == Path(tempfile.gettempdir())
+    monkeypatch.setenv("HOME", "")
+    assert cache.cache_dir().parent.parent == Path(tempfile.gettempdir())
+    monkeypatch.setenv("SOFTHAND_CACHE", "/elsewhere")
+    assert cache.cache_dir() == Path("/elsewhere/meshes")

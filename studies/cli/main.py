@@ -101,6 +101,12 @@ def main(argv: list[str] | None = None) -> int:
         print(f"softhand: error: unknown verb {short(repr(verb), 80)}; allowed: {', '.join(VERBS)}",
               file=sys.stderr)
         return 2
+    try:
+        os.getcwd()  # every relative path, and some libraries' loading, go through it
+    except FileNotFoundError:
+        print(f"softhand {verb}: error: the current folder no longer exists; change to one that does",
+              file=sys.stderr)
+        return 2
     module = _verb_module(verb)
     parser = ArgumentParser(prog=f"softhand {verb}", description=module.HELP)
     module.configure(parser)

@@ -46,6 +46,7 @@ def run(args) -> int:
     from softhand.studies.design import optimise as design_opt
     from softhand.studies.design.task import load_task
     from softhand.studies.design.task import LOWER, UPPER
+    from softhand.studies.cli.checks import check_writable
     from softhand.studies.io.files import check_output_tree, removed_unless_finished, write_atomic, write_json
 
     lo, hi = LOWER["mesh_size_mm"], UPPER["mesh_size_mm"]
@@ -61,6 +62,7 @@ def run(args) -> int:
                 raise InputError(option, value, "sets the FEM proof, which --no-fem skips")
     task = load_task(args.task)
     out = Path(args.out) if args.out else Path("results") / "design" / task.name
+    check_writable(out, "dir", "--out")  # also the default folder, which argparse's checks do not see
     check_output_tree(out, "--out", files=("result.json", "design.toml", "rejected_design.toml", "pareto.png",
                                            "grasp.pvd"), folders=("knee", "grasp"))
     if not args.no_fem:
