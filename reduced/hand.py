@@ -70,11 +70,38 @@ def _reservoir_pressure(theta, design: HandDesign):
 
 def bend_angle(P, design: HandDesign, reservoir: bool = True):
     """Inverse of :func:`pressure`: free bend theta [rad] at pump pressure P [MPa], vectorised."""
+    return invert_monotone(lambda th: pressure(th, design, reservoir), P, _bend_bracket(design, reservoir),
+                           field="pressure_MPa", unit="MPa")
+
+
+def bend_angles(P, design: HandDesign) -> tuple[np.ndarray, np.ndarray]:
+    """(theta with the reservoir, eq. (27); theta without, eq. (28)) [rad] at pump pressures P
+    [MPa]; one InputError naming the pressures both answer for if P is outside them."""
+    (lo_r, hi_r), (lo_f, hi_f) = (pressure_span(design, r) for r in (True, False))
+    lo, hi = max(lo_r, lo_f), min(hi_r, hi_f)
+    values = np.asarray(P, dtype=float)
+    bad = ~np.isfinite(values) | (values < lo) | (values > hi)
+    if np.any(bad):
+        raise InputError("pressure_MPa", float(values[bad].flat[0]),
+                         f"must be in [{lo:.4g}, {hi:.4g}] MPa (the pressures the hand reaches both "
+                         f"with its reservoir, eq. (27), and without, eq. (28))")
+    return bend_angle(P, design, reservoir=True), bend_angle(P, design, reservoir=False)
+
+
+def pressure_span(design: HandDesign, reservoir: bool = True) -> tuple[float, float]:
+    """The pump pressures [MPa] :func:`bend_angle` answers for: the ends of the increasing
+    branch of P(theta) through theta = 0."""
+    x, fx, slope = _table(lambda th: pressure(th, design, reservoir), _bend_bracket(design, reservoir),
+                          _TABLE_SIZE)
+    _, fx, _ = _increasing_run(x, fx, slope, 0.0)
+    return float(fx[0]), float(fx[-1])
+
+
+def _bend_bracket(design: HandDesign, reservoir: bool) -> tuple[float, float]:
     lo, hi = THETA_RANGE
     if reservoir:  # the fingers cannot take more oil than the reservoir holds
         hi = min(hi, volume_limit(design))
-    return invert_monotone(lambda th: pressure(th, design, reservoir), P, (lo, hi),
-                           field="pressure_MPa", unit="MPa")
+    return lo, hi
 
 
 def volume_limit(design: HandDesign) -> float:

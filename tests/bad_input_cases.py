@@ -154,6 +154,7 @@ EXTRA_FILES = {
     "rep_three_hinges.toml": "n_s = 3\nhinge_s_mm = [40.0, 80.0, 120.0]\n",
     # a finger table the design's model would not use (finger_model = "paper")
     "st_table_unused.toml": 'kind = "curve"\n[design]\nfinger_table = "nope.csv"\n[sweep]\ntheta_deg = [10]\n',
+    "st_curve_pressure.toml": 'kind = "curve"\n[sweep]\npressure_mpa = [3.7, -3.7]\n',  # -3.7: with, not without
     "st_table_swept.toml": 'kind = "curve"\n[sweep]\ntheta_deg = [10]\nfinger_table = ["nope.csv"]\n',
 }
 
@@ -302,5 +303,7 @@ def replay_cases() -> list[tuple[str, list[str]]]:
               ["reproduce", "--only", "fig7_reduced", "--out", "kind/rep"],
               ["reproduce", "--only", "fig7_reduced", "--out", "kind/rep2"], [*control, "--out", "kind/ctl"]]
     cases += [("kind", k) for k in kinds]
-    cases += [("study", ["study", "run", s, "--workers", "1"]) for s in ("st_table_unused.toml", "st_table_swept.toml")]
+    cases += [("study", ["study", "run", s, "--workers", "1"]) for s in ("st_table_unused.toml", "st_table_swept.toml",
+                                                                          "st_curve_pressure.toml")]
+    cases += [("range", ["curve", "--pressure-mpa", "-3.7"]), ("range", ["curve", "--pressure-mpa", "3.78"])]
     return [(f"{name}-{k}-{' '.join(argv[1:])[:40]}", argv) for k, (name, argv) in enumerate(cases)]

@@ -7,6 +7,7 @@ import pytest
 
 from softhand.reduced import grasp, hand
 from softhand.reduced.design import HandDesign
+from softhand.reduced.errors import InputError
 from softhand.studies.cli.main import main
 
 D = HandDesign()
@@ -162,3 +163,21 @@ def test_grasp_whose_fem_w_does_not_converge_is_one_line_exit_1(capsys, monkeypa
     out, err = capsys.readouterr()
     assert out == "" and err.count("\n") == 1 and "Traceback" not in err
     assert "P = 0.6 MPa" in err and "residual history" not in err
+
+
+def test_the_pressures_of_a_curve_are_those_both_models_reach():
+    """P -> theta answers with and without the reservoir, or names the pressures both reach:
+    the larger of the two lower ends, the smaller of the upper ones (each end a pressure its
+    model reaches, eq. (27) / (28) at the end of its bend range)."""
+    from softhand.reduced import hand
+
+    d = HandDesign()
+    (lo_r, hi_r), (lo_f, hi_f) = hand.pressure_span(d, True), hand.pressure_span(d, False)
+    lo, hi = max(lo_r, lo_f), min(hi_r, hi_f)
+    assert lo_r != lo_f and hi_r != hi_f  # the two models' ranges differ at both ends here
+    theta, theta_free = hand.bend_angles(np.array([lo, hi]), d)
+    np.testing.assert_allclose(hand.pressure(theta, d, reservoir=True), [lo, hi], rtol=1e-9, atol=1e-12)
+    np.testing.assert_allclose(hand.pressure(theta_free, d, reservoir=False), [lo, hi], rtol=1e-9, atol=1e-12)
+    for outside in (lo - 1e-3, hi + 1e-3):
+        with pytest.raises(InputError, match=f"must be in \\[{lo:.4g}, {hi:.4g}\\] MPa"):
+            hand.bend_angles(outside, d)

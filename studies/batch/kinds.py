@@ -29,9 +29,8 @@ def curve(params: dict, design: HandDesign, outdir: Path) -> dict:
         return {"P_MPa": hand.pressure(theta, design, reservoir=True),
                 "P_no_reservoir_MPa": hand.pressure(theta, design, reservoir=False),
                 "V_mm3": V, **{k: float(v) for k, v in reservoir.state(V, design).items()}}
-    P = params["pressure_mpa"]
-    return {"theta_deg": math.degrees(hand.bend_angle(P, design, reservoir=True)),
-            "theta_no_reservoir_deg": math.degrees(hand.bend_angle(P, design, reservoir=False))}
+    theta, theta_free = hand.bend_angles(params["pressure_mpa"], design)
+    return {"theta_deg": math.degrees(theta), "theta_no_reservoir_deg": math.degrees(theta_free)}
 
 
 def grasp(params: dict, design: HandDesign, outdir: Path) -> dict:

@@ -120,7 +120,7 @@ def _pressure_reached(params: dict, design: HandDesign, src: str) -> None:
         from softhand.reduced import hand
 
         try:
-            hand.bend_angle(params["pressure_mpa"], design)
+            hand.bend_angles(params["pressure_mpa"], design)
         except InputError as exc:
             raise InputError(f"{src}: pressure_mpa", params["pressure_mpa"], exc.allowed) from None
 

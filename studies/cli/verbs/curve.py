@@ -45,8 +45,7 @@ def rows_at_pressures(P: np.ndarray, design: HandDesign) -> list[dict]:
     """Per pump pressure [MPa]: the free bend angle with / without reservoir [deg]."""
     # rounded to 1e-10 deg, far below the inverse's error (~1e-11 rad), so that an exact
     # zero prints as 0 (+ 0.0 turns -0.0 into 0.0)
-    theta, theta_free = (np.round(np.degrees(hand.bend_angle(P, design, reservoir=res)), 10) + 0.0
-                         for res in (True, False))
+    theta, theta_free = (np.round(np.degrees(t), 10) + 0.0 for t in hand.bend_angles(P, design))
     return [{"P_MPa": float(p), "theta_deg": float(t), "theta_no_reservoir_deg": float(u)}
             for p, t, u in zip(P, theta, theta_free)]
 
@@ -93,8 +92,7 @@ def plot_curve(path, design: HandDesign, rows: list[dict], *, by_pressure: bool 
     span = np.linspace(lo, hi, 200) if hi > lo else np.array([lo])
     if by_pressure:
         P = P_free = span
-        theta, theta_free = (np.degrees(hand.bend_angle(span, design, reservoir=res))
-                             for res in (True, False))
+        theta, theta_free = (np.degrees(t) for t in hand.bend_angles(span, design))
     else:
         theta = theta_free = span
         P, P_free = (hand.pressure(np.radians(span), design, reservoir=res) for res in (True, False))
