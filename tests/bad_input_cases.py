@@ -154,6 +154,10 @@ EXTRA_FILES = {
     "rep_three_hinges.toml": "n_s = 3\nhinge_s_mm = [40.0, 80.0, 120.0]\n",
     # a finger table the design's model would not use (finger_model = "paper")
     "st_table_unused.toml": 'kind = "curve"\n[design]\nfinger_table = "nope.csv"\n[sweep]\ntheta_deg = [10]\n',
+    # outputs that are an input file (same name, or another path to it)
+    "fit_data.png": "P_MPa,theta_deg\n0.2,10\n0.4,25\n0.6,40\n0.8,55\n",
+    "same_design.toml": "V0_mm3 = 17800.0\n",
+    "mat_data.toml": GOOD_MATERIAL,
     "st_curve_pressure.toml": 'kind = "curve"\n[sweep]\npressure_mpa = [3.7, -3.7]\n',  # -3.7: with, not without
     "st_table_swept.toml": 'kind = "curve"\n[sweep]\ntheta_deg = [10]\nfinger_table = ["nope.csv"]\n',
 }
@@ -305,5 +309,10 @@ def replay_cases() -> list[tuple[str, list[str]]]:
     cases += [("kind", k) for k in kinds]
     cases += [("study", ["study", "run", s, "--workers", "1"]) for s in ("st_table_unused.toml", "st_table_swept.toml",
                                                                           "st_curve_pressure.toml")]
+    cases += [("same", s) for s in (
+        ["fit", "--data", "fit_data.png", "--params", "V0_mm3", "--plot", "./fit_data.png"],
+        ["fit", "--data", "fit_data.png", "--params", "V0_mm3", "--design", "same_design.toml",
+         "--out", "same_design.toml"],
+        ["material", "fit", "--data", "mat_data.toml", "--model", "yeoh", "--out", "mat_data.toml"])]
     cases += [("range", ["curve", "--pressure-mpa", "-3.7"]), ("range", ["curve", "--pressure-mpa", "3.78"])]
     return [(f"{name}-{k}-{' '.join(argv[1:])[:40]}", argv) for k, (name, argv) in enumerate(cases)]

@@ -36,6 +36,8 @@ SUFFIXES = {"plot": PLOT_SUFFIXES, "render": RENDER_SUFFIXES, "animation": ANIMA
             "toml": (".toml",), "csv": (".csv",)}
 #: output kinds whose writer reads the suffix as it is spelled (the 3D renderer: not '.PNG')
 EXACT_SUFFIX = ("render", "animation")
+#: argument names of the files a verb reads (an output may not be one of them)
+INPUTS = ("data", "design", "task", "space", "check", "table", "disturbance", "file")
 #: verbs that may use the on-disk caches (meshes, grasp weights)
 CACHE_VERBS = ("bend", "weights", "grasp", "study", "reproduce", "reservoir")
 
@@ -70,6 +72,20 @@ def check_outputs(verb: str, args, parser) -> None:
         value = getattr(args, dest, None)
         if value is not None:
             check_writable(value, kind, option_name(dest, parser))
+            if kind != "dir":
+                _not_an_input(value, option_name(dest, parser), args, parser)
+
+
+def _not_an_input(path, field: str, args, parser) -> None:
+    """An output file that is one of the files read (the same file, by any path) would
+    overwrite it: InputError naming both options."""
+    if not os.path.isfile(path):
+        return
+    for dest in INPUTS:
+        given = getattr(args, dest, None)
+        if isinstance(given, str) and os.path.isfile(given) and os.path.samefile(path, given):
+            raise InputError(field, str(path), f"is the file {option_name(dest, parser)} reads; writing "
+                                               f"it would overwrite it: give another file")
 
 
 def check_choices(option: str, names, allowed, what: str, shown: str | None = None) -> None:
