@@ -314,5 +314,7 @@ def replay_cases() -> list[tuple[str, list[str]]]:
         ["fit", "--data", "fit_data.png", "--params", "V0_mm3", "--design", "same_design.toml",
          "--out", "same_design.toml"],
         ["material", "fit", "--data", "mat_data.toml", "--model", "yeoh", "--out", "mat_data.toml"])]
+    cases += [("place", ["weights", "--diameter-mm", d, "--depth-mm", y]) for d, y in (("180", "0"), ("180", "-5"),
+                                                                                      ("120,240", "100"))]
     cases += [("range", ["curve", "--pressure-mpa", "-3.7"]), ("range", ["curve", "--pressure-mpa", "3.78"])]
     return [(f"{name}-{k}-{' '.join(argv[1:])[:40]}", argv) for k, (name, argv) in enumerate(cases)]

@@ -227,3 +227,25 @@ def test_w_of_a_finger_that_does_not_touch_the_object_is_said_to_be_no_grasps(fo
     assert (said in err) == warned
     if warned:
         assert "touches it at theta 167 deg (cavity pressure 3.59 MPa)" in err
+
+
+@pytest.mark.parametrize("diameter", [180.0, 240.0])  # objects the open fingers reach at depth 0
+def test_the_placement_check_needs_no_mesh_and_agrees_with_the_default_depth(diameter):
+    """The open finger's pads from the design's link chain alone: the default depth (the object
+    clear of the pads by the clearance) passes, and a depth a hair shallower than where the
+    gap closes is refused."""
+    from scipy.optimize import brentq
+
+    from softhand.fem.constraints import PlanarChain
+    from softhand.fem.hand.grasp import _open_gap, check_placement
+    from softhand.reduced.errors import InputError
+
+    d, options = HandDesign(), GraspOptions()
+    pads = pads_of(PlanarChain(np.c_[d.hinge_s, np.full(d.n_s, d.d)]), d, options)
+    depth = default_depth(pads, d, diameter, options)
+    check_placement(d, diameter, depth)
+    assert _open_gap(pads, d, diameter, 0.0) < 0.0 < _open_gap(pads, d, diameter, depth)
+    touching = brentq(lambda y: _open_gap(pads, d, diameter, y), 0.0, depth, xtol=1e-12)
+    check_placement(d, diameter, touching + 1e-6)
+    with pytest.raises(InputError, match="overlaps the open finger"):
+        check_placement(d, diameter, touching - 1e-6)

@@ -30,6 +30,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 from scipy.optimize import brentq
 
+from softhand.fem.constraints import PlanarChain
 from softhand.fem.contact import Circle, Pads, contact_load, gaps
 from softhand.fem.hand.finger import FingerModel
 from softhand.fem.hand.frame import hand_frame, to_finger_frame
@@ -74,6 +75,17 @@ def _open_gap(pads: Pads, design: HandDesign, diameter: float, depth: float) -> 
     """Smallest gap [mm] between the open finger's pads and the object centred at depth."""
     centre = to_finger_frame([0.0, depth], design)
     return float(np.min(gaps(pads, Circle(tuple(centre), 0.5 * diameter), np.zeros(design.n_s)).g))
+
+
+def check_placement(design: HandDesign, diameter: float, depth: float,
+                    options: GraspOptions | None = None) -> None:
+    """InputError if the object (diameter [mm]) centred at depth [mm] overlaps the open
+    finger's pads: the design's link chain (as :class:`fem.hand.finger.FingerModel` builds it),
+    no mesh, so it is checked before any meshing or FEM."""
+    chain = PlanarChain(np.c_[design.hinge_s, np.full(design.n_s, design.d)])
+    if _open_gap(pads_of(chain, design, options or GraspOptions()), design, diameter, depth) < 0.0:
+        raise InputError("depth_mm", depth, f"the object (diameter {diameter:g} mm) overlaps the open "
+                                            "finger at this depth; place it deeper")
 
 
 def default_depth(pads: Pads, design: HandDesign, diameter: float, options: GraspOptions) -> float:
@@ -125,8 +137,7 @@ class GraspModel:
         self.pads = pads_of(finger.chain, design, options)
         self.depth = default_depth(self.pads, design, diameter, options) if depth is None \
             else float(depth)
-        if _open_gap(self.pads, design, diameter, self.depth) < 0.0:
-            raise InputError("depth_mm", self.depth, "the object overlaps the open finger")
+        check_placement(design, diameter, self.depth, options)
         self.circle = Circle(tuple(to_finger_frame([0.0, self.depth], design)), 0.5 * diameter)
         self.weight = self.mass * design.g / design.n  #: the weight share, eq. (24) [N]
         # one solver for every state of this model: the symbolic analysis is done once. Double

@@ -137,6 +137,14 @@ def _run(args) -> int:
     if args.fig8 is not None and diameters.size > 1:
         raise InputError("--fig8", args.fig8, "is for one object: give one --diameter-mm")
     _distinct(diameters, args.diameter_mm, "--diameter-mm")
+    if case.depth_mm is not None:  # an object placed into the open finger: before any FEM or message
+        from softhand.fem.hand.grasp import check_placement
+
+        for D in diameters:
+            try:
+                check_placement(case.design, float(D), case.depth_mm)
+            except InputError as exc:
+                raise InputError("--depth-mm", args.depth_mm, exc.allowed) from None
     if check is not None and not diameters.min() <= check <= diameters.max():
         raise InputError("--check-mm", args.check_mm, f"must lie within the diameters "
                          f"[{diameters.min():g}, {diameters.max():g}] mm")
