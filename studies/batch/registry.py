@@ -158,7 +158,7 @@ KINDS: dict[str, Kind] = {
                       mesh=Num(0.05, 24.0), checks=(_oil_to_theta_max,)),
     "weights": Kind("softhand.studies.batch.kinds:weights",
                     {"diameter_mm": Num(60.0, 500.0), "mass_kg": Num(0.0, 20.0),
-                     "pressure_mpa": Num(0.01, 3.0), "dP_mpa": Num(0.001, 0.5)}, fem=True,
+                     "pressure_mpa": Num(0.01, 5.0), "dP_mpa": Num(0.001, 0.5)}, fem=True,
                     mesh=Num(2.0, 12.0)),
     # the load path as a design space's (studies.calibration.space.LIMITS); bend_case needs all four
     "finger_bend": Kind("softhand.studies.calibration.finger:bend_case",

@@ -105,8 +105,10 @@ def study_from_dict(doc: dict, *, path: Path | None = None, max_cases: int = MAX
     kind = _kind(doc.get("kind"), src)
     name = doc.get("name", path.stem if path else None)
     if not isinstance(name, str) or not _NAME_RE.match(name) or len(name) > 100:
-        raise InputError(f"{src}: name", name,
-                         "must be a string of at most 100 letters, digits, '_', '-', '.'")
+        given = "" if "name" in doc else (" (the study's results folder is named after its file "
+                                          "unless the file sets name = \"...\")")
+        raise InputError(f"{src}: name", name, "must be a string of at most 100 letters, digits, '_', "
+                         f"'-', '.', starting with a letter or digit{given}")
     description = doc.get("description", "")
     if not isinstance(description, str):
         raise InputError(f"{src}: description", description, "must be a string")
