@@ -142,22 +142,31 @@ def test_a_file_where_a_case_folder_goes_is_refused_before_any_case_runs(quick_s
     assert main(argv) == 0
 
 
-def test_sigterm_stops_a_run_like_ctrl_c(logged_study, tmp_path):
-    root = tmp_path / "res"
+@pytest.mark.parametrize("group", [False, True], ids=["SIGTERM to the parent", "Ctrl-C to the group"])
+def test_sigterm_stops_a_run_like_ctrl_c(logged_study, tmp_path, group):
+    """SIGTERM to the parent only (a process manager), or SIGINT to the whole process group (Ctrl-C
+    in a terminal): exit 130, finished cases kept, and no case's private folder left behind."""
+    root, tmp = tmp_path / "res", tmp_path / "tmp"
+    tmp.mkdir()
     proc = subprocess.Popen(_cli("study", "run", str(logged_study), "--workers", "2",
-                                 "--results", str(root), "--no-progress"),
-                            env=_env(tmp_path), stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+                                 "--results", str(root), "--no-progress"), start_new_session=True,
+                            env={**_env(tmp_path), "TMPDIR": str(tmp)}, stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE)
     sdir = study_dir(load_study(logged_study), root)
     deadline = time.monotonic() + 60
     while len(list(sdir.glob(f"[!.]*/{RESULT}"))) < 2 and time.monotonic() < deadline:
         time.sleep(0.05)
-    proc.send_signal(signal.SIGTERM)  # to the parent only, as a process manager does
+    if group:
+        os.killpg(proc.pid, signal.SIGINT)
+    else:
+        proc.send_signal(signal.SIGTERM)
     _, err = proc.communicate(timeout=60)
     assert proc.returncode == 130, err.decode()[-1500:]
-    assert b"interrupted" in err and b"Traceback" not in err
+    assert err.decode().strip() == "softhand study: interrupted; finished results are kept"
     index = (sdir / "index.csv").read_text().splitlines()
     done = [line for line in index[1:] if ",done," in line]
     assert 2 <= len(done) < 31 and len(index) == 32
+    assert list(tmp.iterdir()) == []  # the cases in flight: their folders removed
 
 
 def _children(pid: int) -> list[int]:

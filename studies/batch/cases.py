@@ -150,6 +150,11 @@ def _stored_number(value) -> bool:
 
 
 # ---------------------------------------------------------------------- one case
+#: the private folders of the cases this process is computing (a pool worker told to stop
+#: removes them before it exits: :func:`studies.batch.pool.stop_worker`)
+CASE_FOLDERS: set[str] = set()
+
+
 def execute_case(kind, params: dict, design: HandDesign) -> dict:
     """Compute one case in a private temporary folder; return numbers, files, timing.
 
@@ -159,6 +164,7 @@ def execute_case(kind, params: dict, design: HandDesign) -> dict:
     """
     start = time.perf_counter()
     with tempfile.TemporaryDirectory(prefix="softhand-case-") as tmp:
+        CASE_FOLDERS.add(tmp)
         try:
             out = (kind if callable(kind) else resolve_kind(kind))(dict(params), design, Path(tmp))
             numbers, extra = _split_output(out)
@@ -168,6 +174,7 @@ def execute_case(kind, params: dict, design: HandDesign) -> dict:
                     "wall_time_s": time.perf_counter() - start}
         files = {p.relative_to(tmp).as_posix(): p.read_bytes()
                  for p in sorted(Path(tmp).rglob("*")) if p.is_file()}
+    CASE_FOLDERS.discard(tmp)  # after the folder is gone (an exception leaves a name of none)
     return {"status": "done", "numbers": numbers, **extra, "files": files,
             "wall_time_s": time.perf_counter() - start}
 

@@ -9,12 +9,13 @@ from __future__ import annotations
 
 import itertools
 import os
+import shutil
 import signal
 import sys
 from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 from concurrent.futures.process import BrokenProcessPool
 
-from softhand.studies.batch.cases import Case, execute_case
+from softhand.studies.batch.cases import CASE_FOLDERS, Case, execute_case
 from softhand.studies.batch.studyfile import Study
 
 
@@ -96,11 +97,21 @@ def limit_threads(threads: int) -> None:
     threadpool_limits(limits=threads)
 
 
+def stop_worker(signum, frame) -> None:
+    """A pool worker's SIGTERM (the parent stopping the pool): the private folder of the case
+    it is computing removed, then exit at once (nothing of the case reaches the results)."""
+    for folder in list(CASE_FOLDERS):
+        shutil.rmtree(folder, ignore_errors=True)
+    os._exit(128 + signum)
+
+
 def _worker_init(parent: int, threads: int) -> None:
     """In each pool worker: its share of the cores' threads; die with the parent (Linux:
-    PR_SET_PDEATHSIG); default SIGTERM."""
+    PR_SET_PDEATHSIG); SIGTERM ends it at once, without the case's temporary folder; Ctrl-C
+    (SIGINT to the whole process group) is the parent's to handle: it stops the workers."""
     limit_threads(threads)
-    signal.signal(signal.SIGTERM, signal.SIG_DFL)
+    signal.signal(signal.SIGTERM, stop_worker)
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
     try:
         import ctypes
 
