@@ -5,6 +5,7 @@ from pathlib import Path
 import pytest
 
 from softhand.reduced import hand
+from softhand.reduced.errors import InputError
 from softhand.studies.cli.main import main
 from softhand.studies.calibration.space import finger_design, load_space
 
@@ -114,3 +115,28 @@ def test_mesh_correction_scales_only_the_designs_on_longer_slices(tmp_path):
     assert P[:2] == pytest.approx([0.4 * 10 / 11, 0.8 * 10 / 11], rel=1e-9)
     assert P[2:] == pytest.approx([0.4, 0.8], rel=1e-9)  # design 1 (5 mm gap): as computed (CSV: 10 digits)
     assert math.isclose(table.rows["q_tilde"][2] * 4.0**3, 100.0, rel_tol=1e-9)
+
+
+def test_latin_hypercube_designs_keep_the_design_rules(tmp_path):
+    """The packaged box holds designs with a + b >= d (a 6 + b 7 > d 10): its Latin hypercubes
+    keep only designs, drawing further hypercubes from the same seed until lhs are found;
+    a box that holds none is refused naming lhs."""
+    from softhand.studies.calibration.space import MAX_DRAWS, latin_hypercube
+
+    box = {"a_mm": (3.0, 6.0), "b_mm": (3.0, 7.0), "d_mm": (10.0, 20.0), "l0_mm": (120.0, 200.0),
+           "tie_width_mm": (5.0, 15.0)}
+    unchecked = latin_hypercube(box, 20, 3)
+    assert any(p["a_mm"] + p["b_mm"] >= p["d_mm"] for p in unchecked)  # the case this is about
+    text = (Path(__file__).parent.parent / "studies" / "finger_space.toml").read_text()
+    space = tmp_path / "s.toml"
+    space.write_text(text.replace("lhs = 6", "lhs = 20").replace("seed = 1", "seed = 3"))
+    points = load_space(space).points
+    sampled = points[-20:]
+    assert len(sampled) == 20 and all(p["a_mm"] + p["b_mm"] < p["d_mm"] for p in sampled)
+    kept = [p for p in unchecked if p["a_mm"] + p["b_mm"] < p["d_mm"]]
+    assert list(sampled[:len(kept)]) == kept  # the first hypercube's designs first, in order
+    assert all(lo <= p[k] <= hi for p in sampled for k, (lo, hi) in box.items())
+    space.write_text("lhs = 20\n[space]\n" + "".join(f"{k} = [{lo}, {hi}]\n" for k, (lo, hi) in
+                                                      {**box, "d_mm": (6.0, 6.5)}.items()))
+    with pytest.raises(InputError, match=f"lhs = 20: too many: {MAX_DRAWS} Latin hypercubes"):
+        load_space(space)

@@ -79,12 +79,26 @@ def finger_design(point: dict, base: HandDesign = HandDesign()) -> HandDesign:
                         tie_width=float(point["tie_width_mm"]))
 
 
-def latin_hypercube(box: dict, n: int, seed: int) -> list[dict]:
-    """n points of a Latin hypercube in the box (one per stratum of each variable)."""
+#: most Latin hypercubes drawn to find a design space's lhs designs that keep the design rules
+MAX_DRAWS = 50
+
+
+def latin_hypercube(box: dict, n: int, seed: int, keep=lambda point: True) -> list[dict]:
+    """n points of a Latin hypercube in the box (one per stratum of each variable) that
+    ``keep`` accepts: where it refuses some (a box whose corners break the design rules, e.g.
+    a + b >= d), further hypercubes from the same seeded generator make up the number, their
+    points in order (at most MAX_DRAWS hypercubes; fewer points if they do not suffice)."""
     rng = np.random.default_rng(seed)
-    u = (np.array([rng.permutation(n) for _ in VARIABLES]).T + rng.uniform(size=(n, len(VARIABLES)))) / n
     lo, hi = (np.array([box[v][i] for v in VARIABLES]) for i in (0, 1))
-    return [dict(zip(VARIABLES, np.round(lo + row * (hi - lo), 3).tolist())) for row in u]
+    points = []
+    for _ in range(MAX_DRAWS):
+        u = (np.array([rng.permutation(n) for _ in VARIABLES]).T + rng.uniform(size=(n, len(VARIABLES)))) / n
+        points += [p for p in (dict(zip(VARIABLES, np.round(lo + row * (hi - lo), 3).tolist())) for row in u)
+                   if keep(p)]
+        if len(points) >= n:
+            return points[:n]
+    return points
+
 
 
 #: (lowest, highest) of a design space's numbers: designs sampled, pressures [MPa], the target
@@ -116,7 +130,18 @@ def load_space(path: str | Path) -> DesignSpace:
         raise InputError(f"{src}: design", tables, "must be [[design]] tables")
     points = [_point(p, box, f"{src}: design[{i}]") for i, p in enumerate(tables)]
     lhs, seed = (_whole(doc, key, default, src) for key, default in (("lhs", 0), ("seed", 0)))
-    points += latin_hypercube(box, lhs, seed) if lhs else []
+    if "base_design" in doc and not isinstance(doc["base_design"], str):
+        raise InputError(f"{src}: base_design", doc["base_design"], "must be a file name")
+    try:
+        base = load_design(path.parent / doc["base_design"]) if "base_design" in doc else HandDesign()
+    except InputError as exc:
+        raise exc.renamed(f"{src}: base_design") from None
+    sampled = latin_hypercube(box, lhs, seed, keep=lambda p: _keeps_the_rules(p, base)) if lhs else []
+    if len(sampled) < lhs:
+        raise InputError(f"{src}: lhs", lhs, f"too many: {MAX_DRAWS} Latin hypercubes of the [space] box gave "
+                         f"{len(sampled)} designs that keep the design rules (a + b < d, ties shorter than "
+                         f"the links l0/6); narrow the box or sample fewer")
+    points += sampled
     if not points:
         raise InputError(f"{src}: design", [], "no designs: give lhs > 0 or [[design]] tables")
     pressures = doc.get("pressures_mpa", [0.2, 0.5, 0.8])
@@ -133,12 +158,6 @@ def load_space(path: str | Path) -> DesignSpace:
     mesh, axial = (_bounded(doc, key, None, src) for key in ("mesh_size_mm", "axial_size_mm"))
     if mesh is not None and axial is not None:
         raise InputError(f"{src}: axial_size_mm", axial, "applies to the layered mesh; remove mesh_size_mm")
-    if "base_design" in doc and not isinstance(doc["base_design"], str):
-        raise InputError(f"{src}: base_design", doc["base_design"], "must be a file name")
-    try:
-        base = load_design(path.parent / doc["base_design"]) if "base_design" in doc else HandDesign()
-    except InputError as exc:
-        raise exc.renamed(f"{src}: base_design") from None
     pair = doc.get("mesh_pair")
     if pair is not None:
         if not isinstance(pair, dict) or "pressures_mpa" not in pair:
@@ -163,6 +182,14 @@ def load_space(path: str | Path) -> DesignSpace:
                         **{k: float(v) for k, v in numbers.items()})
     space.designs()  # validates every design now
     return space
+
+
+def _keeps_the_rules(point: dict, base: HandDesign) -> bool:
+    try:
+        finger_design(point, base)
+    except InputError:
+        return False
+    return True
 
 
 def _number(value) -> bool:
