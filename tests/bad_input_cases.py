@@ -183,7 +183,8 @@ def replay_cases() -> list[tuple[str, list[str]]]:
                   ["--check", "missing.toml"], ["--check", GOOD_SPACE, "--table", "missing.csv"],
                   ["--check", GOOD_SPACE, "--table", "/dev/zero"], ["--check", GOOD_SPACE, "--table", "."],
                   ["--check", GOOD_SPACE, "--table", "good.csv"],
-                  ["--space", GOOD_SPACE, "--check", GOOD_SPACE], []]
+                  ["--space", GOOD_SPACE, "--check", GOOD_SPACE], [],
+                  ["--space", GOOD_SPACE, "--out", "t.csv", "--table", "good.csv"]]
     cases += [("calibrate", ["calibrate", "finger", *c]) for c in calibrate]
     cases += [("calibrate", ["calibrate"]), ("calibrate", ["calibrate", "thumb"])]
     design = [["--task", t, "--no-fem"] for t in sorted(EXTRA_FILES) if t.startswith("t_")]

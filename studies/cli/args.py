@@ -84,7 +84,9 @@ def _count(count: float) -> str:
 def check_range(field: str, value: float, lo: float, hi: float, unit: str = "") -> float:
     """``value`` if finite and in [lo, hi], else InputError naming ``field``."""
     if not (math.isfinite(value) and lo <= value <= hi):
-        raise InputError(field, value, f"must be a number in [{lo:g}, {hi:g}]{unit and ' ' + unit}")
+        what, (lo, hi) = ("a whole number", (lo, hi)) if isinstance(value, int) and isinstance(lo, int) \
+            and isinstance(hi, int) else ("a number", (f"{lo:g}", f"{hi:g}"))
+        raise InputError(field, value, f"must be {what} in [{lo}, {hi}]{unit and ' ' + unit}")
     return value
 
 

@@ -54,6 +54,9 @@ def run(args) -> int:
 
     if not 1 <= args.workers <= MAX_WORKERS:
         raise InputError("--workers", args.workers, f"must be a whole number in [1, {MAX_WORKERS}]")
+    if args.table is not None and args.check is None:
+        raise InputError("--table", args.table, "is the table --check compares with the FEM; --space "
+                                                "and --design write one (--out)")
     if args.table is not None:
         from softhand.reduced.finger_fem import read_table
 
