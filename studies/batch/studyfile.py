@@ -237,7 +237,9 @@ def _axis_values(spec, where: str) -> tuple:
     if isinstance(spec, str):
         return tuple(round(float(v), 12) for v in parse_values(spec, where))
     if not isinstance(spec, list) or not spec:
-        raise InputError(where, spec, "empty sweep; give a non-empty list or 'start:stop:step'")
+        what = "empty sweep" if isinstance(spec, list) else "a sweep is a list of values or a range"
+        one = f" ([{spec}] for one value)" if _is_number(spec) else ""
+        raise InputError(where, spec, f"{what}; give a non-empty list or 'start:stop:step'{one}")
     if not all(_is_scalar(v) for v in spec):
         raise InputError(where, spec, "must list numbers or strings")
     return tuple(spec)
