@@ -478,6 +478,9 @@ def test_a_design_run_stopped_mid_proof_leaves_none_of_its_files(tmp_path, monke
     monkeypatch.setattr(design_verb, "_prove", stopped_proof)
     assert cli.main(["design", "--task", str(task), "--out", str(out), "--seed", "3"]) == 130
     assert sorted(p.name for p in out.iterdir()) == ["notes.txt"]
+    fresh = tmp_path / "fresh" / "out"  # a folder the stopped run made goes too
+    assert cli.main(["design", "--task", str(task), "--out", str(fresh), "--seed", "3"]) == 130
+    assert not fresh.exists()
 
 
 def test_the_optimiser_reports_each_generation():

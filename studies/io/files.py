@@ -132,20 +132,21 @@ def check_output_tree(folder: str | Path, field: str, *, files=(), folders=()) -
 @contextmanager
 def removed_unless_finished(folder: str | Path):
     """The files written under ``folder`` in this block (new, or rewritten: another inode, size
-    or time) and the folders it made are removed if the block does not finish (an error,
-    Ctrl-C, SIGTERM): a run stopped half-way leaves none of its outputs. Others' files stay."""
+    or time) and the folders it made, ``folder`` itself too if the block made it, are removed
+    if the block does not finish (an error, Ctrl-C, SIGTERM): a run stopped half-way leaves
+    none of its outputs. Others' files stay."""
     folder = Path(folder)
-    before = _stamps(folder)
+    existed, before = folder.exists(), _stamps(folder)
     try:
         yield
     except BaseException:
         after = _stamps(folder)
-        for path in sorted(after, key=lambda p: -len(p.parts)):  # files first, then their folders
-            if before.get(path) != after[path]:
-                try:
-                    path.rmdir() if after[path] == "folder" else path.unlink()
-                except OSError:
-                    pass  # a folder of others' files; a file already gone
+        made = [path for path in after if before.get(path) != after[path]] + ([] if existed else [folder])
+        for path in sorted(made, key=lambda p: -len(p.parts)):  # files first, then their folders
+            try:
+                path.unlink() if after.get(path, "folder") != "folder" else path.rmdir()
+            except OSError:
+                pass  # a folder of others' files; a file already gone
         raise
 
 

@@ -76,9 +76,9 @@ def run(args) -> int:
         result = {**_result(task, opt, base, None, args.seed), "report": design_opt.infeasible_report(task, opt)}
         print_json(result) if args.json else _print(result, task, opt)
         return 1
-    out.mkdir(parents=True, exist_ok=True)
-    (out / "result.json").unlink(missing_ok=True)  # the record of an earlier run, which this one replaces
     with removed_unless_finished(out):  # a run stopped mid-proof leaves none of its files
+        out.mkdir(parents=True, exist_ok=True)
+        (out / "result.json").unlink(missing_ok=True)  # the record of an earlier run, which this one replaces
         design_file = write_atomic(out / "design.toml", ev.design.to_toml())
         result = _result(task, opt, base, design_file, args.seed)
         if args.pareto:

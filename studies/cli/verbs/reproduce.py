@@ -20,6 +20,7 @@ def configure(parser) -> None:
 
 
 def run(args) -> int:
+    from softhand.reduced.errors import InputError
     from softhand.studies.cli.checks import check_choices
     from softhand.studies.io.files import check_output_tree
     from softhand.studies.reproduce.core import check_design, exit_code, reproduce, sections
@@ -29,6 +30,10 @@ def run(args) -> int:
     if args.only is not None:
         only = tuple(k.strip() for k in args.only.split(","))
         check_choices("--only", only, keys, "section", shown=args.only)
+        skipped = [s.key for s in sections() if s.key in only and not s.in_quick]
+        if args.quick and len(skipped) == len(only):
+            raise InputError("--only", args.only, f"names only sections --quick skips ({', '.join(skipped)}); "
+                                                  "drop --quick to build them")
     check_output_tree(args.out, "--out", files=("report.md", "summary.csv"), folders=keys)
     design = design_from_args(args)
     check_design(design)
