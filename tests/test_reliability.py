@@ -12,7 +12,7 @@ import pytest
 from softhand.studies.cli.main import main
 from softhand.studies.batch.runner import RESULT, plan, study_dir
 from softhand.studies.batch.studyfile import load_study
-from test_runner import install_kind
+from test_runner import _default_sigint, install_kind
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -151,7 +151,7 @@ def test_sigterm_stops_a_run_like_ctrl_c(logged_study, tmp_path, group):
     proc = subprocess.Popen(_cli("study", "run", str(logged_study), "--workers", "2",
                                  "--results", str(root), "--no-progress"), start_new_session=True,
                             env={**_env(tmp_path), "TMPDIR": str(tmp)}, stdout=subprocess.PIPE,
-                            stderr=subprocess.PIPE)
+                            stderr=subprocess.PIPE, preexec_fn=_default_sigint)
     sdir = study_dir(load_study(logged_study), root)
     deadline = time.monotonic() + 60
     while len(list(sdir.glob(f"[!.]*/{RESULT}"))) < 2 and time.monotonic() < deadline:

@@ -65,11 +65,11 @@ def test_dask_local_cluster_gives_the_same_results_as_the_process_pool(tmp_path)
 
 
 def _default_sigint():
-    """The child's SIGINT disposition back to the default. An ignored SIGINT is inherited
-    across exec and Python then installs no KeyboardInterrupt handler; in two fresh-clone
-    runs of the full suite the child ran to the end (exit 0) despite the SIGINT, never when
-    run alone. Python's own record showed no change in pytest's handler, so the suspect is a
-    C library ignoring SIGINT at the OS level; with this the full suite passes."""
+    """The child's SIGINT disposition back to the default, as a terminal's foreground job has
+    it. A test run started in the background of a shell without job control (``cmd &`` in a
+    script, as a CI runner may do) has SIGINT ignored; that is inherited across exec, Python
+    then installs no KeyboardInterrupt handler, and the child ran to the end (exit 0) despite
+    the SIGINT."""
     signal.signal(signal.SIGINT, signal.SIG_DFL)
 
 
