@@ -70,31 +70,38 @@ def _reservoir_pressure(theta, design: HandDesign):
 
 def bend_angle(P, design: HandDesign, reservoir: bool = True):
     """Inverse of :func:`pressure`: free bend theta [rad] at pump pressure P [MPa], vectorised."""
-    return invert_monotone(lambda th: pressure(th, design, reservoir), P, _bend_bracket(design, reservoir),
-                           field="pressure_MPa", unit="MPa")
+    return _invert_pressure(P, design, reservoir, _pressure_branch(design, reservoir))
 
 
 def bend_angles(P, design: HandDesign) -> tuple[np.ndarray, np.ndarray]:
     """(theta with the reservoir, eq. (27); theta without, eq. (28)) [rad] at pump pressures P
     [MPa]; one InputError naming the pressures both answer for if P is outside them."""
-    (lo_r, hi_r), (lo_f, hi_f) = (pressure_span(design, r) for r in (True, False))
-    lo, hi = max(lo_r, lo_f), min(hi_r, hi_f)
+    branches = [_pressure_branch(design, r) for r in (True, False)]
+    lo, hi = max(b[1][0] for b in branches), min(b[1][-1] for b in branches)
     values = np.asarray(P, dtype=float)
     bad = ~np.isfinite(values) | (values < lo) | (values > hi)
     if np.any(bad):
         raise InputError("pressure_MPa", float(values[bad].flat[0]),
                          f"must be in [{lo:.4g}, {hi:.4g}] MPa (the pressures the hand reaches both "
                          f"with its reservoir, eq. (27), and without, eq. (28))")
-    return bend_angle(P, design, reservoir=True), bend_angle(P, design, reservoir=False)
+    return tuple(_invert_pressure(P, design, r, b) for r, b in zip((True, False), branches))
 
 
 def pressure_span(design: HandDesign, reservoir: bool = True) -> tuple[float, float]:
     """The pump pressures [MPa] :func:`bend_angle` answers for: the ends of the increasing
     branch of P(theta) through theta = 0."""
-    x, fx, slope = _table(lambda th: pressure(th, design, reservoir), _bend_bracket(design, reservoir),
-                          _TABLE_SIZE)
-    _, fx, _ = _increasing_run(x, fx, slope, 0.0)
+    _, fx, _ = _pressure_branch(design, reservoir)
     return float(fx[0]), float(fx[-1])
+
+
+def _pressure_branch(design: HandDesign, reservoir: bool):
+    """(theta, P, dP/dtheta) tabulated on the increasing branch of P(theta) through 0."""
+    return monotone_branch(lambda th: pressure(th, design, reservoir), _bend_bracket(design, reservoir))
+
+
+def _invert_pressure(P, design: HandDesign, reservoir: bool, branch):
+    return invert_monotone(lambda th: pressure(th, design, reservoir), P, _bend_bracket(design, reservoir),
+                           field="pressure_MPa", unit="MPa", branch=branch)
 
 
 def _bend_bracket(design: HandDesign, reservoir: bool) -> tuple[float, float]:
@@ -114,19 +121,25 @@ def volume_limit(design: HandDesign) -> float:
         else THETA_RANGE[1]
 
 
+def monotone_branch(fn, bracket: tuple[float, float], anchor: float = 0.0, size: int = _TABLE_SIZE):
+    """(x, fn(x), fn'(x)) on ``size`` points of ``bracket``, kept where fn increases around
+    ``anchor`` (:func:`invert_monotone`'s table)."""
+    return _increasing_run(*_table(fn, bracket, size), anchor)
+
+
 def invert_monotone(fn, y, bracket: tuple[float, float], *, field: str, unit: str = "",
-                    anchor: float = 0.0, size: int = _TABLE_SIZE):
+                    anchor: float = 0.0, size: int = _TABLE_SIZE, branch=None):
     """x with fn(x) = y on the increasing branch of the vectorised fn through ``anchor``.
 
     Tabulates fn on ``size`` points of ``bracket``, keeps the increasing run that holds
-    ``anchor``, interpolates the inverse with cubic Hermite polynomials (slopes 1/fn' by
-    central differences), then takes chord-Newton steps on fn until each step is below
-    1e-12 of the bracket (one step for a smooth fn). InputError for y off the branch.
+    ``anchor`` (or takes ``branch``, :func:`monotone_branch`'s table of the same), interpolates
+    the inverse with cubic Hermite polynomials (slopes 1/fn' by central differences), then
+    takes chord-Newton steps on fn until each step is below 1e-12 of the bracket (one step for
+    a smooth fn). InputError for y off the branch.
     """
     y = np.asarray(y, dtype=float)
     shape = y.shape
-    x, fx, slope = _table(fn, bracket, size)
-    x, fx, slope = _increasing_run(x, fx, slope, anchor)
+    x, fx, slope = monotone_branch(fn, bracket, anchor, size) if branch is None else branch
     bad = ~np.isfinite(y) | (y < fx[0]) | (y > fx[-1])
     if np.any(bad):
         raise InputError(field, float(y[bad].flat[0]),

@@ -78,12 +78,14 @@ def _open_gap(pads: Pads, design: HandDesign, diameter: float, depth: float) -> 
 
 
 def check_placement(design: HandDesign, diameter: float, depth: float,
-                    options: GraspOptions | None = None) -> None:
+                    options: GraspOptions | None = None, *, pads: Pads | None = None) -> None:
     """InputError if the object (diameter [mm]) centred at depth [mm] overlaps the open
-    finger's pads: the design's link chain (as :class:`fem.hand.finger.FingerModel` builds it),
-    no mesh, so it is checked before any meshing or FEM."""
-    chain = PlanarChain(np.c_[design.hinge_s, np.full(design.n_s, design.d)])
-    if _open_gap(pads_of(chain, design, options or GraspOptions()), design, diameter, depth) < 0.0:
+    finger's pads (default: those of the design's link chain as :class:`fem.hand.finger.FingerModel`
+    builds it, no mesh, so it is checked before any meshing or FEM)."""
+    if pads is None:
+        chain = PlanarChain(np.c_[design.hinge_s, np.full(design.n_s, design.d)])
+        pads = pads_of(chain, design, options or GraspOptions())
+    if _open_gap(pads, design, diameter, depth) < 0.0:
         raise InputError("depth_mm", depth, f"the object (diameter {diameter:g} mm) overlaps the open "
                                             "finger at this depth; place it deeper")
 
@@ -137,7 +139,7 @@ class GraspModel:
         self.pads = pads_of(finger.chain, design, options)
         self.depth = default_depth(self.pads, design, diameter, options) if depth is None \
             else float(depth)
-        check_placement(design, diameter, self.depth, options)
+        check_placement(design, diameter, self.depth, pads=self.pads)
         self.circle = Circle(tuple(to_finger_frame([0.0, self.depth], design)), 0.5 * diameter)
         self.weight = self.mass * design.g / design.n  #: the weight share, eq. (24) [N]
         # one solver for every state of this model: the symbolic analysis is done once. Double
