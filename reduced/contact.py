@@ -50,7 +50,7 @@ def _closest(theta_hat, centre, design: HandDesign):
     p = kinematics.joint_positions(theta_hat, design)
     A, AB = p[..., :-1, :], np.diff(p, axis=-2)
     C = np.asarray(centre, dtype=float)
-    tau = np.clip(np.einsum("...i,...i", C - A, AB) / np.einsum("...i,...i", AB, AB), 0.0, 1.0)
+    tau = np.minimum(np.maximum(np.einsum("...i,...i", C - A, AB) / np.einsum("...i,...i", AB, AB), 0.0), 1.0)
     x = A + tau[..., None] * AB
     alpha = kinematics.link_angles(theta_hat, design)
     inward = -np.stack([np.cos(alpha), np.sin(alpha)], axis=-1)

@@ -28,7 +28,7 @@ class Hermite:
 
     def _locate(self, t):
         t = np.asarray(t, float)
-        i = np.clip(np.floor((t - self.x0) / self.h).astype(int), 0, self.f.size - 2)
+        i = np.minimum(np.maximum(np.floor((t - self.x0) / self.h).astype(int), 0), self.f.size - 2)
         return i, (t - self.x0) / self.h - i
 
     def __call__(self, t):

@@ -109,7 +109,7 @@ def volume_rate(theta, design: HandDesign) -> np.ndarray:
     if t.a.shape[1] != design.n_s:
         raise InputError("n_s", design.n_s, f"the hinge table has {t.a.shape[1]} hinges")
     theta = np.asarray(theta, float)
-    i = np.clip(np.searchsorted(t.theta, theta) - 1, 0, len(t.theta) - 2)
+    i = np.minimum(np.maximum(np.searchsorted(t.theta, theta) - 1, 0), len(t.theta) - 2)
     j = np.arange(design.n_s)
     slope = (t.a[i + 1, j] - t.a[i, j]) / (t.theta[i + 1] - t.theta[i])
     return (t.a[i, j] + slope * (theta - t.theta[i])) * design.a ** 2 * math.pi * design.d

@@ -96,7 +96,7 @@ def _residuals(Z, k: int, depth: float, radius: float, weight: float, target: st
     C = np.array([0.0, depth])
     A, AB = p[:, k], p[:, k + 1] - p[:, k]
     tau = np.ones(len(Z)) if corner else \
-        np.clip(np.einsum("bi,bi->b", C - A, AB) / np.einsum("bi,bi->b", AB, AB), 0.0, 1.0)
+        np.minimum(np.maximum(np.einsum("bi,bi->b", C - A, AB) / np.einsum("bi,bi->b", AB, AB), 0.0), 1.0)
     xs = A + tau[:, None] * AB                                      # closest point of pad k
     rho = np.linalg.norm(C - xs, axis=1)
     nu = (C - xs) / rho[:, None]

@@ -61,7 +61,7 @@ def _locate(V, design: HandDesign, tab: dict):
     if np.any(v <= 0.0):
         raise InputError("V_mm3", float(np.min(V)), "reservoir volume must be positive")
     x = tab["v"]
-    i = np.clip(np.searchsorted(x, v) - 1, 0, x.size - 2)
+    i = np.minimum(np.maximum(np.searchsorted(x, v) - 1, 0), x.size - 2)
     dx = x[i + 1] - x[i]
     return v, np.minimum((v - x[i]) / dx, 1.0), i, dx
 
