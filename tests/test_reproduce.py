@@ -62,6 +62,25 @@ def test_missing_and_failing_sections_are_reported_and_the_others_go_on(tmp_path
     assert "see [data](fine/data.csv)" in report and (tmp_path / "fine" / "data.csv").is_file()
 
 
+
+def _stop(ctx, outdir):
+    raise KeyboardInterrupt
+
+
+def test_an_interrupted_run_reports_what_it_left_out_by_choice_as_such(tmp_path):
+    fake = [Section("first", "First", (), _ok), Section("stop", "Stop", (), _stop),
+            Section("later", "Later", (), _ok), Section("unchosen", "Unchosen", (), _ok)]
+    try:
+        reproduce(tmp_path, section_list=fake, only=("first", "stop", "later"), progress=False)
+    except KeyboardInterrupt:
+        pass
+    else:
+        raise AssertionError("the interrupt was swallowed")
+    report = (tmp_path / "report.md").read_text()
+    status = {title: report.split(f"## {title}")[1].split("##")[0] for title in ("Stop", "Later", "Unchosen")}
+    assert "interrupted" in status["Stop"] and "interrupted" in status["Later"]
+    assert "not selected" in status["Unchosen"] and "interrupted" not in status["Unchosen"]
+
 def test_cli(tmp_path, capsys):
     out = str(tmp_path / "r")
     assert main(["reproduce", "--out", out, "--only", "table2_reduced", "--no-progress"]) == 0

@@ -120,16 +120,24 @@ def reproduce(out: str | Path = "results/reproduce", *, quick: bool = False,
             outcomes.append(_one(section, ctx, out, only, fresh))
     finally:
         bar.close()
-        write_report(out, ctx, outcomes + [Outcome(s, "not run", "interrupted")
+        write_report(out, ctx, outcomes + [_not_built(s, ctx, only) or Outcome(s, "not run", "interrupted")
                                            for s in todo[len(outcomes):]])
     return outcomes
 
 
-def _one(section: Section, ctx: Context, out: Path, only, fresh: bool) -> Outcome:
+def _not_built(section: Section, ctx: Context, only) -> Outcome | None:
+    """The outcome of a section this run leaves out by choice (``--only``, ``--quick``), else None."""
     if only is not None and section.key not in only:
         return Outcome(section, "not selected")
     if ctx.quick and not section.in_quick:
         return Outcome(section, "skipped", "not part of --quick")
+    return None
+
+
+def _one(section: Section, ctx: Context, out: Path, only, fresh: bool) -> Outcome:
+    chosen = _not_built(section, ctx, only)
+    if chosen is not None:
+        return chosen
     try:
         lack = missing(section)
     except Exception as exc:  # the module exists but does not import: a failure, not absence
