@@ -10,7 +10,7 @@ def configure(parser) -> None:
     parser.add_argument("--out", default="results/reproduce", metavar="DIR",
                         help="output folder (default: results/reproduce)")
     parser.add_argument("--quick", action="store_true",
-                        help="CI-sized meshes and fewer points (a few minutes)")
+                        help="CI-sized meshes and fewer points (one to two minutes on 2 cores)")
     parser.add_argument("--only", default=None, metavar="KEY,KEY",
                         help="build only these sections (keys as in the report's folders)")
     parser.add_argument("--fresh", action="store_true",
