@@ -1,0 +1,92 @@
+"""The README's sample sessions of the fast verbs print what the README shows.
+
+Each ``$ softhand ...`` line of a README code block is run (in a scratch folder that sees the
+repository's ``studies/``) and its output compared line by line with the lines below it: a
+line ``...`` in the README skips printed lines up to the next one shown, and
+``(exit code N)`` after a line marks an error line (on stderr) and the exit code. The FEM
+verbs' samples (``verify``, ``bend``, ``weights``, ...) take minutes and are re-measured by
+hand; these are the ones a test can afford.
+"""
+import re
+import shlex
+from pathlib import Path
+
+import pytest
+
+from softhand.studies.cli.main import main
+
+ROOT = Path(__file__).resolve().parents[1]
+#: the samples run here, by the start of their command line (all of the reduced model's
+#: verbs, and the reservoir sheet's FEM, ~2 s)
+FAST = ("curve ", "grasp ", "control ", "fit ", "material fit ", "reservoir")
+_EXIT = re.compile(r"\s+\(exit code (\d+)\)$")
+
+
+def samples(text: str):
+    """[(command line, shown output lines)] of the README's code blocks, in order."""
+    found, command, shown, inside = [], None, [], False
+    for line in text.splitlines():
+        if line.strip().startswith("```"):
+            if command is not None:
+                found.append((command, shown))
+            command, shown, inside = None, [], not inside
+            continue
+        if not inside:
+            continue
+        if line.strip().startswith("$ "):
+            if command is not None:
+                found.append((command, shown))
+            command, shown = line.strip()[2:], []
+        elif command is not None:
+            shown.append(line.rstrip())
+    return found
+
+
+def _fast(command: str) -> bool:
+    return command.startswith("softhand ") and command[len("softhand "):].startswith(FAST)
+
+
+#: the samples with output shown (a block may also list commands alone)
+README_SAMPLES = [s for s in samples((ROOT / "README.md").read_text()) if _fast(s[0]) and any(s[1])]
+
+
+def _matches(shown: list[str], printed: list[str]) -> bool:
+    """printed equals shown, where a shown ``...`` stands for any run of printed lines."""
+    if not shown:
+        return not printed
+    if shown[0] == "...":
+        return any(_matches(shown[1:], printed[k:]) for k in range(len(printed) + 1))
+    return bool(printed) and printed[0] == shown[0] and _matches(shown[1:], printed[1:])
+
+
+def test_the_readme_shows_samples_of_every_fast_verb():
+    shown = {c.split()[1] for c, _ in README_SAMPLES}
+    assert shown >= {"curve", "grasp", "control", "fit", "material", "reservoir"}, shown
+
+
+@pytest.fixture(scope="module")
+def scratch(tmp_path_factory):
+    """One folder for all samples (a later sample may read what an earlier one wrote)."""
+    folder = tmp_path_factory.mktemp("readme")
+    (folder / "studies").symlink_to(ROOT / "studies")
+    return folder
+
+
+@pytest.mark.parametrize("command, shown", README_SAMPLES, ids=[c for c, _ in README_SAMPLES])
+def test_a_readme_sample_prints_what_the_readme_shows(command, shown, scratch, monkeypatch, capsys):
+    monkeypatch.chdir(scratch)
+    argv = shlex.split(command.split("  #")[0])[1:]
+    code = _EXIT.search(shown[-1]) if shown else None
+    shown = [_EXIT.sub("", line) for line in shown]
+    while shown and not shown[-1]:
+        shown.pop()
+    try:
+        got = main(argv)
+    except SystemExit as exc:  # argparse's own errors
+        got = exc.code
+    out, err = capsys.readouterr()
+    expected = int(code.group(1)) if code else 0
+    assert got == expected, (command, err)
+    printed = (err if code else out).rstrip("\n").splitlines()
+    assert _matches(shown, [line.rstrip() for line in printed]), (
+        f"{command}\n--- README\n" + "\n".join(shown) + "\n--- printed\n" + "\n".join(printed))
