@@ -1,7 +1,8 @@
 """The README's sample sessions of the fast verbs print what the README shows.
 
 Each ``$ softhand ...`` line of a README code block is run (in a scratch folder that sees the
-repository's ``studies/``) and its output compared line by line with the lines below it: a
+repository's ``studies/``) and its output compared line by line with the lines below it (words exactly, numbers to the
+digits shown): a
 line ``...`` in the README skips printed lines up to the next one shown, and
 ``(exit code N)`` after a line marks an error line (on stderr) and the exit code. The FEM
 verbs' samples (``verify``, ``bend``, ``weights``, ...) take minutes and are re-measured by
@@ -50,13 +51,25 @@ def _fast(command: str) -> bool:
 README_SAMPLES = [s for s in samples((ROOT / "README.md").read_text()) if _fast(s[0]) and any(s[1])]
 
 
+_NUMBER = re.compile(r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?")
+
+
+def _same_line(shown: str, printed: str) -> bool:
+    """The same words, and numbers equal to the last digit shown (rel. 1e-3, or both below
+    1e-9 in size: a round-off residual such as 5.8e-15 may differ between machines)."""
+    if _NUMBER.sub("#", shown).split() != _NUMBER.sub("#", printed).split():
+        return False
+    pairs = zip(map(float, _NUMBER.findall(shown)), map(float, _NUMBER.findall(printed)))
+    return all(abs(a - b) <= 1e-3 * abs(a) or max(abs(a), abs(b)) < 1e-9 for a, b in pairs)
+
+
 def _matches(shown: list[str], printed: list[str]) -> bool:
-    """printed equals shown, where a shown ``...`` stands for any run of printed lines."""
+    """printed equals shown line by line, where a shown ``...`` stands for any run of printed lines."""
     if not shown:
         return not printed
     if shown[0] == "...":
         return any(_matches(shown[1:], printed[k:]) for k in range(len(printed) + 1))
-    return bool(printed) and printed[0] == shown[0] and _matches(shown[1:], printed[1:])
+    return bool(printed) and _same_line(shown[0], printed[0]) and _matches(shown[1:], printed[1:])
 
 
 def test_the_readme_shows_samples_of_every_fast_verb():
