@@ -15,7 +15,6 @@ line and the column.
 """
 from __future__ import annotations
 
-import csv
 import math
 from dataclasses import dataclass
 from pathlib import Path
@@ -23,7 +22,7 @@ from pathlib import Path
 import numpy as np
 
 from .errors import InputError
-from .inputfiles import plain_float
+from .inputfiles import csv_cells, plain_float
 
 #: column -> what it holds (unit in the name)
 COLUMNS = {
@@ -108,7 +107,7 @@ def _read_rows(path: Path) -> tuple[list[str], list[tuple[int, list[str]]]]:
         raise InputError("--data", str(path), "is empty; need a header row "
                          f"(e.g. {','.join(BENDING_COLUMNS)}) and data rows")
     parsed = [(i, [c.strip() for c in cells])
-              for (i, _), cells in zip(lines, csv.reader(line for _, line in lines))]
+              for (i, _), cells in zip(lines, csv_cells([line for _, line in lines], "--data", path))]
     (_, header), rows = parsed[0], parsed[1:]
     if not rows:
         raise InputError("--data", str(path), "has a header but no data rows")

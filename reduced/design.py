@@ -40,6 +40,7 @@ import dataclasses
 import hashlib
 import json
 import math
+import os
 import warnings
 from dataclasses import dataclass
 from pathlib import Path
@@ -236,6 +237,11 @@ def _material_changes(part: str, table, source: str, values: dict) -> dict:
     material = rubber.from_parameters(model, params, source=f"{source}: {part}.material")
     name = _MODULUS_OF[part]
     given = values.get(_KEY_OF[name])
+    if given is not None:  # overridden, but still a value of the file: a bad one is bad input
+        try:
+            _in_bounds(_KEY_OF[name], given)
+        except InputError as exc:
+            raise exc.renamed(f"{source}: {_KEY_OF[name]}") from None
     if _is_number(given) and not math.isclose(given, material.mu0, rel_tol=1e-9):
         warnings.warn(f"{source}: {_KEY_OF[name]} = {given} is overridden by [{part}.material], "
                       f"whose initial shear modulus is {material.mu0:.6g} MPa")
@@ -311,5 +317,7 @@ def load_design(path: str | Path | None = None) -> HandDesign:
     values = read_toml(path, "--design", "a design TOML file")
     table = values.get("finger_table")
     if isinstance(table, str) and table and not Path(table).is_absolute():
-        values["finger_table"] = str((path.parent / table).resolve())  # relative to the file
+        # relative to the file; absolute without touching the file system (a link loop or a NUL
+        # in the name is the table reader's one line to say)
+        values["finger_table"] = os.path.abspath(path.parent / table)
     return design_from_dict(values, source=path.name)

@@ -54,7 +54,8 @@ from .errors import InputError
 from .finger_fem_terms import KernelFit, term_matrix
 from .finger_fem_table import COLUMNS, GROUPS, LABELS, PRIORS, TABLE_FILE, Table, _bad, read_table
 
-__all__ = ["TABLE_FILE", "GROUPS", "COLUMNS", "PRIORS", "Table", "read_table", "groups_of", "curves", "FEM"]
+__all__ = ["TABLE_FILE", "GROUPS", "COLUMNS", "PRIORS", "Table", "read_table", "check_table", "groups_of",
+           "curves", "FEM"]
 
 N_LINKS = 6
 # ---------------------------------------------------------------------- groups and the fit
@@ -133,7 +134,11 @@ class _TermsFit:
         r = table.rows
         self.terms, self.betas = (table.p_terms, table.q_terms), []
         for terms, target in zip(self.terms, (y, ln_kappa)):
-            beta = lstsq_terms(r, r["theta"], target, terms)
+            try:
+                beta = lstsq_terms(r, r["theta"], target, terms)
+            except (np.linalg.LinAlgError, ValueError) as error:  # e.g. SVD on columns that overflow
+                raise _bad(path, f"has '# fit:' terms whose least-squares fit fails ({error}); "
+                                 f"use fewer or lower powers") from None
             if beta is None:
                 raise _bad(path, f"has too few designs ({np.unique(r['design']).size}) for the "
                                  f"fit's terms ({' '.join(terms)}); use fewer in '# fit:'")
@@ -160,6 +165,12 @@ def _fit(path: str) -> tuple[Table, object, float]:
         except ValueError as error:
             raise _bad(path, f"has {error}") from None
     return table, fit, float(table.rows["theta"].max())
+
+
+def check_table(path) -> Table:
+    """The table at ``path``, read and fitted (cached): InputError naming it if either fails, so
+    a run can refuse a bad table before its work rather than at its first use."""
+    return _fit(str(path))[0]
 
 
 def check_space(design: HandDesign, table: Table) -> dict:

@@ -17,7 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from .errors import InputError
-from .finger_fem_terms import check_terms, legacy_terms
+from .finger_fem_terms import KERNEL_FEATURES, MAX_FACTORS, check_terms, legacy_terms
 from .inputfiles import plain_float, read_input_file
 
 TABLE_FILE = Path(__file__).resolve().parent / "data" / "finger_fem.csv"
@@ -29,6 +29,10 @@ COLUMNS = ("design", *GROUPS, "theta", "p_tilde", "q_tilde")
 PRIORS = ("paper", "rings")
 #: the radial basis functions a kernel fit may use (scipy.interpolate.RBFInterpolator's)
 KERNELS = ("thin_plate_spline", "cubic", "linear")
+
+
+#: the highest design degree of an older table's '# fit:' line (its terms are counted too)
+MAX_DESIGN_DEGREE = 6
 
 
 @dataclass(frozen=True)
@@ -94,6 +98,10 @@ def read_table(path: str | Path = TABLE_FILE) -> Table:
             features = check_terms(spec.get("features", "").split())
         except ValueError as error:
             raise _bad(path, f"has '# fit:' features: {error}") from None
+        unknown = [f for f in features if f not in KERNEL_FEATURES]
+        if unknown:
+            raise _bad(path, f"has '# fit:' feature {unknown[0][:40]!r}; a kernel fit's features are "
+                             f"among {', '.join(KERNEL_FEATURES)}")
         return Table(path.name, rows, ranges, (), (), prior=prior, header=tuple(comments),
                      kernel=spec["kernel"], features=features)
     terms = _terms(spec, ranges, path)
@@ -132,10 +140,15 @@ def _terms(spec: dict, ranges: dict, path) -> tuple[tuple[str, ...], tuple[str, 
         raise _bad(path, "needs the lines '# range: b_a=lo:hi, d_a=..., link_a=..., tie_link=...' "
                          "and '# fit: p_terms=..., q_terms=...' (or design_degree=D, "
                          "theta_degree=T)") from None
-    if min(degrees) < 0:
-        raise _bad(path, "has a negative degree in '# fit:'")
+    if min(degrees) < 0 or degrees[0] > MAX_DESIGN_DEGREE or degrees[1] > MAX_FACTORS:
+        raise _bad(path, f"has '# fit:' design_degree={degrees[0]}, theta_degree={degrees[1]}; "
+                         f"allowed 0..{MAX_DESIGN_DEGREE} and 0..{MAX_FACTORS}")
     varying = {g: ranges[g][1] > ranges[g][0] * (1 + 1e-9) for g in GROUPS}
-    return tuple(legacy_terms(kind, varying, *degrees) for kind in ("p", "q"))
+    terms = tuple(legacy_terms(kind, varying, *degrees) for kind in ("p", "q"))
+    try:
+        return tuple(check_terms(t) for t in terms)
+    except ValueError as error:
+        raise _bad(path, f"has '# fit:' degrees giving {error}") from None
 
 
 def _header(comments: list[str], path) -> tuple[dict, dict, str]:

@@ -42,12 +42,23 @@ BASE = {
 }
 
 
+#: the most terms a least-squares fit may name, and the most factors in one term (th^12 of
+#: theta = pi is 1e6: beyond that the columns stop telling designs apart in double precision)
+MAX_TERMS, MAX_FACTORS = 100, 12
+
+
 def check_terms(terms) -> tuple[str, ...]:
-    """The terms as a tuple; ValueError naming the first one that is not a product of BASE."""
+    """The terms as a tuple; ValueError naming the first one that is not a product of BASE
+    (of at most MAX_FACTORS factors), or if there are more than MAX_TERMS."""
     terms = tuple(terms)
+    if len(terms) > MAX_TERMS:
+        raise ValueError(f"{len(terms)} terms; at most {MAX_TERMS}")
     for term in terms:
-        if not term or any(f not in BASE for f in term.split("*")):
+        factors = term.split("*")
+        if not term or any(f not in BASE for f in factors):
             raise ValueError(f"term {term!r}: allowed are products of {', '.join(BASE)} joined by '*'")
+        if len(factors) > MAX_FACTORS:
+            raise ValueError(f"term {term[:40]!r}... has {len(factors)} factors; at most {MAX_FACTORS}")
     return terms
 
 

@@ -2,6 +2,7 @@
 else is one :class:`reduced.errors.InputError` line naming the option."""
 from __future__ import annotations
 
+import csv
 import re
 import stat
 import tomllib
@@ -43,6 +44,8 @@ def read_input_file(path: str | Path, field: str, what: str) -> bytes:
     """The bytes of a small regular input file; InputError (one line) for anything else."""
     if not str(path).strip():  # Path('') is '.', which would be reported instead
         raise InputError(field, str(path), f"is empty; give {what}")
+    if "\0" in str(path):  # no file system has such a name (os.stat raises ValueError)
+        raise InputError(field, str(path), f"contains a NUL character; give {what}")
     path = Path(path)
     try:
         mode = path.stat().st_mode  # before opening: a FIFO's open waits for a writer
@@ -62,6 +65,15 @@ def read_input_file(path: str | Path, field: str, what: str) -> bytes:
     if len(data) > MAX_FILE_BYTES:
         raise InputError(field, str(path), f"is larger than {MAX_FILE_BYTES} bytes; give {what}")
     return data
+
+
+def csv_cells(lines, field: str, path) -> list[list[str]]:
+    """The cells of CSV text lines (csv.reader); InputError (one line) where the csv module
+    cannot read them (e.g. a cell beyond its field size limit, 131 072 characters)."""
+    try:
+        return list(csv.reader(lines))
+    except csv.Error as exc:
+        raise InputError(field, str(path), f"is not a CSV file this reader can read ({exc})") from None
 
 
 def read_toml(path: str | Path, field: str, what: str) -> dict:

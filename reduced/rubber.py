@@ -230,6 +230,12 @@ def from_parameters(model: str, values: dict, *, source: str = "material") -> Ru
     else:
         names = parameter_names(model)
     canonical = {n.lower(): n for n in names}
+    seen = {}
+    for key in values:  # names match regardless of case: two spellings of one name are one given twice
+        if key.lower() in seen:
+            raise InputError(f"{source}.{key}", values[key], f"is given twice (also as {seen[key.lower()]}; "
+                             "parameter names match regardless of case)")
+        seen[key.lower()] = key
     values = {canonical.get(k.lower(), k): v for k, v in values.items()}
     unknown = set(values) - set(names)
     if unknown:

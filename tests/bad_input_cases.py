@@ -162,6 +162,64 @@ EXTRA_FILES = {
     "st_table_swept.toml": 'kind = "curve"\n[sweep]\ntheta_deg = [10]\nfinger_table = ["nope.csv"]\n',
 }
 
+
+def _table(fit_line: str) -> str:
+    """The package's finger table with its '# fit:' line replaced."""
+    from softhand.reduced.finger_fem_table import TABLE_FILE
+
+    return "\n".join(fit_line if line.startswith("# fit:") else line
+                     for line in TABLE_FILE.read_text().splitlines()) + "\n"
+
+
+_NUL = '"a\\u0000b"'  # a TOML string with a NUL character: no file system has such a name
+_BIG_CELL = "1" * 200_000  # beyond the csv module's field size limit (131 072)
+_VTU = EXTRA_FILES["good.vtu"]
+EXTRA_FILES.update({
+    # NUL characters in the file names that files give
+    "d_nul_table.toml": f'finger_model = "fem"\nfinger_table = {_NUL}\n',
+    "st_nul_design.toml": f'kind = "curve"\ndesign = {_NUL}\n[sweep]\ntheta_deg = [10]\n',
+    "st_nul_file.toml": f'kind = "curve"\n[design]\nfile = {_NUL}\n[sweep]\ntheta_deg = [10]\n',
+    "st_nul_table.toml": f'kind = "curve"\n[design]\nfinger_model = "fem"\nfinger_table = {_NUL}\n'
+                         '[sweep]\ntheta_deg = [10]\n',
+    "sp_nul_base.toml": f"base_design = {_NUL}\n" + SPACE,
+    "t_nul_table.toml": TASK + f"[design]\nfinger_table = {_NUL}\n",
+    "t_missing_table.toml": TASK + '[design]\nfinger_table = "nope.csv"\n',
+    # cells beyond the csv module's limit
+    "fit_big_cell.csv": "P_MPa,theta_deg\n0.2," + _BIG_CELL + "\n",
+    "m_big_cell.csv": "mode,stretch,stress_MPa\nuniaxial,1.5," + _BIG_CELL + "\n",
+    "push_big_cell.csv": "t_s,force_N\n0,0\n5," + _BIG_CELL + "\n",
+    # finger tables whose fit line asks for what no fit can be
+    "ft_degree_huge.csv": _table("# fit: prior=rings, design_degree=1, theta_degree=100000000"),
+    "ft_design_degree_huge.csv": _table("# fit: prior=rings, design_degree=200, theta_degree=1"),
+    "ft_long_term.csv": _table("# fit: prior=rings, p_terms=" + "*".join(["th"] * 20_000) + ", q_terms=lb"),
+    "ft_many_terms.csv": _table("# fit: prior=rings, p_terms=" + " ".join(["lb*th"] * 101) + ", q_terms=lb"),
+    "ft_product_feature.csv": _table("# fit: prior=rings, kernel=cubic, features=lb*ld lb ld lL lt s2"),
+    "d_ft_degree_huge.toml": 'finger_model = "fem"\nfinger_table = "ft_degree_huge.csv"\n',
+    "d_ft_design_degree_huge.toml": 'finger_model = "fem"\nfinger_table = "ft_design_degree_huge.csv"\n',
+    "d_ft_long_term.toml": 'finger_model = "fem"\nfinger_table = "ft_long_term.csv"\n',
+    "d_ft_many_terms.toml": 'finger_model = "fem"\nfinger_table = "ft_many_terms.csv"\n',
+    "d_ft_product_feature.toml": 'finger_model = "fem"\nfinger_table = "ft_product_feature.csv"\n',
+    # material tables: one parameter in two spellings; a bad modulus the table overrides
+    "d_mat_twice.toml": '[finger.material]\nmodel = "yeoh"\nC10_MPa = 0.5\nc10_mpa = 0.05\n',
+    "d_mat_ogden_twice.toml": '[finger.material]\nmodel = "ogden"\nmu1_MPa = 0.5\nMU1_MPA = 0.5\nalpha1 = 2.0\n',
+    "d_mu_nan_overridden.toml": 'mu_sf_MPa = nan\n[finger.material]\nmodel = "neo-hookean"\nmu_MPa = 0.5\n',
+    "d_mu_negative_overridden.toml": 'mu_sf_MPa = -1.0\n[finger.material]\nmodel = "neo-hookean"\nmu_MPa = 0.5\n',
+    "d_mu_sr_inf_overridden.toml": 'mu_sr_MPa = inf\n[reservoir.material]\nmodel = "neo-hookean"\nmu_MPa = 0.5\n',
+    # VTK files declaring sizes VTK would try to allocate
+    "v_huge.vtu": _VTU.replace('NumberOfPoints="4"', 'NumberOfPoints="1000000000000"'),
+    "v_huge_single_quotes.pvd": "<VTKFile type='Collection'><Collection><DataSet timestep='0' "
+                                "file='v_huge.vtu'/></Collection></VTKFile>",
+    "v_huge_single_quotes.vtm": "<VTKFile type='vtkMultiBlockDataSet'><vtkMultiBlockDataSet><DataSet "
+                                "index='0' file='v_huge.vtu'/></vtkMultiBlockDataSet></VTKFile>",
+    "v_huge_after_comment.vtu": _VTU.replace("<UnstructuredGrid>", "<!--" + "x" * 1_100_000 + "-->"
+                                             "<UnstructuredGrid>", 1).replace('NumberOfPoints="4"',
+                                                                              'NumberOfPoints="1000000000000"'),
+    "v_legacy_dimensions.vtk": "# vtk DataFile Version 3.0\nx\nASCII\nDATASET STRUCTURED_POINTS\n"
+                               "DIMENSIONS 100000 100000 100000\nORIGIN 0 0 0\nSPACING 1 1 1\n",
+    "v_legacy_points.vtk": "# vtk DataFile Version 3.0\nx\nASCII\nDATASET UNSTRUCTURED_GRID\n"
+                           "POINTS 1000000000000 float\n0 0 0\n",
+})
+
 GOOD_TASK, GOOD_SPACE = "good_task.toml", "good_space.toml"
 
 
@@ -318,4 +376,22 @@ def replay_cases() -> list[tuple[str, list[str]]]:
     cases += [("place", ["weights", "--diameter-mm", d, "--depth-mm", y]) for d, y in (("180", "0"), ("180", "-5"),
                                                                                       ("120,240", "100"))]
     cases += [("range", ["curve", "--pressure-mpa", "-3.7"]), ("range", ["curve", "--pressure-mpa", "3.78"])]
+    files = [["curve", "--theta-deg", "10", "--design", d] for d in (
+        "d_nul_table.toml", "d_ft_degree_huge.toml", "d_ft_design_degree_huge.toml", "d_ft_long_term.toml",
+        "d_ft_many_terms.toml", "d_ft_product_feature.toml", "d_mat_twice.toml", "d_mat_ogden_twice.toml",
+        "d_mu_nan_overridden.toml", "d_mu_negative_overridden.toml", "d_mu_sr_inf_overridden.toml")]
+    files += [["study", "run", s, "--workers", "1"] for s in ("st_nul_design.toml", "st_nul_file.toml",
+                                                             "st_nul_table.toml")]
+    files += [["study", "status", "st_nul_file.toml"], ["calibrate", "finger", "--space", "sp_nul_base.toml",
+                                                         "--out", "t.csv"]]
+    files += [["design", "--task", t, "--no-fem"] for t in ("t_nul_table.toml", "t_missing_table.toml")]
+    files += [["calibrate", "finger", "--check", GOOD_SPACE, "--table", t] for t in (
+        "ft_product_feature.csv", "ft_degree_huge.csv")]
+    files += [["fit", "--data", "fit_big_cell.csv", "--params", "V0_mm3"],
+              ["material", "fit", "--data", "m_big_cell.csv", "--model", "yeoh"],
+              [*control, "--disturbance", "push_big_cell.csv"]]
+    files += [["inspect", v, "--out", "o.png"] for v in (
+        "v_huge.vtu", "v_huge_single_quotes.pvd", "v_huge_single_quotes.vtm", "v_huge_after_comment.vtu",
+        "v_legacy_dimensions.vtk", "v_legacy_points.vtk")]
+    cases += [("files", f) for f in files]
     return [(f"{name}-{k}-{' '.join(argv[1:])[:40]}", argv) for k, (name, argv) in enumerate(cases)]

@@ -6,14 +6,13 @@ before the first row it is 0, after the last row it keeps the last value.
 """
 from __future__ import annotations
 
-import csv
 import math
 from pathlib import Path
 
 import numpy as np
 
 from softhand.reduced.errors import InputError
-from softhand.reduced.inputfiles import plain_float
+from softhand.reduced.inputfiles import csv_cells, plain_float
 from softhand.studies.io.files import save_figure
 
 DISTURBANCE_HEADER = ("t_s", "force_N")
@@ -35,7 +34,8 @@ def read_disturbance(path: str | Path, t_end: float | None = None):
         text = data.decode("utf-8-sig")
     except UnicodeDecodeError:
         raise InputError("--disturbance", str(path), "is not a text (CSV) file") from None
-    rows = [(number, cells) for number, cells in enumerate(csv.reader(text.splitlines()), start=1)
+    rows = [(number, cells) for number, cells in enumerate(csv_cells(text.splitlines(), "--disturbance", path),
+                                                           start=1)
             if cells and "".join(cells).strip() and not cells[0].lstrip().startswith("#")]
     if not rows or tuple(c.strip() for c in rows[0][1]) != DISTURBANCE_HEADER:
         raise InputError("--disturbance", str(path), f"must start with the header {','.join(DISTURBANCE_HEADER)}")

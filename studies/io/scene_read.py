@@ -54,28 +54,66 @@ def load_scene(path: str | Path, step: int | None = None) -> tuple[pv.MultiBlock
 
 #: most points or cells a piece of a file may declare (a result of this toolkit has < 1e7)
 MAX_ENTITIES = 100_000_000
-#: how much of each XML file is searched for its pieces' declared sizes [bytes]
-HEADER_BYTES = 1 << 20
+#: the file is searched for declared sizes in chunks of this many bytes [bytes]
+CHUNK_BYTES = 1 << 20
+#: sizes an XML file declares (NumberOfPoints="n", either quote), the files a .pvd / .vtm names
+_XML_SIZE = re.compile(rb"""(NumberOf\w+)\s*=\s*["']\s*(\d+)""")
+_XML_FILE = re.compile(rb"""\bfile\s*=\s*(?:"([^"]*)"|'([^']*)')""")
+#: sizes a legacy .vtk declares: POINTS n, CELLS n m, POLYGONS n m, ..., DIMENSIONS nx ny nz
+_LEGACY_SIZE = re.compile(rb"^[ \t]*(POINTS|CELLS|CELL_TYPES|VERTICES|LINES|POLYGONS|TRIANGLE_STRIPS|"
+                          rb"POINT_DATA|CELL_DATA|OFFSETS|CONNECTIVITY)[ \t]+(\d+)(?:[ \t]+(\d+))?",
+                          re.MULTILINE)
+_LEGACY_DIMENSIONS = re.compile(rb"^[ \t]*DIMENSIONS[ \t]+(\d+)[ \t]+(\d+)[ \t]+(\d+)", re.MULTILINE)
+
+
+def _chunks(path: Path):
+    """The file's bytes in overlapping chunks (a declaration split by a chunk's end is seen
+    whole in the next), up to an XML file's appended binary data, which declares nothing."""
+    with path.open("rb") as f:
+        tail = b""
+        while True:
+            chunk = f.read(CHUNK_BYTES)
+            if not chunk:
+                return
+            text = tail + chunk
+            end = text.find(b"<AppendedData")
+            yield text if end < 0 else text[:end]
+            if end >= 0:
+                return
+            tail = text[-256:]
+
+
+def _declared(text: bytes):
+    """(what, count) of every size the text declares, XML or legacy."""
+    for key, count in _XML_SIZE.findall(text):
+        yield key.decode(), int(count)
+    for key, *counts in _LEGACY_SIZE.findall(text):
+        for count in filter(None, counts):
+            yield key.decode(), int(count)
+    for dims in _LEGACY_DIMENSIONS.findall(text):
+        yield "DIMENSIONS (points)", int(np.prod([float(d) for d in dims]))
 
 
 def _check_sizes(path: Path, depth: int = 0) -> None:
     """No piece of the file (or of the files a .pvd / .vtm names) declares more than
     MAX_ENTITIES points or cells: VTK allocates them before reading and aborts the process
     when it cannot."""
+    names, steps = [], False
     try:
-        with path.open("rb") as f:
-            head = f.read(HEADER_BYTES)
+        for text in _chunks(path):
+            for key, count in _declared(text):
+                if count > MAX_ENTITIES:
+                    raise InputError("file", str(path), f"declares {key} = {count}; "
+                                     f"at most {MAX_ENTITIES} (not a result of this toolkit?)")
+            steps = steps or re.search(rb"<DataSet\b", text) is not None
+            names += [(a or b) for a, b in _XML_FILE.findall(text)]
     except OSError:
         return  # VTK's reader reports it
-    for key, count in re.findall(rb'(NumberOf\w+)\s*=\s*"\s*(\d+)', head):
-        if int(count) > MAX_ENTITIES:
-            raise InputError("file", str(path), f"declares {key.decode()} = {int(count)}; "
-                             f"at most {MAX_ENTITIES} (not a result of this toolkit?)")
-    if path.suffix == ".pvd" and depth == 0 and not re.search(rb"<DataSet\b", head):
+    if path.suffix == ".pvd" and depth == 0 and not steps:
         raise InputError("file", str(path), "must be a VTK series with at least one step (this .pvd "
                                             "names no DataSet)")
     if path.suffix in (".pvd", ".vtm") and depth < 2:
-        for name in dict.fromkeys(re.findall(rb'file\s*=\s*"([^"]+)"', head)):
+        for name in dict.fromkeys(names):
             child = path.parent / name.decode("utf-8", "replace")
             if child.is_file():
                 _check_sizes(child, depth + 1)

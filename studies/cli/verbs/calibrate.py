@@ -58,10 +58,10 @@ def run(args) -> int:
         raise InputError("--table", args.table, "is the table --check compares with the FEM; --space "
                                                 "and --design write one (--out)")
     if args.table is not None:
-        from softhand.reduced.finger_fem import read_table
+        from softhand.reduced.finger_fem import check_table
 
         try:
-            read_table(args.table)  # before any FEM
+            check_table(args.table)  # read and fitted before any FEM
         except InputError as exc:
             raise exc.renamed("--table") from None
     if args.check is None and not args.out:
