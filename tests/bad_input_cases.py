@@ -218,6 +218,15 @@ EXTRA_FILES.update({
                                "DIMENSIONS 100000 100000 100000\nORIGIN 0 0 0\nSPACING 1 1 1\n",
     "v_legacy_points.vtk": "# vtk DataFile Version 3.0\nx\nASCII\nDATASET UNSTRUCTURED_GRID\n"
                            "POINTS 1000000000000 float\n0 0 0\n",
+    # study cases the kinds' checks refuse when the study is read, not as failed or endless cases
+    "st_control_three_hinges.toml": 'kind = "control"\n[sweep]\nn_s = [3]\n',
+    "st_grasp_three_hinges.toml": 'kind = "grasp"\n[params]\npressure_mpa = 0.8\ntheta_deg = 30\n[sweep]\nn_s = [3]\n',
+    "st_bend_past_pmax.toml": 'kind = "finger_bend"\n[params]\npressures_mpa = [0.2, 3.0]\ntheta_target_deg = 60\n'
+                              'p_max_mpa = 1\np_step_mpa = 0.5\n[sweep]\nmu_sf_MPa = [1.15]\n',
+    "st_bend_tiny_pressure.toml": 'kind = "finger_bend"\n[params]\npressures_mpa = [1e-300]\ntheta_target_deg = 60\n'
+                                  'p_max_mpa = 1\np_step_mpa = 0.5\n[sweep]\nmu_sf_MPa = [1.15]\n',
+    "st_reservoir_fine.toml": 'kind = "reservoir"\nmesh_size_mm = 0.05\n[sweep]\nR_mm = [500.0]\nt_mm = [1.0]\n',
+    "sp_press_tiny.toml": "pressures_mpa = [1e-300]\n" + SPACE,
 })
 
 GOOD_TASK, GOOD_SPACE = "good_task.toml", "good_space.toml"
@@ -393,5 +402,9 @@ def replay_cases() -> list[tuple[str, list[str]]]:
     files += [["inspect", v, "--out", "o.png"] for v in (
         "v_huge.vtu", "v_huge_single_quotes.pvd", "v_huge_single_quotes.vtm", "v_huge_after_comment.vtu",
         "v_legacy_dimensions.vtk", "v_legacy_points.vtk")]
+    files += [["study", "run", s, "--workers", "1"] for s in (
+        "st_control_three_hinges.toml", "st_grasp_three_hinges.toml", "st_bend_past_pmax.toml",
+        "st_bend_tiny_pressure.toml", "st_reservoir_fine.toml")]
+    files += [["calibrate", "finger", "--space", "sp_press_tiny.toml", "--out", "t.csv"]]
     cases += [("files", f) for f in files]
     return [(f"{name}-{k}-{' '.join(argv[1:])[:40]}", argv) for k, (name, argv) in enumerate(cases)]

@@ -113,6 +113,43 @@ def _oil_to_theta_max(params: dict, design: HandDesign, src: str) -> None:
     design.check_volume(math.radians(params.get("theta_max_deg", 90.0)))  # the kind's default
 
 
+def _paper_weights_fit(params: dict, design: HandDesign, src: str) -> None:
+    """Without ``weights``, the case takes the paper's w for its diameter: the design needs its
+    number of hinges (as ``softhand control`` / ``grasp`` refuse it up front)."""
+    if "weights" not in params:
+        from softhand.reduced.grasp import weights_for_diameter
+
+        try:
+            weights_for_diameter(params.get("diameter_mm", 180.0), design)
+        except InputError as exc:
+            raise exc.renamed(f"{src}: {exc.field}") from None
+
+
+#: the reservoir sheet's most elements along the radius and through the thickness (as
+#: ``softhand reservoir --n-radial/--n-thick`` allow)
+RESERVOIR_ELEMENTS = {"n_radial": 400, "n_thick": 20}
+
+
+def _reservoir_mesh(params: dict, design: HandDesign, src: str) -> None:
+    """The sheet's elements that mesh_size_mm gives this design (R / h, t / h) within what the
+    reservoir verb allows."""
+    h = params.get("mesh_size_mm")
+    if h is None:
+        return
+    for name, length in (("n_radial", design.R), ("n_thick", design.t)):
+        n, most = math.ceil(length / h), RESERVOIR_ELEMENTS[name]
+        if n > most:
+            raise InputError(f"{src}: mesh_size_mm", h, f"gives {n} elements {'along the radius' if name == 'n_radial' else 'through the thickness'} "
+                             f"of this design's sheet; at most {most}: a mesh size >= {length / most:.4g} mm")
+
+
+def _path_within_p_max(params: dict, design: HandDesign, src: str) -> None:
+    """The pressures end at or below the load path's end p_max_mpa (as a design space checks)."""
+    if params.get("pressures_mpa") and "p_max_mpa" in params and params["pressures_mpa"][-1] > params["p_max_mpa"]:
+        raise InputError(f"{src}: pressures_mpa", params["pressures_mpa"],
+                         f"must end at or below p_max_mpa = {params['p_max_mpa']:g} MPa, the load path's end")
+
+
 def _pressure_reached(params: dict, design: HandDesign, src: str) -> None:
     """A pressure the design's free hand reaches (its range depends on the design): the reduced
     model's inverse, at load time, not as a failed case."""
@@ -149,23 +186,23 @@ KINDS: dict[str, Kind] = {
     "grasp": Kind("softhand.studies.batch.kinds:grasp",
                   {"pressure_mpa": _PRESSURE, "theta_deg": _THETA, "mass_kg": _MASS,
                    "diameter_mm": _PAPER_D, "weights": NumList(20, -MAX_WEIGHT, MAX_WEIGHT)},
-                  required=("pressure_mpa", "theta_deg"), checks=(_grasp_weights,)),
+                  required=("pressure_mpa", "theta_deg"), checks=(_grasp_weights, _paper_weights_fit)),
     "control": Kind("softhand.studies.batch.kinds:control",
                     {"theta_ref_deg": Num(-29.9, 119.9), "mass_kg": _MASS, "diameter_mm": _PAPER_D,
                      "push_n": Num(-1000.0, 1000.0), "push_at_s": Num(1.0, 600.0),
-                     "t_end_s": Num(2.0, 600.0)}, checks=(_push_before_end,)),
+                     "t_end_s": Num(2.0, 600.0)}, checks=(_push_before_end, _paper_weights_fit)),
     "reservoir": Kind("softhand.studies.batch.kinds:reservoir", {"theta_max_deg": Num(1.0, 180.0)}, fem=True,
-                      mesh=Num(0.05, 24.0), checks=(_oil_to_theta_max,)),
+                      mesh=Num(0.05, 24.0), checks=(_oil_to_theta_max, _reservoir_mesh)),
     "weights": Kind("softhand.studies.batch.kinds:weights",
                     {"diameter_mm": Num(60.0, 500.0), "mass_kg": Num(0.0, 20.0),
                      "pressure_mpa": Num(0.01, 5.0), "dP_mpa": Num(0.001, 0.5)}, fem=True,
                     mesh=Num(2.0, 12.0)),
     # the load path as a design space's (studies.calibration.space.LIMITS); bend_case needs all four
     "finger_bend": Kind("softhand.studies.calibration.finger:bend_case",
-                        {"pressures_mpa": NumList(200, 0.0, 5.0, increasing=True, above_lo=True),
+                        {"pressures_mpa": NumList(200, 0.01, 5.0, increasing=True),
                          "theta_target_deg": Num(1.0, 180.0), "p_max_mpa": Num(0.01, 5.0),
                          "p_step_mpa": Num(0.01, 5.0), "axial_size_mm": Num(0.25, 20.0)},
-                        fem=True, mesh=Num(2.0, 12.0), checks=(_one_mesh, finger_mesh_fits),
+                        fem=True, mesh=Num(2.0, 12.0), checks=(_one_mesh, finger_mesh_fits, _path_within_p_max),
                         required=("pressures_mpa", "theta_target_deg", "p_max_mpa", "p_step_mpa")),
 }
 #: the entry-point group where installed packages declare more kinds

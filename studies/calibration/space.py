@@ -103,7 +103,7 @@ def latin_hypercube(box: dict, n: int, seed: int, keep=lambda point: True) -> li
 
 #: (lowest, highest) of a design space's numbers: designs sampled, pressures [MPa], the target
 #: angle [deg], the mesh [mm] (the bounds of ``softhand bend``'s options)
-LIMITS = {"lhs": (0, 200), "seed": (0, 2**32 - 1), "pressures_mpa": (0.0, 5.0),
+LIMITS = {"lhs": (0, 200), "seed": (0, 2**32 - 1), "pressures_mpa": (0.01, 5.0),
           "theta_target_deg": (1.0, 180.0), "p_max_mpa": (0.01, 5.0), "p_step_mpa": (0.01, 5.0),
           "mesh_size_mm": (0.5, 12.0), "axial_size_mm": (0.25, 20.0)}
 #: most pressures of one design's path
@@ -147,9 +147,9 @@ def load_space(path: str | Path) -> DesignSpace:
     pressures = doc.get("pressures_mpa", [0.2, 0.5, 0.8])
     lo, hi = LIMITS["pressures_mpa"]
     if not isinstance(pressures, list) or not 0 < len(pressures) <= MAX_PRESSURES or any(
-            not _number(p) or not lo < p <= hi for p in pressures) or any(np.diff(pressures) <= 0):
+            not _number(p) or not lo <= p <= hi for p in pressures) or any(np.diff(pressures) <= 0):
         raise InputError(f"{src}: pressures_mpa", pressures,
-                         f"must be 1 to {MAX_PRESSURES} increasing numbers in ({lo:g}, {hi:g}] MPa")
+                         f"must be 1 to {MAX_PRESSURES} increasing numbers in [{lo:g}, {hi:g}] MPa")
     numbers = {key: _bounded(doc, key, default, src)
                for key, default in (("theta_target_deg", 64.0), ("p_max_mpa", 2.0), ("p_step_mpa", 0.5))}
     if pressures[-1] > numbers["p_max_mpa"]:
@@ -165,9 +165,9 @@ def load_space(path: str | Path) -> DesignSpace:
         pair = dict(pair)
         pressures_pair = pair.pop("pressures_mpa")
         if not isinstance(pressures_pair, list) or not 2 <= len(pressures_pair) <= MAX_PRESSURES or any(
-                not _number(p) or not lo < p <= hi for p in pressures_pair) or any(np.diff(pressures_pair) <= 0):
+                not _number(p) or not lo <= p <= hi for p in pressures_pair) or any(np.diff(pressures_pair) <= 0):
             raise InputError(f"{src}: mesh_pair.pressures_mpa", pressures_pair,
-                             f"must be 2 to {MAX_PRESSURES} increasing numbers in ({lo:g}, {hi:g}] MPa")
+                             f"must be 2 to {MAX_PRESSURES} increasing numbers in [{lo:g}, {hi:g}] MPa")
         pair = (_point(pair, {k: (0.0, math.inf) for k in VARIABLES}, f"{src}: mesh_pair"),
                 tuple(float(p) for p in pressures_pair))
     from softhand.reduced.finger_fem import PRIORS
