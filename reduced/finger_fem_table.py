@@ -31,6 +31,8 @@ PRIORS = ("paper", "rings")
 KERNELS = ("thin_plate_spline", "cubic", "linear")
 
 
+#: the largest design id (a table holds at most a few thousand designs)
+MAX_DESIGN_ID = 10**6
 #: the highest design degree of an older table's '# fit:' line (its terms are counted too)
 MAX_DESIGN_DEGREE = 6
 
@@ -112,9 +114,11 @@ def _check_designs(rows: dict, path) -> None:
     """Each design (a whole-number id) one point of the groups, each of its angles once: a
     design's rows are one FEM curve."""
     ids = rows["design"]
-    if np.any(ids < 0) or np.any(ids != np.round(ids)):
-        bad = int(np.flatnonzero((ids < 0) | (ids != np.round(ids)))[0])
-        raise _bad(path, f"has design = {ids[bad]:g} in data row {bad + 1}; design ids are whole numbers >= 0")
+    wrong = (ids < 0) | (ids > MAX_DESIGN_ID) | (ids != np.round(ids))
+    if np.any(wrong):
+        bad = int(np.flatnonzero(wrong)[0])
+        raise _bad(path, f"has design = {ids[bad]:g} in data row {bad + 1}; design ids are whole numbers "
+                         f"in 0..{MAX_DESIGN_ID}")
     for i in np.unique(ids):
         at = np.flatnonzero(ids == i)
         for g in GROUPS:

@@ -218,6 +218,13 @@ EXTRA_FILES.update({
                                "DIMENSIONS 100000 100000 100000\nORIGIN 0 0 0\nSPACING 1 1 1\n",
     "v_legacy_points.vtk": "# vtk DataFile Version 3.0\nx\nASCII\nDATASET UNSTRUCTURED_GRID\n"
                            "POINTS 1000000000000 float\n0 0 0\n",
+    "ft_id_huge.csv": _table("# fit: prior=rings, kernel=cubic, features=lb ld lL lt s2").replace(
+        "\n0,", "\n1e300,", 1),
+    "d_ft_id_huge.toml": 'finger_model = "fem"\nfinger_table = "ft_id_huge.csv"\n',
+    "v_legacy_no_fields.vtk": "# vtk DataFile Version 3.0\nx\nASCII\nDATASET UNSTRUCTURED_GRID\nPOINTS 4 float\n"
+                              "0 0 0 1 0 0 0 1 0 0 0 1\nCELLS 1 5\n4 0 1 2 3\nCELL_TYPES 1\n10\n",
+    "v_many_steps.pvd": "<VTKFile type='Collection'><Collection>" + "".join(
+        f"<DataSet timestep='{k}' file='good.vtu'/>" for k in range(1001)) + "</Collection></VTKFile>",
     # study cases the kinds' checks refuse when the study is read, not as failed or endless cases
     "st_control_three_hinges.toml": 'kind = "control"\n[sweep]\nn_s = [3]\n',
     "st_grasp_three_hinges.toml": 'kind = "grasp"\n[params]\npressure_mpa = 0.8\ntheta_deg = 30\n[sweep]\nn_s = [3]\n',
@@ -406,5 +413,8 @@ def replay_cases() -> list[tuple[str, list[str]]]:
         "st_control_three_hinges.toml", "st_grasp_three_hinges.toml", "st_bend_past_pmax.toml",
         "st_bend_tiny_pressure.toml", "st_reservoir_fine.toml")]
     files += [["calibrate", "finger", "--space", "sp_press_tiny.toml", "--out", "t.csv"]]
+    files += [["curve", "--theta-deg", "10", "--design", "d_ft_id_huge.toml"],
+              ["inspect", "v_legacy_no_fields.vtk", "--out", "o.png"],
+              ["inspect", "v_many_steps.pvd", "--animate", "o.gif"]]
     cases += [("files", f) for f in files]
     return [(f"{name}-{k}-{' '.join(argv[1:])[:40]}", argv) for k, (name, argv) in enumerate(cases)]

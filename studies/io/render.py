@@ -85,6 +85,10 @@ def inspect(path: str | Path, *, field: str | None = None, step: int | None = No
                         float(np.nanmax(values)), tuple(peak.tolist()), None if png is None else str(png))
 
 
+#: most steps an animation draws (the FEM verbs write at most 200 pressures or volumes)
+MAX_FRAMES = 1000
+
+
 def animate(path: str | Path, out: str | Path, *, field: str | None = None,
             view: str | None = None, hand: bool = True, fps: float = 4.0) -> FieldSummary:
     """Render every step of a ``.pvd`` with one camera and colour range into a GIF or MP4."""
@@ -99,7 +103,11 @@ def animate(path: str | Path, out: str | Path, *, field: str | None = None,
     if out.suffix == ".mp4" and importlib.util.find_spec("imageio_ffmpeg") is None:
         raise InputError("--animate", str(out), "MP4 needs imageio-ffmpeg (pip install imageio-ffmpeg); "
                                                 "or write a .gif")
-    scenes = [load_scene(path, k) for k in range(load_scene(path)[2])]
+    steps = load_scene(path)[2]
+    if steps > MAX_FRAMES:
+        raise InputError("file", str(path), f"has {steps} steps; --animate draws at most {MAX_FRAMES} "
+                                            "(a result of this toolkit has at most a few hundred)")
+    scenes = [load_scene(path, k) for k in range(steps)]
     bodies = [s[body_name(s.keys())] for s, _, _ in scenes]
     field = field or default_field(field_names(bodies[-1]))
     ranges = np.array([[np.nanmin(v), np.nanmax(v)] for v in (_checked_values(b, field)[0] for b in bodies)])
@@ -129,7 +137,9 @@ def _check_view(view) -> None:
 
 def _checked_values(body, field):
     if field is None:
-        raise InputError("field", None, f"no default field; allowed: {', '.join(field_names(body))}")
+        names = field_names(body)
+        raise InputError("field", None, f"no default field; allowed: {', '.join(names)}" if names
+                         else "the file has no point or cell fields to colour by")
     values, location = field_values(body, field)
     if not np.any(np.isfinite(values)):
         raise InputError("field", field, "has no finite values in this file")

@@ -165,8 +165,6 @@ def _run(args) -> int:
 def _one(case, args) -> dict:
     from softhand.studies.weights import run_case
 
-    if not args.no_cache:
-        print("softhand weights: running the grasp FEM (or reading the cache)...", file=sys.stderr)
     result = run_case(case, cache=not args.no_cache, out=args.out)
     if args.out:
         with kept_if_unwritable(Path(args.out) / "result.json", "weights"):
