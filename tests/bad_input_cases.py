@@ -220,6 +220,8 @@ EXTRA_FILES.update({
                            "POINTS 1000000000000 float\n0 0 0\n",
     "ft_id_huge.csv": _table("# fit: prior=rings, kernel=cubic, features=lb ld lL lt s2").replace(
         "\n0,", "\n1e300,", 1),
+    "st_grasp_bad_table.toml": 'kind = "grasp"\n[design]\nfinger_model = "fem"\nfinger_table = "ft_product_feature.csv"\n'
+                               '[params]\npressure_mpa = 0.8\n[sweep]\ntheta_deg = [10, 20]\n',
     "d_ft_id_huge.toml": 'finger_model = "fem"\nfinger_table = "ft_id_huge.csv"\n',
     "v_legacy_no_fields.vtk": "# vtk DataFile Version 3.0\nx\nASCII\nDATASET UNSTRUCTURED_GRID\nPOINTS 4 float\n"
                               "0 0 0 1 0 0 0 1 0 0 0 1\nCELLS 1 5\n4 0 1 2 3\nCELL_TYPES 1\n10\n",
@@ -415,6 +417,7 @@ def replay_cases() -> list[tuple[str, list[str]]]:
     files += [["calibrate", "finger", "--space", "sp_press_tiny.toml", "--out", "t.csv"]]
     files += [["curve", "--theta-deg", "10", "--design", "d_ft_id_huge.toml"],
               ["inspect", "v_legacy_no_fields.vtk", "--out", "o.png"],
-              ["inspect", "v_many_steps.pvd", "--animate", "o.gif"]]
+              ["inspect", "v_many_steps.pvd", "--animate", "o.gif"],
+              ["study", "run", "st_grasp_bad_table.toml", "--workers", "1"]]
     cases += [("files", f) for f in files]
     return [(f"{name}-{k}-{' '.join(argv[1:])[:40]}", argv) for k, (name, argv) in enumerate(cases)]
