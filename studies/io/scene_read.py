@@ -46,7 +46,9 @@ def load_scene(path: str | Path, step: int | None = None) -> tuple[pv.MultiBlock
             raise InputError("file", str(path), f"must be a readable VTK file: {_first_line(exc)}") from None
     scene = _flatten(data, path.stem)
     if not any(b.n_points for b in scene):
-        raise InputError("file", str(path), "must be a VTK file with a mesh (found no points)")
+        raise InputError("file", str(path), "must be a VTK file with a mesh VTK can read (it read no "
+                                            "points: none, or in a piece with an array it could not "
+                                            "parse, e.g. nan in ASCII)")
     for name, block in zip(scene.keys(), scene):
         _check_block(block, name, path)
     return scene, index, n
