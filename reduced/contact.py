@@ -47,13 +47,14 @@ _SCAN, _SCAN_POINTS, _REFINE_POINTS = (0.0, np.pi), 181, 101
 
 def _closest(theta_hat, centre, design: HandDesign):
     """Closest point x* (..., n_s+1, 2) of every pad to ``centre`` and whether the pad faces it."""
-    p = kinematics.joint_positions(theta_hat, design)
-    A, AB = p[..., :-1, :], np.diff(p, axis=-2)
+    alpha = kinematics.link_angles(theta_hat, design)
+    p = kinematics.positions_at(alpha, design)
+    A, AB = p[..., :-1, :], p[..., 1:, :] - p[..., :-1, :]
     C = np.asarray(centre, dtype=float)
     tau = np.minimum(np.maximum(np.einsum("...i,...i", C - A, AB) / np.einsum("...i,...i", AB, AB), 0.0), 1.0)
     x = A + tau[..., None] * AB
-    alpha = kinematics.link_angles(theta_hat, design)
-    inward = -np.stack([np.cos(alpha), np.sin(alpha)], axis=-1)
+    inward = np.empty(alpha.shape + (2,))
+    inward[..., 0], inward[..., 1] = -np.cos(alpha), -np.sin(alpha)
     return x, np.einsum("...i,...i", inward, C - x) > 0.0, p
 
 

@@ -40,17 +40,28 @@ def hinge_angles(theta, w):
 def link_angles(theta_hat, design: HandDesign):
     """Direction alpha_k of links 0..n_s from the downward vertical, inward positive [rad], (..., n_s+1)."""
     theta_hat = np.asarray(theta_hat, float)
-    zero = np.zeros(theta_hat.shape[:-1] + (1,))
-    return -design.theta0 + np.concatenate([zero, np.cumsum(theta_hat, axis=-1)], axis=-1)
+    alpha = np.empty(theta_hat.shape[:-1] + (theta_hat.shape[-1] + 1,))
+    alpha[..., 0] = 0.0
+    np.cumsum(theta_hat, axis=-1, out=alpha[..., 1:])
+    return -design.theta0 + alpha
 
 
 def joint_positions(theta_hat, design: HandDesign):
     """Base, hinges 1..n_s and tip as (x, y) [mm] (x outward, y down), shape (..., n_s + 2, 2)."""
-    alpha = link_angles(theta_hat, design)
+    return positions_at(link_angles(theta_hat, design), design)
+
+
+def positions_at(alpha, design: HandDesign):
+    """:func:`joint_positions` from the links' directions alpha (..., n_s + 1) [rad]
+    (:func:`link_angles`), for a caller that has them already."""
     lengths = np.asarray(design.link_lengths)
-    steps = lengths[:, None] * np.stack([-np.sin(alpha), np.cos(alpha)], axis=-1)  # (..., n_s+1, 2)
-    base = np.broadcast_to(np.array([design.base_offset, 0.0]), steps.shape[:-2] + (1, 2))
-    return np.concatenate([base, base + np.cumsum(steps, axis=-2)], axis=-2)
+    steps = np.empty(alpha.shape + (2,))  # (..., n_s+1, 2): each link's vector
+    steps[..., 0] = -np.sin(alpha) * lengths
+    steps[..., 1] = np.cos(alpha) * lengths
+    out = np.empty(alpha.shape[:-1] + (alpha.shape[-1] + 1, 2))
+    out[..., 0, :] = (design.base_offset, 0.0)
+    out[..., 1:, :] = out[..., :1, :] + np.cumsum(steps, axis=-2)
+    return out
 
 
 def tip_position(theta_hat, design: HandDesign):
