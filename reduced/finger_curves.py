@@ -33,12 +33,14 @@ class Hermite:
 
     def __call__(self, t):
         i, s = self._locate(t)
-        h00, h10, h01, h11 = 2 * s**3 - 3 * s**2 + 1, s**3 - 2 * s**2 + s, 3 * s**2 - 2 * s**3, s**3 - s**2
+        s2, s3 = s**2, s**3
+        h00, h10, h01, h11 = 2 * s3 - 3 * s2 + 1, s3 - 2 * s2 + s, 3 * s2 - 2 * s3, s3 - s2
         return h00 * self.f[i] + self.h * (h10 * self.m[i] + h11 * self.m[i + 1]) + h01 * self.f[i + 1]
 
     def derivative(self, t):
         i, s = self._locate(t)
-        d00, d10, d11 = 6 * s**2 - 6 * s, 3 * s**2 - 4 * s + 1, 3 * s**2 - 2 * s
+        s2 = s**2
+        d00, d10, d11 = 6 * s2 - 6 * s, 3 * s2 - 4 * s + 1, 3 * s2 - 2 * s
         return d00 * (self.f[i] - self.f[i + 1]) / self.h + d10 * self.m[i] + d11 * self.m[i + 1]
 
 
