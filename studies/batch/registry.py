@@ -136,16 +136,18 @@ def _reservoir_mesh(params: dict, design: HandDesign, src: str) -> None:
     h = params.get("mesh_size_mm")
     if h is None:
         return
-    for name, length in (("n_radial", design.R), ("n_thick", design.t)):
+    for name, length, where in (("n_radial", design.R, "along the radius"),
+                                ("n_thick", design.t, "through the thickness")):
         n, most = math.ceil(length / h), RESERVOIR_ELEMENTS[name]
         if n > most:
-            raise InputError(f"{src}: mesh_size_mm", h, f"gives {n} elements {'along the radius' if name == 'n_radial' else 'through the thickness'} "
-                             f"of this design's sheet; at most {most}: a mesh size >= {length / most:.4g} mm")
+            raise InputError(f"{src}: mesh_size_mm", h, f"gives {n} elements {where} of this design's "
+                             f"sheet; at most {most}: a mesh size >= {length / most:.4g} mm")
 
 
 def _path_within_p_max(params: dict, design: HandDesign, src: str) -> None:
     """The pressures end at or below the load path's end p_max_mpa (as a design space checks)."""
-    if params.get("pressures_mpa") and "p_max_mpa" in params and params["pressures_mpa"][-1] > params["p_max_mpa"]:
+    pressures = params.get("pressures_mpa")
+    if pressures and "p_max_mpa" in params and pressures[-1] > params["p_max_mpa"]:
         raise InputError(f"{src}: pressures_mpa", params["pressures_mpa"],
                          f"must end at or below p_max_mpa = {params['p_max_mpa']:g} MPa, the load path's end")
 
