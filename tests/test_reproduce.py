@@ -99,3 +99,19 @@ def test_no_progress_silences_the_sections_own_bars_too(tmp_path, capsys):
     assert "inflating the sheet" in capsys.readouterr().err
     assert main(argv) == 0
     assert re.search(r"reservoir_fem\s+reused", capsys.readouterr().out)
+
+
+def test_an_interrupted_rerun_reports_finished_sections_as_reused(tmp_path):
+    done = [Section("first", "First", (), _ok), Section("second", "Second", (), _ok)]
+    reproduce(tmp_path, section_list=done, progress=False)
+    try:  # Ctrl-C in a section before the two finished ones are reached
+        reproduce(tmp_path, section_list=[Section("stop", "Stop", (), _stop), *done], progress=False)
+    except KeyboardInterrupt:
+        pass
+    else:
+        raise AssertionError("the interrupt was swallowed")
+    report = (tmp_path / "report.md").read_text()
+    for title in ("First", "Second"):
+        body = report.split(f"## {title}")[1].split("##")[0]
+        assert "reused" in body and "interrupted" not in body, body
+    assert "see [data](first/data.csv)" in report  # their text and numbers, as a finished run's

@@ -225,3 +225,18 @@ def test_pool_workers_share_the_cores_threads(tmp_path, monkeypatch):
     study = load_study(write_study(tmp_path, f'name = "t"\nkind = "{kind}"\n[sweep]\nx = [1, 2, 3, 4]\n'))
     assert run_study(study, results_root=tmp_path / "r", workers=2, progress=False).ok
     assert {n["threads"] for n in results_by_key(tmp_path / "r", study).values()} == {1}
+
+
+def test_a_commit_stopped_half_way_leaves_no_temporary_folder(tmp_path, monkeypatch):
+    from softhand.studies.batch import cases
+
+    calls = []
+
+    def interrupted(path, obj):  # Ctrl-C while the record is written, after the files
+        calls.append(path)
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(cases, "write_json", interrupted)
+    with pytest.raises(KeyboardInterrupt):
+        cases.commit(tmp_path / "case", {"status": "done"}, {"sub/a.vtu": b"x" * 10})
+    assert calls and list(tmp_path.iterdir()) == []

@@ -217,13 +217,17 @@ def commit(final: Path, record: dict, files: dict) -> Path:
     """
     tmp = final.parent / f".{final.name}.{uuid.uuid4().hex[:8]}.tmp"
     tmp.mkdir(parents=True)
-    for rel, data in files.items():
-        (tmp / rel).parent.mkdir(parents=True, exist_ok=True)
-        (tmp / rel).write_bytes(data)
-    write_json(tmp / (RESULT if record["status"] == "done" else FAILED), record)
-    if final.exists():
-        shutil.rmtree(final)  # an earlier failure, a corrupt file, or a result of other inputs
-    os.rename(tmp, final)
+    try:
+        for rel, data in files.items():
+            (tmp / rel).parent.mkdir(parents=True, exist_ok=True)
+            (tmp / rel).write_bytes(data)
+        write_json(tmp / (RESULT if record["status"] == "done" else FAILED), record)
+        if final.exists():
+            shutil.rmtree(final)  # an earlier failure, a corrupt file, or a result of other inputs
+        os.rename(tmp, final)
+    except BaseException:  # Ctrl-C, SIGTERM, a full disk: no half-written folder stays behind
+        shutil.rmtree(tmp, ignore_errors=True)
+        raise
     return final
 
 

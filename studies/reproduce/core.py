@@ -120,7 +120,8 @@ def reproduce(out: str | Path = "results/reproduce", *, quick: bool = False,
             outcomes.append(_one(section, ctx, out, only, fresh))
     finally:
         bar.close()
-        write_report(out, ctx, outcomes + [_not_built(s, ctx, only) or Outcome(s, "not run", "interrupted")
+        write_report(out, ctx, outcomes + [_not_built(s, ctx, only) or _finished(s, ctx, out, fresh)
+                                           or Outcome(s, "not run", "interrupted")
                                            for s in todo[len(outcomes):]])
     return outcomes
 
@@ -144,11 +145,10 @@ def _one(section: Section, ctx: Context, out: Path, only, fresh: bool) -> Outcom
         return Outcome(section, "failed", f"{type(exc).__name__}: {exc}")
     if lack:
         return Outcome(section, "not available", lack)
+    reused = _finished(section, ctx, out, fresh)
+    if reused is not None:
+        return reused
     folder, key = out / section.key, section_key(section, ctx)
-    previous = _read(folder / RESULT)
-    if not fresh and previous and previous.get("case") == key:
-        return Outcome(section, "reused", previous["provenance"]["finished_utc"],
-                       previous["provenance"]["wall_time_s"], previous["numbers"])
     params = {"section": section.key, "quick": ctx.quick}
     output = execute_case(run_section, params, ctx.design)
     commit(folder, {"section": section.key, "case": key,
@@ -156,6 +156,15 @@ def _one(section: Section, ctx: Context, out: Path, only, fresh: bool) -> Outcom
     if output["status"] != "done":
         return Outcome(section, "failed", output["error"], output["wall_time_s"])
     return Outcome(section, "done", "", output["wall_time_s"], output["numbers"])
+
+
+def _finished(section: Section, ctx: Context, out: Path, fresh: bool) -> Outcome | None:
+    """The section's result on disk if it is this run's (same inputs, no ``--fresh``), else None."""
+    previous = None if fresh else _read(out / section.key / RESULT)
+    if previous and previous.get("case") == section_key(section, ctx):
+        return Outcome(section, "reused", previous["provenance"]["finished_utc"],
+                       previous["provenance"]["wall_time_s"], previous["numbers"])
+    return None
 
 
 def _read(path: Path) -> dict | None:
