@@ -58,3 +58,26 @@ def test_failed_write_leaves_nothing_behind(tmp_path):
 def test_csv_lists_become_semicolon_cells(tmp_path):
     path = write_csv(tmp_path / "t.csv", [{"P": 0.1, "w": [0.2, 0.8]}])
     assert path.read_text().splitlines() == ["P,w", "0.1,0.2;0.8"]
+
+
+def test_a_reservoir_run_replaces_the_last_runs_outputs_and_leaves_none_when_stopped(tmp_path, monkeypatch):
+    from softhand.studies.cli.main import main
+    from softhand.studies.io import reservoir_files
+
+    out = tmp_path / "rs"
+    (tmp_path / "rs").mkdir()
+    (out / "notes.txt").write_text("the user's")
+    assert main(["reservoir", "--volume-mm3", "13000,15000,17000", "--out", str(out), "--no-progress"]) == 0
+    assert len(list(out.glob("sheet_V*_rz.vtu"))) == 3
+    assert main(["reservoir", "--volume-mm3", "14000", "--out", str(out), "--no-progress"]) == 0
+    assert sorted(p.name for p in out.glob("sheet_V*_rz.vtu")) == ["sheet_V14000_rz.vtu"]  # none stale
+
+    write = reservoir_files.write_sheet_vtk
+
+    def stopped(result, folder):  # Ctrl-C half-way through the VTK
+        write(result, folder)
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(reservoir_files, "write_sheet_vtk", stopped)
+    assert main(["reservoir", "--volume-mm3", "16000", "--out", str(out), "--no-progress"]) == 130
+    assert sorted(p.name for p in out.iterdir()) == ["notes.txt"]  # no half of two runs

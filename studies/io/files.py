@@ -6,6 +6,7 @@ import io
 import json
 import logging
 import math
+import shutil
 import sys
 from contextlib import contextmanager
 from pathlib import Path
@@ -148,6 +149,23 @@ def removed_unless_finished(folder: str | Path):
             except OSError:
                 pass  # a folder of others' files; a file already gone
         raise
+
+
+@contextmanager
+def replaced_outputs(folder: str | Path | None, patterns):
+    """A verb's run into ``folder``: an earlier run's outputs there (the verb's own ``patterns``,
+    nothing else) are removed first, and the files this run writes are removed if it does not
+    finish (:func:`removed_unless_finished`), so the folder never mixes two runs' files nor keeps
+    a half-written series. ``folder`` None: no outputs asked, nothing done."""
+    if folder is None:
+        yield
+        return
+    folder = Path(folder)
+    for pattern in patterns:
+        for path in folder.glob(pattern):
+            shutil.rmtree(path) if path.is_dir() and not path.is_symlink() else path.unlink()
+    with removed_unless_finished(folder):
+        yield
 
 
 def _stamps(folder: Path, depth: int = 3) -> dict:

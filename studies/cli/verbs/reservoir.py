@@ -16,7 +16,7 @@ from pathlib import Path
 from softhand.reduced.errors import InputError
 from softhand.studies.cli.args import MAX_FEM_POINTS, MOST_FEM_POINTS, add_design_option, add_json_option, \
     add_max_cases_option, add_progress_option, design_from_args, max_cases, parse_values, print_json, print_table
-from softhand.studies.io.files import write_outputs
+from softhand.studies.io.files import replaced_outputs, write_outputs
 
 HELP = "inflate the reservoir sheet (FEM) and measure the ellipse assumption (eqs. 11-18)"
 
@@ -60,6 +60,10 @@ def _study(args):
                           n_thick=args.n_thick)
 
 
+#: what a reservoir run writes into --out (an earlier run's are removed when this one writes)
+OUTPUT_PATTERNS = ("result.json", "rows.csv", "sheet.pvd", "sheet", "sheet_V*_rz.vtu")
+
+
 def run(args) -> int:
     study = _study(args)
     if args.write_calibration:
@@ -76,7 +80,8 @@ def run(args) -> int:
     except NotConverged as exc:
         return _failed(exc, study, Path(args.out or FAILED_OUT))
     summary = result.summary()
-    write_outputs(result, "reservoir", args.out, args.plot)
+    with replaced_outputs(args.out, OUTPUT_PATTERNS):  # the earlier run's stay until this one has finished
+        write_outputs(result, "reservoir", args.out, args.plot)
     if args.json:
         print_json({"rows": result.rows, **summary})
     else:

@@ -20,7 +20,7 @@ from softhand.reduced.paper import FIG8
 from softhand.studies.cli.args import MOST_FEM_POINTS, add_design_option, add_json_option, \
     add_max_cases_option, add_progress_option, design_from_args, max_cases, parse_values, print_json, print_table
 from softhand.studies.design.task import UPPER
-from softhand.studies.io.files import kept_if_unwritable
+from softhand.studies.io.files import kept_if_unwritable, replaced_outputs
 
 HELP = "hinge weight vectors w for an object diameter from the grasp FEM; F_v vs eq. (25)"
 
@@ -165,11 +165,16 @@ def _run(args) -> int:
 def _one(case, args) -> dict:
     from softhand.studies.weights import run_case
 
-    result = run_case(case, cache=not args.no_cache, out=args.out)
-    if args.out:
-        with kept_if_unwritable(Path(args.out) / "result.json", "weights"):
-            result.write(args.out)
+    with replaced_outputs(args.out, OUTPUT_PATTERNS):  # the series is written as the states converge
+        result = run_case(case, cache=not args.no_cache, out=args.out)
+        if args.out:
+            with kept_if_unwritable(Path(args.out) / "result.json", "weights"):
+                result.write(args.out)
     return result.summary()
+
+
+#: what one grasp writes into --out (an earlier run's are removed before it writes)
+OUTPUT_PATTERNS = ("result.json", "grasp.pvd", "grasp")
 
 
 def _print_one(result: dict) -> None:
