@@ -81,3 +81,25 @@ def test_a_reservoir_run_replaces_the_last_runs_outputs_and_leaves_none_when_sto
     monkeypatch.setattr(reservoir_files, "write_sheet_vtk", stopped)
     assert main(["reservoir", "--volume-mm3", "16000", "--out", str(out), "--no-progress"]) == 130
     assert sorted(p.name for p in out.iterdir()) == ["notes.txt"]  # no half of two runs
+
+
+def test_a_stopped_bend_leaves_no_half_written_series(tmp_path, monkeypatch):
+    from softhand.studies import bending
+    from softhand.studies.cli.main import main
+
+    real = bending.run
+
+    def stopped(study, on_state=None, model=None):  # Ctrl-C once a loaded state is in the series
+        def once(m, state):
+            on_state(m, state)
+            if state.P > 0:
+                raise KeyboardInterrupt
+        return real(study, on_state=once, model=model)
+
+    monkeypatch.setattr(bending, "run", stopped)
+    out = tmp_path / "b"
+    out.mkdir()
+    (out / "notes.txt").write_text("the user's")
+    assert main(["bend", "--mesh-size-mm", "6", "--pressure-mpa", "0.2,0.4", "--peak-mpa", "0",
+                 "--out", str(out), "--no-progress"]) == 130
+    assert sorted(p.name for p in out.iterdir()) == ["notes.txt"]

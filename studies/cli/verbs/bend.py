@@ -136,7 +136,7 @@ def run(args) -> int:
 
     from softhand.fem.newton import NotConverged
     from softhand.studies.bending import BendingStudy, run as run_study, vtk_writer
-    from softhand.studies.io.files import kept_if_unwritable
+    from softhand.studies.io.files import kept_if_unwritable, removed_unless_finished
 
     pressures = _check(args)
     design = design_from_args(args)
@@ -166,16 +166,17 @@ def run(args) -> int:
         bar.set_postfix(P=f"{state.P:.2f}", theta=f"{state.theta * 57.29578:.1f}deg")
         bar.update(0 if state.P > pressures[-1] and state.P < study.peak_mpa else 1)
 
-    on_state = vtk_writer(out / "finger.pvd", then=progress)
-    try:
-        result = replace(run_study(study, on_state=on_state, model=model), build_seconds=build)
-    except NotConverged as exc:
-        return _failed(exc, converged, study, on_state.write, out)
-    finally:
-        bar.close()
-    summary = result.summary()
-    with kept_if_unwritable(f"{out}/result.json, table.csv", "bend"):
-        result.write(out)
+    with removed_unless_finished(out):  # stopped (Ctrl-C, SIGTERM): no half-written series stays
+        on_state = vtk_writer(out / "finger.pvd", then=progress)
+        try:
+            result = replace(run_study(study, on_state=on_state, model=model), build_seconds=build)
+        except NotConverged as exc:  # Newton gave up: its last converged state is kept, with a record
+            return _failed(exc, converged, study, on_state.write, out)
+        finally:
+            bar.close()
+        summary = result.summary()
+        with kept_if_unwritable(f"{out}/result.json, table.csv", "bend"):
+            result.write(out)
     if args.plot:
         with kept_if_unwritable(args.plot, "bend"):
             result.plot(args.plot)
