@@ -2,6 +2,7 @@
 import json
 import os
 import stat
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -103,3 +104,25 @@ def test_a_stopped_bend_leaves_no_half_written_series(tmp_path, monkeypatch):
     assert main(["bend", "--mesh-size-mm", "6", "--pressure-mpa", "0.2,0.4", "--peak-mpa", "0",
                  "--out", str(out), "--no-progress"]) == 130
     assert sorted(p.name for p in out.iterdir()) == ["notes.txt"]
+
+
+def test_a_design_run_replaces_the_last_runs_outputs_and_leaves_none_when_stopped(tmp_path, monkeypatch, capsys):
+    from softhand.studies.cli.main import main
+    from softhand.studies.io import files
+
+    task = str(Path(__file__).resolve().parents[1] / "studies" / "designs" / "tasks" / "paper_task.toml")
+    out = tmp_path / "d"
+    (out / "knee").mkdir(parents=True)
+    (out / "knee" / "design.toml").write_text("an earlier run's")
+    (out / "grasp.pvd").write_text("an earlier run's")
+    (out / "notes.txt").write_text("the user's")
+    argv = ["design", "--task", task, "--no-fem", "--no-progress", "--json", "--out", str(out)]
+    assert main(argv) == 0
+    assert sorted(p.name for p in out.iterdir()) == ["design.toml", "notes.txt", "result.json"]
+
+    def stopped(path, data):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(files, "write_atomic", stopped)
+    assert main(argv) == 130
+    assert sorted(p.name for p in out.iterdir()) == ["notes.txt"]  # no half of a run, no orphan

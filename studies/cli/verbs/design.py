@@ -22,6 +22,9 @@ from softhand.reduced.errors import InputError, MeshRejected, MeshTooLarge
 from softhand.studies.cli.args import add_json_option, add_progress_option, print_json, print_table
 
 HELP = "size finger and reservoir for an object (reduced model, optimiser) and prove it with the FEM"
+#: what a design run writes into --out (an earlier run's are removed before it writes)
+OUTPUT_FILES = ("result.json", "design.toml", "rejected_design.toml", "pareto.png", "grasp.pvd")
+OUTPUT_FOLDERS = ("knee", "grasp")
 
 
 def configure(parser) -> None:
@@ -47,7 +50,7 @@ def run(args) -> int:
     from softhand.studies.design.task import load_task
     from softhand.studies.design.task import LOWER, UPPER
     from softhand.studies.cli.checks import check_writable
-    from softhand.studies.io.files import check_output_tree, removed_unless_finished, write_atomic, write_json
+    from softhand.studies.io.files import check_output_tree, replaced_outputs, write_atomic, write_json
 
     lo, hi = LOWER["mesh_size_mm"], UPPER["mesh_size_mm"]
     if args.mesh_size_mm is not None and not lo <= args.mesh_size_mm <= hi:
@@ -63,8 +66,7 @@ def run(args) -> int:
     task = load_task(args.task)
     out = Path(args.out) if args.out else Path("results") / "design" / task.name
     check_writable(out, "dir", "--out")  # also the default folder, which argparse's checks do not see
-    check_output_tree(out, "--out", files=("result.json", "design.toml", "rejected_design.toml", "pareto.png",
-                                           "grasp.pvd"), folders=("knee", "grasp"))
+    check_output_tree(out, "--out", files=OUTPUT_FILES, folders=OUTPUT_FOLDERS)
     if not args.no_fem:
         _check_proof_size(task, args)
     say = (lambda text: print(f"softhand design: {text}", file=sys.stderr)) if args.json else print
@@ -76,9 +78,10 @@ def run(args) -> int:
         result = {**_result(task, opt, base, None, args.seed), "report": design_opt.infeasible_report(task, opt)}
         print_json(result) if args.json else _print(result, task, opt)
         return 1
-    with removed_unless_finished(out):  # a run stopped mid-proof leaves none of its files
+    # an earlier run's outputs go first (the folder never mixes two runs), and a run stopped
+    # mid-proof leaves none of its own
+    with replaced_outputs(out, OUTPUT_FILES + OUTPUT_FOLDERS):
         out.mkdir(parents=True, exist_ok=True)
-        (out / "result.json").unlink(missing_ok=True)  # the record of an earlier run, which this one replaces
         design_file = write_atomic(out / "design.toml", ev.design.to_toml())
         result = _result(task, opt, base, design_file, args.seed)
         if args.pareto:
