@@ -418,6 +418,7 @@ def replay_cases() -> list[tuple[str, list[str]]]:
     files += [["curve", "--theta-deg", "10", "--design", "d_ft_id_huge.toml"],
               ["inspect", "v_legacy_no_fields.vtk", "--out", "o.png"],
               ["inspect", "v_many_steps.pvd", "--animate", "o.gif"],
-              ["study", "run", "st_grasp_bad_table.toml", "--workers", "1"]]
+              ["study", "run", "st_grasp_bad_table.toml", "--workers", "1"],
+              ["weights", "--diameter-mm", "180", "--plot", "w.png"]]
     cases += [("files", f) for f in files]
     return [(f"{name}-{k}-{' '.join(argv[1:])[:40]}", argv) for k, (name, argv) in enumerate(cases)]

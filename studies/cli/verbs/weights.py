@@ -136,6 +136,9 @@ def _run(args) -> int:
         raise InputError("--out", args.out, "applies to one diameter, not to a sweep or --fig8")
     if args.fig8 is not None and diameters.size > 1:
         raise InputError("--fig8", args.fig8, "is for one object: give one --diameter-mm")
+    if args.plot is not None and diameters.size == 1 and args.fig8 is None:
+        raise InputError("--plot", args.plot, "draws w(D) of several diameters or the Fig. 8 analogue "
+                         "(--fig8); one diameter's grasp is in --out's VTK (softhand inspect)")
     _distinct(diameters, args.diameter_mm, "--diameter-mm")
     if case.depth_mm is not None:  # an object placed into the open finger: before any FEM or message
         from softhand.fem.hand.grasp import check_placement
