@@ -21,3 +21,15 @@ def test_unknown_verb_is_one_line_exit_2(capsys):
     assert main(["frobnicate"]) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "frobnicate" in err
+
+
+def test_ctrl_c_while_a_verb_imports_its_libraries_is_one_line(monkeypatch, capsys):
+    from softhand.studies.cli import main as front
+
+    def importing(verb):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(front, "_verb_module", importing)
+    assert main(["curve", "--theta-deg", "10"]) == 130
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "interrupted" in err

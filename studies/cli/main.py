@@ -107,7 +107,11 @@ def main(argv: list[str] | None = None) -> int:
         print(f"softhand {verb}: error: the current folder no longer exists; change to one that does",
               file=sys.stderr)
         return 2
-    module = _verb_module(verb)
+    try:  # the verb's libraries take a moment to import: Ctrl-C then is one line too
+        module = _verb_module(verb)
+    except KeyboardInterrupt:
+        print(f"softhand {verb}: interrupted", file=sys.stderr)
+        return 130
     parser = ArgumentParser(prog=f"softhand {verb}", description=module.HELP)
     module.configure(parser)
     args = parser.parse_args(rest)
