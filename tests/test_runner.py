@@ -240,3 +240,18 @@ def test_a_commit_stopped_half_way_leaves_no_temporary_folder(tmp_path, monkeypa
     with pytest.raises(KeyboardInterrupt):
         cases.commit(tmp_path / "case", {"status": "done"}, {"sub/a.vtu": b"x" * 10})
     assert calls and list(tmp_path.iterdir()) == []
+
+
+def test_case_folders_of_processes_that_are_gone_are_removed(tmp_path, monkeypatch):
+    import tempfile
+
+    from softhand.studies.batch import cases
+
+    gone = subprocess.run([sys.executable, "-c", "import os; print(os.getpid())"], capture_output=True,
+                          text=True).stdout.strip()
+    monkeypatch.setattr(tempfile, "tempdir", str(tmp_path))
+    (tmp_path / f"softhand-case-{gone}-abc").mkdir()  # a SIGKILLed run's
+    (tmp_path / f"softhand-case-{os.getpid()}-def").mkdir()  # this process's, in use
+    (tmp_path / "softhand-case-xyz").mkdir()  # an older name: not this scheme's to judge
+    cases._remove_orphans()
+    assert sorted(p.name for p in tmp_path.iterdir()) == [f"softhand-case-{os.getpid()}-def", "softhand-case-xyz"]

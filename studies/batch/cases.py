@@ -163,7 +163,8 @@ def execute_case(kind, params: dict, design: HandDesign) -> dict:
     Never raises for a failing kind: the error comes back as ``status = 'failed'``.
     """
     start = time.perf_counter()
-    with tempfile.TemporaryDirectory(prefix="softhand-case-") as tmp:
+    _remove_orphans()
+    with tempfile.TemporaryDirectory(prefix=f"softhand-case-{os.getpid()}-") as tmp:
         CASE_FOLDERS.add(tmp)
         try:
             out = (kind if callable(kind) else resolve_kind(kind))(dict(params), design, Path(tmp))
@@ -177,6 +178,21 @@ def execute_case(kind, params: dict, design: HandDesign) -> dict:
     CASE_FOLDERS.discard(tmp)  # after the folder is gone (an exception leaves a name of none)
     return {"status": "done", "numbers": numbers, **extra, "files": files,
             "wall_time_s": time.perf_counter() - start}
+
+
+def _remove_orphans() -> None:
+    """Remove the case folders of processes that no longer run (killed by SIGKILL, which no
+    process can clean up after): each folder is named after the process that made it."""
+    for folder in Path(tempfile.gettempdir()).glob("softhand-case-*-*"):
+        pid = folder.name.split("-")[2]
+        try:
+            if not pid.isdigit() or folder.lstat().st_uid != os.getuid():
+                continue
+            os.kill(int(pid), 0)
+        except ProcessLookupError:  # that process is gone
+            shutil.rmtree(folder, ignore_errors=True)
+        except OSError:  # alive but another user's, or the folder vanished meanwhile
+            continue
 
 
 def _split_output(out) -> tuple[dict, dict]:

@@ -107,7 +107,7 @@ def stop_worker(signum, frame) -> None:
 
 def _worker_init(parent: int, threads: int) -> None:
     """In each pool worker: its share of the cores' threads; die with the parent (Linux:
-    PR_SET_PDEATHSIG); SIGTERM ends it at once, without the case's temporary folder; Ctrl-C
+    PR_SET_PDEATHSIG, as SIGTERM); SIGTERM ends it at once, without the case's temporary folder; Ctrl-C
     (SIGINT to the whole process group) is the parent's to handle: it stops the workers."""
     limit_threads(threads)
     signal.signal(signal.SIGTERM, stop_worker)
@@ -115,7 +115,8 @@ def _worker_init(parent: int, threads: int) -> None:
     try:
         import ctypes
 
-        ctypes.CDLL(None, use_errno=True).prctl(1, signal.SIGKILL)  # 1 = PR_SET_PDEATHSIG
+        # 1 = PR_SET_PDEATHSIG; SIGTERM, not SIGKILL: stop_worker removes the case's folder first
+        ctypes.CDLL(None, use_errno=True).prctl(1, signal.SIGTERM)
     except (OSError, AttributeError):
         pass  # not Linux: workers exit when they find the pool's pipe closed
     if os.getppid() != parent:  # the parent died before the death signal was armed
