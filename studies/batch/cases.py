@@ -163,7 +163,9 @@ def execute_case(kind, params: dict, design: HandDesign) -> dict:
     Never raises for a failing kind: the error comes back as ``status = 'failed'``.
     """
     start = time.perf_counter()
-    _remove_orphans()
+    if not _ORPHANS_REMOVED:  # once per process: a study of many quick cases lists the folder once
+        _remove_orphans()
+        _ORPHANS_REMOVED.append(True)
     with tempfile.TemporaryDirectory(prefix=f"softhand-case-{os.getpid()}-") as tmp:
         CASE_FOLDERS.add(tmp)
         try:
@@ -178,6 +180,9 @@ def execute_case(kind, params: dict, design: HandDesign) -> dict:
     CASE_FOLDERS.discard(tmp)  # after the folder is gone (an exception leaves a name of none)
     return {"status": "done", "numbers": numbers, **extra, "files": files,
             "wall_time_s": time.perf_counter() - start}
+
+
+_ORPHANS_REMOVED: list = []
 
 
 def _remove_orphans() -> None:
