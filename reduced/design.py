@@ -305,9 +305,16 @@ def design_from_dict(values: dict, base: HandDesign | None = None, *, source: st
         if part in values:
             changes.update(_material_changes(part, values[part], source, values))
     design = dataclasses.replace(base, **changes)
-    if changes.get("finger_table") and design.finger_model != "fem":  # the table would be unused
-        raise InputError(f"{source}: finger_table", values["finger_table"], f"is the table of "
-                         f"finger_model = 'fem'; this design's finger_model is {design.finger_model!r}")
+    if changes.get("finger_table"):
+        if design.finger_model != "fem":  # the table would be unused
+            raise InputError(f"{source}: finger_table", values["finger_table"], f"is the table of "
+                             f"finger_model = 'fem'; this design's finger_model is {design.finger_model!r}")
+        from . import finger
+
+        try:  # read and fitted now (cached per file), not where a run first uses it
+            finger.check_data(design)
+        except InputError as exc:
+            raise exc.renamed(f"{source}: finger_table") from None
     return design
 
 

@@ -184,9 +184,20 @@ class FingerFunctions:
     energy_rate: Fn  #: dW_f/dtheta [N mm / rad]
     volume: Fn  #: oil volume Q inside one finger [mm^3]
     volume_rate: Fn  #: dQ/dtheta of one finger [mm^3 / rad]
+    #: ``check(design)``: InputError if the model's own data for the design (a calibration
+    #: table) cannot be used; None: the model has none
+    check: Callable[[HandDesign], None] | None = None
 
 
 _MODELS: dict[str, FingerFunctions] = {}
+
+
+def check_data(design: HandDesign) -> None:
+    """The design's finger model's own data (its calibration table) read and checked now, not
+    where a run first uses it: InputError naming it."""
+    check = model(design.finger_model).check
+    if check is not None:
+        check(design)
 
 
 def register_model(name: str, functions: FingerFunctions) -> None:

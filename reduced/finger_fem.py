@@ -230,5 +230,5 @@ def _volume_rate(theta, design):
 
 
 FEM = finger.FingerFunctions(energy=_energy, energy_rate=_energy_rate, volume=_volume,
-                             volume_rate=_volume_rate)
+                             volume_rate=_volume_rate, check=lambda design: check_table(_table_path(design)))
 finger.register_model("fem", FEM)

@@ -10,7 +10,8 @@ from pathlib import Path
 
 from .errors import InputError
 
-__all__ = ["MAX_FILE_BYTES", "MAX_NESTING", "nesting_depth", "plain_float", "read_input_file", "read_toml"]
+__all__ = ["MAX_FILE_BYTES", "MAX_NESTING", "csv_cells", "nesting_depth", "plain_float", "read_input_file",
+           "read_toml"]
 
 
 #: largest design / study / data file read [bytes]; a bigger one (or /dev/zero) is refused

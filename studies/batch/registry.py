@@ -144,12 +144,17 @@ def _reservoir_mesh(params: dict, design: HandDesign, src: str) -> None:
                              f"sheet; at most {most}: a mesh size >= {length / most:.4g} mm")
 
 
+def check_path_end(pressures, p_max: float, where: str) -> None:
+    """The listed pressures [MPa] end at or below the load path's end p_max (a design space's,
+    and the finger_bend kind's)."""
+    if pressures[-1] > p_max:
+        raise InputError(where, pressures, f"must end at or below p_max_mpa = {p_max:g} MPa, the load path's end")
+
+
 def _path_within_p_max(params: dict, design: HandDesign, src: str) -> None:
     """The pressures end at or below the load path's end p_max_mpa (as a design space checks)."""
-    pressures = params.get("pressures_mpa")
-    if pressures and "p_max_mpa" in params and pressures[-1] > params["p_max_mpa"]:
-        raise InputError(f"{src}: pressures_mpa", params["pressures_mpa"],
-                         f"must end at or below p_max_mpa = {params['p_max_mpa']:g} MPa, the load path's end")
+    if params.get("pressures_mpa") and "p_max_mpa" in params:
+        check_path_end(params["pressures_mpa"], params["p_max_mpa"], f"{src}: pressures_mpa")
 
 
 def _pressure_reached(params: dict, design: HandDesign, src: str) -> None:

@@ -132,10 +132,6 @@ def study_from_dict(doc: dict, *, path: Path | None = None, max_cases: int = MAX
     for case_params, case_design in study.cases():  # every case now, not in a worker
         try:
             reservoir.check_holds(case_design.V0, case_design)  # a swept V0 or R too
-            if case_design.finger_model == "fem" and case_design.finger_table:
-                from softhand.reduced.finger_fem import check_table
-
-                check_table(case_design.finger_table)  # read and fitted once (cached), not per case
         except InputError as exc:
             raise exc.renamed(f"{src}: {exc.field}") from None
         _check_case(case_params, case_design, spec, src)

@@ -38,6 +38,7 @@ import numpy as np
 
 from softhand.reduced.design import HandDesign, load_design
 from softhand.reduced.errors import InputError
+from softhand.studies.batch.registry import check_path_end
 from softhand.studies.batch.studyfile import _NAME_RE
 
 #: the dimensional variables of a design space, in this order
@@ -100,7 +101,6 @@ def latin_hypercube(box: dict, n: int, seed: int, keep=lambda point: True) -> li
     return points
 
 
-
 #: (lowest, highest) of a design space's numbers: designs sampled, pressures [MPa], the target
 #: angle [deg], the mesh [mm] (the bounds of ``softhand bend``'s options)
 LIMITS = {"lhs": (0, 200), "seed": (0, 2**32 - 1), "pressures_mpa": (0.01, 5.0),
@@ -152,9 +152,7 @@ def load_space(path: str | Path) -> DesignSpace:
                          f"must be 1 to {MAX_PRESSURES} increasing numbers in [{lo:g}, {hi:g}] MPa")
     numbers = {key: _bounded(doc, key, default, src)
                for key, default in (("theta_target_deg", 64.0), ("p_max_mpa", 2.0), ("p_step_mpa", 0.5))}
-    if pressures[-1] > numbers["p_max_mpa"]:
-        raise InputError(f"{src}: pressures_mpa", pressures, f"must end at or below p_max_mpa = "
-                         f"{numbers['p_max_mpa']:g} MPa, the load path's end")
+    check_path_end(pressures, numbers["p_max_mpa"], f"{src}: pressures_mpa")
     mesh, axial = (_bounded(doc, key, None, src) for key in ("mesh_size_mm", "axial_size_mm"))
     if mesh is not None and axial is not None:
         raise InputError(f"{src}: axial_size_mm", axial, "applies to the layered mesh; remove mesh_size_mm")

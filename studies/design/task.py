@@ -140,13 +140,6 @@ def task_from_dict(data: dict, *, folder: Path = Path("."), name: str = "task") 
     if isinstance(table, str) and table and not Path(table).is_absolute():
         fixed["finger_table"] = os.path.abspath(folder / table)  # next to the task, as a design file's
     base = design_from_dict({**MODELS, **fixed, **tables["material"]}, base, source="design")
-    if base.finger_model == "fem" and base.finger_table:
-        from softhand.reduced.finger_fem import check_table
-
-        try:
-            check_table(base.finger_table)  # before the search, not at its first design
-        except InputError as exc:
-            raise exc.renamed("design.finger_table") from None
     free, clipped = _calibrated(_free(tables["free"], base), base)
     _some_design_keeps_the_rules(free, base)
     obj, grasp, pump, limits, fem = (tables[s] for s in ("object", "grasp", "pump", "limits", "fem"))

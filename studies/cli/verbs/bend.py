@@ -136,7 +136,7 @@ def run(args) -> int:
 
     from softhand.fem.newton import NotConverged
     from softhand.studies.bending import BendingStudy, run as run_study, vtk_writer
-    from softhand.studies.io.files import kept_if_unwritable, removed_unless_finished
+    from softhand.studies.io.files import kept_if_unwritable, replaced_outputs
 
     pressures = _check(args)
     design = design_from_args(args)
@@ -155,7 +155,6 @@ def run(args) -> int:
     model = FingerModel(study.design, study.options)
     build = time.perf_counter() - t0
     out = Path(args.out)
-    clear_outputs(out)
     n_steps = len(pressures) + (1 if study.peak_mpa else 0)
     bar = tqdm(total=n_steps, desc="bend", unit="pressure", file=sys.stderr, leave=False,
                disable=args.no_progress)
@@ -166,7 +165,8 @@ def run(args) -> int:
         bar.set_postfix(P=f"{state.P:.2f}", theta=f"{state.theta * 57.29578:.1f}deg")
         bar.update(0 if state.P > pressures[-1] and state.P < study.peak_mpa else 1)
 
-    with removed_unless_finished(out):  # stopped (Ctrl-C, SIGTERM): no half-written series stays
+    # the last run's outputs go now; stopped (Ctrl-C, SIGTERM), no half-written series stays
+    with replaced_outputs(out, OUTPUT_PATTERNS):
         on_state = vtk_writer(out / "finger.pvd", then=progress)
         try:
             result = replace(run_study(study, on_state=on_state, model=model), build_seconds=build)
@@ -206,15 +206,6 @@ def run(args) -> int:
 
 #: the files and folders a bend run writes into --out; removed before a run so runs never mix
 OUTPUT_PATTERNS = ("result.json", "table.csv", "hand.csv", "finger.pvd", "finger", "finger_*.vtu")
-
-
-def clear_outputs(out: Path) -> None:
-    """Remove an earlier run's files from ``out`` (only softhand's own, nothing else)."""
-    import shutil
-
-    for pattern in OUTPUT_PATTERNS:
-        for path in out.glob(pattern):
-            shutil.rmtree(path) if path.is_dir() else path.unlink()
 
 
 def _failed(exc, converged, study, write_vtk, out: Path) -> int:
