@@ -21,7 +21,7 @@ Locking: the rubber is nearly incompressible (κ ≫ μ). The element is the biq
 the Hu–Washizu three-field functional with element-wise linear dilatation and pressure,
 condensed (exact for :math:`U = κ/2 (J-1)^2`, whose U' is affine). Q2/P1disc satisfies the
 inf–sup condition, so the answers converge to the incompressible limit independently of
-κ/μ (``tests/test_axisym.py``: κ/μ = 10²…10⁵ against the incompressible thick-sphere closed
+κ/μ (``tests/fem/test_axisym.py``: κ/μ = 10²…10⁵ against the incompressible thick-sphere closed
 form). ``pressure="P0"`` gives the classical mean dilatation (Q2/P0, Simo–Taylor–Pister
 1985); it is stable too, but a piecewise-constant pressure cannot follow the linear
 through-thickness pressure of a bending plate: with n layers it loses 1/n² of the

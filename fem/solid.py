@@ -18,7 +18,7 @@ constant pressure p and dilatation theta condensed out on each element,
 with element pressure :math:`p_e = U'(\bar J_e)`. The volume constraint is
 enforced once per element instead of once per quadrature point, which removes
 volumetric locking (P2-P0 is inf-sup stable); as kappa -> inf it converges to the
-incompressible solution (tests/test_solid.py: the plane-strain tube gives the
+incompressible solution (tests/fem/test_solid.py: the plane-strain tube gives the
 same answer for kappa/mu = 1e2..1e5). Its exact tangent is
 
 .. math::
@@ -32,7 +32,7 @@ kappa times the second-order volume error, which poisons the next tangent's
 geometric term. The mixed (u, p) iteration keeps the P0 pressure linearised at the
 previous iterate instead (:class:`PressureAnchor`, :class:`MixedNewton`, passed as
 ``anchor=``); it is the Newton method of the uncondensed three-field problem and
-converges in ~4-5 full steps for kappa/mu = 1e2..1e5 alike (tests/test_solid.py),
+converges in ~4-5 full steps for kappa/mu = 1e2..1e5 alike (tests/fem/test_solid.py),
 where the displacement iteration needs cut-backs or diverges (kappa/mu >= 1e4).
 
 Kernels: F, P and A are evaluated once per iterate at all quadrature points; the

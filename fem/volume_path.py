@@ -10,7 +10,7 @@ the bordered (symmetric, indefinite) system of :func:`fem.loads.volume_control` 
 DOFs and p, which stays regular at and past the pressure maximum, where :math:`K - pH_V`
 itself is singular. Along the path :math:`dΠ/dV^* = p`, so :math:`\int p\,dV = Π` is an
 independent check of the residual, the tangent-free parts and the volume functional
-(``tests/test_reservoir.py``).
+(``tests/fem/test_reservoir.py``).
 
 The path is the load path of :func:`fem.newton.solve_path` with the load t = V* [mm^3]:
 the same Newton iteration, line search, cut-back and step growth as every other FEM

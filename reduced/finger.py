@@ -56,7 +56,7 @@ from .errors import InputError
 from .registry import lookup
 
 #: Gauss-Legendre orders across the wall (r) and around the tube (phi, half turn); the
-#: relative quadrature error is below 1e-11 for -pi/2 <= theta <= pi (tests/test_reduced_finger.py).
+#: relative quadrature error is below 1e-11 for -pi/2 <= theta <= pi (tests/reduced/test_reduced_finger.py).
 ORDERS = (5, 10)
 #: theta-values evaluated per block, so that the (block, nodes) work arrays stay in cache
 _BLOCK = 2048

@@ -13,7 +13,7 @@ The file ``reduced/data/reservoir_fem.csv`` holds :math:`\tilde W, \tilde p, \ti
 on the same v grid at τ = 1/24 (Table I) and τ = 1/12, with its provenance in the header;
 this model rescales them to the design's R, t, μ_sr and interpolates linearly in τ
 (extrapolates outside [1/24, 1/12]; at τ = 1/48 that is within 0.5 %, see
-``tests/test_reservoir.py``). Between table points W̃ is the cubic Hermite interpolant of
+``tests/fem/test_reservoir.py``). Between table points W̃ is the cubic Hermite interpolant of
 the values W̃ and slopes p̃, and p̃ its derivative, so p = dW/dV holds exactly within the
 model (energy-consistent, p continuous). Above the table's last volume p̃ continues
 linearly (W̃ quadratically); V <= 0 is an error, as in the ellipse model.

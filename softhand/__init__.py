@@ -1,6 +1,6 @@
 """softhand: model fluid-driven soft robot hands.
 
-Sub-packages (dependencies point down; ``tests/test_layers.py`` enforces it):
+Sub-packages (dependencies point down; ``tests/project/test_layers.py`` enforces it):
 
 * :mod:`softhand.studies` -- the studies, batch runner, reproduce, verification, the CLI;
 * :mod:`softhand.fem` -- the hyperelastic FEM core on scikit-fem, and the hand models

@@ -1,6 +1,6 @@
-"""Bad inputs of the verbs and file types beyond tests/test_bad_inputs.py's table.
+"""Bad inputs of the verbs and file types beyond tests/studies/test_bad_inputs.py's table.
 
-Shared by tests/test_bad_inputs.py (in-process) and benchmarks/bad_input_replay.py (one
+Shared by tests/studies/test_bad_inputs.py (in-process) and benchmarks/bad_input_replay.py (one
 ``softhand`` process per case). Each case: (name, argv); its input files are EXTRA_FILES.
 """
 from __future__ import annotations

@@ -3,7 +3,7 @@
 A case is a function ``case(quick: bool) -> list[Check]`` registered in :data:`REGISTRY`
 by its import path (imported only when run). To add a case, write the function anywhere
 under ``studies/`` or ``fem/`` and add one line to :data:`REGISTRY`; its checks then appear
-in ``softhand verify`` and in ``tests/test_verify.py``.
+in ``softhand verify`` and in ``tests/studies/test_verify.py``.
 """
 from __future__ import annotations
 

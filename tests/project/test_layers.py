@@ -17,7 +17,7 @@ from pathlib import Path
 
 import pytest
 
-ROOT = Path(__file__).resolve().parent.parent
+ROOT = Path(__file__).resolve().parents[2]
 LAYERS = ("reduced", "meshes", "fem", "studies")
 #: third-party packages each layer may not import (reduced stays light: ~0.2 s start-up)
 FORBIDDEN = {"reduced": ("skfem", "gmsh", "pyvista", "meshio", "matplotlib", "dask")}

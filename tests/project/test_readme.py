@@ -16,7 +16,7 @@ import pytest
 
 from softhand.studies.cli.main import main
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 #: the samples run here, by the start of their command line (all of the reduced model's
 #: verbs, and the reservoir sheet's FEM, ~2 s)
 FAST = ("curve ", "grasp ", "control ", "fit ", "material fit ", "reservoir")

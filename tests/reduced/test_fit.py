@@ -226,7 +226,7 @@ from pathlib import Path  # noqa: E402
 from softhand.reduced.design import load_design  # noqa: E402
 from softhand.studies.cli.main import main  # noqa: E402
 
-EXAMPLES = Path(__file__).resolve().parent.parent / "studies" / "data"
+EXAMPLES = Path(__file__).resolve().parents[2] / "studies" / "data"
 
 
 @pytest.mark.parametrize("text", [

@@ -14,7 +14,7 @@ from softhand.reduced.errors import InputError
 from softhand.studies.cli.main import main
 
 DESIGN = grasp_fem.fem_finger(HandDesign())
-STATES = json.loads((Path(__file__).parent / "data" / "grasp_fem_states.json").read_text())
+STATES = json.loads((Path(__file__).resolve().parents[1] / "data" / "grasp_fem_states.json").read_text())
 
 
 def test_hinge_moments_are_the_gradient_of_the_hinge_energy():

@@ -12,7 +12,7 @@ under ``tests/data/golden/`` was written; the comparison is recursive:
 * timings, versions, paths and solver statistics are skipped (``VOLATILE``).
 
 Regenerate after an intended change of results with
-``python tests/test_golden.py --update`` and say in the commit why the numbers moved.
+``python tests/studies/test_golden.py --update`` and say in the commit why the numbers moved.
 """
 from __future__ import annotations
 
@@ -25,8 +25,8 @@ from pathlib import Path
 
 import pytest
 
-GOLDEN = Path(__file__).resolve().parent / "data" / "golden"
-ROOT = Path(__file__).resolve().parent.parent
+GOLDEN = Path(__file__).resolve().parents[1] / "data" / "golden"
+ROOT = Path(__file__).resolve().parents[2]
 RTOL = 1e-9
 FEM_RTOL = 2e-5
 #: keys whose values depend on the machine, the clock or the package versions
@@ -108,7 +108,7 @@ def test_compare_sees_a_change():
 
 if __name__ == "__main__":
     if sys.argv[1:] != ["--update"]:
-        sys.exit("usage: python tests/test_golden.py --update")
+        sys.exit("usage: python tests/studies/test_golden.py --update")
     GOLDEN.mkdir(parents=True, exist_ok=True)
     for name, (argv, _) in CASES.items():
         (GOLDEN / f"{name}.json").write_text(json.dumps(run_json(argv), indent=1) + "\n")

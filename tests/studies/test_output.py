@@ -110,7 +110,7 @@ def test_a_design_run_replaces_the_last_runs_outputs_and_leaves_none_when_stoppe
     from softhand.studies.cli.main import main
     from softhand.studies.io import files
 
-    task = str(Path(__file__).resolve().parents[1] / "studies" / "designs" / "tasks" / "paper_task.toml")
+    task = str(Path(__file__).resolve().parents[2] / "studies" / "designs" / "tasks" / "paper_task.toml")
     out = tmp_path / "d"
     (out / "knee").mkdir(parents=True)
     (out / "knee" / "design.toml").write_text("an earlier run's")

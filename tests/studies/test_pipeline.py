@@ -14,7 +14,7 @@ from softhand.reduced import control, grasp, paper, reservoir
 from softhand.reduced.design import HandDesign
 from softhand.reduced.versions import package_version
 
-ROOT = Path(__file__).resolve().parent.parent
+ROOT = Path(__file__).resolve().parents[2]
 SOURCES = [p for layer in ("fem", "reduced", "meshes", "studies") for p in (ROOT / layer).rglob("*.py")]
 
 

@@ -14,7 +14,7 @@ from softhand.studies.batch.runner import RESULT, plan, study_dir
 from softhand.studies.batch.studyfile import load_study
 from test_runner import _default_sigint, install_kind
 
-ROOT = Path(__file__).resolve().parent.parent
+ROOT = Path(__file__).resolve().parents[2]
 
 #: the curve kind, slowed down so that concurrent runs overlap, logging every computation
 LOGGED_CURVE = '''

@@ -14,7 +14,7 @@ from softhand.studies.cli.main import main
 from softhand.studies.batch.runner import RESULT, case_key, plan, run_study, status, study_dir
 from softhand.studies.batch.studyfile import load_study
 
-ROOT = Path(__file__).resolve().parent.parent
+ROOT = Path(__file__).resolve().parents[2]
 
 N_SLOW = 24  # cases of the killed-run test
 SLOW_KIND = '''

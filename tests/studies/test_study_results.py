@@ -1,7 +1,7 @@
 """Each study's result is computed, summarised and written once: the verb's ``--json`` is the
 result's summary, the files the verb writes are the ones the result writes, and the batch kind
 keeps the result's numbers. The grasp FEM is replaced by a closed-form stand-in (w linear in D)
-where only the pipeline is under test; the FEM itself is tested in tests/test_grasp.py."""
+where only the pipeline is under test; the FEM itself is tested in tests/fem/test_grasp.py."""
 import contextlib
 import io
 import json
@@ -15,7 +15,7 @@ from softhand.reduced import grasp
 from softhand.reduced.design import HandDesign
 from softhand.studies.cli.main import main
 
-ROOT = Path(__file__).resolve().parent.parent
+ROOT = Path(__file__).resolve().parents[2]
 
 
 def verb_json(argv: list[str]) -> dict:
