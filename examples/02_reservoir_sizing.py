@@ -8,8 +8,7 @@ import math
 
 from scipy.optimize import brentq
 
-from softhand.reduced import hand, reservoir
-from softhand.reduced.design import load_design
+from softhand.reduced import hand, load_design, reservoir
 
 design = load_design()
 target = 0.08  # [MPa]

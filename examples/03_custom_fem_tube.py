@@ -10,13 +10,9 @@ import math
 
 import numpy as np
 
-from softhand.fem.assembly import Restriction
-from softhand.fem.linsolve import make_solver
-from softhand.fem.loads import FollowerPressure
-from softhand.fem.materials import NeoHookean
-from softhand.fem.newton import NewtonOptions, PathOptions, solve_path
-from softhand.fem.solid import MixedNewton, Solid
-from softhand.meshes.tube import Tube, tube_mesh
+from softhand.fem import (FollowerPressure, MixedNewton, NeoHookean, NewtonOptions, PathOptions,
+                          Restriction, Solid, make_solver, solve_path)
+from softhand.meshes import Tube, tube_mesh
 
 a, p = 4.0, 0.3                                   # cavity radius [mm], oil pressure [MPa]
 mesh = tube_mesh(Tube(a, 9.0, 30.0, cap=5.0, sector="quarter"), size=3.0)

@@ -7,10 +7,8 @@ built from a dict: a kind, a design, sweep axes combined as a product. Results g
 import math
 import tempfile
 
-from softhand.reduced import hand
-from softhand.reduced.design import load_design
-from softhand.studies.batch.runner import index_rows, run_study
-from softhand.studies.batch.studyfile import study_from_dict
+from softhand.reduced import hand, load_design
+from softhand.studies import index_rows, run_study, study_from_dict
 
 study = study_from_dict({
     "name": "moduli",

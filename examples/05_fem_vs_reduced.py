@@ -7,14 +7,14 @@ balance: the stored energy equals the work the oil did on the way, W = int P dQ.
 """
 import numpy as np
 
-from softhand.fem.hand.finger import FingerOptions
-from softhand.reduced.design import load_design
-from softhand.studies.bending import BendingStudy, run
+from softhand.fem import FingerOptions
+from softhand.reduced import load_design
+from softhand.studies import BendingStudy, bending
 
 design = load_design()
 ci_mesh = FingerOptions(mesher="gmsh", mesh_size=6.0)          # ~10k unknowns
 pressures = tuple(np.round(np.arange(0.0, 0.81, 0.1), 10))
-result = run(BendingStudy(design=design, pressures_mpa=pressures, options=ci_mesh))
+result = bending.run(BendingStudy(design=design, pressures_mpa=pressures, options=ci_mesh))
 
 for r in result.rows[2::2]:
     print(f"P = {r['P_MPa']:.1f} MPa: FEM {r['theta_deg']:6.2f} deg, eq. (28) "

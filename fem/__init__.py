@@ -1,1 +1,13 @@
-"""Hyperelastic FEM on scikit-fem: materials, forms, loads, constraints, contact, Newton, I/O."""
+"""Hyperelastic FEM on scikit-fem: materials, forms, loads, constraints, contact, Newton, I/O.
+
+Its public face, imported on first use: the building blocks of a model of one's own
+(:class:`NeoHookean`, :class:`Solid`, :class:`FollowerPressure`, :func:`solve_path`, ...) and
+the hand's models built from them (:class:`FingerModel`, :class:`GraspModel`,
+:class:`SheetModel`).
+"""
+if __name__ != "softhand.fem":  # the folder on sys.path, imported by its short name
+    raise ImportError(f"'{__name__}' is softhand.fem: import softhand.fem (after pip install -e .)")
+
+import lazy_loader
+
+__getattr__, __dir__, __all__ = lazy_loader.attach_stub(__name__, __file__)

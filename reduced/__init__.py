@@ -1,1 +1,12 @@
-"""The paper's analytical virtual-work model (numpy/scipy only; no FEM imports)."""
+"""The paper's analytical virtual-work model and the design vocabulary (NumPy/SciPy only).
+
+Its public face: the design (:class:`HandDesign`, :func:`load_design`), the one input error
+(:class:`InputError`), and the model's modules (:mod:`~softhand.reduced.finger`,
+:mod:`~softhand.reduced.hand`, :mod:`~softhand.reduced.reservoir`, ...), imported on first use.
+"""
+if __name__ != "softhand.reduced":  # the folder on sys.path, imported by its short name
+    raise ImportError(f"'{__name__}' is softhand.reduced: import softhand.reduced (after pip install -e .)")
+
+import lazy_loader
+
+__getattr__, __dir__, __all__ = lazy_loader.attach_stub(__name__, __file__)

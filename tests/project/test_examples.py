@@ -17,3 +17,11 @@ def test_example_runs(script, tmp_path):
     out = subprocess.run([sys.executable, str(script)], cwd=tmp_path, capture_output=True,
                          text=True, timeout=900)
     assert out.returncode == 0, f"{script.name} failed:\n{out.stdout[-2000:]}\n{out.stderr[-3000:]}"
+
+
+@pytest.mark.parametrize("script", EXAMPLES, ids=lambda p: p.stem)
+def test_examples_import_the_layers_public_faces(script):
+    """What an example imports is what a user is meant to import: softhand.<layer>, not its modules."""
+    deep = [line for line in script.read_text().splitlines()
+            if line.startswith(("from softhand.", "import softhand.")) and line.split()[1].count(".") > 1]
+    assert not deep, deep
