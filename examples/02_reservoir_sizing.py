@@ -1,4 +1,6 @@
-"""Sizing the reservoir: which initial oil volume V0 gives a 0.08 MPa pressure offset?
+"""
+Sizing the reservoir: which initial oil volume V0 gives a 0.08 MPa pressure offset?
+===================================================================================
 
 Eq. (27): the charged rubber sheet pushes oil into the fingers, so the pump needs
 p_r(V) less. The offset at rest is p_r(V0); find V0 for a target with a root finder,

@@ -1,8 +1,10 @@
-"""A problem of your own on the FEM core: a closed rubber tube under oil pressure.
+"""
+A problem of your own on the FEM core: a closed rubber tube under oil pressure
+==============================================================================
 
 A quarter of a tube (inner radius 4, outer 9, cavity 30 mm, 5 mm end cap) in a softer
 rubber than the paper's, clamped at its base, inflated by a follower pressure. The pieces:
-a gmsh mesh with named surfaces (:mod:`meshes.tube`), a material law, the mean-dilatation
+a gmsh mesh with named surfaces (:mod:`softhand.meshes.tube`), a material law, the mean-dilatation
 solid, a load, Dirichlet conditions, load stepping with the mixed (u, p) Newton iteration,
 and the support's reaction force.
 """

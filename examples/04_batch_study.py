@@ -1,4 +1,6 @@
-"""A batch study from Python: the free hand's P(theta) for three finger moduli.
+"""
+A batch study from Python: the free hand's P(theta) for three finger moduli
+===========================================================================
 
 The same study a TOML file describes (``softhand study run studies/curve_moduli.toml``),
 built from a dict: a kind, a design, sweep axes combined as a product. Results go to

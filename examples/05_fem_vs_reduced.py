@@ -1,7 +1,9 @@
-"""The finger FEM against the paper's reduced model, and the FEM against itself.
+"""
+The finger FEM against the paper's reduced model, and the FEM against itself
+============================================================================
 
 The finger FEM (fiber-reinforced tube, rigid hinged links tied at rings) on the coarse CI
-mesh bends less than eq. (28) predicts (README: how much, on the converged mesh, and why).
+mesh bends less than eq. (28) predicts (docs/validation.md: how much, on the converged mesh, and why).
 Whatever the discretisation, a converged hyperelastic state must satisfy the energy
 balance: the stored energy equals the work the oil did on the way, W = int P dQ.
 """

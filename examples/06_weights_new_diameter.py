@@ -1,4 +1,6 @@
-"""The hinge weight vector w for an object the paper did not grasp, and the pressure to hold it.
+"""
+The hinge weight vector w for an object the paper did not grasp, and the pressure to hold it
+============================================================================================
 
 The paper gives w (eqs. (21)-(23)) for a 180 mm and a 240 mm object only. For another
 diameter the kinematics give one in milliseconds: place the object as the grasp FEM does,

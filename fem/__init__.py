@@ -1,9 +1,9 @@
 """Hyperelastic FEM on scikit-fem: materials, forms, loads, constraints, contact, Newton, I/O.
 
 Its public face, imported on first use: the building blocks of a model of one's own
-(:class:`NeoHookean`, :class:`Solid`, :class:`FollowerPressure`, :func:`solve_path`, ...) and
-the hand's models built from them (:class:`FingerModel`, :class:`GraspModel`,
-:class:`SheetModel`).
+(:class:`~softhand.fem.materials.NeoHookean`, :class:`~softhand.fem.solid.Solid`, :class:`~softhand.fem.loads.FollowerPressure`, :func:`~softhand.fem.newton.solve_path`, ...) and
+the hand's models built from them (:class:`~softhand.fem.hand.finger.FingerModel`, :class:`~softhand.fem.hand.grasp.GraspModel`,
+:class:`~softhand.fem.hand.reservoir.SheetModel`).
 """
 if __name__ != "softhand.fem":  # the folder on sys.path, imported by its short name
     raise ImportError(f"'{__name__}' is softhand.fem: import softhand.fem (after pip install -e .)")

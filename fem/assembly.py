@@ -105,7 +105,7 @@ class ElementScatter:
     def block_matrix_data(self, Ke: np.ndarray) -> np.ndarray:
         """CSR data of the sum of ALL elements' matrices given in the block layout
         Ke[e, n, a, b, m] (row dof: node n, component a; column dof: node m, component b;
-        shape (nel, nloc, 3, 3, nloc), as :func:`fem.solid.element_matrices` writes them).
+        shape (nel, nloc, 3, 3, nloc), as :func:`softhand.fem.solid.element_matrices` writes them).
 
         One bincount over the whole mesh (a chunk-wise scatter re-reads the nnz-long data
         array once per chunk); the positions in that layout are computed once and kept as
@@ -134,7 +134,7 @@ class ElementScatter:
 
     def add_chunk_vectors(self, out: np.ndarray, parts: list) -> None:
         """out += scatter of the element vectors of ALL elements, given chunk by chunk in order
-        (the parts of :func:`fem.threads.map_chunks`): one bincount, the dofs kept."""
+        (the parts of :func:`softhand.fem.threads.map_chunks`): one bincount, the dofs kept."""
         dofs = self._cache.get("vector_dofs")
         if dofs is None:
             dofs = self._cache["vector_dofs"] = self.vector_dofs().ravel()
@@ -152,7 +152,7 @@ class Restriction:
 
     ``restrict(K)`` is a gather of K.data (no sparse slicing per Newton iterate);
     :meth:`block_matrix` scatters element matrices straight into the restricted
-    pattern (no full matrix, no gather: what :meth:`fem.solid.Solid.residual_tangent`
+    pattern (no full matrix, no gather: what :meth:`softhand.fem.solid.Solid.residual_tangent`
     does with ``restriction=``); ``expand(x, fill)`` puts a reduced vector back into a full one.
     """
 

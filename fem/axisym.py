@@ -27,12 +27,12 @@ form). ``pressure="P0"`` gives the classical mean dilatation (Q2/P0, Simo–Tayl
 through-thickness pressure of a bending plate: with n layers it loses 1/n² of the
 volumetric share of the bending stiffness (plate 19 % too soft with 2 layers), which P1
 represents exactly with one. Both parts of ψ come from the 3D material of
-:mod:`fem.materials` through its ``split()``.
+:mod:`softhand.fem.materials` through its ``split()``.
 
 Assembly: the 18 × 18 element matrices of all elements come from one ``einsum`` over
-quadrature points and are scattered into a CSR pattern built once (:class:`fem.assembly.DofScatter`).
+quadrature points and are scattered into a CSR pattern built once (:class:`softhand.fem.assembly.DofScatter`).
 
-:class:`RevolvedVolume` is the volume enclosed between a boundary curve of the mesh,
+:class:`~softhand.fem.axisym.RevolvedVolume` is the volume enclosed between a boundary curve of the mesh,
 revolved about the axis, and the plane z = 0: the oil volume of a reservoir sheet measured
 from its clamp plane, or the cavity of a balloon modelled with a z = 0 symmetry plane.
 """
@@ -50,7 +50,7 @@ __all__ = ["AxisymSolid", "RevolvedVolume"]
 class AxisymSolid:
     """Nearly incompressible hyperelastic solid of revolution on a quadrilateral r–z mesh.
 
-    ``material`` is a :mod:`fem.materials` law whose ``split()`` gives (isochoric law,
+    ``material`` is a :mod:`softhand.fem.materials` law whose ``split()`` gives (isochoric law,
     volumetric part with ``U, dU, ddU``); the volumetric part enters through the mean
     dilatation. ``intorder`` 4 integrates the Q2 stiffness (and the 1/r terms) well.
     """

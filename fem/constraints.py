@@ -30,7 +30,7 @@ displacement DOFs of the tied nodes follow the links, :math:`u = T(y)` with
 term from the rotation (the constraint's geometric stiffness).
 
 Loads on the links (contact, a grasped object's weight) enter as generalised forces on
-:math:`q`: :meth:`PlanarChain.point_load` turns point forces on link points into
+:math:`q`: :meth:`~softhand.fem.constraints.PlanarChain.point_load` turns point forces on link points into
 :math:`Q = J^T f` and its derivative.
 
 Angles are positive counter-clockwise about +z (radians).
@@ -47,7 +47,7 @@ OMEGA = np.array([[0.0, -1.0], [1.0, 0.0]])
 
 
 def rotation(phi) -> np.ndarray:
-    """In-plane rotation matrices R(phi), shape (2, 2, *phi.shape)."""
+    """In-plane rotation matrices R(phi), shape ``(2, 2, *phi.shape)``."""
     c, s = np.cos(phi), np.sin(phi)
     return np.array([[c, -s], [s, c]])
 

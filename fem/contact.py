@@ -4,7 +4,7 @@ The object is seen in the chain's plane as a circle (centre :math:`C`, radius :m
 a cylinder whose axis is normal to the bending plane, or a sphere centred in that plane --
 against flat rigid pads the two give the same contact. Link :math:`k` grasps with its
 *pad*, the segment of its reference line :math:`y = y_p` between its two ends
-:math:`s_k, s_{k+1}`, facing :math:`+y` (the finger frame of :mod:`fem.finger`: the hinge
+:math:`s_k, s_{k+1}`, facing :math:`+y` (the finger frame of :mod:`softhand.fem.hand.finger`: the hinge
 plate side). A link touches the object with the point of its pad closest to :math:`C`:
 
 .. math:: x^* = x(X^*, q),\quad X^* = \arg\min_{X \in \text{pad}} |C - x(X, q)|,\qquad

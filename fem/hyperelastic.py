@@ -1,12 +1,12 @@
-r"""Nearly incompressible rubber of any :mod:`reduced.rubber` model as an FEM law.
+r"""Nearly incompressible rubber of any :mod:`softhand.reduced.rubber` model as an FEM law.
 
 The strain energy is split into an isochoric and a volumetric part,
 
 .. math:: \psi(F) = W(\bar\lambda_1, \bar\lambda_2, \bar\lambda_3) + \tfrac{\kappa}{2}(J - 1)^2,
           \qquad \bar\lambda_i = J^{-1/3}\lambda_i ,
 
-so that the mean-dilatation solids (P2-P0 in :mod:`fem.solid`, Q2/P1disc in
-:mod:`fem.axisym`) take the volumetric part element-wise: locking-free for every model.
+so that the mean-dilatation solids (P2-P0 in :mod:`softhand.fem.solid`, Q2/P1disc in
+:mod:`softhand.fem.axisym`) take the volumetric part element-wise: locking-free for every model.
 The same W object serves the reduced model; here it is evaluated at the isochoric
 invariants or stretches of F.
 
@@ -24,7 +24,7 @@ stretches of F (from the eigen-decomposition of C); P = sum_a Phi_a n_a (x) N_a 
 tangent is the spectral formula with the coefficients
 (Phi_a lambda_a - Phi_b lambda_b) / (lambda_a^2 - lambda_b^2) and
 (Phi_a lambda_b - Phi_b lambda_a) / (lambda_a^2 - lambda_b^2), replaced by their limits
-where two stretches coincide (:func:`_pair_coefficients`).
+where two stretches coincide (``_pair_coefficients()``).
 """
 from __future__ import annotations
 
@@ -47,7 +47,7 @@ def _eye4(ndim_batch):
 
 @dataclass(frozen=True)
 class IsochoricRubber(Law):
-    """The isochoric part W(J^{-1/3} lambda_i) of a :mod:`reduced.rubber` model."""
+    """The isochoric part W(J^{-1/3} lambda_i) of a :mod:`softhand.reduced.rubber` model."""
 
     material: rubber_models.Rubber
 
@@ -181,8 +181,8 @@ def _pair_coefficients(lam, Phi1, Phi2):
 
 @dataclass(frozen=True)
 class RubberLaw(SplitLaw):
-    """W(J^{-1/3} lambda_i) + kappa/2 (J - 1)^2: any :mod:`reduced.rubber` model, split for the
-    mean-dilatation solids (``kappa`` default 1000 mu0, as :class:`fem.materials.NeoHookean`)."""
+    """W(J^{-1/3} lambda_i) + kappa/2 (J - 1)^2: any :mod:`softhand.reduced.rubber` model, split for the
+    mean-dilatation solids (``kappa`` default 1000 mu0, as :class:`softhand.fem.materials.NeoHookean`)."""
 
     material: rubber_models.Rubber
     kappa: float | None = None  #: bulk modulus [MPa]
@@ -197,7 +197,7 @@ class RubberLaw(SplitLaw):
 
 
 def rubber_law(material: rubber_models.Rubber, kappa: float):
-    """The FEM law of a rubber: the closed-form :class:`fem.materials.NeoHookean` for NH."""
+    """The FEM law of a rubber: the closed-form :class:`softhand.fem.materials.NeoHookean` for NH."""
     from softhand.fem.materials import NeoHookean
 
     if isinstance(material, rubber_models.NeoHookean):

@@ -18,7 +18,7 @@ vertices), so a field is never evaluated where the state is not known to be vali
 mean-dilatation solid) its volumetric part is :math:`U'(\bar J)\,I`, as in that formulation.
 
 A *scene* (:func:`write_scene`, :class:`SceneSeries`) is a ``.vtm`` multiblock file of
-named blocks (:class:`fem.scene.Block`: the tube, the links, the object, ...), each a
+named blocks (:class:`softhand.fem.hand.scene.Block`: the tube, the links, the object, ...), each a
 ``.vtu`` in a folder next to it; a :class:`SceneSeries` lists one scene per load step in
 a ``.pvd``. All files are written atomically (temporary name + rename).
 """
@@ -70,7 +70,7 @@ def write_state(path: str | Path, basis: Basis, u: np.ndarray, law=None, *, J_ba
 
 
 class VtkSeries:
-    """A ``.pvd`` collection over load steps; each :meth:`write` adds a ``.vtu`` and rewrites
+    """A ``.pvd`` collection over load steps; each ``write()`` adds a ``.vtu`` and rewrites
     the ``.pvd`` (atomically), so after an interruption every listed state is complete."""
 
     def __init__(self, pvd_path: str | Path):
@@ -87,7 +87,7 @@ class VtkSeries:
 
 
 def write_scene(path: str | Path, blocks, field_data: dict | None = None) -> Path:
-    """Write the blocks (:class:`fem.scene.Block`) as ``<stem>/<name>.vtu`` and the ``.vtm``
+    """Write the blocks (:class:`softhand.fem.hand.scene.Block`) as ``<stem>/<name>.vtu`` and the ``.vtm``
     listing them by name; every block gets ``field_data`` (numbers, e.g. the pressure)."""
     path = Path(path)
     rows = []
@@ -220,7 +220,7 @@ def _extend_to_nodes(value: np.ndarray, scalar: Basis) -> np.ndarray:
 
 def solid_output(solid, u: np.ndarray) -> dict:
     """Keyword arguments of :func:`write_state` / :meth:`VtkSeries.write` for a
-    :class:`fem.solid.Solid` (its vector basis, law and, if mean-dilatation, J_bar)."""
+    :class:`softhand.fem.solid.Solid` (its vector basis, law and, if mean-dilatation, J_bar)."""
     from skfem import ElementVector
 
     basis = Basis(solid.mesh, ElementVector(solid.element), intorder=2)

@@ -27,7 +27,7 @@ EPS[0, 2, 1] = EPS[2, 1, 0] = EPS[1, 0, 2] = -1.0
 
 
 def identity(batch=()) -> np.ndarray:
-    """Identity tensor broadcast to shape (3, 3, *batch)."""
+    """Identity tensor broadcast to shape ``(3, 3, *batch)``."""
     return np.eye(3).reshape((3, 3) + (1,) * len(batch)) * np.ones(batch)
 
 
@@ -39,7 +39,7 @@ def det(F: np.ndarray) -> np.ndarray:
 
 
 def cofactor(F: np.ndarray) -> np.ndarray:
-    """cof F = J F^{-T} = dJ/dF, shape (3, 3, *batch)."""
+    """cof F = J F^{-T} = dJ/dF, shape ``(3, 3, *batch)``."""
     C = np.empty_like(F)
     for a in range(3):
         b, c = (a + 1) % 3, (a + 2) % 3
@@ -50,22 +50,22 @@ def cofactor(F: np.ndarray) -> np.ndarray:
 
 
 def inv_transpose(F: np.ndarray) -> np.ndarray:
-    """F^{-T}, shape (3, 3, *batch)."""
+    """F^{-T}, shape ``(3, 3, *batch)``."""
     return cofactor(F) / det(F)
 
 
 def d2det(F: np.ndarray) -> np.ndarray:
-    """Second derivative of J: eps_abc eps_KLM F_cM, shape (3, 3, 3, 3, *batch) [a, K, b, L]."""
+    """Second derivative of J: eps_abc eps_KLM F_cM, shape ``(3, 3, 3, 3, *batch)`` [a, K, b, L]."""
     return np.einsum("abc,KLM,cM...->aKbL...", EPS, EPS, F, optimize=True)
 
 
 def right_cauchy_green(F: np.ndarray) -> np.ndarray:
-    """C = F^T F, shape (3, 3, *batch)."""
+    """C = F^T F, shape ``(3, 3, *batch)``."""
     return np.einsum("aK...,aL...->KL...", F, F)
 
 
 def outer(A: np.ndarray, B: np.ndarray) -> np.ndarray:
-    """(A ⊗ B)_{aKbL} = A_aK B_bL, shape (3, 3, 3, 3, *batch)."""
+    """(A ⊗ B)_{aKbL} = A_aK B_bL, shape ``(3, 3, 3, 3, *batch)``."""
     return np.einsum("aK...,bL...->aKbL...", A, B)
 
 
@@ -75,7 +75,7 @@ def outer_swap(A: np.ndarray, B: np.ndarray) -> np.ndarray:
 
 
 def deformation_gradient(grad_u: np.ndarray) -> np.ndarray:
-    """F = I + grad u for grad u of shape (3, 3, *batch)."""
+    """F = I + grad u for grad u of shape ``(3, 3, *batch)``."""
     F = grad_u.copy()
     F[0, 0] += 1.0
     F[1, 1] += 1.0

@@ -15,7 +15,7 @@ SuperLU's default COLAMD; the one python-mumps wheel does not import with NumPy 
 fallback is announced once (a :class:`RuntimeWarning`) with its expected slowdown.
 
 The backends, their bookkeeping, the reuse of the symbolic analysis and PARDISO's mixed
-precision are in :mod:`fem.linsolve_backends`.
+precision are in :mod:`softhand.fem.linsolve_backends`.
 """
 from __future__ import annotations
 

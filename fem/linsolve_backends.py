@@ -1,4 +1,4 @@
-"""The sparse direct solver backends behind :func:`fem.linsolve.make_solver`.
+"""The sparse direct solver backends behind :func:`softhand.fem.linsolve.make_solver`.
 
 The symbolic analysis (ordering + symbolic factorisation) is done once per sparsity
 pattern and reused for every later matrix with the same pattern (PARDISO phase 11
@@ -11,7 +11,7 @@ x <- x + LU^-1 (b - K x) with the residual in double, until
 ``||b - K x|| <= REFINE_RTOL ||b||`` -- the accuracy of the double-precision solve (2e-11
 there). Each step gains a factor ~cond(K) eps_single (60x on that tangent, 4-5 steps).
 When the refinement stalls or is too slow to reach it in REFINE_MAX steps (an
-ill-conditioned K, e.g. kappa/mu = 1000 rubber with fibers) the solver falls back to double precision for good and says so in :meth:`describe`.
+ill-conditioned K, e.g. kappa/mu = 1000 rubber with fibers) the solver falls back to double precision for good and says so in ``describe()``.
 """
 from __future__ import annotations
 
@@ -29,9 +29,9 @@ REFINE_MAX = 8  #: mixed precision: refinement steps before falling back to doub
 def _pardiso_handle(**kwargs):
     """A new pypardiso solver. pypardiso looks for MKL by a recursive glob of the environment
     (0.2-0.3 s, 80 000 entries here) unless PYPARDISO_MKL_RT names the library: it is looked
-    for first where the MKL wheels put it (:func:`_wheel_mkl_rt`), and the first handle's
+    for first where the MKL wheels put it (``_wheel_mkl_rt()``), and the first handle's
     library is put there. MKL's OpenMP threads sleep as soon as a parallel region ends
-    (``KMP_BLOCKTIME=0``, read when MKL starts its threads; see :mod:`fem.threads`) unless the
+    (``KMP_BLOCKTIME=0``, read when MKL starts its threads; see :mod:`softhand.fem.threads`) unless the
     environment sets it."""
     os.environ.setdefault("KMP_BLOCKTIME", "0")
     if "PYPARDISO_MKL_RT" not in os.environ and (found := _wheel_mkl_rt()):

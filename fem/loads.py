@@ -197,7 +197,7 @@ def volume_control(R: np.ndarray, K: sp.spmatrix | None, p: float, cavity, u, V_
 
     R, K: residual and tangent of everything else at u (solid + other loads; K None: the
     residual alone); cavity: its volume functional (``value``, ``gradient``, ``hessian``:
-    :class:`CavityVolume`, :class:`fem.axisym.RevolvedVolume`);
+    :class:`CavityVolume`, :class:`softhand.fem.axisym.RevolvedVolume`);
     returns (R_b (ndofs+1,), K_b CSR (ndofs+1)^2 or None, symmetric if K is):
 
         [ R - p dV/du ]      [ K - p d2V/du2   -dV/du ]

@@ -21,10 +21,10 @@ Laws (J = det F, I1 = tr C, C = F^T F, F^{-T} = cof F / J):
 
 Laws add up (``NeoHookean(...) + Fibers(...)``). A law with a volumetric part
 offers ``split() -> (deviatoric_law, volumetric)``; the solid uses it for the
-locking-free mean-dilatation (P2-P0) formulation, see :mod:`fem.solid`. A sum splits
+locking-free mean-dilatation (P2-P0) formulation, see :mod:`softhand.fem.solid`. A sum splits
 into the sum of its parts' deviatoric laws and its one volumetric part, so
 ``NeoHookeanIsochoric(mu) + Volumetric(kappa)`` is split like ``NeoHookean(mu, kappa)``
-(two volumetric parts are refused). Other rubber models: :mod:`fem.hyperelastic`.
+(two volumetric parts are refused). Other rubber models: :mod:`softhand.fem.hyperelastic`.
 Small-strain limits: NH -> Hooke with shear modulus mu and bulk modulus kappa;
 cNH -> Hooke with Lame constants lambda, mu.
 """
@@ -116,7 +116,7 @@ class NeoHookeanIsochoric(Law):
 
 
 class SplitLaw(Law):
-    """A law defined by its :meth:`split` (isochoric part, volumetric part): energy, stress and
+    """A law defined by its ``split()`` (isochoric part, volumetric part): energy, stress and
     tangent are the sums of the parts'."""
 
     def energy(self, F):
@@ -178,9 +178,9 @@ class CompressibleNeoHookean(Law):
 
 @dataclass(frozen=True, eq=False)
 class Fibers(Law):
-    r"""Tension-only fiber family psi = k/2 (lam_f - 1)^2 for lam_f = |F a0| > 1, else 0.
+    r"""Tension-only fiber family psi = k/2 (lam_f - 1)^2 for lam_f = ``|F a0|`` > 1, else 0.
 
-    ``a0``: reference fiber direction(s), shape (3,) or (3, *b) with b aligned with the
+    ``a0``: reference fiber direction(s), shape ``(3,)`` or ``(3, *b)`` with b aligned with the
     LEADING batch axes of F (e.g. (3, nel) per element or (3, nel, nqp) per quadrature
     point for the solid's batch (nel, nqp)); normalised here.
     """
@@ -202,7 +202,7 @@ class Fibers(Law):
         return a0, f, lam, lam > 1.0
 
     def stretch(self, F):
-        """Fiber stretch |F a0|, shape batch."""
+        """Fiber stretch ``|F a0|``, shape batch."""
         return self._kinematics(F)[2]
 
     def energy(self, F):

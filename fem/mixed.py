@@ -1,11 +1,11 @@
-r"""The mixed (u, p) Newton iteration of a nearly incompressible :class:`fem.solid.Solid`.
+r"""The mixed (u, p) Newton iteration of a nearly incompressible :class:`softhand.fem.solid.Solid`.
 
 After a Newton step of the condensed mean-dilatation residual its element pressures
 U'(Jbar) are off by kappa times the second-order volume error, which poisons the next
 tangent's geometric term. The mixed iteration keeps the P0 pressure linearised at the
-previous accepted iterate (:class:`PressureAnchor`, made by ``Solid.anchor``); that is
+previous accepted iterate (:class:`~softhand.fem.mixed.PressureAnchor`, made by ``Solid.anchor``); that is
 Newton's method on the uncondensed three-field problem, ~4-5 full steps for kappa/mu =
-1e2..1e5 alike. :class:`MixedNewton` re-anchors it from the Newton driver's ``on_accept``.
+1e2..1e5 alike. :class:`~softhand.fem.mixed.MixedNewton` re-anchors it from the Newton driver's ``on_accept``.
 """
 from __future__ import annotations
 
@@ -33,12 +33,12 @@ class PressureAnchor:
 
 
 class MixedNewton:
-    """Glue for :func:`fem.newton.newton`: ``on_accept`` re-anchors the element pressures.
+    """Glue for :func:`softhand.fem.newton.newton`: ``on_accept`` re-anchors the element pressures.
 
     ``expand(x)`` must return the **full** displacement at the unknowns x, prescribed values
     included: the pressures are linearised at that state, and an anchor taken at a state
     with the prescribed displacements missing (zeros) makes Newton converge only linearly.
-    A :class:`fem.assembly.Restriction` built with ``values=`` expands that way. Usage::
+    A :class:`softhand.fem.assembly.Restriction` built with ``values=`` expands that way. Usage::
 
         red = Restriction(solid.ndofs, free, values=u_prescribed)
         mixed = MixedNewton(solid, red.expand)

@@ -32,7 +32,7 @@ the boundary elements alone), or none; or Newton starts at the secant extrapolat
 the last two converged states (``predictor="secant"``); a step that fails is
 halved (cut-back) down to ``min_dt``; easy steps let the increment grow again, and so do
 ``grow_after`` converged steps in a row after a cut-back.
-On final failure :class:`NotConverged` carries the last converged (t, x).
+On final failure :class:`~softhand.fem.newton.NotConverged` carries the last converged (t, x).
 """
 from __future__ import annotations
 
@@ -59,7 +59,7 @@ class NewtonOptions:
     #: steps, halved only where R is not finite (the mixed (u, p) iteration, see fem.solid.MixedNewton)
     #: "decrease": the first step whole, then halving until ``newton``'s ``merit`` decreases
     merit: str = "slope"
-    eta: float = 0.5  #: "slope": accept when |R(x + s dx).dx| <= eta |R(x).dx|
+    eta: float = 0.5  #: "slope": accept when ``|R(x + s dx).dx|`` <= eta ``|R(x).dx|``
     max_backtracks: int = 6  #: trial steps before taking the last one
     armijo: float = 1e-4  #: "residual": sufficient-decrease constant c
     #: "always": factorise the tangent at every iterate (Newton); "adaptive": quasi-Newton on
@@ -116,21 +116,21 @@ def newton(fun, x0, options: NewtonOptions = NewtonOptions(), *, solver=None, sc
            direction=None, on_accept=None, residual=None, converged=None, merit=None) -> NewtonResult:
     """Solve R(x) = 0 from x0; raises NotConverged with the residual history.
 
-    fun(x) -> (R, K); solver: a :mod:`fem.linsolve` solver (default auto, unsymmetric);
+    fun(x) -> (R, K); solver: a :mod:`softhand.fem.linsolve` solver (default auto, unsymmetric);
     scale: reference for the relative tolerance (default ||R(x0)||);
     direction: search direction of the first iteration instead of -K^{-1} R (a load-step
     predictor, line-searched like a Newton step); on_accept(x): called with x0 and every
-    accepted iterate before fun is evaluated around it (e.g. :class:`fem.solid.MixedNewton`);
+    accepted iterate before fun is evaluated around it (e.g. :class:`softhand.fem.mixed.MixedNewton`);
     residual(x) -> R: optional, fun's residual alone, for the line search's trial points and
     (Newton) the iterates, whose tangent is then evaluated only when a step needs it (not at a
     start that takes ``direction``, nor at the converged iterate);
     converged(x, R, it) -> bool: optional test of the iterate x (it Newton iterations so far)
     instead of ||R|| <= atol + rtol scale, e.g. one tolerance per block of a bordered system
-    (:mod:`fem.volume_path`); merit(x, R) -> float: the measure of ``options.merit = "decrease"``.
+    (:mod:`softhand.fem.volume_path`); merit(x, R) -> float: the measure of ``options.merit = "decrease"``.
 
     ``options.refactor = "adaptive"`` (quasi-Newton): the direction is
     :math:`-H R` with H the limited-memory BFGS update (secant pairs of the accepted steps
-    since the last factorisation, :func:`fem.newton_steps.bfgs_direction`) of the inverse of the last
+    since the last factorisation, :func:`softhand.fem.newton_steps.bfgs_direction`) of the inverse of the last
     factorised tangent, so an iteration costs a residual and a solve with the stored factor
     instead of an assembly and a factorisation. A step that does not lower ||R|| is
     discarded and redone with the tangent at the same iterate; one that lowers it by less
@@ -233,7 +233,7 @@ def forcing_term(history, tol: float, largest: float, etas) -> float:
 @dataclass(frozen=True)
 class PathOptions:
     steps: int = 5  #: initial number of equal load steps on t in [0, 1] (the whole path)
-    #: first increment of t instead (e.g. a volume [mm^3] for :func:`fem.volume_path.follow_volume`)
+    #: first increment of t instead (e.g. a volume [mm^3] for :func:`softhand.fem.volume_path.follow_volume`)
     first_step: float | None = None
     max_step: float = np.inf  #: largest increment of t
     min_dt: float = 1e-4  #: smallest load increment before giving up
@@ -278,7 +278,7 @@ def solve_path(fun_t, x0, options: PathOptions = PathOptions(), *, solver=None, 
     relative tolerance at t (e.g. the norm of the external load); callback(t, x) after each
     converged step; on_accept: passed to :func:`newton` (also called before each predictor);
     residual_t(x, t) -> R, converged_t(x, R, it, t) -> bool and merit_t(x, R, t) -> float:
-    optional, :func:`newton`'s ``residual``, ``converged`` and ``merit`` at t. On failure the :class:`NotConverged` also carries ``t``,
+    optional, :func:`newton`'s ``residual``, ``converged`` and ``merit`` at t. On failure the :class:`~softhand.fem.newton.NotConverged` also carries ``t``,
     the load it failed at.
     """
     solver = solver or make_solver()

@@ -1,4 +1,4 @@
-"""The pieces of :mod:`fem.newton`'s iterations: the step length on the Newton direction
+"""The pieces of :mod:`softhand.fem.newton`'s iterations: the step length on the Newton direction
 (line search, see that module's docstring for the merits), the limited-memory BFGS
 direction of its quasi-Newton mode, and a load step's predictor and step-size update."""
 from __future__ import annotations
@@ -30,7 +30,7 @@ def add_pair(pairs, s, y, memory):
 
 def line_search(fun, x, dx, R0, norm0, options, residual=None, merit=None, first=False):
     """Step length on x + s dx; returns the accepted (x, R, K, ||R||, s); K is None when
-    only ``residual`` was evaluated (the caller evaluates a tangent where a step needs one). See :mod:`fem.newton`'s docstring.
+    only ``residual`` was evaluated (the caller evaluates a tangent where a step needs one). See :mod:`softhand.fem.newton`'s docstring.
 
     merit(x, R) -> float: the measure "decrease" compares (default ||R||); first: the solve's
     first step ("decrease" takes it whole)."""

@@ -30,7 +30,7 @@ Newton for nearly incompressible rubber: the residual above is a penalty-like
 function of u; after a Newton step its element pressures U'(Jbar) are off by
 kappa times the second-order volume error, which poisons the next tangent's
 geometric term. The mixed (u, p) iteration keeps the P0 pressure linearised at the
-previous iterate instead (:class:`PressureAnchor`, :class:`MixedNewton`, passed as
+previous iterate instead (:class:`~softhand.fem.mixed.PressureAnchor`, :class:`~softhand.fem.mixed.MixedNewton`, passed as
 ``anchor=``); it is the Newton method of the uncondensed three-field problem and
 converges in ~4-5 full steps for kappa/mu = 1e2..1e5 alike (tests/fem/test_solid.py),
 where the displacement iteration needs cut-backs or diverges (kappa/mu >= 1e4).
@@ -39,9 +39,9 @@ Kernels: F, P and A are evaluated once per iterate at all quadrature points; the
 element matrices come from two batched matrix products over all basis pairs,
 written in a block layout that needs no transposed copy into one buffer for the
 whole mesh (kept between iterates: nel (3 nloc)^2 doubles, 117 MB at 80k DOFs), and
-scattered by :class:`fem.assembly.ElementScatter` into a CSR pattern built once, in
+scattered by :class:`softhand.fem.assembly.ElementScatter` into a CSR pattern built once, in
 one pass. Elements are processed in chunks (memory of the intermediates), never one
-by one, the chunks side by side in threads (:mod:`fem.threads`).
+by one, the chunks side by side in threads (:mod:`softhand.fem.threads`).
 """
 from __future__ import annotations
 
@@ -62,7 +62,7 @@ FORMULATIONS = ("mean_dilatation", "displacement")
 class Solid:
     """A hyperelastic body: ``Solid(mesh, law)``; see the module docstring for the formulations.
 
-    mesh: skfem MeshTet or MeshTet2 (quadratic geometry); law: a :mod:`fem.materials` law
+    mesh: skfem MeshTet or MeshTet2 (quadratic geometry); law: a :mod:`softhand.fem.materials` law
     (fiber directions per element, shape (3, nel), or per quadrature point, (3, nel, nqp));
     intorder: quadrature degree (default 2: 4 points, exact for linear P2 stiffness);
     chunk: elements per vectorised batch (bounds the memory of element matrices).
@@ -176,7 +176,7 @@ class Solid:
                          restriction: "Restriction | None" = None):
         """(residual, tangent CSR) in one pass over the elements.
 
-        restriction: a :class:`fem.assembly.Restriction` (e.g. to the free dofs): returns
+        restriction: a :class:`softhand.fem.assembly.Restriction` (e.g. to the free dofs): returns
         (R[keep], K[keep][:, keep]), the tangent scattered straight into the restricted
         pattern (no full matrix and no gather per Newton iterate).
 
@@ -185,7 +185,7 @@ class Solid:
         linearised at the last accepted Newton iterate (``self.anchor(u_k)``) instead of
         U'(Jbar(u)). The residual is unchanged (so is the solution); Newton then
         converges in a number of iterations independent of kappa/mu (see
-        :class:`MixedNewton`), where the plain displacement iteration needs many more
+        :class:`~softhand.fem.mixed.MixedNewton`), where the plain displacement iteration needs many more
         and diverges for kappa/mu >~ 1e4.
         """
         if restriction is not None:
@@ -201,7 +201,7 @@ class Solid:
     def residual_element_matrices(self, u: np.ndarray, anchor: "PressureAnchor | None" = None):
         """(residual, element matrices in the block layout of :func:`element_matrices`, not yet
         scattered) for callers that add element terms of their own before the one scatter
-        (:meth:`fem.assembly.ElementScatter.block_matrix_data`); the buffer is reused by the
+        (:meth:`softhand.fem.assembly.ElementScatter.block_matrix_data`); the buffer is reused by the
         next call."""
         return self._assemble(u, tangent=True, anchor=anchor, scatter=False)
 

@@ -8,7 +8,7 @@ chunks' intermediates, ~20 MB, evict each other from the cache), and 40 ms in ch
 512 on two (:data:`CHUNK`).
 
 Threads: ``OMP_NUM_THREADS`` when it is set (a batch worker's share of the cores, see
-:mod:`studies.batch.pool`), else the cores this process may run on.
+:mod:`softhand.studies.batch.pool`), else the cores this process may run on.
 
 Threads that wait by spinning: OpenBLAS's threads (NumPy's and SciPy's BLAS) and MKL's
 OpenMP threads (PARDISO) keep a core busy for a while after each call. The FEM's BLAS
@@ -17,8 +17,8 @@ threads, which then spun beside PARDISO's factorisation and the element kernels:
 finger curve (default mesh, 2 cores) took 19.8 s with them, 15.9 s with OpenBLAS on one
 thread (PARDISO's time 9.6 -> 6.8 s) and 15.0 s with MKL's threads also asleep right after
 a parallel region (``KMP_BLOCKTIME=0``: the tangent 133 -> 114 ms). :func:`quiet_blas`
-does the first when a FEM solver is made (:func:`fem.linsolve.make_solver`); the second is
-set before MKL is loaded (:mod:`fem.linsolve_backends`), unless the environment says otherwise.
+does the first when a FEM solver is made (:func:`softhand.fem.linsolve.make_solver`); the second is
+set before MKL is loaded (:mod:`softhand.fem.linsolve_backends`), unless the environment says otherwise.
 """
 from __future__ import annotations
 

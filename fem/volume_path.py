@@ -6,23 +6,23 @@ control has no solution. The equilibrium states are the stationary points of
 
 .. math:: L(u, p) = Π(u) - p\,(V(u) - V^*),
 
-the bordered (symmetric, indefinite) system of :func:`fem.loads.volume_control` on the free
+the bordered (symmetric, indefinite) system of :func:`softhand.fem.loads.volume_control` on the free
 DOFs and p, which stays regular at and past the pressure maximum, where :math:`K - pH_V`
 itself is singular. Along the path :math:`dΠ/dV^* = p`, so :math:`\int p\,dV = Π` is an
 independent check of the residual, the tangent-free parts and the volume functional
 (``tests/fem/test_reservoir.py``).
 
-The path is the load path of :func:`fem.newton.solve_path` with the load t = V* [mm^3]:
+The path is the load path of :func:`softhand.fem.newton.solve_path` with the load t = V* [mm^3]:
 the same Newton iteration, line search, cut-back and step growth as every other FEM
 path, set up by :func:`volume_path_options`: Newton starts at the secant extrapolation
 of the last two states, takes its first step whole and halves later ones until the merit
-|R_u| / f + |R_V| / v decreases (f the largest force scale |p g_V|, |Π'| met in the solve,
+``|R_u|`` / f + ``|R_V|`` / v decreases (f the largest force scale ``|p g_V|``, ``|Π'|`` met in the solve,
 v the volume scale); increments in mm^3 from a first step up to a largest one. Only the
 measures are the border's own: the merit, and the convergence test -- the force residual
-relative to the pressure load |p g_V| (or |Π'|), the volume residual relative to the
+relative to the pressure load ``|p g_V|`` (or ``|Π'|``), the volume residual relative to the
 volume scale, or the merit below a round-off floor and no longer halving (the bordered
 matrix's condition grows with κ/μ and the mesh). Raises :class:`VolumeNotConverged` (a
-:class:`fem.newton.NotConverged`, the one failure type of the FEM solvers) with the residual
+:class:`softhand.fem.newton.NotConverged`, the one failure type of the FEM solvers) with the residual
 history and the last converged state.
 """
 from __future__ import annotations
@@ -46,7 +46,7 @@ FLOOR = 1e-5
 
 def volume_path_options(*, first_step: float = 1.0, max_step: float = 200.0, atol: float = 0.0,
                         min_step: float = 1e-6, max_iter: int = 12) -> PathOptions:
-    """:class:`fem.newton.PathOptions` of a volume path: increments [mm^3] from ``first_step``
+    """:class:`softhand.fem.newton.PathOptions` of a volume path: increments [mm^3] from ``first_step``
     up to ``max_step``, grown 1.5x after a step of at most 5 iterations, halved down to
     ``min_step``; ``max_iter`` Newton iterations a step, from the secant predictor; ``atol``:
     force residual floor [N] (round-off of the stiff volumetric terms); the force residual
@@ -70,7 +70,7 @@ class PathState:
 
 class VolumeNotConverged(NotConverged):
     """Newton failed at the smallest volume step; ``last``: the last converged :class:`PathState`
-    (also as ``last_converged`` = (volume, u) and ``x`` = its u, like every :class:`NotConverged`)."""
+    (also as ``last_converged`` = (volume, u) and ``x`` = its u, like every :class:`~softhand.fem.newton.NotConverged`)."""
 
     def __init__(self, message, history, last: PathState):
         super().__init__(message, history, last.u, (last.volume, last.u))
@@ -85,7 +85,7 @@ class _Bordered:
         self.solid, self.volume, self.volume_scale, self.newton = solid, volume, volume_scale, newton
         self.free, self.red = free, Restriction(n + 1, np.append(free, n))
         self.merits, self.fnorm = [], 1.0  # the merits and the largest force scale of this solve
-        self.forces = (None, 0.0)  # (x, max(|p g_V|, |Π'|)) of the last call
+        self.forces = (None, 0.0)  # (x, max(``|p g_V|``, ``|Π'|``)) of the last call
 
     def split(self, x):
         """(u [mm] (ndofs,), p [MPa]) of x."""
@@ -100,22 +100,22 @@ class _Bordered:
         f = self.solid.residual(u)
         Rb, Kb = volume_control(f, self.solid.tangent(u) if tangent else None, p, self.volume, u, V)
         Rb, f = self.red.vector(Rb), f[self.free]
-        self.forces = (x, max(np.linalg.norm(f - Rb[:-1]), np.linalg.norm(f)))  # |p g_V|, |Π'|
+        self.forces = (x, max(np.linalg.norm(f - Rb[:-1]), np.linalg.norm(f)))  # ``|p g_V|``, ``|Π'|``
         return Rb, None if Kb is None else self.red.restrict(Kb)
 
     def force_scale(self, x, V) -> float:
-        """max(|p g_V|, |Π'|) [N] at x."""
+        """max(``|p g_V|``, ``|Π'|``) [N] at x."""
         if not (self.forces[0] is x or np.array_equal(self.forces[0], x)):
             self(x, V, tangent=False)
         return self.forces[1]
 
     def merit(self, x, R, V) -> float:
-        """|R_u| / f + |R_V| / v: f the largest force scale of the solve (x's included)."""
+        """``|R_u|`` / f + ``|R_V|`` / v: f the largest force scale of the solve (x's included)."""
         f = max(self.fnorm, self.force_scale(x, V))
         return float(np.linalg.norm(R[:-1]) / f + abs(R[-1]) / max(abs(V), self.volume_scale))
 
     def converged(self, x, R, it, V) -> bool:
-        """Force residual within rtol |p g_V| + atol and volume residual within VTOL, or the
+        """Force residual within rtol ``|p g_V|`` + atol and volume residual within VTOL, or the
         merit below FLOOR and no longer halving (round-off)."""
         fscale = self.force_scale(x, V)
         self.fnorm = max(fscale, self.newton.atol, 1e-300) if it == 0 else max(self.fnorm, fscale)
@@ -134,7 +134,7 @@ def follow_volume(solid, volume, fixed_dofs, targets, *, options: PathOptions | 
     ``volume``: the cavity's functional (``value``, ``gradient``, ``hessian`` of V(u));
     ``targets`` [mm^3] must run strictly monotonically away from the start volume, up
     (inflating) or down (oil leaving); ``options``: default :func:`volume_path_options`;
-    ``solver``: a :mod:`fem.linsolve` solver (default: auto, symmetric). Returns (states at
+    ``solver``: a :mod:`softhand.fem.linsolve` solver (default: auto, symmetric). Returns (states at
     the targets, every converged state from the start on).
     """
     options = options or volume_path_options()

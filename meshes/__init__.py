@@ -1,6 +1,6 @@
 """gmsh geometry as code, meshes with named physical groups, and a mesh cache.
 
-Its public face: the test tube (:class:`Tube`, :func:`tube_mesh`), imported on first use; the
+Its public face: the test tube (:class:`~softhand.meshes.tube.Tube`, :func:`~softhand.meshes.tube.tube_mesh`), imported on first use; the
 finger's and the reservoir's meshers are in :mod:`softhand.meshes.finger` and
 :mod:`softhand.meshes.reservoir`.
 """

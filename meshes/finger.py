@@ -59,7 +59,7 @@ class FingerTube:
 
 
 def finger_geometry(model, tube: FingerTube, size: float) -> None:
-    """gmsh geometry function (see :mod:`meshes.gmsh_io`) of a :class:`FingerTube`."""
+    """gmsh geometry function (see :mod:`softhand.meshes.gmsh_io`) of a :class:`FingerTube`."""
     occ = model.occ
     r_out, cavity_end = tube.a + tube.b, tube.length - tube.cap
     cuts = tube.cuts()
@@ -146,7 +146,7 @@ def _band_of(tube: FingerTube, x: float) -> str:
 
 def finger_tube_mesh(tube: FingerTube, *, size: float, refine: int = 0) -> skfem.MeshTet2:
     """The cached quadratic (curved) tetrahedral mesh of ``tube``, element size ``size`` [mm],
-    each element then split ``refine`` times (size / 2**refine; see :func:`meshes.gmsh_io.generate_msh`)."""
+    each element then split ``refine`` times (size / 2**refine; see :func:`softhand.meshes.gmsh_io.generate_msh`)."""
     return load_mesh(finger_geometry, tube, size=size, order=2, refine=refine)
 
 

@@ -7,7 +7,7 @@ dataclass (or a mapping) of its dimensions in mm, ``size`` the target element si
 (it may refine locally with gmsh mesh size fields; point sizes are ignored). Only elements in physical groups are saved, so a
 geometry without a group of its top dimension gets one named ``"domain"``.
 
-gmsh is imported only inside ``meshes/``; callers use :mod:`meshes.cache`.
+gmsh is imported only inside ``meshes/``; callers use :mod:`softhand.meshes.cache`.
 """
 from __future__ import annotations
 

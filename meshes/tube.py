@@ -38,7 +38,7 @@ class Tube:
 
 
 def tube_geometry(model, tube: Tube, size: float) -> None:
-    """gmsh geometry function (see :mod:`meshes.gmsh_io`) of a :class:`Tube`."""
+    """gmsh geometry function (see :mod:`softhand.meshes.gmsh_io`) of a :class:`Tube`."""
     occ = model.occ
     top = tube.length + tube.cap
     body = [(3, occ.addCylinder(0, 0, 0, 0, 0, top, tube.outer_radius))]
@@ -77,5 +77,5 @@ def _classify_surfaces(model, tube: Tube) -> dict[str, list[int]]:
 
 def tube_mesh(tube: Tube, *, size: float, order: int = 2, refine: int = 0) -> skfem.Mesh:
     """The cached mesh of ``tube`` with element size ``size`` [mm] (MeshTet2 for order 2),
-    each element split ``refine`` times (see :func:`meshes.gmsh_io.generate_msh`)."""
+    each element split ``refine`` times (see :func:`softhand.meshes.gmsh_io.generate_msh`)."""
     return load_mesh(tube_geometry, tube, size=size, order=order, refine=refine)

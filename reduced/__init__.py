@@ -1,7 +1,7 @@
 """The paper's analytical virtual-work model and the design vocabulary (NumPy/SciPy only).
 
-Its public face: the design (:class:`HandDesign`, :func:`load_design`), the one input error
-(:class:`InputError`), and the model's modules (:mod:`~softhand.reduced.finger`,
+Its public face: the design (:class:`~softhand.reduced.design.HandDesign`, :func:`~softhand.reduced.design.load_design`), the one input error
+(:class:`~softhand.reduced.errors.InputError`), and the model's modules (:mod:`~softhand.reduced.finger`,
 :mod:`~softhand.reduced.hand`, :mod:`~softhand.reduced.reservoir`, ...), imported on first use.
 """
 if __name__ != "softhand.reduced":  # the folder on sys.path, imported by its short name

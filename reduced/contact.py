@@ -1,7 +1,7 @@
 r"""Where the closing finger meets an object: placement, contact angle, rolling weight vector.
 
 The object is a circle of diameter D in the bending plane, centred on the hand's axis at
-depth ``depth`` below the palm (the hand frame of :mod:`reduced.kinematics`: x outward,
+depth ``depth`` below the palm (the hand frame of :mod:`softhand.reduced.kinematics`: x outward,
 y down). Link k grasps with its *pad*, the segment of the hinge plate between its two
 joints, facing the hand's axis (the inward normal -n_out = -(cos alpha_k, sin alpha_k)).
 Its gap is the distance from the centre C to the closest pad point minus D/2; a pad whose
@@ -20,7 +20,7 @@ FEM (``fem.contact``), written here with NumPy alone so that the reduced model c
 
 The gap's gradient is analytic: hinge j turns every point beyond it, so the closest pad
 point x* of link k moves by dx*/dq_j = Omega (x* - x_j) (j <= k, Omega the rotation by
-+90 deg in the hand frame) and dg/dq_j = -nu . dx*/dq_j, nu = (C - x*)/|C - x*|.
++90 deg in the hand frame) and dg/dq_j = -nu . dx*/dq_j, nu = (C - x*)/``|C - x*|``.
 Units: mm, rad.
 """
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""The controllers of the hand's pump (see :mod:`reduced.control`, which runs them on the plant).
+"""The controllers of the hand's pump (see :mod:`softhand.reduced.control`, which runs them on the plant).
 
 :class:`AngleController` is the 2-DOF angle controller of eqs. (30), (31): feedforward
 f(theta_ref) (eq. (27) of the nominal design) + PI on the mean finger angle, with anti-windup

@@ -10,7 +10,7 @@ Two kinds of data, told apart by their columns:
 Lines starting with ``#`` are comments (a data file should say where it came from).
 Inside, angles are in radians (``theta``); degrees only in the file. Every problem
 (no such file, empty file, unknown or missing column, text in a number, a row with the
-wrong number of cells) is an :class:`~reduced.errors.InputError` naming the file, the
+wrong number of cells) is an :class:`~softhand.reduced.errors.InputError` naming the file, the
 line and the column.
 """
 from __future__ import annotations

@@ -15,7 +15,7 @@ Ambiguities of the paper resolved here (see ``docs/conventions.md``):
 
 Rubber. The paper's rubber is Neo-Hookean with the shear moduli ``mu_sf_MPa`` (finger)
 and ``mu_sr_MPa`` (reservoir sheet). A design file may give another strain energy per
-part (:mod:`reduced.rubber`) as a table::
+part (:mod:`softhand.reduced.rubber`) as a table::
 
     [finger.material]
     model = "yeoh"            # neo-hookean | mooney-rivlin | yeoh | gent | ogden
@@ -106,7 +106,7 @@ class HandDesign:
 
     # ------------------------------------------------------------------ validation
     def validate(self) -> None:
-        """Raise :class:`InputError` naming the first bad field (bounds: :data:`BOUNDS`)."""
+        """Raise :class:`~softhand.reduced.errors.InputError` naming the first bad field (bounds: :data:`~softhand.reduced.design_rules.BOUNDS`)."""
         for name, key in _KEY_OF.items():
             if key in BOUNDS:
                 _in_bounds(key, _to_public(name, getattr(self, name)))
@@ -209,6 +209,7 @@ _KEY_OF = {
     "finger_model": "finger_model", "tie_width": "tie_width_mm", "finger_table": "finger_table",
 }
 _FIELD_OF = {key: name for name, key in _KEY_OF.items()}
+#: the keys of a design file and of design overrides, with their units
 PUBLIC_KEYS = tuple(_KEY_OF.values())
 #: parts that may carry a ``[<part>.material]`` table, and the modulus key it sets
 PARTS = ("finger", "reservoir")

@@ -1,6 +1,6 @@
-"""What values a :class:`reduced.design.HandDesign` may take: one table of bounds per public
+"""What values a :class:`softhand.reduced.design.HandDesign` may take: one table of bounds per public
 key, the checks between fields, and the model-name check (each raises one
-:class:`reduced.errors.InputError` naming the field)."""
+:class:`softhand.reduced.errors.InputError` naming the field)."""
 from __future__ import annotations
 
 import math

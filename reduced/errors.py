@@ -1,6 +1,6 @@
 """The one error type for bad user input, shared by every layer.
 
-The CLI turns an :class:`InputError` into one line on stderr and exit code 2. The line is
+The CLI turns an :class:`~softhand.reduced.errors.InputError` into one line on stderr and exit code 2. The line is
 bounded in length: a huge value (a 50 MB list, a long string) is cut to its start.
 """
 from __future__ import annotations

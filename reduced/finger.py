@@ -13,7 +13,7 @@ Kevlar windings keep lambda_2 = 1 and the rubber is incompressible, so lambda_3 
 .. math:: W_f = \int \frac{\mu_{sf}}{2}(\lambda_f^2 + \lambda_f^{-2} - 2)\, l_0 \rho\, dr\, d\phi,
           \qquad \frac{dW_f}{d\theta} = \mu_{sf}\,\zeta_f(\theta)   \quad (9), (10).
 
-Other rubber (``design.finger_rubber``, :mod:`reduced.rubber`): the same kinematics
+Other rubber (``design.finger_rubber``, :mod:`softhand.reduced.rubber`): the same kinematics
 lambda_1 = lambda_f, lambda_2 = 1, lambda_3 = 1/lambda_f (pure shear, planar tension) give
 
 .. math:: W_f = \int \hat W(\lambda_f)\, l_0 \rho\, dr\, d\phi, \qquad

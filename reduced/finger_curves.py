@@ -19,7 +19,7 @@ _KNOTS = KNOTS
 
 
 class Hermite:
-    """Cubic Hermite interpolant on the uniform knots :data:`_KNOTS` of values f and slopes m
+    """Cubic Hermite interpolant on the uniform knots ``_KNOTS`` of values f and slopes m
     (the end pieces continue as polynomials); NumPy only, so ``softhand curve`` starts fast."""
 
     def __init__(self, f: np.ndarray, m: np.ndarray):

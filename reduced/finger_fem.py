@@ -9,7 +9,7 @@ L = l0 / 6 (5 equal hinges) and the tie width w. So
 
 The physics already known carries most of it: the paper's eq. (28) for P (the table's
 ``prior``: ``"paper"``, or ``"rings"``: eq. (28) with the tube stretching only over its untied
-length l0 - 6 w, the finger FEM's kinematic bound, see :func:`prior_pressure`), and for the oil
+length l0 - 6 w, the finger FEM's kinematic bound, see :func:`~softhand.reduced.finger_fem.prior_pressure`), and for the oil
 the kinematic a^2 pi d theta of eq. (2) (the tube's axis lengthens by d theta) plus the tube's
 own dilation under pressure, a^3 kappa P / mu_sf. The table ``reduced/data/finger_fem.csv``
 holds the FEM's (theta, P/mu, Delta Q/a^3) at the sampled designs; this model fits

@@ -25,7 +25,7 @@ TABLE_FILE = Path(__file__).resolve().parent / "data" / "finger_fem.csv"
 GROUPS = ("b_a", "d_a", "link_a", "tie_link")
 LABELS = {"b_a": "b/a", "d_a": "d/a", "link_a": "link/a", "tie_link": "tie/link"}
 COLUMNS = ("design", *GROUPS, "theta", "p_tilde", "q_tilde")
-#: the physics a table's residual is taken against (see :func:`prior_pressure`)
+#: the physics a table's residual is taken against (see :func:`~softhand.reduced.finger_fem.prior_pressure`)
 PRIORS = ("paper", "rings")
 #: the radial basis functions a kernel fit may use (scipy.interpolate.RBFInterpolator's)
 KERNELS = ("thin_plate_spline", "cubic", "linear")

@@ -4,19 +4,19 @@ A fit is linear in a constant and a list of *terms*; a term is one base feature 
 of base features joined by ``*`` (``lb*th``, ``lt*lt``). The base features are those a free
 tube segment's physics names:
 
-=====  ==========================================================================
-``lb``  ln(b/a): the wall's thickness
-``ld``  ln(d/a): the lever arm of the plate
-``lL``  ln(L/a): the link length (hinge spacing, L = l0 / 6)
-``lt``  -ln(1 - w/L): the tied share of a link (w the tie width)
-``s2``  (b / (L - w))^2: the squared shape factor of the untied segment (a short segment
-        bonded at both ends cannot contract, so it stiffens as this square)
-``th``  theta [rad], the finger's bend
-=====  ==========================================================================
+======  ==========================================================================
+``lb``   ln(b/a): the wall's thickness
+``ld``   ln(d/a): the lever arm of the plate
+``lL``   ln(L/a): the link length (hinge spacing, L = l0 / 6)
+``lt``   -ln(1 - w/L): the tied share of a link (w the tie width)
+``s2``   (b / (L - w))^2: the squared shape factor of the untied segment (a short segment
+         bonded at both ends cannot contract, so it stiffens as this square)
+``th``   theta [rad], the finger's bend
+======  ==========================================================================
 
 A table names its terms in its ``# fit:`` line (``p_terms=s2 lb ld th``); older tables give
 polynomial degrees instead, which :func:`legacy_terms` turns into the same list. A table of
-the design space is instead interpolated over :data:`KERNEL_FEATURES` (:class:`KernelFit`).
+the design space is instead interpolated over :data:`~softhand.reduced.finger_fem_terms.KERNEL_FEATURES` (:class:`KernelFit`).
 """
 from __future__ import annotations
 

@@ -1,7 +1,7 @@
 r"""Calibrate design parameters to measurements: bounded nonlinear least squares.
 
-Given measured points (:class:`~reduced.csvdata.Measurements`) and a model that predicts
-the measured quantity from a :class:`~reduced.design.HandDesign`, find the named public
+Given measured points (:class:`~softhand.reduced.csvdata.Measurements`) and a model that predicts
+the measured quantity from a :class:`~softhand.reduced.design.HandDesign`, find the named public
 design parameters :math:`p` (e.g. ``V0_mm3``, ``mu_sf_MPa``) that minimise
 
 .. math:: S(p) = \sum_i r_i(p)^2, \qquad r_i = y_i^{model}(p) - y_i^{measured}
@@ -10,7 +10,7 @@ in the data's own units (degrees for free bending, newtons for grasp forces), as
 paper does for V0 (section III-B). Parameters are scaled by their starting values,
 :math:`x = p / p_0`, so the optimiser sees numbers of order one.
 
-Uncertainty and identifiability: :mod:`reduced.lsq` (standard errors, correlations, the
+Uncertainty and identifiability: :mod:`softhand.reduced.lsq` (standard errors, correlations, the
 parameter combinations the data cannot see); nothing is returned silently.
 """
 from __future__ import annotations

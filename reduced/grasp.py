@@ -6,9 +6,9 @@ virtual-work balance (1) becomes eq. (25):
 .. math:: P n a^2 \pi d + n F_x J_x w + m g J_y w = n \mu_{sf}\zeta_f(\theta) + \mu_{sr}\zeta_r(\theta),
 
 i.e. n a^2 pi d (f(theta) - P) = n F_x J_x w + m g J_y w with f the free-hand pressure (27)
-(:func:`reduced.hand.pressure`). Given (P, theta, m, w) it is solved for F_x; F_y = m g / n
+(:func:`softhand.reduced.hand.pressure`). Given (P, theta, m, w) it is solved for F_x; F_y = m g / n
 (24); the normal force on the finger pad is F_v = F_x cos(theta - theta0) + F_y sin(theta - theta0)
-(29). Signs and axes: :mod:`reduced.kinematics` (x outward, y down; F is the object's force
+(29). Signs and axes: :mod:`softhand.reduced.kinematics` (x outward, y down; F is the object's force
 on the finger; F_v > 0 while the finger squeezes the object).
 
 The inverses users need, both at a prescribed normal force F_v (default 0, the limit where
@@ -19,7 +19,7 @@ the finger just stops pressing on the object):
 * :func:`angle_at`: the bend angle reached at pump pressure P under the same load -- the
   inverse of :func:`pressure_to_hold` in theta.
 
-The paper's two weight vectors ship as :data:`PAPER_WEIGHTS` (from :mod:`reduced.paper`); the 180 mm one sums to 1.40,
+The paper's two weight vectors ship as :data:`~softhand.reduced.paper.WEIGHTS` (from :mod:`softhand.reduced.paper`); the 180 mm one sums to 1.40,
 violating (23): :func:`check_weights` warns and can normalise.
 """
 from __future__ import annotations
@@ -37,7 +37,7 @@ from .paper import WEIGHTS as PAPER_WEIGHTS
 
 #: newtons per kilogram-force (standard gravity, by definition of the kgf)
 KGF = 9.80665
-#: |sum(w) - 1| above which check_weights warns (the paper prints w to two decimals)
+#: ``|sum(w) - 1|`` above which check_weights warns (the paper prints w to two decimals)
 SUM_TOLERANCE = 5e-3
 
 
@@ -54,7 +54,7 @@ class GraspForces(NamedTuple):
 def weights_for_diameter(diameter_mm: float, design: HandDesign) -> np.ndarray:
     """The weight vector w (n_s,) for an object of the given diameter [mm], as stored (unchecked).
 
-    For now the paper's presets (:data:`PAPER_WEIGHTS`); the one place to extend (FEM-derived w).
+    For now the paper's presets (:data:`~softhand.reduced.paper.WEIGHTS`); the one place to extend (FEM-derived w).
     """
     w = PAPER_WEIGHTS.get(float(diameter_mm))
     if w is None:
@@ -66,7 +66,7 @@ def weights_for_diameter(diameter_mm: float, design: HandDesign) -> np.ndarray:
     return np.array(w, dtype=float)
 
 
-#: largest |w_i|: a hinge turning more than ten times the mean bend is no grasp (the paper's
+#: largest ``|w_i|``: a hinge turning more than ten times the mean bend is no grasp (the paper's
 #: w lie in [-0.2, 0.8]; the studies' grasp kind has the same bound)
 MAX_WEIGHT = 10.0
 

@@ -11,7 +11,7 @@ and drops the tip assumption:
   dM_j/dP = -A_j, A_j = dV/d theta_hat_j the oil the hinge draws per radian *at fixed P*.
   With A_j a function of the hinge's bend theta_j = n_s theta_hat_j alone, and M_j = 0 on
   the free curve P_free(theta) of the calibrated finger (``finger_model = "fem"``,
-  :mod:`reduced.finger_fem`; it bends its equal hinges equally),
+  :mod:`softhand.reduced.finger_fem`; it bends its equal hinges equally),
 
   .. math:: M_j = -A_j(\theta_j)\,\big(P - P_{free}(\theta_j)\big), \qquad
             E_j = \int_0^{\hat\theta_j} M_j .
@@ -25,7 +25,7 @@ and drops the tip assumption:
   the paper's design (Table I): other designs reuse its A_j / (a^2 pi d) with their own
   free curve. Without this, the free finger's W_f and Q split equally over the hinges, the
   contact force of a finger held by the object low on it comes out 50 % too large.
-* **The contact where it is** (:mod:`reduced.contact`, the grasp FEM's geometry): the
+* **The contact where it is** (:mod:`softhand.reduced.contact`, the grasp FEM's geometry): the
   object's force on pad k at its closest point x*, F = -N nu + T t_k (normal force N along
   the outward normal -nu, the weight share T = m g / n along the link, as in the grasp FEM).
 * **Virtual work hinge by hinge** (eq. (1) with every hinge free, not only along w):
@@ -186,7 +186,7 @@ def _solve_link(P, depth, radius, link, weight, q0, design, corner=False):
 def grasp_state(design: HandDesign, diameter_mm: float, P: float, mass_kg: float = 0.0, *,
                 depth_mm: float | None = None) -> GraspState:
     """The finger at cavity pressure P [MPa] closing on the object (diameter [mm], mass [kg])
-    at depth [mm] (default: the grasp FEM's placement, :func:`reduced.contact.object_depth`)."""
+    at depth [mm] (default: the grasp FEM's placement, :func:`softhand.reduced.contact.object_depth`)."""
     design = fem_finger(design)
     depth = contact.object_depth(diameter_mm, design) if depth_mm is None else float(depth_mm)
     radius, weight = 0.5 * float(diameter_mm), float(mass_kg) * design.g / design.n

@@ -1,7 +1,7 @@
-r"""The FEM-informed grasp (:mod:`reduced.grasp_fem`) posed for a design: the pump pressure that
+r"""The FEM-informed grasp (:mod:`softhand.reduced.grasp_fem`) posed for a design: the pump pressure that
 holds the object with a given F_v, and F_v at a given pump pressure, each by one solve.
 
-:func:`reduced.grasp_fem.grasp_state` finds the finger's equilibrium at one cavity pressure P.
+:func:`softhand.reduced.grasp_fem.grasp_state` finds the finger's equilibrium at one cavity pressure P.
 A design question fixes something else -- F_v (the pressure that holds the object) or the
 pump's pressure (the force it gives) -- and a root finder on P around ``grasp_state`` costs a
 dozen equilibria. Here P is one more unknown of the same equilibrium: with pad k touching
@@ -11,7 +11,7 @@ z = (q_1..q_k, q_d, N, P) solve
 .. math:: M_j(q, P) - N\,\partial_j g_k - T_j = 0 \ (j \le k), \quad M_{k+1}(q, P) = 0,
           \quad g_k(q) = 0, \quad c(q, N, P) = 0,
 
-(M_{k+1} = 0 is P_free(n_s q_d) = P: the distal hinges as the free finger's), the first three exactly :func:`reduced.grasp_fem.grasp_state`'s equations, and the last the
+(M_{k+1} = 0 is P_free(n_s q_d) = P: the distal hinges as the free finger's), the first three exactly :func:`softhand.reduced.grasp_fem.grasp_state`'s equations, and the last the
 design's condition: F_v(q, N) = F_req, or P - p_r(theta) = P_pump, the pump pressure being the
 cavity's less the reservoir's pressure at the oil the fingers have taken at the bend theta =
 sum q (as ``softhand grasp --model fem`` and eq. (27)). The answer is accepted if it is the
@@ -42,7 +42,7 @@ from .errors import InputError
 #: tolerance of the fast solve (Newton step, relative on the unknowns) and of the slow path's brentq [MPa]
 _XTOL, _PTOL = 1e-13, 1e-13
 #: where one pad stops holding the object alone, the end is bisected to this [MPa] (after 0.05 MPa)
-#: before the second Newton solve for it from there (:func:`_end_between`)
+#: before the second Newton solve for it from there (``_end_between()``)
 BRACKET_RESOLUTION = 1e-3
 
 
@@ -85,7 +85,7 @@ def reservoir_pressure(theta, design: HandDesign, reservoir: bool = True):
 def _residuals(Z, k: int, depth: float, radius: float, weight: float, target: str, value: float,
                design: HandDesign, reservoir: bool, corner: bool = False):
     """The module's equations at a batch of unknowns Z (B, m + 2), m = k held hinges (+ 1 for the
-    distal ones) -> (residuals (B, m + 2), F_v (B,)); :func:`reduced.grasp_fem.grasp_state`'s
+    distal ones) -> (residuals (B, m + 2), F_v (B,)); :func:`softhand.reduced.grasp_fem.grasp_state`'s
     equilibrium with pad k touching (``corner``: with its far end, the hinge it shares with pad
     k+1), written for many states at once."""
     n_s, m = design.n_s, Z.shape[1] - 2
@@ -120,7 +120,7 @@ def _residuals(Z, k: int, depth: float, radius: float, weight: float, target: st
 
 
 def _newton(fun, z0, scale, *, max_iter: int = 40):
-    """Newton on fun (batched, see :func:`_residuals`) from z0: one batched call per iteration
+    """Newton on fun (batched, see ``_residuals()``) from z0: one batched call per iteration
     gives the residual and its Jacobian by forward differences (steps 1e-7 scale); a step that
     does not decrease the residual is taken back and halved. The root, or None."""
     z, h = np.asarray(z0, float), 1e-7 * np.asarray(scale, float)
@@ -148,7 +148,7 @@ def fast_hold(design: HandDesign, diameter_mm: float, mass_kg: float, target: st
               reservoir: bool = True) -> Hold | None:
     """The grasp with F_v = value [N] (``target="F_v"``) or pump pressure value [MPa]
     (``target="P_pump"``), by one Newton solve of the module's equations from the contact; None
-    if that solve fails or is not the state :func:`reduced.grasp_fem.grasp_state` reaches (see
+    if that solve fails or is not the state :func:`softhand.reduced.grasp_fem.grasp_state` reaches (see
     module doc).
 
     A pump pressure well above contact often presses a later pad than the one that touched
@@ -159,7 +159,7 @@ def fast_hold(design: HandDesign, diameter_mm: float, mass_kg: float, target: st
     equilibrium, against a dozen for the slow path). The pump pressure grows with the
     cavity's, so its answer is the only one; F_v need not (it drops where the touching pad
     changes): a later pad's F_v is kept only if it is the root the slow path finds, the one
-    in the first interval of its grid (:func:`_first_on_the_grid`)."""
+    in the first interval of its grid (``_first_on_the_grid()``)."""
     design = grasp_fem.fem_finger(design)
     depth = contact.object_depth(diameter_mm, design)
     theta_c, first = contact.contact_angle(diameter_mm, design, depth=depth)
@@ -213,7 +213,7 @@ def _grid(P0: float, top: float):
 def _first_on_the_grid(held: Hold, P_contact: float, design: HandDesign, diameter_mm: float, mass_kg: float,
                        F_v: float) -> bool:
     """Whether F_v at held (on a later pad than the first) is the root :func:`slow_hold` finds:
-    F_v below the asked one at every point of its grid (:func:`_grid` from the contact
+    F_v below the asked one at every point of its grid (``_grid()`` from the contact
     pressure) below held's pressure, so that held lies in the grid's first interval where F_v
     reaches it. A few states at pressures of one pad, against the slow path's bracket and brentq."""
     for P in _grid(P_contact + 1e-9, held.P_cavity):
@@ -255,7 +255,7 @@ def _pads(first: int, n_s: int) -> list[tuple[int, bool]]:
     return [(k, corner) for k in range(first, n_s + 1) for corner in (False, True)[:1 + (k < n_s)]]
 
 
-#: how far above a pad's end [MPa] :func:`_snap_below` looks for the state the finger snaps to
+#: how far above a pad's end [MPa] ``_snap_below()`` looks for the state the finger snaps to
 SNAP_PROBE = 1e-6
 
 
@@ -301,7 +301,7 @@ def _hold_on_pad(k: int, design: HandDesign, diameter_mm: float, depth: float, m
 
 
 def _held(k: int, solved, design: HandDesign, reservoir: bool) -> Hold | None:
-    """The Hold of :func:`_solve_on_pad`'s solution with pad k touching, None if it is not
+    """The Hold of ``_solve_on_pad()``'s solution with pad k touching, None if it is not
     acceptable (N < 0, another pad in the object)."""
     z, gaps, F_v = solved
     if z[-2] < 0.0 or np.min(gaps) < -grasp_fem._PENETRATION:
@@ -313,7 +313,7 @@ def _held(k: int, solved, design: HandDesign, reservoir: bool) -> Hold | None:
 
 def _solve_on_pad(k: int, design: HandDesign, diameter_mm: float, depth: float, mass_kg: float, target: str,
                   value: float, reservoir: bool, z0, corner: bool = False):
-    """The Newton solve of :func:`_hold_on_pad`, unchecked: (z, the gaps of the pads but k (and
+    """The Newton solve of ``_hold_on_pad()``, unchecked: (z, the gaps of the pads but k (and
     k+1 for a corner), F_v), or None if it fails or leaves a residual."""
     radius, weight = 0.5 * float(diameter_mm), float(mass_kg) * design.g / design.n
     m = len(z0) - 2
@@ -339,7 +339,7 @@ def _hinges(z, k: int, n_s: int) -> np.ndarray:
 
 def _largest_pressure(design: HandDesign) -> float:
     """The largest cavity pressure [MPa] either path answers at: the free finger's at (nearly)
-    its largest bend, where :func:`reduced.grasp_fem.grasp_state` stops."""
+    its largest bend, where :func:`softhand.reduced.grasp_fem.grasp_state` stops."""
     return float(hand.finger_pressure(0.999 * hand.THETA_RANGE[1], design))
 
 
@@ -355,7 +355,7 @@ def _condition(target: str, value: float, design: HandDesign, reservoir: bool):
 def slow_hold(design: HandDesign, diameter_mm: float, mass_kg: float, target: str, value: float, *,
               reservoir: bool = True) -> Hold:
     """The same grasp as :func:`fast_hold`, by brentq on the cavity pressure around
-    :func:`reduced.grasp_fem.grasp_state` (from the contact pressure up to the free finger's
+    :func:`softhand.reduced.grasp_fem.grasp_state` (from the contact pressure up to the free finger's
     pressure at its largest bend). Where one pad stops holding the object alone before the
     condition is met, the end is solved for (:func:`one_pad_end`'s way) and the refusal
     names it: its cavity and pump pressures and F_v."""
@@ -471,10 +471,10 @@ def one_pad_end(design: HandDesign, diameter_mm: float, mass_kg: float, *, reser
     not reach): the start is the state of pad k (its face, then its far end) at that pump
     pressure (as :func:`fast_hold`) in which pad j is inside the object, for the pads k in
     turn; the end is kept if it is
-    :func:`reduced.grasp_fem.grasp_state`'s state at its pressure and ``grasp_state`` has none
+    :func:`softhand.reduced.grasp_fem.grasp_state`'s state at its pressure and ``grasp_state`` has none
     :data:`END_PROBE` above it (a pad change is not an end). Otherwise ``grasp_state`` is
-    stepped up through the slow path's grid (:func:`_grid`) until it has no state and the end
-    found between (:func:`_end_between`)."""
+    stepped up through the slow path's grid (``_grid()``) until it has no state and the end
+    found between (``_end_between()``)."""
     design = grasp_fem.fem_finger(design)
     P_top = _largest_pressure(design)
     depth = contact.object_depth(diameter_mm, design)
@@ -509,7 +509,7 @@ def one_pad_end(design: HandDesign, diameter_mm: float, mass_kg: float, *, reser
 def _end_between(state, s_lo: grasp_fem.GraspState, hi: float, design: HandDesign, diameter_mm: float,
                  mass_kg: float, reservoir: bool) -> Hold:
     """The one-pad grasp's end between the state s_lo and the cavity pressure hi (no state there):
-    bisected to 0.05 MPa and solved for from there (:func:`_end_on_pad`); failing that, bisected
+    bisected to 0.05 MPa and solved for from there (``_end_on_pad()``); failing that, bisected
     to :data:`BRACKET_RESOLUTION` and solved for; failing that, bisected to 1e-13 MPa."""
     for tol in (0.05, BRACKET_RESOLUTION):
         s_lo, hi = _bisect_end(state, s_lo, hi, tol)

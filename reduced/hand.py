@@ -6,8 +6,8 @@ Eq. (25) with F_x = F_y = 0 gives, for n fingers sharing one pump and one reserv
                     = \frac{\mu_{sf}\zeta_f(\theta)}{a^2\pi d} - p_r(V(\theta))   \quad (27)
 
 since mu_sr zeta_r / (n a^2 pi d) = -p_r(V(theta)) (dV/dtheta = -n a^2 pi d); the second form
-works for every reservoir model of :mod:`reduced.reservoir`. Without reservoir (28) the last
-term is absent. For any finger model of :mod:`reduced.finger` (W_f, Q of one finger) the
+works for every reservoir model of :mod:`softhand.reduced.reservoir`. Without reservoir (28) the last
+term is absent. For any finger model of :mod:`softhand.reduced.finger` (W_f, Q of one finger) the
 same balance P n dQ/dtheta = d(n W_f + W_r)/dtheta reads P = (dW_f/dtheta)/(dQ/dtheta) -
 p_r(V0 - n (Q(theta) - Q(0))); the paper's model gives (27), (28) as printed. P is the pump's differential pressure: with the reservoir P(0) < 0, i.e. at
 zero pump pressure the charged sheet already bends the fingers a little (reported, not clipped).
@@ -46,7 +46,7 @@ def check_theta(theta) -> np.ndarray:
 
 def finger_pressure(theta, design: HandDesign):
     """Eq. (28): P = mu_sf zeta_f / (a^2 pi d) [MPa], the hand without reservoir, theta [rad];
-    for another rubber mu_sf zeta_f is dW_f/dtheta (:func:`reduced.finger.finger_force`); for any
+    for another rubber mu_sf zeta_f is dW_f/dtheta (:func:`softhand.reduced.finger.finger_force`); for any
     finger model P = (dW_f/dtheta) / (dQ/dtheta)."""
     if design.finger_model == "paper":  # as printed, bit for bit
         return finger.finger_force(theta, design) / (design.a**2 * math.pi * design.d)

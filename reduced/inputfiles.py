@@ -1,5 +1,5 @@
 """Small input files read safely: a regular file of at most MAX_FILE_BYTES, or TOML; anything
-else is one :class:`reduced.errors.InputError` line naming the option."""
+else is one :class:`softhand.reduced.errors.InputError` line naming the option."""
 from __future__ import annotations
 
 import csv

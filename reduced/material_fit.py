@@ -1,4 +1,4 @@
-r"""Fit a rubber model (:mod:`reduced.rubber`) to nominal stress vs stretch test data.
+r"""Fit a rubber model (:mod:`softhand.reduced.rubber`) to nominal stress vs stretch test data.
 
 Data: a CSV file with the columns ``mode`` (``uniaxial``, ``equibiaxial``, ``pure-shear``;
 any mix), ``stretch`` [-] and ``stress_MPa`` (nominal stress: force per reference area,
@@ -6,7 +6,7 @@ in the stretched direction); ``lambda`` and ``nominal_stress_MPa`` are accepted 
 names of the last two, ``biaxial``, ``planar`` (and ``ut``, ``et``, ``ps``) of the modes.
 Lines starting with ``#`` are comments.
 
-Refused (one :class:`~reduced.errors.InputError`), as no rubber test gives them: a stretch
+Refused (one :class:`~softhand.reduced.errors.InputError`), as no rubber test gives them: a stretch
 outside :data:`STRETCH_LIMITS`, a stress beyond :data:`MAX_STRESS` MPa, data whose largest
 stress is below :data:`MIN_STRESS` MPa, a stress of the wrong sign (negative in tension,
 positive in compression, nonzero at stretch 1) beyond :data:`SIGN_SCATTER` of the largest,
@@ -22,13 +22,13 @@ NH, Mooney-Rivlin and Yeoh are linear in their parameters: solved directly. Gent
 Ogden are fitted by :func:`scipy.optimize.least_squares` from several starts (Ogden:
 exponents on a grid, the moduli for each by linear least squares; Gent: locking
 parameters on a grid) and refined. Standard errors and correlations come from the
-Jacobian at the optimum as in :func:`reduced.lsq.diagnose`: Cov = S/(N - k) (J^T J)^{-1}.
+Jacobian at the optimum as in :func:`softhand.reduced.lsq.diagnose`: Cov = S/(N - k) (J^T J)^{-1}.
 Ogden's terms are reported in ascending alpha_p (W does not depend on their order). A
 standard error never drops below :data:`PRECISION` of its parameter's scale: with
 data without scatter the statistical error is round-off, the solver's precision is not.
 
 Drucker stability (incompressible): the Hessian of W in the log strains
-(:meth:`reduced.rubber.Rubber.drucker_hessian`) must be positive definite. It is checked
+(:meth:`softhand.reduced.rubber_base.Rubber.drucker_hessian`) must be positive definite. It is checked
 in uniaxial, equibiaxial and pure-shear deformation at stretches over a stated range
 (tension above 1, compression below), by default 1/lambda_max .. lambda_max of the data.
 """
@@ -64,11 +64,11 @@ _COLUMN_ALIASES = {"mode": "mode", "stretch": "stretch", "lambda": "stretch",
 PRECISION = 1e-10
 #: stretches a rubber test can give [-]; also the bounds of ``--stability-range``
 STRETCH_LIMITS = (0.01, 100.0)
-#: largest |nominal stress| of a rubber test [MPa]
+#: largest ``|nominal stress|`` of a rubber test [MPa]
 MAX_STRESS = 1e4
-#: the data's largest |stress| must reach this [MPa] (1 Pa): else there is no stiffness to fit
+#: the data's largest ``|stress|`` must reach this [MPa] (1 Pa): else there is no stiffness to fit
 MIN_STRESS = 1e-6
-#: a stress of the wrong sign is allowed as scatter up to this fraction of the largest |stress|
+#: a stress of the wrong sign is allowed as scatter up to this fraction of the largest ``|stress|``
 SIGN_SCATTER = 0.01
 
 
@@ -134,7 +134,7 @@ def check_data(data: StressData) -> None:
                          f"must be in [{-MAX_STRESS:g}, {MAX_STRESS:g}] MPa (nominal stress of a rubber)")
     top = float(np.max(np.abs(data.stress)))
     if not top >= MIN_STRESS:
-        raise InputError(f"{data.source}: column stress_MPa", f"largest |stress| {top:g} MPa",
+        raise InputError(f"{data.source}: column stress_MPa", f"largest ``|stress|`` {top:g} MPa",
                          f"must be at least {MIN_STRESS:g} MPa (1 Pa): no stiffness to fit "
                          "(stresses are in MPa)")
     tol = SIGN_SCATTER * top
@@ -152,7 +152,7 @@ def check_data(data: StressData) -> None:
         other = "nonzero" if side[i] == 0 else "the other sign"
         raise InputError(_cell(data, i, "stress_MPa"), f"{data.stress[i]:g}",
                          f"{need}; {other} only as scatter up to {SIGN_SCATTER:.0%} of the "
-                         f"largest |stress| ({top:g} MPa)")
+                         f"largest ``|stress|`` ({top:g} MPa)")
 
 
 def _cell(data, i, col):

@@ -3,7 +3,7 @@ Fig. 7's reservoir offset, the Fig. 8 grasps and Table II.
 
 Everything a study compares with the paper is read from here; numbers are exactly as
 printed (the 180 mm weight vector sums to 1.40, violating eq. (23); see
-:func:`reduced.grasp.check_weights`).
+:func:`softhand.reduced.grasp.check_weights`).
 """
 from __future__ import annotations
 

@@ -18,7 +18,7 @@ the values W̃ and slopes p̃, and p̃ its derivative, so p = dW/dV holds exactl
 model (energy-consistent, p continuous). Above the table's last volume p̃ continues
 linearly (W̃ quadratically); V <= 0 is an error, as in the ellipse model.
 
-NumPy only; registered as ``"fem"`` in :mod:`reduced.reservoir`.
+NumPy only; registered as ``"fem"`` in :mod:`softhand.reduced.reservoir`.
 """
 from __future__ import annotations
 

@@ -1,10 +1,10 @@
 r"""Incompressible rubber: strain energies W(lambda1, lambda2, lambda3) and their derivatives.
 
 One place for the hyperelastic models (their common interface, the test modes and the
-invariants in :mod:`reduced.rubber_base`), pure NumPy and vectorised over any array shape.
+invariants in :mod:`softhand.reduced.rubber_base`), pure NumPy and vectorised over any array shape.
 The reduced model evaluates them on its kinematics (finger: lambda, 1, 1/lambda;
 reservoir: lambda, lambda, 1/lambda^2); ``softhand material fit`` on the test modes; the
-FEM (:mod:`fem.materials`) builds its isochoric stress and tangent tensors from the
+FEM (:mod:`softhand.fem.materials`) builds its isochoric stress and tangent tensors from the
 invariant derivatives of the same objects, at the isochoric stretches J^{-1/3} lambda_i.
 
 Models (I1 = sum lambda_i^2, I2 = sum_{i<j} lambda_i^2 lambda_j^2, both at J = 1):
@@ -186,6 +186,7 @@ class Ogden(Rubber):
         return eye * diag[:, None]
 
 
+#: the rubber models by name
 MODELS = {cls.model: cls for cls in (NeoHookean, MooneyRivlin, Yeoh, Gent, Ogden)}
 
 
@@ -202,7 +203,7 @@ _MODEL_ALIASES = {"neohookean": "neo-hookean", "nh": "neo-hookean", "mooneyrivli
 
 
 def canonical_model(model: str) -> str:
-    """The model's name as in :data:`MODELS` (case, '_' or ' ' for '-', a few short names)."""
+    """The model's name as in :data:`~softhand.reduced.rubber.MODELS` (case, '_' or ' ' for '-', a few short names)."""
     name = str(model).strip().lower().replace("_", "-").replace(" ", "-")
     return _MODEL_ALIASES.get(name.replace("-", ""), name)
 
@@ -289,7 +290,7 @@ def drucker_check(material: Rubber, stretch_range: tuple[float, float], n: int =
             "skipped": skipped}
 
 
-#: largest |alpha_p| of an Ogden term: a hand's stretches of 2 raised to 300 give 1e90 MPa
+#: largest ``|alpha_p|`` of an Ogden term: a hand's stretches of 2 raised to 300 give 1e90 MPa
 MAX_OGDEN_ALPHA = 30.0
 #: stretches every mode of a hand's rubber reaches in use (tube walls, reservoir sheet): the
 #: material must be defined and Drucker-stable over them, or the models' answers are nonsense

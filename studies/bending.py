@@ -1,6 +1,6 @@
 """Free bending of the finger under pressure: the FEM against eqs. (28) and (2).
 
-:func:`run` builds the finger FEM (:mod:`fem.hand.finger`), follows the pressures and returns
+:func:`run` builds the finger FEM (:mod:`softhand.fem.hand.finger`), follows the pressures and returns
 one row per pressure with the reduced model's values next to the FEM's:
 
 * ``theta_reduced_deg``: eq. (28) (one finger, no reservoir) solved for theta at the same P;
@@ -10,7 +10,7 @@ one row per pressure with the reduced model's values next to the FEM's:
 Optionally the path continues to ``peak_mpa`` (2.0 MPa: the pressure the paper's FEM
 says the finger withstands) and reports the peak stretch and stress there; with ``hand``
 the whole hand follows, P = p_finger - p_r(V0 - n dQ) with the reservoir-sheet FEM
-(:func:`studies.compare.whole_hand`).
+(:func:`softhand.studies.compare.whole_hand`).
 
 The result is computed, plotted and written here once: :meth:`BendingResult.write` (result.json,
 table.csv, hand.csv), :meth:`BendingResult.plot` (Fig. 7 with FEM points) and
@@ -65,7 +65,7 @@ class BendingResult:
     build_seconds: float        #: meshing (cached) and setting up the model
     model: FingerModel = field(repr=False)
     states: list[FingerState] = field(repr=False)
-    hand: WholeHandResult | None = None  #: the whole hand (:func:`studies.compare.whole_hand`), or None
+    hand: WholeHandResult | None = None  #: the whole hand (:func:`softhand.studies.compare.whole_hand`), or None
 
     def summary(self) -> dict:
         """Numbers and provenance for result.json."""
@@ -88,7 +88,7 @@ class BendingResult:
         return ["result.json", "table.csv", *names]
 
     def plot(self, path, **labels) -> None:
-        """Fig. 7 with FEM points (:func:`studies.io.bend_plot.plot_bending`)."""
+        """Fig. 7 with FEM points (:func:`softhand.studies.io.bend_plot.plot_bending`)."""
         from softhand.studies.io.bend_plot import plot_bending
 
         plot_bending(path, self.rows, self.model.design, self.hand and self.hand.rows, **labels)

@@ -6,11 +6,11 @@ Eq. (25) without grasp forces, with the reservoir's pressure p_r(V) = dW_r/dV, g
 
 where p_finger(theta) is the cavity pressure that bends a free finger to theta and
 Delta Q(theta) its cavity volume change. Here both come from the finger FEM (a bending
-sweep's (P, theta, dQ) rows), p_r from the reservoir-sheet FEM (:mod:`fem.hand.reservoir`) at
+sweep's (P, theta, dQ) rows), p_r from the reservoir-sheet FEM (:mod:`softhand.fem.hand.reservoir`) at
 the oil volumes left; the reduced counterpart is eq. (27) (eq. (28) + the ellipse model with
 eq. (2)'s volume). The reservoir's pressure offset p_r(V0) is what the paper reads off
 Fig. 7 as "0.1 MPa lower pressure". The result summarises and writes itself; the bending
-study (:mod:`studies.bending`) runs it with ``hand=True``.
+study (:mod:`softhand.studies.bending`) runs it with ``hand=True``.
 """
 from __future__ import annotations
 
@@ -51,7 +51,7 @@ class WholeHandResult:
         return ["hand.csv"]
 
     def max_abs_difference_MPa(self) -> float:
-        """Largest |P_hand,FEM - P_eq.(27)| over the rows [MPa]."""
+        """Largest ``|P_hand,FEM - P_eq.(27)|`` over the rows [MPa]."""
         return float(np.nanmax([abs(r["P_hand_fem_MPa"] - r["P_hand_eq27_MPa"]) for r in self.rows]))
 
 

@@ -1,8 +1,8 @@
 """The control study: angle control (eqs. (30), (31)) against pressure control under a push.
 
-:func:`run` simulates the hand (:mod:`reduced.plant`) holding the object under angle control
+:func:`run` simulates the hand (:mod:`softhand.reduced.plant`) holding the object under angle control
 to ``theta_ref`` with a push on the object, then under pressure control at the pressure angle
-control held just before the push (:func:`reduced.control.flexibility`), and returns a
+control held just before the push (:func:`softhand.reduced.control.flexibility`), and returns a
 :class:`ControlResult` that summarises (both runs, Table II's three states, the gains, the
 plant), writes (the time series at the sensor rate and summary.json) and plots (Fig. 10)
 itself. ``softhand control``, the batch kind ``control`` and the ``table2_control`` and
@@ -60,7 +60,7 @@ class ControlStudy:
         return read_disturbance(self.disturbance, t_end=self.t_end_s)
 
     def gains(self, w) -> Gains:
-        """kp, ki as given, the missing ones from the plant (:func:`reduced.control.default_gains`)."""
+        """kp, ki as given, the missing ones from the plant (:func:`softhand.reduced.controllers.default_gains`)."""
         g = default_gains(HandTables(self.design, w), self.plant)
         return Gains(g.kp if self.kp is None else self.kp, g.ki if self.ki is None else self.ki,
                      anti_windup=self.anti_windup)
@@ -115,7 +115,7 @@ class ControlResult:
         return list(FILES)
 
     def plot(self, path, mode: str = "angle") -> None:
-        """Fig. 10 (c), (d) analogue (:func:`studies.io.control_files.plot_fig10`)."""
+        """Fig. 10 (c), (d) analogue (:func:`softhand.studies.io.control_files.plot_fig10`)."""
         from softhand.studies.io.control_files import plot_fig10
 
         plot_fig10(path, self.flex, mode, math.degrees(self.study.theta_ref))
@@ -133,7 +133,7 @@ def summary_dict(s) -> dict:
 
 
 def run(study: ControlStudy) -> ControlResult:
-    """Angle control with the push, then pressure control (:func:`reduced.control.flexibility`)."""
+    """Angle control with the push, then pressure control (:func:`softhand.reduced.control.flexibility`)."""
     w = study.weights()
     gains = study.gains(w)
     plant_design = study.design.replace(mu_sf=study.plant_mu_scale * study.design.mu_sf,

@@ -1,6 +1,6 @@
 """The Fig. 8 analogue by grasp FEM: F_v against theta at several pressures, against eq. (25).
 
-For one object (:class:`studies.weights.WeightsCase`: diameter, mass, design, mesh) the object
+For one object (:class:`softhand.studies.weights.WeightsCase`: diameter, mass, design, mesh) the object
 is placed at its default depth plus each offset, and the pressures are followed in turn;
 every point is a converged FEM contact state with its own w (from P and P + dP). Eq. (25)
 -> (29) is evaluated at the same (P, theta) with that w and with the paper's w for the
@@ -33,7 +33,7 @@ class Fig8Result:
     rows: list  #: one FEM contact state per (depth, pressure), see :func:`run`
 
     def errors(self) -> dict:
-        """RMS and largest |F_v(eq. 25) - F_v_fem| [kgf] over the points, with the FEM's own w at
+        """RMS and largest ``|F_v(eq. 25) - F_v_fem|`` [kgf] over the points, with the FEM's own w at
         each point and (``paper_w_*``) with the paper's w when it has one (None: no point)."""
         out = {}
         for prefix, key in (("", "F_v_reduced_N"), ("paper_w_", "F_v_reduced_paper_w_N")):
@@ -67,7 +67,7 @@ class Fig8Result:
         return lines
 
     def plot(self, path) -> None:
-        """F_v [kgf] vs theta: FEM points, eq. (25) lines (:func:`studies.io.weights_plot.plot_fig8`)."""
+        """F_v [kgf] vs theta: FEM points, eq. (25) lines (:func:`softhand.studies.io.weights_plot.plot_fig8`)."""
         from softhand.studies.io.weights_plot import plot_fig8
 
         plot_fig8(path, self)

@@ -2,7 +2,7 @@
 
 :func:`run` fits the public design keys of a :class:`FitStudy` to the measured points
 (free-bending angles through eq. (27) or (28), or grasping forces through eqs. (24), (25),
-(29); :mod:`reduced.fit`) and returns a :class:`FitStudyResult` that summarises (values,
+(29); :mod:`softhand.reduced.fit`) and returns a :class:`FitStudyResult` that summarises (values,
 standard errors, correlation, errors, every identifiability note), writes the calibrated
 design (a TOML file every verb reads with ``--design``) and plots itself (data against the
 fitted model, residuals). ``softhand fit`` only reads its options and prints.
@@ -66,7 +66,7 @@ class FitStudyResult:
         return [str(path)]
 
     def plot(self, path) -> None:
-        """Data against the fitted model, and the residuals (:func:`studies.io.fit_plot.plot_fit`)."""
+        """Data against the fitted model, and the residuals (:func:`softhand.studies.io.fit_plot.plot_fit`)."""
         from softhand.studies.io.fit_plot import plot_fit
 
         plot_fit(self.fit, self.study.data, self.study.predictor, path)

@@ -2,7 +2,7 @@
 
 :func:`state` -- pump pressure, bend angle, mass and a weight vector w -> F_x (25), F_y (24),
 F_v (29) in N and kgf, with the free finger's pressure at that angle; :func:`state_fem` -- the
-same state by the calibrated finger in equilibrium against the object (:mod:`reduced.grasp_fem`).
+same state by the calibrated finger in equilibrium against the object (:mod:`softhand.reduced.grasp_fem`).
 ``softhand grasp`` and the batch kind ``grasp`` only choose the inputs. Axes and signs:
 docs/conventions.md (F_v > 0: the finger squeezes).
 """

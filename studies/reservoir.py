@@ -1,6 +1,6 @@
 """The reservoir study: FEM inflation of the sheet against the paper's ellipse model (11)–(18).
 
-``run(study)`` inflates the clamped sheet (:mod:`fem.hand.reservoir`) through the requested oil
+``run(study)`` inflates the clamped sheet (:mod:`softhand.fem.hand.reservoir`) through the requested oil
 volumes and through the operating range, and returns per volume the FEM pressure, apex
 height, strain energy, the ellipse model's values at the same volume, the largest vertical
 gap between the FEM wet-surface profile and the half-ellipse, and the verdict: the ellipse
@@ -166,7 +166,7 @@ def run(study: ReservoirStudy, *, progress=None) -> ReservoirStudyResult:
 
 
 def calibration_rows(model: SheetModel, *, v_max: float = 1.75, n: int = 71, progress=None) -> list:
-    """FEM table for :mod:`reduced.reservoir_fem`: v = V/R³ in [0, v_max] on n points, with
+    """FEM table for :mod:`softhand.reduced.reservoir_fem`: v = V/R³ in [0, v_max] on n points, with
     τ = t/R, p̃ = pR/(μt), W̃ = W/(μtR²), h̃ = h/R."""
     R, t, mu = model.R, model.t, model.mu
     v = np.linspace(0.0, v_max, n)[1:]

@@ -1,12 +1,12 @@
 """Hinge weight vectors w from the grasp FEM, over object diameters; F_v against eq. (25).
 
 * :func:`weights` -- one grasp case (diameter, mass, cavity pressure, mesh) through the FEM
-  (:mod:`fem.hand.grasp`), cached on disk by its inputs: w, theta, hinge angles, contact forces,
+  (:mod:`softhand.fem.hand.grasp`), cached on disk by its inputs: w, theta, hinge angles, contact forces,
   F_v from the FEM and from eq. (25) with this w at the same P, theta, m.
   :func:`run_case` wraps it in a :class:`CaseResult` that summarises and writes itself.
 * :func:`run` (:class:`WeightsStudy`) -- w(D) over diameters, and w at an unseen diameter
   by interpolation checked against the FEM there (:class:`WeightsResult`: summary, plot, write).
-* The Fig. 8 analogue (F_v against theta at several pressures) is :mod:`studies.fig8`.
+* The Fig. 8 analogue (F_v against theta at several pressures) is :mod:`softhand.studies.fig8`.
 
 ``softhand weights``, ``softhand grasp --diameter-mm``, the batch kind ``weights`` and the
 ``weights_fem`` section of ``softhand reproduce`` only choose the inputs.
@@ -134,7 +134,7 @@ def compute(case: WeightsCase, out=None) -> dict:
 
 
 def write_vtk(out, model, states) -> None:
-    """The contact states as the scene series grasp.pvd (see :mod:`fem.hand.scene`)."""
+    """The contact states as the scene series grasp.pvd (see :mod:`softhand.fem.hand.scene`)."""
     from softhand.fem.io import SceneSeries
     from softhand.fem.hand.scene import grasp_scene
 
@@ -296,7 +296,7 @@ class WeightsResult:
         return ["result.json", "table.csv"]
 
     def plot(self, path) -> None:
-        """w_i against D (:func:`studies.io.weights_plot.plot_weights`)."""
+        """w_i against D (:func:`softhand.studies.io.weights_plot.plot_weights`)."""
         from softhand.studies.io.weights_plot import plot_weights
 
         plot_weights(path, self)

@@ -10,7 +10,7 @@ a <= r <= b with :math:`r^3 - R^3 = a^3 - A^3`; with λ = r/R the radial equilib
 
 whose thin-wall limit is :math:`p = 2μ (H/R)(λ^{-1} - λ^{-7})`, maximal at λ = 7^{1/6}.
 
-FEM: a quarter annulus in r–z (:mod:`meshes.shell`), u_r = 0 on the axis, u_z = 0 on the
+FEM: a quarter annulus in r–z (:mod:`softhand.meshes.shell`), u_r = 0 on the axis, u_z = 0 on the
 equator plane, the cavity volume V = (2/3)π a³ prescribed (its half above the equator) and
 p its Lagrange multiplier. λ_a is taken from the prescribed volume over the *discrete*
 reference cavity volume, so the O(h³) geometry error of the circle does not enter p.
@@ -41,7 +41,7 @@ class ThickSphere:
     n_radial: int = 1  #: Q2 elements through the wall
     n_polar: int = 8  #: Q2 elements from the pole to the equator
     pressure_space: str = "P1"  #: dilatation/pressure space per element, "P1" or "P0"
-    #: a :mod:`reduced.rubber` model (its initial shear modulus replaces mu); None: Neo-Hookean
+    #: a :mod:`softhand.reduced.rubber` model (its initial shear modulus replaces mu); None: Neo-Hookean
     material: object = None
 
     @property
@@ -58,7 +58,7 @@ def closed_form_pressure(lambda_a, A: float, B: float, mu: float):
 
 
 def closed_form_pressure_general(lambda_a, A: float, B: float, material):
-    r"""Exact p [MPa] of an incompressible thick sphere of any :mod:`reduced.rubber` model:
+    r"""Exact p [MPa] of an incompressible thick sphere of any :mod:`softhand.reduced.rubber` model:
 
     .. math:: p = \int_{\lambda_b}^{\lambda_a} \frac{\hat W'(\lambda)}{\lambda^3 - 1}\,d\lambda,
               \qquad \hat W(\lambda) = W(\lambda, \lambda, \lambda^{-2}),

@@ -2,29 +2,29 @@ r"""The finger FEM: a fiber-reinforced rubber tube held by a hinged rigid shell,
 
 Model (the paper's section II-B, with the choices the paper leaves open made explicit):
 
-* the NBR tube of :mod:`meshes.finger` (inner radius a, wall b, length l0 with an end cap
+* the NBR tube of :mod:`softhand.meshes.finger` (inner radius a, wall b, length l0 with an end cap
   of thickness ``cap`` at the tip), half model on the bending plane z = 0;
 * nearly incompressible Neo-Hookean rubber (mu_sf, kappa = ``kappa_ratio`` mu) in the
-  mean-dilatation P2-P0 formulation of :mod:`fem.solid`, plus a tension-only fiber family
+  mean-dilatation P2-P0 formulation of :mod:`softhand.fem.solid`, plus a tension-only fiber family
   (the Kevlar windings) along the hoop direction e_phi = (0, -z, y)/r, stiffness
   ``fiber_ratio`` mu, everywhere in the wall (the cap too). The windings' energy is
-  integrated with its own rule (:class:`Windings`, degree ``fiber_intorder``, default the
+  integrated with its own rule (:class:`~softhand.fem.hand.windings.Windings`, degree ``fiber_intorder``, default the
   14-point degree-5 rule whose points include the edge midpoints): the 4-point rule of the
   rubber samples the tension-only switch only inside the elements and misses the taut
   layer at the cavity wall, which made theta converge from above, non-monotonically, with
   the number of elements through the wall (docs/finger.md, mesh convergence);
 * oil pressure P on the cavity: the closed-cavity load P dV/du with its symmetric load
-  stiffness P d2V/du2, V the cavity volume of :class:`fem.loads.CavityVolume` (closed by
+  stiffness P d2V/du2, V the cavity volume of :class:`softhand.fem.loads.CavityVolume` (closed by
   the symmetry plane z = 0 and the fixed inlet plane x = 0);
-* the shell: a :class:`fem.constraints.PlanarChain` with hinges at (``hinge_s``, d) in the
+* the shell: a :class:`softhand.fem.constraints.PlanarChain` with hinges at (``hinge_s``, d) in the
   finger frame (the hinge plate at y = +d), link 0 fixed; the tube's base face is clamped
   to link 0 and the outer-surface band ``tie<k>`` moves rigidly with link k
-  (:class:`fem.constraints.ChainConstraint`);
+  (:class:`softhand.fem.constraints.ChainConstraint`);
 * unknowns y = (free displacements, hinge angles q); theta = sum(q); the hand's base
-  inclination theta0_hat only rotates the result (:func:`to_hand_frame`).
+  inclination theta0_hat only rotates the result (:func:`~softhand.fem.hand.frame.to_hand_frame`).
 
 Which part of the outer surface the shell holds is a modelling choice
-(:class:`FingerOptions` ``tie``): ``"ring"`` ties a band of width ``tie_width`` in the
+(:class:`~softhand.fem.hand.finger_options.FingerOptions` ``tie``): ``"ring"`` ties a band of width ``tie_width`` in the
 middle of each link (the shell clamps the tube at rings and lets it bend between
 them), ``"full"`` ties each link's whole length except ``hinge_gap`` around each hinge
 (a closed shell that lets the tube deform only at the hinges). docs/finger.md compares
@@ -32,7 +32,7 @@ them.
 
 Generalised forces on the links (contact with an object, its weight) are passed to
 :meth:`FingerModel.residual_tangent` as ``link_load(q) -> (Q, dQ/dq)``; see
-:meth:`fem.constraints.PlanarChain.point_load`.
+:meth:`softhand.fem.constraints.PlanarChain.point_load`.
 """
 from __future__ import annotations
 
@@ -155,7 +155,7 @@ class FingerModel:
         """Reduced residual and tangent at pressure P [MPa].
 
         ``link_load(q) -> (Q, dQdq)``: generalised external forces on the hinge angles
-        [N mm] and their derivative (e.g. from :meth:`PlanarChain.point_load`).
+        [N mm] and their derivative (e.g. from :meth:`~softhand.fem.constraints.PlanarChain.point_load`).
         """
         u = self.constraint.expand(y)
         R, Ke = self.solid.residual_element_matrices(u)
@@ -217,7 +217,7 @@ class FingerModel:
         return Basis(self.mesh, ElementVector(ElementTetP2()), intorder=2)
 
     def element_dilatation(self, y) -> np.ndarray:
-        """Mean dilatation J_bar per element (for the VTK stress of :mod:`fem.io`)."""
+        """Mean dilatation J_bar per element (for the VTK stress of :mod:`softhand.fem.io`)."""
         u = self.constraint.expand(y)
         W = self.solid.W
         return (W * kin.det(self.solid.F(u))).sum(axis=1) / W.sum(axis=1)

@@ -80,7 +80,7 @@ def ring_width(design: HandDesign, options: FingerOptions) -> float:
 
 
 def tie_bands(design: HandDesign, options: FingerOptions) -> tuple[tuple[float, float], ...]:
-    """(x_start, x_end) of the tube band each link holds [mm] (see :class:`FingerOptions`)."""
+    """(x_start, x_end) of the tube band each link holds [mm] (see :class:`~softhand.fem.hand.finger_options.FingerOptions`)."""
     s = np.array((0.0, *design.hinge_s, design.l0))
     if options.tie == "ring":
         width = ring_width(design, options)

@@ -1,4 +1,4 @@
-"""The finger frame and the hand frame of :mod:`reduced.kinematics`, both ways.
+"""The finger frame and the hand frame of :mod:`softhand.reduced.kinematics`, both ways.
 
 Finger frame: x along the finger axis, the hinge plate at y = +d. The hinge plate's base
 point (0, d) is the hand frame's (base_offset, 0); the finger axis x is the base link's
@@ -27,6 +27,6 @@ def to_hand_frame(points: np.ndarray, design: HandDesign) -> np.ndarray:
 
 
 def to_finger_frame(points, design: HandDesign) -> np.ndarray:
-    """Hand-frame points (..., 2) [mm] -> the finger frame (inverse of :func:`to_hand_frame`)."""
+    """Hand-frame points (..., 2) [mm] -> the finger frame (inverse of :func:`~softhand.fem.hand.frame.to_hand_frame`)."""
     M, origin = hand_frame(design)
     return np.array([0.0, design.d]) + (np.asarray(points, dtype=float) - origin) @ M

@@ -1,21 +1,21 @@
-r"""The grasp FEM: the finger FEM of :mod:`fem.finger` closing on a rigid object.
+r"""The grasp FEM: the finger FEM of :mod:`softhand.fem.hand.finger` closing on a rigid object.
 
 The object (diameter D) is centred on the hand's axis, at depth ``depth`` below the palm
-(the hand frame of :mod:`reduced.kinematics`: x outward, y down, the finger base on the
+(the hand frame of :mod:`softhand.reduced.kinematics`: x outward, y down, the finger base on the
 hinge plate at (``base_offset``, 0)). By default (:func:`default_depth`) the hand comes
 down over the object until the object's top is ``palm_gap`` below the palm, or -- for
 objects too big to pass between the open fingers -- until the open fingers' pads are
 ``clearance`` from its surface. The fingers then close under the cavity pressure P.
 
-Contact: frictionless, rigid link pads against the analytic object (:mod:`fem.contact`),
-augmented Lagrangian with Uzawa updates until the largest |gap| of a loaded pad is below
+Contact: frictionless, rigid link pads against the analytic object (:mod:`softhand.fem.contact`),
+augmented Lagrangian with Uzawa updates until the largest ``|gap|`` of a loaded pad is below
 ``gap_tol`` (its own convergence check: gap at convergence vs penalty); the penalty grows
 tenfold whenever an update does not cut that gap by 4 (two nearly dependent contacts,
 e.g. both sides of a hinge, make plain Uzawa slow). The object's
 weight share m g / n (eq. (24)) acts tangentially on the touching pads, split by their
 normal forces. The mesh is the half tube (symmetry plane z = 0), so the model's links
 carry half of every physical load: the generalised forces passed to the finger are
-half those of :func:`fem.contact.contact_load`; the forces reported are physical.
+half those of :func:`softhand.fem.contact.contact_load`; the forces reported are physical.
 
 Weight vector (eqs. (21)-(23)): w = (q(P + dP) - q(P)) / sum(q(P + dP) - q(P)), the
 virtual displacement of the hinge angles between two converged contact states, so
@@ -80,7 +80,7 @@ def _open_gap(pads: Pads, design: HandDesign, diameter: float, depth: float) -> 
 def check_placement(design: HandDesign, diameter: float, depth: float,
                     options: GraspOptions | None = None, *, pads: Pads | None = None) -> None:
     """InputError if the object (diameter [mm]) centred at depth [mm] overlaps the open
-    finger's pads (default: those of the design's link chain as :class:`fem.hand.finger.FingerModel`
+    finger's pads (default: those of the design's link chain as :class:`softhand.fem.hand.finger.FingerModel`
     builds it, no mesh, so it is checked before any meshing or FEM)."""
     if pads is None:
         chain = PlanarChain(np.c_[design.hinge_s, np.full(design.n_s, design.d)])
@@ -149,7 +149,7 @@ class GraspModel:
         self.solver = make_solver(symmetric=self.weight == 0.0, precision="double")
 
     def load(self, q, multipliers, shares, penalty: float | None = None):
-        """Physical contact load at hinge angles q (:class:`fem.contact.ContactLoad`)."""
+        """Physical contact load at hinge angles q (:class:`softhand.fem.contact.ContactLoad`)."""
         penalty = self.options.penalty if penalty is None else penalty
         return contact_load(gaps(self.pads, self.circle, q), penalty, multipliers,
                             weight=self.weight, shares=shares)

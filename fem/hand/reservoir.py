@@ -1,10 +1,10 @@
 r"""The reservoir sheet FEM: a clamped circular NBR sheet inflated by a prescribed oil volume.
 
-Model (axisymmetric, :mod:`fem.axisym`): the sheet 0 <= r <= R, 0 <= z <= t, nearly
+Model (axisymmetric, :mod:`softhand.fem.axisym`): the sheet 0 <= r <= R, 0 <= z <= t, nearly
 incompressible Neo-Hookean (μ = μ_sr, κ = 1000 μ by default), clamped over its rim face
 r = R (u = 0), u_r = 0 on the axis. Oil fills the space between the clamp plane z = 0 and
-the wet underside; its volume V (measured from the clamp plane, :class:`RevolvedVolume`)
-is prescribed and the oil pressure p is the Lagrange multiplier (:mod:`fem.volume_path`).
+the wet underside; its volume V (measured from the clamp plane, :class:`~softhand.fem.axisym.RevolvedVolume`)
+is prescribed and the oil pressure p is the Lagrange multiplier (:mod:`softhand.fem.volume_path`).
 
 Starting from flat. A *membrane* has no stiffness against a transverse load when flat,
 so a membrane solver must start from a pre-deflection. This model is a solid: the flat
@@ -47,12 +47,12 @@ class SheetModel:
     n_radial: int = 40  #: Q2 elements along the radius
     n_thick: int = 2  #: Q2 elements through the thickness
     clamp_ratio: float = 3.0  #: radial element size at the axis / at the clamp
-    #: the rubber's strain energy (:mod:`reduced.rubber`; scaled to mu); None: Neo-Hookean
+    #: the rubber's strain energy (:mod:`softhand.reduced.rubber`; scaled to mu); None: Neo-Hookean
     material: Rubber | None = None
 
     @classmethod
     def from_design(cls, design, **mesh) -> "SheetModel":
-        """Geometry and material of a :class:`reduced.design.HandDesign`; mesh keywords as given."""
+        """Geometry and material of a :class:`softhand.reduced.design.HandDesign`; mesh keywords as given."""
         material = None if design.reservoir_is_neo_hookean else design.reservoir_rubber
         return cls(R=design.R, t=design.t, mu=design.mu_sr, material=material, **mesh)
 
@@ -180,7 +180,7 @@ def sheet_vtk(solid, state: SheetState):
     """The r–z section of a deformed sheet (points, cells, point_data) on its Q2 mesh
     (``quad9``): reference points (r, z, 0) with the ``displacement_mm`` (u_r, u_z, 0) and
     the ``hoop_stretch`` (Warp By Vector shows it). The sheet revolved in 3D is
-    :func:`fem.scene.sheet_block`."""
+    :func:`softhand.fem.hand.scene.sheet_block`."""
     from skfem import Basis, ElementQuad2
 
     scalar = Basis(solid.mesh, ElementQuad2())

@@ -1,12 +1,12 @@
 r"""The scene of a result, as named VTK blocks: what a person needs to see to understand it.
 
 A finger state (free bending or a grasp) becomes, in the hand frame of
-:mod:`reduced.kinematics` (x outward, y down, z normal to the bending plane; the
+:mod:`softhand.reduced.kinematics` (x outward, y down, z normal to the bending plane; the
 modelled finger's bending plane is z = 0):
 
 * ``tube``: the rubber tube, the computed half (z >= 0) and its mirror image (z <= 0,
   cell data ``mirrored`` = 1; vectors and tensors reflected), with the fields of
-  :func:`fem.io.state_fields` at the reference positions plus ``displacement_mm``;
+  :func:`softhand.fem.io.state_fields` at the reference positions plus ``displacement_mm``;
 * ``link_0`` .. ``link_<n_s>``: the rigid shell's links as boxes between the tube and the
   grasping face y = d of the finger frame, in their current (rotated) position;
 * ``hinge_1`` .. ``hinge_<n_s>``: the hinge pins, cylinders along z at the current hinge axes;
@@ -21,7 +21,7 @@ the axis, at the reference (flat) position with the revolved ``displacement_mm``
 Every block carries field data (``pressure_MPa``, and ``n_fingers`` for a finger scene,
 ``volume_mm3`` for a sheet). The links and hinges are drawn with ``link_gap`` between
 neighbours and a pin radius ``pin_radius`` of this module: they are pictures, not the
-model's geometry (the model's shell is the tie of :mod:`fem.finger`).
+model's geometry (the model's shell is the tie of :mod:`softhand.fem.hand.finger`).
 """
 from __future__ import annotations
 
@@ -53,7 +53,7 @@ class Block:
 
 
 def hand_rotation(design) -> np.ndarray:
-    """3 x 3 rotation finger frame -> hand frame (z kept); see :func:`fem.hand.frame.to_hand_frame`."""
+    """3 x 3 rotation finger frame -> hand frame (z kept); see :func:`softhand.fem.hand.frame.to_hand_frame`."""
     return np.block([[hand_frame(design)[0], np.zeros((2, 1))], [np.zeros((1, 2)), np.ones((1, 1))]])
 
 
@@ -64,8 +64,8 @@ def to_hand(points, design) -> np.ndarray:
 
 
 def finger_blocks(model, y, *, load=None) -> list[Block]:
-    """The tube, links and hinges of finger ``model`` (:class:`fem.finger.FingerModel`) at
-    reduced state ``y``; with ``load`` (a :class:`fem.contact.ContactLoad`) the pad forces."""
+    """The tube, links and hinges of finger ``model`` (:class:`softhand.fem.hand.finger.FingerModel`) at
+    reduced state ``y``; with ``load`` (a :class:`softhand.fem.contact.ContactLoad`) the pad forces."""
     from softhand.fem.io import state_fields
 
     design, basis = model.design, _vector_basis(model)
@@ -220,7 +220,7 @@ def finger_scene(model, y, P: float) -> tuple[list[Block], dict]:
 
 
 def grasp_scene(grasp, state) -> tuple[list[Block], dict]:
-    """(blocks, field data) of a converged contact state of :class:`fem.grasp.GraspModel`."""
+    """(blocks, field data) of a converged contact state of :class:`softhand.fem.hand.grasp.GraspModel`."""
     blocks = finger_blocks(grasp.finger, state.y, load=grasp.state_load(state))
     blocks.append(sphere_block([0.0, grasp.depth, 0.0], 0.5 * grasp.diameter))
     return blocks, {"pressure_MPa": float(state.P), "theta_deg": math.degrees(state.theta),

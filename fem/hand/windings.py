@@ -1,7 +1,7 @@
 r"""The Kevlar windings of the finger: a tension-only hoop fiber family and its own quadrature.
 
 :class:`WindingFibers` is the fiber law (a smooth onset of width ``toe``, or a jump);
-:func:`hoop_directions` the winding direction e_phi around the tube axis; :class:`Windings`
+:func:`hoop_directions` the winding direction e_phi around the tube axis; :class:`~softhand.fem.hand.windings.Windings`
 the windings' energy, residual and tangent on a P2 tetrahedral mesh, integrated with a rule
 of their own (see its docstring for why).
 """
@@ -27,7 +27,7 @@ class WindingFibers(Fibers):
 
     so the fiber stiffness k G'' rises linearly from 0 to k over 0 < e < delta (the slack of
     wound threads) instead of jumping at lambda_f = 1. ``toe = 0`` is
-    :class:`fem.materials.Fibers` (stiff already at lambda_f = 1). The jump makes Newton
+    :class:`softhand.fem.materials.Fibers` (stiff already at lambda_f = 1). The jump makes Newton
     chatter where the hoop stretch is near 1, i.e. in much of the bent tube; docs/finger.md
     shows the effect of delta on theta.
     """
@@ -89,10 +89,10 @@ class Windings:
     With f = F a0 = a0 + sum_n u_n g_n (g_n = grad N_n . a0) and c1 = k (G''/lam^2 -
     G'/lam^3), c2 = k G'/lam: r_na = sum_q w k G'/lam f_a g_n and
     K_(na)(mb) = sum_q w (c1 f_a g_n f_b g_m + c2 delta_ab g_n g_m): two batched products,
-    far cheaper than the general anisotropic tangent of :mod:`fem.solid`, written in the
-    block layout K[e, n, a, b, m] of :func:`fem.solid.element_matrices` and added to the
+    far cheaper than the general anisotropic tangent of :mod:`softhand.fem.solid`, written in the
+    block layout K[e, n, a, b, m] of :func:`softhand.fem.solid.element_matrices` and added to the
     rubber's element matrices, so the two are scattered together, once
-    (:meth:`fem.assembly.ElementScatter.block_matrix_data`).
+    (:meth:`softhand.fem.assembly.ElementScatter.block_matrix_data`).
     """
 
     def __init__(self, mesh, fibers_k: float, toe: float, intorder: int, scatter, chunk=threads.CHUNK):
@@ -134,7 +134,7 @@ class Windings:
 
     def add_residual_tangent(self, u: np.ndarray, R: np.ndarray, Ke_all: np.ndarray) -> None:
         """R += the windings' internal force; Ke_all (element matrices of the whole mesh in the
-        block layout of :func:`fem.solid.element_matrices`, e.g. the rubber's) += their tangent."""
+        block layout of :func:`softhand.fem.solid.element_matrices`, e.g. the rubber's) += their tangent."""
         k = self.law.k
         nloc = self.g.shape[2]
 

@@ -151,7 +151,7 @@ def _stored_number(value) -> bool:
 
 # ---------------------------------------------------------------------- one case
 #: the private folders of the cases this process is computing (a pool worker told to stop
-#: removes them before it exits: :func:`studies.batch.pool.stop_worker`)
+#: removes them before it exits: :func:`softhand.studies.batch.pool.stop_worker`)
 CASE_FOLDERS: set[str] = set()
 
 

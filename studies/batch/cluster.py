@@ -5,7 +5,7 @@ glibc's adaptive thresholds: every freed block above 128 KiB goes back to the op
 and the next allocation faults its pages in again. The FEM allocates and frees megabytes of
 element-kernel temporaries per assembly, and a CI-mesh finger case took 8.9 s in a Dask worker
 against 3.6 s in a plain process (one thread each). The local cluster's workers start without
-that variable; on any other cluster :func:`_case_on_worker` raises the thresholds in the worker
+that variable; on any other cluster ``_case_on_worker()`` raises the thresholds in the worker
 itself (4.1 s), once per process.
 """
 from __future__ import annotations
@@ -84,7 +84,7 @@ def _case_on_worker(kind: str, params: dict, design: dict) -> dict:
 
 
 def roomy_malloc() -> bool:
-    """glibc's mmap and trim thresholds raised to :data:`_ROOMY` in this process, once; False
+    """glibc's mmap and trim thresholds raised to ``_ROOMY`` in this process, once; False
     where the C library has no ``mallopt`` (not glibc)."""
     if os.getpid() in _roomy_pids:
         return True

@@ -1,7 +1,7 @@
 """Case functions of the batch runner's kinds that have no module of their own.
 
 Each has the kind signature ``fn(case_params: dict, design, outdir) -> dict of numbers``
-(see :mod:`studies.batch.studyfile`) and calls the owning library; imports stay inside the
+(see :mod:`softhand.studies.batch.studyfile`) and calls the owning library; imports stay inside the
 functions so a worker only imports what its kind needs.
 """
 from __future__ import annotations
@@ -34,7 +34,7 @@ def curve(params: dict, design: HandDesign, outdir: Path) -> dict:
 
 
 def grasp(params: dict, design: HandDesign, outdir: Path) -> dict:
-    """Eqs. (24), (25), (29) at one state (:func:`studies.grasp.state`): F_x, F_y, F_v for (P, theta, m) and w.
+    """Eqs. (24), (25), (29) at one state (:func:`softhand.studies.grasp.state`): F_x, F_y, F_v for (P, theta, m) and w.
 
     ``weights`` (n_s numbers) or ``diameter_mm`` (the paper's presets, 180 or 240).
     """
@@ -50,7 +50,7 @@ def grasp(params: dict, design: HandDesign, outdir: Path) -> dict:
 
 
 def control(params: dict, design: HandDesign, outdir: Path) -> dict:
-    """The flexibility experiment (Table II) at one setting (:mod:`studies.control`)."""
+    """The flexibility experiment (Table II) at one setting (:mod:`softhand.studies.control`)."""
     from softhand.studies.control import ControlStudy, run
 
     result = run(ControlStudy(design=design, theta_ref=math.radians(params.get("theta_ref_deg", 50.0)),
@@ -92,7 +92,7 @@ def reservoir(params: dict, design: HandDesign, outdir: Path) -> dict:
 
 
 def weights(params: dict, design: HandDesign, outdir: Path) -> dict:
-    """One grasp by FEM (:func:`studies.weights.run_case`): w, theta, F_v by FEM and eq. (25)."""
+    """One grasp by FEM (:func:`softhand.studies.weights.run_case`): w, theta, F_v by FEM and eq. (25)."""
     from softhand.studies.weights import WeightsCase, run_case
 
     case = WeightsCase(design=design, **{k: float(v) for k, v in params.items()})

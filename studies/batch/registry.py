@@ -1,8 +1,8 @@
 """The registry of study kinds: what one case computes and the parameters it accepts.
 
-The built-in kinds are :data:`KINDS`; installed packages add more through the
-``softhand.kinds`` entry-point group (:func:`all_kinds`). A study file names a kind; no
-import path written in a file is ever imported (see :mod:`studies.batch.studyfile`).
+The built-in kinds are :data:`~softhand.studies.batch.registry.KINDS`; installed packages add more through the
+``softhand.kinds`` entry-point group (:func:`~softhand.studies.batch.registry.all_kinds`). A study file names a kind; no
+import path written in a file is ever imported (see :mod:`softhand.studies.batch.studyfile`).
 """
 from __future__ import annotations
 

@@ -13,7 +13,7 @@ Resumable and safe by construction:
   finished cases complete and nothing half-written (a leftover temporary folder of a case
   is removed by the next run that claims the case). The same path serves the process
   pool and Dask, and a Dask cluster needs no shared file system;
-* several runs of one study may run at once: each case is claimed (:mod:`studies.claims`)
+* several runs of one study may run at once: each case is claimed (:mod:`softhand.studies.batch.claims`)
   before it is computed, a case another run holds is left to it and taken as reused once
   done, so every case is computed once;
 * a case file that does not parse (truncated, empty, ``null``, edited) counts as not done:

@@ -1,4 +1,4 @@
-"""Study files: a TOML description of a batch of cases, validated into a :class:`Study`.
+"""Study files: a TOML description of a batch of cases, validated into a :class:`~softhand.studies.batch.studyfile.Study`.
 
 A study file names a *kind* (what one case computes), a design, the sweep axes and
 optionally fixed parameters and a mesh size::
@@ -20,14 +20,14 @@ optionally fixed parameters and a mesh size::
     mass_kg = 2.0
 
 A sweep axis is either a parameter of the kind or a public design key
-(:data:`reduced.design.PUBLIC_KEYS`). Every error is one line naming the field.
+(:data:`softhand.reduced.design.PUBLIC_KEYS`). Every error is one line naming the field.
 
-A study file is data: its kind is a *name*, looked up in the built-in :data:`KINDS` and in
-the ``softhand.kinds`` entry-point group of installed packages (:func:`all_kinds`); no
+A study file is data: its kind is a *name*, looked up in the built-in :data:`~softhand.studies.batch.registry.KINDS` and in
+the ``softhand.kinds`` entry-point group of installed packages (:func:`~softhand.studies.batch.registry.all_kinds`); no
 import path written in a file is ever imported. Registering a built-in kind is one line
-in :data:`studies.registry.KINDS`: ``name -> Kind("module:function", {param: Num(lo, hi), ...}, fem=...)``;
+in :data:`softhand.studies.batch.registry.KINDS`: ``name -> Kind("module:function", {param: Num(lo, hi), ...}, fem=...)``;
 a plugin package declares ``[project.entry-points."softhand.kinds"] name =
-"package.module:KIND"`` pointing at a :class:`Kind` (or at the case function itself,
+"package.module:KIND"`` pointing at a :class:`~softhand.studies.batch.registry.Kind` (or at the case function itself,
 whose parameters are then not checked). The function has the signature
 ``fn(case_params: dict, design: HandDesign, outdir: Path) -> dict`` and returns
 numbers (floats or lists of floats; optional ``"mesh"`` and ``"solver"`` dicts go
@@ -36,7 +36,7 @@ imported only when a case of that kind runs.
 
 The whole file is validated before the first case runs: every case's parameters against
 their kind's ranges, every swept design, and the number of cases (at most
-:data:`MAX_CASES` unless the caller allows more).
+:data:`~softhand.studies.batch.registry.MAX_CASES` unless the caller allows more).
 """
 from __future__ import annotations
 
@@ -66,7 +66,7 @@ class Study:
     """A validated study: the product of its sweep axes over a base design."""
 
     name: str  #: results go to results/<name>/
-    kind: str  #: a name of :func:`all_kinds`
+    kind: str  #: a name of :func:`~softhand.studies.batch.registry.all_kinds`
     design: HandDesign  #: the base design, before design axes are applied
     axes: tuple[tuple[str, tuple], ...]  #: (axis name, values) in file order
     params: dict = field(default_factory=dict)  #: fixed case parameters

@@ -2,7 +2,7 @@
 
 :func:`write_table` turns the ``finger_bend`` cases of a design space
 (:mod:`softhand.studies.calibration.finger`) into the nondimensional CSV of
-:mod:`reduced.finger_fem` with its provenance (code version, mesh, date, command);
+:mod:`softhand.reduced.finger_fem` with its provenance (code version, mesh, date, command);
 :func:`heldout_rows` compares the calibrated model with FEM cases it was not built from.
 """
 from __future__ import annotations
@@ -54,7 +54,7 @@ KERNEL = "cubic"
 def choose_fit(rows: list[dict], ranges: dict, prior: str) -> tuple[str, list[str]]:
     """The '# fit:' line's items after the prior for ``rows``, and a provenance note. With
     KERNEL_MIN_DESIGNS designs or more: the cubic radial-basis interpolant over the five
-    features of :data:`KERNEL_FEATURES` (per design a line in theta; exact at the designs).
+    features of :data:`~softhand.reduced.finger_fem_terms.KERNEL_FEATURES` (per design a line in theta; exact at the designs).
     It was chosen by leave-one-design-out error of theta on the 41-design table (rms / worst,
     ``benchmarks/finger_loo.py``): cubic 1.33 / 6.4 %, thin-plate spline 1.62 / 9.0 %, linear
     2.02 / 12.9 % (dQ: 0.87 / 4.5, 0.75 / 2.3, 0.80 / 2.7 %); on the earlier 31-design table,
@@ -77,7 +77,7 @@ def choose_fit(rows: list[dict], ranges: dict, prior: str) -> tuple[str, list[st
 
 def table_csv(rows: list[dict], ranges: dict, provenance: list[str], fit: str,
               prior: str = "paper") -> str:
-    """The calibration CSV of :mod:`reduced.finger_fem`: provenance, range and fit lines, rows."""
+    """The calibration CSV of :mod:`softhand.reduced.finger_fem`: provenance, range and fit lines, rows."""
     lines = [f"# {line}" for line in provenance]
     lines.append("# groups: b_a = b/a, d_a = d/a, link_a = (l0/6)/a, tie_link = tie width/(l0/6); "
                  "theta [rad]; p_tilde = P/mu_sf; q_tilde = dQ/a^3 (one finger)")
@@ -156,11 +156,11 @@ def write_design_with_table(design: HandDesign, table: Path) -> Path:
 def heldout_rows(results: list[tuple[HandDesign, dict]], table: str | None = None):
     """Per FEM point of each design: theta and dQ by FEM and by the calibrated model, errors
     [%], and the whole hand's pump pressure at the FEM's theta by the models "fem" (finger and
-    reservoir) against finger FEM + reservoir-sheet FEM (:func:`studies.compare.whole_hand`,
+    reservoir) against finger FEM + reservoir-sheet FEM (:func:`softhand.studies.compare.whole_hand`,
     the design's reservoir), error [MPa] (nan where the fingers take more oil than V0); per
     design with an FEM bend >= 60 deg, the model's bend at the FEM's pressure of 60 deg and the
     whole hand's error there (the FEM's pressure and oil at 60 deg by monotone cubic
-    interpolation of its points). Returns (rows, worst |error| per column)."""
+    interpolation of its points). Returns (rows, worst ``|error|`` per column)."""
     rows = []
     for design, record in results:
         model = design.replace(finger_model="fem", finger_table=str(table or ""))

@@ -1,4 +1,4 @@
-"""The hinge table of :mod:`reduced.grasp_fem` from the finger FEM: each hinge's oil per radian at
+"""The hinge table of :mod:`softhand.reduced.grasp_fem` from the finger FEM: each hinge's oil per radian at
 fixed pressure, A_j(theta) = dV/d theta_hat_j.
 
 On the grasp FEM's mesh, the free finger at each pressure P of ``PRESSURES`` (bend theta_free(P));

@@ -3,4 +3,5 @@ import sys
 
 from softhand.studies.cli.main import main
 
-sys.exit(main())
+if __name__ == "__main__":  # not on import (the docs' API reference imports every module)
+    sys.exit(main())

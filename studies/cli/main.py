@@ -8,7 +8,7 @@ Each verb lives in ``studies/cli/verbs/<verb>.py`` and defines
 
 Verb modules are imported only when their verb is called, so ``softhand curve``
 never pays for importing the FEM stack. Bad input anywhere (an
-:class:`reduced.errors.InputError`, or an argparse error) becomes one line on
+:class:`softhand.reduced.errors.InputError`, or an argparse error) becomes one line on
 stderr and exit code 2.
 """
 from __future__ import annotations
@@ -167,7 +167,7 @@ def _sigterm_as_interrupt():
 def _quiet_float_warnings() -> dict:
     """No numpy overflow / invalid-value warnings on stderr: every result the CLI prints is
     checked to be finite, and bad input is refused in one line, not after a page of warnings.
-    The earlier settings, for :func:`_restore_float_warnings`."""
+    The earlier settings, for ``_restore_float_warnings()``."""
     import numpy as np
 
     return np.seterr(all="ignore")

@@ -1,6 +1,6 @@
 r"""Size the hand for a task on the reduced model: the optimiser over the task's free keys.
 
-Each design is judged by :func:`studies.design.evaluate.evaluate` (grasp angle, pressures,
+Each design is judged by :func:`softhand.studies.design.evaluate.evaluate` (grasp angle, pressures,
 forces, constraints). Optimiser: :func:`scipy.optimize.differential_evolution` (seeded, one
 worker: deterministic) with the constraints as a :class:`~scipy.optimize.NonlinearConstraint`
 (feasibility rules: a task that cannot be met ends at the least-violating design), then an

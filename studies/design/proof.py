@@ -1,17 +1,17 @@
 r"""The FEM proof of a design: free bend with the reservoir, and the grasp at the task's object.
 
-Three FEM models check the reduced model's answer (:class:`studies.design_opt.Evaluation`):
+Three FEM models check the reduced model's answer (:class:`softhand.studies.design.evaluate.Evaluation`):
 
-1. **Free bend** (finger FEM, :mod:`fem.finger`): cavity pressures in steps of at most
+1. **Free bend** (finger FEM, :mod:`softhand.fem.hand.finger`): cavity pressures in steps of at most
    ``max_step_mpa`` up to eq. (28)'s pressure at the grasp angle theta_g, then 1.25, 1.5, ...
    times it, until the finger bends past theta_g; the
    cavity pressure p_finger, the cavity volume change dQ and the peak principal stretch at
    theta_g are interpolated (monotone cubic in theta).
-2. **Reservoir** (sheet FEM, :mod:`fem.reservoir`, one path from flat to V0): p_r at the oil
+2. **Reservoir** (sheet FEM, :mod:`softhand.fem.hand.reservoir`, one path from flat to V0): p_r at the oil
    left, V = V0 - n dQ (at the grasp: interpolated on the path), so that the hand's pump
    pressure at contact is
-   P_contact = p_finger(theta_g) - p_r(V) -- as :func:`studies.compare.whole_hand`.
-3. **Grasp** (:mod:`fem.grasp`, the finger closing on the rigid object with its weight share):
+   P_contact = p_finger(theta_g) - p_r(V) -- as :func:`softhand.studies.compare.whole_hand`.
+3. **Grasp** (:mod:`softhand.fem.hand.grasp`, the finger closing on the rigid object with its weight share):
    first at the cavity pressure that the *predicted* pump pressure gives with the FEM
    reservoir (F_v there is the FEM's answer to the prediction), then secant steps in the
    cavity pressure until the FEM's F_v is the required one within ``rtol``: that state is the
@@ -25,7 +25,7 @@ Three FEM models check the reduced model's answer (:class:`studies.design_opt.Ev
    limit, the FEM goes on to the limit (it has no one-pad restriction: the margin the task
    asks for, which the reduced model does not reach).
 
-The finger mesh is the grasp FEM's (:func:`studies.weights.finger_options`) for both finger
+The finger mesh is the grasp FEM's (:func:`softhand.studies.weights.finger_options`) for both finger
 runs, so that the free bend and the grasp share one discretisation.
 """
 from __future__ import annotations

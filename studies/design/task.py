@@ -28,11 +28,11 @@ A task is a TOML file (``studies/designs/tasks/paper_task.toml`` is the paper's)
 
 ``base_design`` is looked up as given, then next to the task file, then in the package.
 A task designs on the FEM-calibrated models (``finger_model = "fem"``, ``reservoir_model =
-"fem"``, :data:`MODELS`) unless its ``[design]`` table names others: those are the models the
+"fem"``, :data:`~softhand.studies.design.task.MODELS`) unless its ``[design]`` table names others: those are the models the
 FEM proof checks. With the packaged finger table, the free bounds are clipped to the box the
 table was calibrated on (:data:`CALIBRATED_SPACE`, its ``[space]``); the table's group ranges
-are the optimiser's constraints (:func:`studies.design.optimise.calibrated_range`).
-Every mistake is one :class:`InputError` naming the key.
+are the optimiser's constraints (:func:`softhand.studies.design.evaluate.calibrated_range`).
+Every mistake is one :class:`~softhand.reduced.errors.InputError` naming the key.
 """
 from __future__ import annotations
 

@@ -10,7 +10,7 @@ from softhand.studies.io.files import figure, save_figure
 def plot_bending(path, rows: list[dict], design, hand_rows: list[dict] | None = None, *,
                  title: str | None = None) -> None:
     """theta vs P: the free finger's FEM points (``rows`` of a bending study) and eq. (28);
-    with ``hand_rows`` (of :func:`studies.compare.whole_hand`) the whole hand's FEM points
+    with ``hand_rows`` (of :func:`softhand.studies.compare.whole_hand`) the whole hand's FEM points
     (finger FEM + reservoir-sheet FEM) and eq. (27)."""
     theta_max = max(max(r["theta_deg"] for r in rows), 1.0)
     theta_deg = np.linspace(0.0, theta_max, 101)

@@ -19,7 +19,7 @@ DISTURBANCE_HEADER = ("t_s", "force_N")
 #: allowed push force [N], of ``--push-N`` and of a disturbance file's rows
 PUSH_LIMITS_N = (-1000.0, 1000.0)
 #: the quiet time before any push [s]: the window the summary measures the hold in
-#: (:func:`reduced.control.summarize`), as for --push-at-s
+#: (:func:`softhand.reduced.control.summarize`), as for --push-at-s
 QUIET_S = 1.0
 
 
@@ -86,7 +86,7 @@ def series_rows(sim, every: int) -> list[dict]:
 
 def plot_fig10(path, result, mode: str, theta_ref_deg: float) -> None:
     """Fig. 10 (c), (d): each finger's angle and the mean, the pump pressure and the push against
-    time, for the ``mode`` run of :func:`reduced.control.flexibility`'s ``result``, the other
+    time, for the ``mode`` run of :func:`softhand.reduced.control.flexibility`'s ``result``, the other
     mode dotted."""
     import matplotlib
     matplotlib.use("Agg")

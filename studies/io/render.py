@@ -9,7 +9,7 @@ the field's unit; its undeformed shape as a faint ghost; the links and hinges of
 the object of a grasp; the contact forces as arrows ending at the pads, labelled in N.
 The title gives the file, the step and the pressure (and bend angle or volume).
 
-A field is named as in the file (``von_mises_MPa``, ``J``, ...; :func:`describe` lists
+A field is named as in the file (``von_mises_MPa``, ``J``, ...; ``describe()`` lists
 them); a vector or tensor field is shown by its magnitude, or by one component with
 ``NAME[i]`` (e.g. ``principal_stretches[0]``, the largest stretch). Point data are
 preferred to cell data of the same name.

@@ -1,7 +1,7 @@
 """What ``softhand inspect`` shows by default: the body, its field, the labels, the camera,
 the colour range, the default file name.
 
-Pure functions of names and numbers (no pyvista here; :mod:`studies.inspect` draws).
+Pure functions of names and numbers (no pyvista here; :mod:`softhand.studies.io.render` draws).
 """
 from __future__ import annotations
 

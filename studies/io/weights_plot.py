@@ -36,7 +36,7 @@ def plot_weights(path, result) -> None:
 
 
 def plot_fig8(path, result) -> None:
-    """F_v [kgf] vs theta [deg] of a :class:`studies.fig8.Fig8Result`: FEM points, eq. (25) lines."""
+    """F_v [kgf] vs theta [deg] of a :class:`softhand.studies.fig8.Fig8Result`: FEM points, eq. (25) lines."""
     from softhand.studies.io.files import save_figure
 
     plt = _pyplot()
@@ -48,7 +48,7 @@ def plot_fig8(path, result) -> None:
 
 
 def draw_fig8(ax, result) -> None:
-    """The Fig. 8 analogue of a :class:`studies.fig8.Fig8Result` on the axes ``ax``: per
+    """The Fig. 8 analogue of a :class:`softhand.studies.fig8.Fig8Result` on the axes ``ax``: per
     pressure the FEM points and eq. (25) with that pressure's mean FEM w."""
     for k, (P, theta_deg, F_v_kgf) in enumerate(result.model_lines()):
         pts = [r for r in result.rows if r["P_MPa"] == P]

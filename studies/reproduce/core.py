@@ -1,6 +1,6 @@
 """``softhand reproduce``: every result of the paper, end to end, into one report.
 
-The report is a list of :class:`Section` s. Each calls the owning module's library
+The report is a list of :class:`~softhand.studies.reproduce.section.Section` s. Each calls the owning module's library
 function (never the CLI), writes its PNG/CSV/VTK files and a ``section.md`` into its
 own folder ``<out>/<section>/``, and returns its headline numbers. A section is
 
@@ -10,8 +10,8 @@ own folder ``<out>/<section>/``, and returns its headline numbers. A section is
   size, design hash, code version): a killed or repeated run resumes where it
   stopped. ``fresh=True`` recomputes everything.
 
-A section's folder is written through the batch runner (:func:`studies.batch.runner.execute_case`
-in a private temporary folder, then :func:`studies.batch.runner.commit`: one rename), so an
+A section's folder is written through the batch runner (:func:`softhand.studies.batch.cases.execute_case`
+in a private temporary folder, then :func:`softhand.studies.batch.cases.commit`: one rename), so an
 interrupted run leaves nothing half-written. ``<out>/report.md`` and
 ``<out>/summary.csv`` are assembled from the section folders at the end.
 """

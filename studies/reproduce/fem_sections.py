@@ -1,4 +1,4 @@
-"""The FEM sections of ``softhand reproduce`` (see :mod:`studies.reproduce.sections`).
+"""The FEM sections of ``softhand reproduce`` (see :mod:`softhand.studies.reproduce.sections`).
 
 Each runs the owning study with the section's mesh size (CI-sized with ``--quick``, the
 study's default otherwise) and lets the study's result write, plot and summarise itself;

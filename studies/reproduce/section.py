@@ -1,6 +1,6 @@
 """What a section of ``softhand reproduce`` is: the context it receives, its record, and the
-Markdown table its text uses. The section builders (:mod:`studies.reproduce.sections`,
-:mod:`studies.reproduce.fem_sections`) and the report (:mod:`studies.reproduce.core`) import
+Markdown table its text uses. The section builders (:mod:`softhand.studies.reproduce.sections`,
+:mod:`softhand.studies.reproduce.fem_sections`) and the report (:mod:`softhand.studies.reproduce.core`) import
 this module, never each other.
 """
 from __future__ import annotations

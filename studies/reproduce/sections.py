@@ -3,8 +3,8 @@
 Each builder ``build(ctx, outdir) -> (markdown, numbers)`` calls the owning library
 function, writes its CSV/PNG/VTK files into ``outdir`` and returns the Markdown body
 (links relative to ``outdir``) and its headline numbers. No printing; no CLI calls.
-The FEM sections live in :mod:`studies.reproduce.fem_sections`; the paper's numbers they
-compare with come from :mod:`reduced.paper`.
+The FEM sections live in :mod:`softhand.studies.reproduce.fem_sections`; the paper's numbers they
+compare with come from :mod:`softhand.reduced.paper`.
 """
 from __future__ import annotations
 

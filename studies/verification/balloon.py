@@ -1,5 +1,5 @@
 """Verification case 4: a thick Neo-Hookean balloon inflated under volume control past its
-pressure maximum, against the exact incompressible thick-sphere p(λ_a) (:mod:`fem.balloon`).
+pressure maximum, against the exact incompressible thick-sphere p(λ_a) (:mod:`softhand.fem.hand.balloon`).
 
 Tolerance 1 %; what remains is the O(μ/κ) = 1e-3 compressibility of the FEM
 material (the closed form is incompressible) and the O(h³) geometry of the curved Q2 cells.

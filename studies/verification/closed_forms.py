@@ -2,7 +2,7 @@ r"""Closed-form solutions the FEM is verified against (``softhand verify``, test
 
 Pure NumPy/SciPy; stresses in MPa, lengths in mm.
 
-**Uniaxial tension** of the nearly incompressible Neo-Hookean law of :mod:`fem.materials`,
+**Uniaxial tension** of the nearly incompressible Neo-Hookean law of :mod:`softhand.fem.materials`,
 :math:`\psi = \tfrac{\mu}{2}(J^{-2/3}I_1 - 3) + \tfrac{\kappa}{2}(J-1)^2`, stretched by λ
 along :math:`e_1` with free lateral faces: the lateral stretch t solves
 :math:`\sigma_{22} = \mu J^{-5/3}\big(t^2 - \tfrac{λ^2 + 2t^2}{3}\big) + κ(J-1) = 0`,

@@ -9,7 +9,7 @@ from softhand.reduced.errors import InputError
 def richardson(coarse: float, medium: float, fine: float, ratio: float = 2.0) -> tuple[float, float]:
     """(observed order p, extrapolated value) of f(h) = f0 + C h^p from h, h/ratio, h/ratio^2.
 
-    p = log(|f_m - f_c| / |f_f - f_m|) / log(ratio), f0 = f_f + (f_f - f_m) / (ratio^p - 1).
+    p = log(``|f_m - f_c|`` / ``|f_f - f_m|``) / log(ratio), f0 = f_f + (f_f - f_m) / (ratio^p - 1).
     Needs monotone convergence (both differences of one sign, shrinking); otherwise the
     three values say nothing about the limit and this raises InputError.
     """

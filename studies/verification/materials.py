@@ -1,6 +1,6 @@
 r"""Verification of every rubber model in the FEM: homogeneous modes and a thin balloon.
 
-``modes``: a unit cube (P2-P0 mean-dilatation solid, :mod:`fem.solid`) under mixed
+``modes``: a unit cube (P2-P0 mean-dilatation solid, :mod:`softhand.fem.solid`) under mixed
 boundary conditions, stretched by lambda along x:
 
 * uniaxial: rollers on x, y, z = 0, the other faces free;
@@ -8,13 +8,13 @@ boundary conditions, stretched by lambda along x:
 * pure shear: x prescribed (lambda), y held (lambda_2 = 1), z free;
 
 nominal stress from the reaction against the incompressible closed form of
-:mod:`reduced.rubber`. The state is homogeneous (exact in P2), so what remains is the
+:mod:`softhand.reduced.rubber`. The state is homogeneous (exact in P2), so what remains is the
 compressibility of the FEM material: kappa = 1e4 mu0 changes the stress by O(mu0/kappa),
 measured 2.7e-5 to 2.7e-4 relative; tolerance 1e-3.
 
 ``balloon_models``: a thin sphere (A = 10 mm, B = 10.2 mm: H/A = 0.02) inflated under
-volume control (axisymmetric Q2/P1disc, :mod:`fem.balloon`) against the exact
-incompressible thick-sphere pressure :func:`fem.balloon.closed_form_pressure_general`, at
+volume control (axisymmetric Q2/P1disc, :mod:`softhand.fem.hand.balloon`) against the exact
+incompressible thick-sphere pressure :func:`softhand.fem.hand.balloon.closed_form_pressure_general`, at
 stretches before and past the pressure maximum, and the (first, local) maximum itself for
 Mooney-Rivlin and Gent (parabola through the three sampled points around it, 0.05 apart in
 stretch). Tolerance 1 % as for the Neo-Hookean balloon. What remains is the FEM material's

@@ -1,5 +1,5 @@
 """Verification of the solid's tangent and of Newton's convergence on the tube problems of
-:mod:`.solid`: the tangent against central differences of the residual (O(eps^2) +
+:mod:`softhand.studies.verification.solid`: the tangent against central differences of the residual (O(eps^2) +
 round-off: 1e-6), and the observed order of full Newton, at least 1.5 (quadratic: 2; an
 inexact tangent: 1).
 """

@@ -1,12 +1,12 @@
 r"""Verification cases of the 3D solid (uniaxial tension, tubes in plane strain,
 locking, a fiber-wound tube, convergence rates): closed form vs FEM.
 
-All cases use the mean-dilatation P2-P0 solid of :mod:`fem.solid` on quadratic
-(isoparametric) tetrahedra, the follower pressure of :mod:`fem.loads` and Newton with
-load stepping of :mod:`fem.newton`. The tube has the finger's radii R_i = 4, R_o = 9 mm and
+All cases use the mean-dilatation P2-P0 solid of :mod:`softhand.fem.solid` on quadratic
+(isoparametric) tetrahedra, the follower pressure of :mod:`softhand.fem.loads` and Newton with
+load stepping of :mod:`softhand.fem.newton`. The tube has the finger's radii R_i = 4, R_o = 9 mm and
 μ = 1.15 MPa. Plane strain is a quarter-annulus slice with u_z = 0 on both faces and
 symmetry planes x = 0, y = 0 (exact for the plane-strain solution, which has u_z = 0 and
-no hoop displacement). Closed forms: :mod:`studies.closed_forms`.
+no hoop displacement). Closed forms: :mod:`softhand.studies.verification.closed_forms`.
 
 What bounds each tolerance:
 
@@ -78,7 +78,7 @@ class Problem:
 
     def solve(self, steps: int = 4) -> np.ndarray:
         """The displacement at t = 1 by load stepping with the mixed (u, p) Newton iteration of
-        :class:`fem.solid.MixedNewton` (κ-independent convergence); raises NotConverged."""
+        :class:`softhand.fem.mixed.MixedNewton` (κ-independent convergence); raises NotConverged."""
         t_now = [0.0]
         mixed = MixedNewton(self.solid, expand=lambda q: self.u(q, t_now[0]))
 

@@ -1,6 +1,6 @@
 """The architecture, enforced: dependencies point down, and no module imports itself in a circle.
 
-Layers, bottom up (the README's Architecture section describes them):
+Layers, bottom up (docs/architecture.md describes them):
 
 * ``softhand.reduced`` -- the design vocabulary and the paper's model; NumPy/SciPy only;
 * ``softhand.meshes`` -- geometry as code; may use ``reduced`` (design, errors);

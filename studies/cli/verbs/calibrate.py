@@ -1,7 +1,7 @@
 """``softhand calibrate finger``: the table of the reduced finger model ``"fem"`` from the FEM.
 
 * ``--space FILE.toml --out FILE.csv``: every design of a design space (see
-  :mod:`studies.finger_calibration`) by the finger FEM, as a batch study on the runner
+  :mod:`softhand.studies.calibration.finger`) by the finger FEM, as a batch study on the runner
   (results/<name>/, resumable, ``--workers N``, ``--scheduler local|tcp://...``), then the
   nondimensional table with its provenance (the package's is reduced/data/finger_fem.csv);
 * ``--design FILE.toml --out FILE.csv``: the same for one design (any geometry with 5 equal

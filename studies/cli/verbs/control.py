@@ -6,7 +6,7 @@ holding the pressure angle control had just before the push. Prints the summary 
 ``--mode`` run (settling time, steady error, P and mean angle before/during the push) and
 the grasping force in the three states of Table II next to the paper's numbers. The plant
 and its parameters: reduced/plant.py and docs/control.md. The study itself is
-:mod:`studies.control`; the disturbance file's format: :mod:`studies.io.control_files`.
+:mod:`softhand.studies.control`; the disturbance file's format: :mod:`softhand.studies.io.control_files`.
 """
 from __future__ import annotations
 
@@ -121,7 +121,7 @@ LIMITS = {"--push-N": PUSH_LIMITS_N, "--push-rise-s": (0.0, 600.0),
 
 
 def study_from_args(args):
-    """The :class:`studies.control.ControlStudy` the arguments ask for (checked)."""
+    """The :class:`softhand.studies.control.ControlStudy` the arguments ask for (checked)."""
     from softhand.studies.control import ControlStudy
 
     _check_inputs(args)

@@ -32,7 +32,7 @@ def configure(parser) -> None:
 
 def rows_at_angles(theta_deg: np.ndarray, design: HandDesign) -> list[dict]:
     """Per bend angle [deg]: P with / without reservoir [MPa], the reservoir's V [mm^3] and
-    :func:`reduced.reservoir.state` (p_r; h, lambda_r for the ellipse model)."""
+    :func:`softhand.reduced.reservoir.state` (p_r; h, lambda_r for the ellipse model)."""
     theta = hand.check_theta(np.radians(theta_deg))
     V = reservoir.oil_volume(theta, design)
     columns = {"theta_deg": theta_deg, "P_MPa": hand.pressure(theta, design),

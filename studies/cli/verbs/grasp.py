@@ -3,15 +3,15 @@
 Given the pump pressure, the bend angle, the object's mass and a weight vector w, prints
 F_x (25), F_y (24) and the normal force F_v (29) in N and kgf. w is given as numbers, by the
 name of one of the paper's vectors (``--weights paper180``), or from the grasp FEM for any
-object diameter (``--diameter-mm D``: :mod:`studies.weights`, cached; the first call for a
+object diameter (``--diameter-mm D``: :mod:`softhand.studies.weights`, cached; the first call for a
 new diameter runs the FEM). ``w_source`` in the output says which. Axes and signs:
 docs/conventions.md (F_v > 0: the finger squeezes).
 
 ``--model fem`` (with ``--diameter-mm D``) replaces eq. (25) by the FEM-informed estimate of
-:mod:`reduced.grasp_fem`: the calibrated finger in equilibrium hinge by hinge against the
+:mod:`softhand.reduced.grasp_fem`: the calibrated finger in equilibrium hinge by hinge against the
 object, touching where the geometry says; P is converted to the cavity pressure with the
 reservoir at theta, and the object's depth is the one that gives theta. Both are computed
-by :mod:`studies.grasp`; this verb reads the options and prints.
+by :mod:`softhand.studies.grasp`; this verb reads the options and prints.
 """
 from __future__ import annotations
 

@@ -6,7 +6,7 @@ maximum (if the path passes one) and the verdict over the operating range (V0 - 
 ``--plot``: profiles, p(V) of both models, and the hand's P(theta) with both reservoir
 models. ``--out DIR``: result.json (rows, verdict, wet-surface profiles z(r) and mid-surface
 stretches per volume, the whole p(V), W(V) path), rows.csv, VTK of the deformed sheet per
-volume (r–z and revolved to 3D); see :class:`studies.reservoir.ReservoirStudyResult`. ``--write-calibration FILE.csv``: the table of ``reduced/reservoir_fem.py``.
+volume (r–z and revolved to 3D); see :class:`softhand.studies.reservoir.ReservoirStudyResult`. ``--write-calibration FILE.csv``: the table of ``reduced/reservoir_fem.py``.
 """
 from __future__ import annotations
 

@@ -1,13 +1,15 @@
-"""The README's sample sessions of the fast verbs print what the README shows.
+"""The sample sessions of README.md and the docs pages print what the page shows.
 
-Each ``$ softhand ...`` line of a README code block is run (in a scratch folder that sees the
+Each ``$ softhand ...`` line of a code block of README.md or docs/*.md is run (in a scratch folder that sees the
 repository's ``studies/``) and its output compared line by line with the lines below it (words exactly, numbers to the
 digits shown): a
 line ``...`` in the README skips printed lines up to the next one shown, and
 ``(exit code N)`` after a line marks an error line (on stderr) and the exit code. The FEM
 verbs' samples (``verify``, ``bend``, ``weights``, ...) take minutes and are re-measured by
-hand; these are the ones a test can afford.
+hand; these are the ones a test can afford. Each ``>>>`` Python session of those pages runs as a
+doctest.
 """
+import doctest
 import re
 import shlex
 from pathlib import Path
@@ -17,6 +19,8 @@ import pytest
 from softhand.studies.cli.main import main
 
 ROOT = Path(__file__).resolve().parents[2]
+#: the pages whose samples are run: the front page and every docs page
+PAGES = [ROOT / "README.md", *sorted((ROOT / "docs").glob("*.md"))]
 #: the samples run here, by the start of their command line (all of the reduced model's
 #: verbs, and the reservoir sheet's FEM, ~2 s)
 FAST = ("curve ", "grasp ", "control ", "fit ", "material fit ", "reservoir")
@@ -24,9 +28,17 @@ _EXIT = re.compile(r"\s+\(exit code (\d+)\)$")
 
 
 def samples(text: str):
-    """[(command line, shown output lines)] of the README's code blocks, in order."""
-    found, command, shown, inside = [], None, [], False
+    """[(command line, shown output lines)] of a page's code blocks, in order. A command line
+    ending in ``\\`` goes on on the next; ``$ cat > FILE <<EOF`` shows a file's lines up to ``EOF``."""
+    found, command, shown, inside, heredoc = [], None, [], False, None
     for line in text.splitlines():
+        if heredoc is not None:
+            if line.strip() == heredoc:
+                found.append((command, shown))
+                command, shown, heredoc = None, [], None
+            else:
+                shown.append(line)
+            continue
         if line.strip().startswith("```"):
             if command is not None:
                 found.append((command, shown))
@@ -38,17 +50,23 @@ def samples(text: str):
             if command is not None:
                 found.append((command, shown))
             command, shown = line.strip()[2:], []
+            if command.startswith("cat > ") and "<<" in command:
+                heredoc = command.split("<<")[1].strip().strip("'\"")
+        elif command is not None and command.endswith("\\") and not shown:
+            command = command[:-1].rstrip() + " " + line.strip()
         elif command is not None:
             shown.append(line.rstrip())
     return found
 
 
 def _fast(command: str) -> bool:
-    return command.startswith("softhand ") and command[len("softhand "):].startswith(FAST)
+    return command.startswith("cat > ") or (
+        command.startswith("softhand ") and command[len("softhand "):].startswith(FAST))
 
 
-#: the samples with output shown (a block may also list commands alone)
-README_SAMPLES = [s for s in samples((ROOT / "README.md").read_text()) if _fast(s[0]) and any(s[1])]
+#: the samples with output shown (a block may also list commands alone), page by page
+SAMPLES = [(page.relative_to(ROOT).as_posix(), *s) for page in PAGES for s in samples(page.read_text())
+           if _fast(s[0]) and any(s[1])]
 
 
 _NUMBER = re.compile(r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?")
@@ -72,8 +90,8 @@ def _matches(shown: list[str], printed: list[str]) -> bool:
     return bool(printed) and _same_line(shown[0], printed[0]) and _matches(shown[1:], printed[1:])
 
 
-def test_the_readme_shows_samples_of_every_fast_verb():
-    shown = {c.split()[1] for c, _ in README_SAMPLES}
+def test_the_pages_show_samples_of_every_fast_verb():
+    shown = {c.split()[1] for _, c, _ in SAMPLES if c.startswith("softhand ")}
     assert shown >= {"curve", "grasp", "control", "fit", "material", "reservoir"}, shown
 
 
@@ -85,9 +103,12 @@ def scratch(tmp_path_factory):
     return folder
 
 
-@pytest.mark.parametrize("command, shown", README_SAMPLES, ids=[c for c, _ in README_SAMPLES])
-def test_a_readme_sample_prints_what_the_readme_shows(command, shown, scratch, monkeypatch, capsys):
+@pytest.mark.parametrize("page, command, shown", SAMPLES, ids=[f"{p}: {c}" for p, c, _ in SAMPLES])
+def test_a_sample_prints_what_its_page_shows(page, command, shown, scratch, monkeypatch, capsys):
     monkeypatch.chdir(scratch)
+    if command.startswith("cat > "):  # a file a later sample reads
+        (scratch / shlex.split(command)[2]).write_text("\n".join(shown) + "\n")
+        return
     argv = shlex.split(command.split("  #")[0])[1:]
     code = _EXIT.search(shown[-1]) if shown else None
     shown = [_EXIT.sub("", line) for line in shown]
@@ -102,4 +123,16 @@ def test_a_readme_sample_prints_what_the_readme_shows(command, shown, scratch, m
     assert got == expected, (command, err)
     printed = (err if code else out).rstrip("\n").splitlines()
     assert _matches(shown, [line.rstrip() for line in printed]), (
-        f"{command}\n--- README\n" + "\n".join(shown) + "\n--- printed\n" + "\n".join(printed))
+        f"{command}\n--- {page}\n" + "\n".join(shown) + "\n--- printed\n" + "\n".join(printed))
+
+
+def test_the_front_page_shows_a_python_session():
+    assert "\n>>> " in (ROOT / "README.md").read_text()
+
+
+@pytest.mark.parametrize("page", [p for p in PAGES if "\n>>> " in p.read_text()], ids=lambda p: p.name)
+def test_a_python_session_prints_what_its_page_shows(page, monkeypatch, tmp_path):
+    monkeypatch.chdir(tmp_path)
+    failed, tried = doctest.testfile(str(page), module_relative=False, verbose=False, report=True,
+                                     optionflags=doctest.ELLIPSIS | doctest.NORMALIZE_WHITESPACE)
+    assert tried and not failed, f"{page.name}: {failed} of {tried} examples failed (printed above)"
