@@ -10,9 +10,10 @@ from softhand.fem.hand.finger import FingerModel, FingerOptions, ring_width, sol
 from softhand.fem.newton import NewtonOptions
 from softhand.reduced import hand, kinematics
 from softhand.reduced.design import HandDesign
+from conftest import CI_FINGER, CI_MESH_ARGS
 
 DESIGN = HandDesign()
-CI = FingerOptions(mesher="gmsh", mesh_size=6.0, edge_ratio=1.0, mesh_refine=0)  # uniform, 9.7k unknowns; theta ~3 % low (docs)
+CI = FingerOptions(**CI_FINGER)
 PRESSURES = (0.4, 0.8)
 
 
@@ -201,7 +202,7 @@ def test_bend_without_progress_writes_nothing_to_stderr(capsys, tmp_path):
     """--no-progress (every verb with a progress bar has it): a log of stdout and stderr holds the
     table and nothing else; without it the bar goes to stderr."""
     from softhand.studies.cli.main import main
-    argv = ["bend", "--pressure-mpa", "0,0.1", "--mesh-size-mm", "6", "--peak-mpa", "0", "--out", str(tmp_path)]
+    argv = ["bend", "--pressure-mpa", "0,0.1", *CI_MESH_ARGS, "--peak-mpa", "0", "--out", str(tmp_path)]
     assert main([*argv, "--no-progress"]) == 0
     quiet = capsys.readouterr()
     assert quiet.err == "" and "theta_deg" in quiet.out

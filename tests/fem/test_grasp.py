@@ -13,15 +13,15 @@ from softhand.fem.newton import NewtonOptions, newton
 from softhand.reduced.design import HandDesign
 from softhand.studies.cli.main import main
 from softhand.studies.weights import interpolate
+from conftest import COARSEST_FINGER
 
 DESIGN = HandDesign()
-CI_MESH = 10.0   # mm; the coarsest mesh the finger FEM builds (docs/grasp.md: w on it vs finer)
 P, DP = 0.45, 0.05  # MPa; the fingers touch the 180 mm object from 0.3 MPa on (FEM, CI mesh)
 
 
 @pytest.fixture(scope="module")
 def grasp180():
-    model = GraspModel(FingerModel(DESIGN, FingerOptions(mesher="gmsh", mesh_size=CI_MESH, edge_ratio=1.0, mesh_refine=0)), 180.0)  # uniform
+    model = GraspModel(FingerModel(DESIGN, FingerOptions(**COARSEST_FINGER)), 180.0)  # docs/grasp.md: w on it vs finer
     a = model.solve(P)
     return model, a, model.solve(P + DP, start=a), model.solve(P + DP / 2, start=a)
 

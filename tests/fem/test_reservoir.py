@@ -13,16 +13,16 @@ from softhand.reduced import reservoir_fem
 from softhand.reduced.design import HandDesign
 from softhand.studies.cli.main import main
 from softhand.studies.reservoir import ReservoirStudy, run, stroke_volume
+from conftest import CI_SHEET
 
 DESIGN = HandDesign()
-COARSE = dict(n_radial=24, n_thick=2)
 STROKE = stroke_volume(DESIGN, math.pi / 2)  # 4737 mm^3 at 90 deg
 
 
 @pytest.fixture(scope="module")
 def study():
     volumes = (DESIGN.V0 - STROKE, DESIGN.V0, DESIGN.V0 + 2000.0)
-    return run(ReservoirStudy(DESIGN, volumes_mm3=volumes, n_range=3, **COARSE))
+    return run(ReservoirStudy(DESIGN, volumes_mm3=volumes, n_range=3, **CI_SHEET))
 
 
 def test_energy_balance_integral_of_p_dV_equals_strain_energy(study):

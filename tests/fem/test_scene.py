@@ -13,6 +13,7 @@ from softhand.fem.hand.scene import finger_scene, link_boxes, to_hand
 from softhand.reduced.design import HandDesign
 from softhand.studies.cli.main import main
 from softhand.studies.io.render import animate, describe, inspect, load_scene
+from conftest import COARSEST_FINGER
 
 DESIGN = HandDesign()
 Q = np.array([0.1, 0.25, 0.15, 0.05, 0.3])  # rad, distinct per hinge so a mix-up shows
@@ -20,7 +21,7 @@ Q = np.array([0.1, 0.25, 0.15, 0.05, 0.3])  # rad, distinct per hinge so a mix-u
 
 @pytest.fixture(scope="module")
 def finger():
-    return FingerModel(DESIGN, FingerOptions(mesher="gmsh", mesh_size=10.0, edge_ratio=1.0, mesh_refine=0))
+    return FingerModel(DESIGN, FingerOptions(**COARSEST_FINGER))
 
 
 @pytest.fixture(scope="module")

@@ -25,6 +25,8 @@ from pathlib import Path
 
 import pytest
 
+from conftest import CI_MESH_ARGS
+
 GOLDEN = Path(__file__).resolve().parents[1] / "data" / "golden"
 ROOT = Path(__file__).resolve().parents[2]
 RTOL = 1e-9
@@ -48,7 +50,7 @@ CASES = {
     "verify_uniaxial": (["verify", "--case", "uniaxial", "--case", "tube"], FEM_RTOL),
     "reservoir": (["reservoir"], FEM_RTOL),
     "bend_ci_mesh": (["bend", "--pressure-mpa", "0.4,0.8", "--mesher", "gmsh",
-                      "--mesh-size-mm", "6", "--peak-mpa", "0"], FEM_RTOL),
+                      *CI_MESH_ARGS, "--peak-mpa", "0"], FEM_RTOL),
 }
 
 

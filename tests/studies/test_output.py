@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 from softhand.studies.io.files import write_atomic, write_csv, write_json
+from conftest import CI_MESH_ARGS
 
 
 def test_write_json_round_trip_with_numpy(tmp_path):
@@ -101,7 +102,7 @@ def test_a_stopped_bend_leaves_no_half_written_series(tmp_path, monkeypatch):
     out = tmp_path / "b"
     out.mkdir()
     (out / "notes.txt").write_text("the user's")
-    assert main(["bend", "--mesh-size-mm", "6", "--pressure-mpa", "0.2,0.4", "--peak-mpa", "0",
+    assert main(["bend", *CI_MESH_ARGS, "--pressure-mpa", "0.2,0.4", "--peak-mpa", "0",
                  "--out", str(out), "--no-progress"]) == 130
     assert sorted(p.name for p in out.iterdir()) == ["notes.txt"]
 

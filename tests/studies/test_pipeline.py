@@ -13,6 +13,7 @@ import pytest
 from softhand.reduced import control, grasp, paper, reservoir
 from softhand.reduced.design import HandDesign
 from softhand.reduced.versions import package_version
+from conftest import CI_FINGER
 
 ROOT = Path(__file__).resolve().parents[2]
 SOURCES = [p for layer in ("fem", "reduced", "meshes", "studies") for p in (ROOT / layer).rglob("*.py")]
@@ -46,7 +47,7 @@ def bent(tmp_path_factory):
     from softhand.studies.bending import BendingStudy, run, vtk_writer
 
     out = tmp_path_factory.mktemp("bend")
-    options = FingerOptions(mesher="gmsh", mesh_size=6.0, edge_ratio=1.0, mesh_refine=0)
+    options = FingerOptions(**CI_FINGER)
     seen = []
     result = run(BendingStudy(pressures_mpa=(0.0, 0.3), options=options, hand=True),
                  on_state=vtk_writer(out / "finger.pvd", then=lambda model, state: seen.append(state.P)))

@@ -12,6 +12,7 @@ import pytest
 from softhand.studies.cli.main import main
 from softhand.studies.batch.runner import RESULT, plan, study_dir
 from softhand.studies.batch.studyfile import load_study
+from conftest import CI_MESH_ARGS
 from test_runner import _default_sigint, install_kind
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -330,7 +331,7 @@ def test_a_grasp_fem_that_stops_saves_the_states_it_reached(tmp_path, monkeypatc
 
     monkeypatch.setattr(grasp.GraspModel, "solve", second_state_fails)
     out = tmp_path / "w"
-    assert main(["weights", "--diameter-mm", "180", "--pressure-mpa", "0.8", "--mesh-size-mm", "6",
+    assert main(["weights", "--diameter-mm", "180", "--pressure-mpa", "0.8", *CI_MESH_ARGS,
                  "--no-cache", "--out", str(out)]) == 1
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "P = 0.8 MPa" in err[0] and "Traceback" not in err[0], err
