@@ -73,7 +73,7 @@ class Measurements:
 def read_measurements(path: str | Path) -> Measurements:
     """Read a measurement CSV (see the module docstring); raises InputError on any problem."""
     path = Path(path)
-    header, rows = _read_rows(path)
+    header, rows = read_rows(path)
     columns = _parse_columns(path.name, header, rows)
     kind = "grasp" if "F_v_N" in columns or "mass_kg" in columns else "bending"
     required = GRASP_COLUMNS if kind == "grasp" else BENDING_COLUMNS
@@ -92,7 +92,7 @@ def read_measurements(path: str | Path) -> Measurements:
     )
 
 
-def _read_rows(path: Path) -> tuple[list[str], list[tuple[int, list[str]]]]:
+def read_rows(path: Path) -> tuple[list[str], list[tuple[int, list[str]]]]:
     """Header cells and (line number, cells) of the data rows; comments and blank lines skipped."""
     from .design import read_input_file
 

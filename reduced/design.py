@@ -46,7 +46,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from . import rubber
-from .design_rules import BOUNDS, CONSISTENCY, _check_model, _in_bounds, _is_number
+from .design_rules import BOUNDS, CONSISTENCY, check_model, in_bounds, is_number
 from .errors import InputError
 from .inputfiles import MAX_FILE_BYTES, read_input_file, read_toml
 
@@ -109,7 +109,7 @@ class HandDesign:
         """Raise :class:`InputError` naming the first bad field (bounds: :data:`BOUNDS`)."""
         for name, key in _KEY_OF.items():
             if key in BOUNDS:
-                _in_bounds(key, _to_public(name, getattr(self, name)))
+                in_bounds(key, _to_public(name, getattr(self, name)))
         for name in ("n", "n_s"):
             value = getattr(self, name)
             if isinstance(value, bool) or not isinstance(value, int):
@@ -124,10 +124,10 @@ class HandDesign:
                              f"must be finite and increase strictly within (0, l0 = {self.l0:g}) mm")
         for check in CONSISTENCY:
             check(self)
-        _check_model("reservoir_model", self.reservoir_model, RESERVOIR_MODELS,
+        check_model("reservoir_model", self.reservoir_model, RESERVOIR_MODELS,
                      self.reservoir_is_neo_hookean, "reservoir", "sheet", self.reservoir_material,
                      "ellipse")
-        _check_model("finger_model", self.finger_model, FINGER_MODELS, self.finger_is_neo_hookean,
+        check_model("finger_model", self.finger_model, FINGER_MODELS, self.finger_is_neo_hookean,
                      "finger", "tube", self.finger_material, "paper")
 
     def check_volume(self, theta_max: float) -> None:
@@ -239,10 +239,10 @@ def _material_changes(part: str, table, source: str, values: dict) -> dict:
     given = values.get(_KEY_OF[name])
     if given is not None:  # overridden, but still a value of the file: a bad one is bad input
         try:
-            _in_bounds(_KEY_OF[name], given)
+            in_bounds(_KEY_OF[name], given)
         except InputError as exc:
             raise exc.renamed(f"{source}: {_KEY_OF[name]}") from None
-    if _is_number(given) and not math.isclose(given, material.mu0, rel_tol=1e-9):
+    if is_number(given) and not math.isclose(given, material.mu0, rel_tol=1e-9):
         warnings.warn(f"{source}: {_KEY_OF[name]} = {given} is overridden by [{part}.material], "
                       f"whose initial shear modulus is {material.mu0:.6g} MPa")
     return {f"{part}_material": material, name: material.mu0}
@@ -261,7 +261,7 @@ def _from_public(key: str, value):
     name = _FIELD_OF[key]
     default = HandDesign.__dataclass_fields__[name].default
     if name == "hinge_s":
-        if not isinstance(value, list) or not all(_is_number(v) for v in value):
+        if not isinstance(value, list) or not all(is_number(v) for v in value):
             raise InputError(key, value, "must be a list of numbers [mm]")
         return tuple(float(v) for v in value)
     if isinstance(default, str):
@@ -272,7 +272,7 @@ def _from_public(key: str, value):
         if not isinstance(value, int) or isinstance(value, bool):
             raise InputError(key, value, "must be a whole number")
         return value
-    if not _is_number(value):
+    if not is_number(value):
         raise InputError(key, value, "must be a number")
     return math.radians(value) if name == "theta0" else float(value)
 

@@ -7,7 +7,7 @@ import math
 
 from .errors import InputError
 
-__all__ = ["BOUNDS", "CONSISTENCY"]
+__all__ = ["BOUNDS", "CONSISTENCY", "check_model", "in_bounds", "is_number"]
 
 
 #: public key -> (lowest, highest) allowed value, both included, in the key's unit. Every
@@ -34,9 +34,9 @@ BOUNDS: dict[str, tuple[float, float]] = {
 }
 
 
-def _in_bounds(key: str, value) -> None:
+def in_bounds(key: str, value) -> None:
     lo, hi = BOUNDS[key]
-    if not _is_number(value) or not math.isfinite(value) or not lo <= value <= hi:
+    if not is_number(value) or not math.isfinite(value) or not lo <= value <= hi:
         raise InputError(key, value, f"must be a number in [{lo:g}, {hi:g}]")
 
 
@@ -62,7 +62,7 @@ def _ties_fit_links(design: "HandDesign") -> None:
 CONSISTENCY = (_tube_fits, _sheet_thinner_than_radius, _ties_fit_links)
 
 
-def _check_model(field: str, name: str, models, neo_hookean: bool, part: str, body: str,
+def check_model(field: str, name: str, models, neo_hookean: bool, part: str, body: str,
                  material, closed_form: str) -> None:
     """A model name the registry knows; the FEM-calibrated table only for a Neo-Hookean part."""
     if name not in models:
@@ -73,5 +73,5 @@ def _check_model(field: str, name: str, models, neo_hookean: bool, part: str, bo
                          f"[{part}.material]")
 
 
-def _is_number(value) -> bool:
+def is_number(value) -> bool:
     return isinstance(value, (int, float)) and not isinstance(value, bool)

@@ -52,7 +52,7 @@ from .finger_curves import Curves, energy_curves
 from .design import HandDesign
 from .errors import InputError
 from .finger_fem_terms import KernelFit, term_matrix
-from .finger_fem_table import COLUMNS, GROUPS, LABELS, PRIORS, TABLE_FILE, Table, _bad, read_table
+from .finger_fem_table import COLUMNS, GROUPS, LABELS, PRIORS, TABLE_FILE, Table, table_error, read_table
 
 __all__ = ["TABLE_FILE", "GROUPS", "COLUMNS", "PRIORS", "Table", "read_table", "check_table", "groups_of",
            "curves", "FEM"]
@@ -122,7 +122,7 @@ def fit_targets(rows: dict, prior: str, path="table") -> tuple[np.ndarray, np.nd
         y[at] = np.log(rows["p_tilde"][at] / prior_pressure(rows["theta"][at], g, prior))
     dilation = rows["q_tilde"] - math.pi * rows["d_a"] * rows["theta"]
     if np.any(dilation <= 0):
-        raise _bad(path, "has dQ/a^3 <= pi (d/a) theta in a row: below the tube's kinematic "
+        raise table_error(path, "has dQ/a^3 <= pi (d/a) theta in a row: below the tube's kinematic "
                          "oil volume of eq. (2)")
     return y, np.log(dilation / rows["p_tilde"])
 
@@ -137,10 +137,10 @@ class _TermsFit:
             try:
                 beta = lstsq_terms(r, r["theta"], target, terms)
             except (np.linalg.LinAlgError, ValueError) as error:  # e.g. SVD on columns that overflow
-                raise _bad(path, f"has '# fit:' terms whose least-squares fit fails ({error}); "
+                raise table_error(path, f"has '# fit:' terms whose least-squares fit fails ({error}); "
                                  f"use fewer or lower powers") from None
             if beta is None:
-                raise _bad(path, f"has too few designs ({np.unique(r['design']).size}) for the "
+                raise table_error(path, f"has too few designs ({np.unique(r['design']).size}) for the "
                                  f"fit's terms ({' '.join(terms)}); use fewer in '# fit:'")
             self.betas.append(beta)
 
@@ -159,11 +159,11 @@ def _fit(path: str) -> tuple[Table, object, float]:
         try:
             fit = KernelFit(table.rows, y, ln_kappa, table.kernel, table.features)
         except np.linalg.LinAlgError as error:  # designs at one point of the features
-            raise _bad(path, f"has designs that coincide in its '# fit:' features "
+            raise table_error(path, f"has designs that coincide in its '# fit:' features "
                              f"({' '.join(table.features)}), so the kernel interpolant cannot be built "
                              f"({error}); name features that tell the designs apart") from None
         except ValueError as error:
-            raise _bad(path, f"has {error}") from None
+            raise table_error(path, f"has {error}") from None
     return table, fit, float(table.rows["theta"].max())
 
 

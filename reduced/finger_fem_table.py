@@ -18,7 +18,7 @@ import numpy as np
 
 from .errors import InputError
 from .finger_fem_terms import KERNEL_FEATURES, MAX_FACTORS, check_terms, legacy_terms
-from .inputfiles import plain_float, read_input_file
+from .inputfiles import plain_float, read_number_table
 
 TABLE_FILE = Path(__file__).resolve().parent / "data" / "finger_fem.csv"
 #: the nondimensional groups, in table column order
@@ -52,7 +52,8 @@ class Table:
     features: tuple[str, ...] = ()  #: the features a kernel fit interpolates in
 
 
-def _bad(path, allowed: str):
+def table_error(path, allowed: str) -> InputError:
+    """The InputError of a bad calibration table ``path``: its field, the file and what is wrong."""
     return InputError("finger_table", str(path), allowed)
 
 
@@ -64,50 +65,37 @@ ROW_LIMITS = {"theta": (1e-6, 2 * math.pi), "p_tilde": (1e-9, 1e6), "q_tilde": (
 def read_table(path: str | Path = TABLE_FILE) -> Table:
     """Read a finger calibration CSV; InputError naming the file on any problem."""
     path = Path(path)
-    data = read_input_file(path, "finger_table", "a CSV written by softhand calibrate finger")
-    try:
-        text = data.decode("utf-8")
-    except UnicodeDecodeError:
-        raise _bad(path, "is not a text (CSV) file") from None
-    comments = [line for line in text.splitlines() if line.startswith("#")]
-    lines = [line for line in text.splitlines() if line.strip() and not line.startswith("#")]
-    if not lines or tuple(c.strip() for c in lines[0].split(",")) != COLUMNS:
-        raise _bad(path, f"needs the header {','.join(COLUMNS)}")
-    try:
-        values = np.array([[plain_float(x) for x in line.split(",")] for line in lines[1:]], ndmin=2)
-    except ValueError:
-        raise _bad(path, "has a cell that is not a number") from None
-    if values.shape[0] == 0 or values.shape[1] != len(COLUMNS) or not np.all(np.isfinite(values)):
-        raise _bad(path, f"needs rows of {len(COLUMNS)} finite numbers")
+    comments, _, values = read_number_table(path, "finger_table", "a CSV written by softhand calibrate finger",
+                                            COLUMNS)
     rows = {c: values[:, i] for i, c in enumerate(COLUMNS)}
     if np.any(rows["theta"] <= 0) or np.any(rows["p_tilde"] <= 0) or np.any(rows["q_tilde"] <= 0):
-        raise _bad(path, "theta, p_tilde and q_tilde must be positive (the P = 0 state is implied)")
+        raise table_error(path, "theta, p_tilde and q_tilde must be positive (the P = 0 state is implied)")
     for column, (lo, hi) in ROW_LIMITS.items():
         bad = np.flatnonzero((rows[column] < lo) | (rows[column] > hi))
         if bad.size:
-            raise _bad(path, f"has {column} = {rows[column][bad[0]]:g} in data row {bad[0] + 1}; a "
+            raise table_error(path, f"has {column} = {rows[column][bad[0]]:g} in data row {bad[0] + 1}; a "
                              f"finger's FEM gives {lo:g} to {hi:g}")
     _check_designs(rows, path)
     ranges, spec, prior = _header(comments, path)
     for g in GROUPS:
         lo, hi = ranges[g]
         if np.any(rows[g] < lo * (1 - 1e-9)) or np.any(rows[g] > hi * (1 + 1e-9)):
-            raise _bad(path, f"has {LABELS[g]} outside its '# range:' [{lo:g}, {hi:g}]")
+            raise table_error(path, f"has {LABELS[g]} outside its '# range:' [{lo:g}, {hi:g}]")
     if "kernel" in spec:
         if spec["kernel"] not in KERNELS:
-            raise _bad(path, f"has kernel={spec['kernel']}; allowed: {', '.join(KERNELS)}")
+            raise table_error(path, f"has kernel={spec['kernel']}; allowed: {', '.join(KERNELS)}")
         try:
             features = check_terms(spec.get("features", "").split())
         except ValueError as error:
-            raise _bad(path, f"has '# fit:' features: {error}") from None
+            raise table_error(path, f"has '# fit:' features: {error}") from None
         unknown = [f for f in features if f not in KERNEL_FEATURES]
         if unknown:
-            raise _bad(path, f"has '# fit:' feature {unknown[0][:40]!r}; a kernel fit's features are "
+            raise table_error(path, f"has '# fit:' feature {unknown[0][:40]!r}; a kernel fit's features are "
                              f"among {', '.join(KERNEL_FEATURES)}")
-        return Table(path.name, rows, ranges, (), (), prior=prior, header=tuple(comments),
+        return Table(path.name, rows, ranges, (), (), prior=prior, header=comments,
                      kernel=spec["kernel"], features=features)
     terms = _terms(spec, ranges, path)
-    return Table(path.name, rows, ranges, *terms, prior=prior, header=tuple(comments))
+    return Table(path.name, rows, ranges, *terms, prior=prior, header=comments)
 
 
 def _check_designs(rows: dict, path) -> None:
@@ -117,17 +105,17 @@ def _check_designs(rows: dict, path) -> None:
     wrong = (ids < 0) | (ids > MAX_DESIGN_ID) | (ids != np.round(ids))
     if np.any(wrong):
         bad = int(np.flatnonzero(wrong)[0])
-        raise _bad(path, f"has design = {ids[bad]:g} in data row {bad + 1}; design ids are whole numbers "
+        raise table_error(path, f"has design = {ids[bad]:g} in data row {bad + 1}; design ids are whole numbers "
                          f"in 0..{MAX_DESIGN_ID}")
     for i in np.unique(ids):
         at = np.flatnonzero(ids == i)
         for g in GROUPS:
             if np.ptp(rows[g][at]) > 1e-9 * np.max(np.abs(rows[g][at])):
-                raise _bad(path, f"has design {i:g} at more than one {LABELS[g]} ({rows[g][at].min():g} to "
+                raise table_error(path, f"has design {i:g} at more than one {LABELS[g]} ({rows[g][at].min():g} to "
                                  f"{rows[g][at].max():g}); a design's rows are one FEM curve of one design")
         theta, count = np.unique(rows["theta"][at], return_counts=True)
         if np.any(count > 1):
-            raise _bad(path, f"has design {i:g} at theta = {theta[count > 1][0]:g} rad more than once; "
+            raise table_error(path, f"has design {i:g} at theta = {theta[count > 1][0]:g} rad more than once; "
                              f"a design's rows are one FEM curve")
 
 
@@ -137,22 +125,22 @@ def _terms(spec: dict, ranges: dict, path) -> tuple[tuple[str, ...], tuple[str, 
         try:
             return tuple(check_terms(spec.get(k, "").split()) for k in ("p_terms", "q_terms"))
         except ValueError as error:
-            raise _bad(path, f"has a '# fit:' {error}") from None
+            raise table_error(path, f"has a '# fit:' {error}") from None
     try:
         degrees = (int(spec["design_degree"]), int(spec["theta_degree"]))
     except (KeyError, ValueError):
-        raise _bad(path, "needs the lines '# range: b_a=lo:hi, d_a=..., link_a=..., tie_link=...' "
+        raise table_error(path, "needs the lines '# range: b_a=lo:hi, d_a=..., link_a=..., tie_link=...' "
                          "and '# fit: p_terms=..., q_terms=...' (or design_degree=D, "
                          "theta_degree=T)") from None
     if min(degrees) < 0 or degrees[0] > MAX_DESIGN_DEGREE or degrees[1] > MAX_FACTORS:
-        raise _bad(path, f"has '# fit:' design_degree={degrees[0]}, theta_degree={degrees[1]}; "
+        raise table_error(path, f"has '# fit:' design_degree={degrees[0]}, theta_degree={degrees[1]}; "
                          f"allowed 0..{MAX_DESIGN_DEGREE} and 0..{MAX_FACTORS}")
     varying = {g: ranges[g][1] > ranges[g][0] * (1 + 1e-9) for g in GROUPS}
     terms = tuple(legacy_terms(kind, varying, *degrees) for kind in ("p", "q"))
     try:
         return tuple(check_terms(t) for t in terms)
     except ValueError as error:
-        raise _bad(path, f"has '# fit:' degrees giving {error}") from None
+        raise table_error(path, f"has '# fit:' degrees giving {error}") from None
 
 
 def _header(comments: list[str], path) -> tuple[dict, dict, str]:
@@ -168,14 +156,14 @@ def _header(comments: list[str], path) -> tuple[dict, dict, str]:
     try:
         ranges = {g: tuple(plain_float(v) for v in spec[g].split(":")) for g in GROUPS}
     except (KeyError, ValueError):
-        raise _bad(path, "needs the lines '# range: b_a=lo:hi, d_a=..., link_a=..., tie_link=...' "
+        raise table_error(path, "needs the lines '# range: b_a=lo:hi, d_a=..., link_a=..., tie_link=...' "
                          "and '# fit: p_terms=..., q_terms=...' (or design_degree=D, "
                          "theta_degree=T)") from None
     if any(len(r) != 2 or not 0 < r[0] <= r[1] < math.inf for r in ranges.values()):
-        raise _bad(path, "has a range lo:hi with not 0 < lo <= hi < inf")
+        raise table_error(path, "has a range lo:hi with not 0 < lo <= hi < inf")
     prior = spec.get("prior", "paper")
     if prior not in PRIORS:
-        raise _bad(path, f"has prior={prior}; allowed: {', '.join(PRIORS)}")
+        raise table_error(path, f"has prior={prior}; allowed: {', '.join(PRIORS)}")
     if ranges["tie_link"][1] >= 1.0:
-        raise _bad(path, "has tie/link >= 1: a ring cannot be wider than its link")
+        raise table_error(path, "has tie/link >= 1: a ring cannot be wider than its link")
     return ranges, spec, prior

@@ -56,6 +56,7 @@ from scipy.optimize import brentq, root
 from . import contact, hand, kinematics
 from .design import HandDesign
 from .errors import InputError
+from .inputfiles import read_number_table
 
 #: a pad other than the touching one penetrating by more than this [mm] moves the contact there
 _PENETRATION = 1e-6
@@ -97,8 +98,10 @@ class HingeTable(NamedTuple):
 @lru_cache(maxsize=4)
 def read_hinge_table(path: str) -> HingeTable:
     """The CSV written by ``python -m softhand.studies.calibration.hinges`` (columns theta, a_1..a_n)."""
-    lines = [ln for ln in Path(path).read_text().splitlines() if ln.strip() and not ln.startswith("#")]
-    data = np.array([[float(v) for v in ln.split(",")] for ln in lines[1:]])
+    _, columns, data = read_number_table(path, "hinge_table", "the hinge CSV of softhand.studies.calibration.hinges")
+    if columns[0] != "theta" or columns[1:] != tuple(f"a_{j}" for j in range(1, len(columns))) \
+            or len(columns) < 2 or np.any(np.diff(data[:, 0]) <= 0):
+        raise InputError("hinge_table", path, "needs the header theta,a_1,...,a_n and increasing theta")
     return HingeTable(data[:, 0], data[:, 1:])
 
 

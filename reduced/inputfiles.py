@@ -7,11 +7,14 @@ import re
 import stat
 import tomllib
 from pathlib import Path
+from typing import NamedTuple
+
+import numpy as np
 
 from .errors import InputError
 
-__all__ = ["MAX_FILE_BYTES", "MAX_NESTING", "csv_cells", "nesting_depth", "plain_float", "read_input_file",
-           "read_toml"]
+__all__ = ["MAX_FILE_BYTES", "MAX_NESTING", "NumberTable", "csv_cells", "nesting_depth", "plain_float",
+           "read_input_file", "read_number_table", "read_toml"]
 
 
 #: largest design / study / data file read [bytes]; a bigger one (or /dev/zero) is refused
@@ -75,6 +78,39 @@ def csv_cells(lines, field: str, path) -> list[list[str]]:
         return list(csv.reader(lines))
     except csv.Error as exc:
         raise InputError(field, str(path), f"is not a CSV file this reader can read ({exc})") from None
+
+
+class NumberTable(NamedTuple):
+    """A calibration table as read: its comment lines (the provenance), header and numbers."""
+
+    comments: tuple[str, ...]  #: the ``#`` lines, as written
+    columns: tuple[str, ...]   #: the header's column names
+    values: np.ndarray         #: (rows, columns), every value finite
+
+
+def read_number_table(path: str | Path, field: str, what: str, columns=None) -> NumberTable:
+    """The one reader of the calibration tables (CSV of numbers after ``#`` provenance lines).
+
+    ``columns``: the header it must have (or None: any). InputError naming ``field`` and the
+    file if it is unreadable, not UTF-8, lacks the header, or has a cell that is not a finite
+    number or a row of the wrong length."""
+    data = read_input_file(path, field, what)
+    try:
+        text = data.decode("utf-8")
+    except UnicodeDecodeError:
+        raise InputError(field, str(path), "is not a text (CSV) file") from None
+    comments = tuple(line for line in text.splitlines() if line.startswith("#"))
+    lines = [line for line in text.splitlines() if line.strip() and not line.startswith("#")]
+    header = tuple(c.strip() for c in lines[0].split(",")) if lines else ()
+    if not header or (columns is not None and header != tuple(columns)):
+        raise InputError(field, str(path), f"needs the header {','.join(columns or ('...',))}")
+    try:
+        values = np.array([[plain_float(x) for x in line.split(",")] for line in lines[1:]], ndmin=2)
+    except ValueError:
+        raise InputError(field, str(path), "has a cell that is not a number") from None
+    if values.shape[0] == 0 or values.shape[1] != len(header) or not np.all(np.isfinite(values)):
+        raise InputError(field, str(path), f"needs rows of {len(header)} finite numbers")
+    return NumberTable(comments, header, values)
 
 
 def read_toml(path: str | Path, field: str, what: str) -> dict:

@@ -42,7 +42,7 @@ import numpy as np
 from scipy.optimize import least_squares
 
 from . import rubber
-from .csvdata import _read_rows
+from .csvdata import read_rows
 from .errors import InputError
 from .inputfiles import plain_float
 from .lsq import FitOptions, diagnose, jacobian
@@ -96,7 +96,7 @@ class StressData:
 def read_test_data(path) -> StressData:
     """Read the CSV (see the module docstring); one InputError naming file, line, column."""
     path = Path(path)
-    given, rows = _read_rows(path)
+    given, rows = read_rows(path)
     header = [_COLUMN_ALIASES.get(c.lower(), c) for c in given]
     if sorted(header) != sorted(COLUMNS):
         raise InputError(f"{path.name}: columns", ",".join(given), f"must be {','.join(COLUMNS)}")

@@ -29,6 +29,7 @@ import numpy as np
 
 from .design import HandDesign
 from .errors import InputError
+from .inputfiles import read_number_table
 from .reservoir import register_model
 
 __all__ = ["TABLE_FILE", "table", "pressure", "strain_energy", "height"]
@@ -40,11 +41,9 @@ COLUMNS = ("v", "p_tilde", "W_tilde", "h_tilde")
 @lru_cache(maxsize=1)
 def table() -> dict:
     """The calibration tables: τ = t/R -> {v = V/R³, p̃ = pR/(μt), W̃ = W/(μtR²), h̃ = h/R}."""
-    lines = [line for line in TABLE_FILE.read_text().splitlines()
-             if line.strip() and not line.startswith("#")]
-    header = lines[0].split(",")
-    values = np.array([[float(x) for x in line.split(",")] for line in lines[1:]])
-    tau = values[:, header.index("tau")]
+    _, header, values = read_number_table(TABLE_FILE, "reservoir_table", "the reservoir calibration CSV "
+                                          "(softhand reservoir --write-calibration)", ("tau", *COLUMNS))
+    tau = values[:, 0]
     return {float(t): {name: values[tau == t, header.index(name)] for name in COLUMNS}
             for t in np.unique(tau)}
 

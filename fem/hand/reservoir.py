@@ -132,7 +132,8 @@ def surface_nodes(solid, u, z0):
     return r0, r0 + u[rdofs[on]], X[1, zdofs[on]] + u[zdofs[on]]
 
 
-def _state(model: SheetModel, solid, s) -> SheetState:
+def sheet_state(model: SheetModel, solid, s) -> SheetState:
+    """The sheet at the path state ``s`` (volume, pressure, energy, u): its profile and stretches."""
     _, r, z = surface_nodes(solid, s.u, 0.0)
     r0m, rm, zm = surface_nodes(solid, s.u, model.t / 2)
     arc = np.hypot(np.gradient(rm, r0m), np.gradient(zm, r0m))
@@ -164,7 +165,7 @@ def inflate(model: SheetModel, volumes, *, options: PathOptions | None = None,
     options = options or volume_path_options(max_step=0.5 * model.R**2 * model.t, atol=atol)
     hits, path = follow_volume(solid, volume, fixed, targets, options=options,
                                volume_scale=model.R**2 * model.t, progress=progress)
-    states = [_state(model, solid, s) for s in hits]
+    states = [sheet_state(model, solid, s) for s in hits]
     by_request = np.empty(volumes.size, dtype=object)
     by_request[order] = [states[i] for i in inverse]
     V = np.array([s.volume for s in path])

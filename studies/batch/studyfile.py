@@ -49,7 +49,7 @@ from pathlib import Path
 from softhand.reduced import reservoir
 from softhand.reduced.design import PUBLIC_KEYS, HandDesign, design_from_dict, load_design, read_toml
 from softhand.reduced.errors import InputError
-from softhand.studies.cli.args import parse_values
+from softhand.studies.io.values import parse_values
 from softhand.studies.batch.registry import ENTRY_POINT_GROUP, KINDS, MAX_CASES, Kind, Num, NumList, all_kinds, \
     resolve_kind
 

@@ -8,7 +8,6 @@
 from __future__ import annotations
 
 import math
-from datetime import datetime, timezone
 from pathlib import Path
 
 import numpy as np
@@ -19,6 +18,7 @@ from softhand.reduced.design import HandDesign
 from softhand.reduced.finger_fem import COLUMNS, GROUPS, groups_of
 from softhand.studies.calibration.finger import MIN_GAP_SLICES
 from softhand.studies.calibration.space import DesignSpace, VARIABLES, finger_design
+from softhand.studies.calibration.tables import table_text, written_by
 from softhand.studies.io.files import write_atomic
 
 
@@ -91,7 +91,6 @@ def table_csv(rows: list[dict], ranges: dict, provenance: list[str], fit: str,
 
 def provenance_lines(command: str, results: list[tuple[HandDesign, dict]], records: list[dict]) -> list[str]:
     """Who wrote the table, when, with which code and mesh."""
-    from softhand.studies.cli.verbs.reservoir import _git_commit
     from softhand.studies.batch.runner import code_version
 
     code = code_version()
@@ -100,8 +99,8 @@ def provenance_lines(command: str, results: list[tuple[HandDesign, dict]], recor
             for r in records}
     dofs = sorted((r.get("mesh") or {}).get("dofs", 0) for r in records)
     wall = sum((r.get("solver") or {}).get("wall_time_s", 0.0) for r in records)
-    return [f"FEM calibration of reduced/finger_fem.py, written {datetime.now(timezone.utc):%Y-%m-%d %H:%M} "
-            f"UTC at commit {_git_commit()} (softhand {code['softhand']}, sources {code['source_sha256']}) by",
+    return [written_by("FEM calibration of reduced/finger_fem.py",
+                       f" (softhand {code['softhand']}, sources {code['source_sha256']})"),
             command,
             f"model: finger FEM (fem/hand/finger.py), FingerOptions, mesher {', '.join(sorted(mesh))}, "
             f"{dofs[0]}..{dofs[-1]} unknowns; {len(results)} designs, {wall / 60:.1f} min of solver wall time"]

@@ -10,7 +10,6 @@ volume (r–z and revolved to 3D); see :class:`studies.reservoir.ReservoirStudyR
 """
 from __future__ import annotations
 
-import subprocess
 from pathlib import Path
 
 from softhand.reduced.errors import InputError
@@ -67,7 +66,11 @@ OUTPUT_PATTERNS = ("result.json", "rows.csv", "sheet.pvd", "sheet", "sheet_V*_rz
 def run(args) -> int:
     study = _study(args)
     if args.write_calibration:
-        return _write_calibration(study, args.write_calibration)
+        from softhand.studies.reservoir import write_calibration
+
+        count = write_calibration(study, args.write_calibration)
+        print(f"wrote {count} rows to {args.write_calibration}")
+        return 0
     from tqdm import tqdm
 
     from softhand.studies.reservoir import COLUMNS, run as run_study
@@ -106,13 +109,13 @@ FAILED_OUT = "results/reservoir"
 def _failed(exc, study, out: Path) -> int:
     """Newton gave up at the smallest volume step: the last converged state (result.json +
     the sheet's VTK) and one error line naming the volume and pressure reached; exit code 1."""
-    from softhand.fem.hand.reservoir import _state
+    from softhand.fem.hand.reservoir import sheet_state
     from softhand.studies.io.failure import save_last_converged
     from softhand.studies.io.reservoir_files import write_sheet_states
 
     model = study.model()
     solid = model.build()[0]
-    state = _state(model, solid, exc.last) if exc.last.u is not None else None
+    state = sheet_state(model, solid, exc.last) if exc.last.u is not None else None
     reached = f"V = {exc.last.volume:.6g} mm^3, p = {exc.last.pressure:.6g} MPa"
     record = {"last_converged": {"V_mm3": exc.last.volume, "p_MPa": exc.last.pressure,
                                  "W_Nmm": exc.last.energy},
@@ -123,35 +126,3 @@ def _failed(exc, study, out: Path) -> int:
         "smallest volume step)", reached, record,
         write_files=(lambda: write_sheet_states(solid, [state], out)) if state else None,
         files="sheet.pvd" if state else "")
-
-
-def _git_commit() -> str:
-    try:
-        return subprocess.run(["git", "rev-parse", "--short", "HEAD"], capture_output=True,
-                              text=True, cwd=Path(__file__).parent, check=True).stdout.strip()
-    except (OSError, subprocess.CalledProcessError):
-        return "unknown"
-
-
-def _write_calibration(study, path) -> int:
-    """FEM tables at the design's thickness t and at 2t (twice the layers: same element shape)."""
-    if not study.design.reservoir_is_neo_hookean:
-        raise InputError("--write-calibration", str(path), "the calibration table of the 'fem' "
-                         "reservoir model is for a Neo-Hookean sheet; this design's sheet is "
-                         f"{study.design.reservoir_material.model}")
-    from dataclasses import replace
-    from datetime import datetime, timezone
-
-    from softhand.studies.io.files import write_atomic
-    from softhand.studies.reservoir import calibration_csv, calibration_rows
-
-    thin = study.model()
-    thick = replace(thin, t=2 * thin.t, n_thick=2 * thin.n_thick)
-    rows = calibration_rows(thin) + calibration_rows(thick)
-    provenance = (f"FEM calibration of reduced/reservoir_fem.py, written "
-                  f"{datetime.now(timezone.utc):%Y-%m-%d %H:%M} UTC at commit {_git_commit()} by\n"
-                  f"softhand reservoir --write-calibration {Path(path).name} "
-                  f"--n-radial {thin.n_radial} --n-thick {thin.n_thick}")
-    write_atomic(path, calibration_csv([thin, thick], rows, provenance))
-    print(f"wrote {len(rows)} rows to {path}")
-    return 0
