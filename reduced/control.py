@@ -40,6 +40,7 @@ from .errors import InputError
 from .grasp import grasp_forces
 from .paper import TABLE_II as PAPER_TABLE_II
 from .plant import HandTables, PlantParams, Push, equilibrium
+from .reservoir import pump_pressure
 
 __all__ = ["Gains", "default_gains", "AngleController", "PressureController", "Simulation",
            "initial_state", "simulate", "Summary", "ramp", "push_interval", "summarize",
@@ -117,7 +118,7 @@ def _integrate(controller, tables: HandTables, plant: PlantParams, theta, F_x, F
             noise_P = rng.normal(0.0, plant.noise_P) if plant.noise_P else 0.0
             P_cmd = controller(theta + noise_t, Pm + noise_P, limit)
         Pm += alpha * (min(max(P_cmd, plant.P_min), plant.P_max) - Pm)
-        p_r = float(np.interp(V, tables.V, tables.p_r))
+        p_r = float(tables.reservoir_pressure(V))
         ps = tables.static_pressure(theta, F_x[k], F_y[k])
         drive = Pm + p_r - ps
         rate = tables.volume_rate(theta)  # dQ/dtheta per finger: a scalar for the paper's model
@@ -126,7 +127,7 @@ def _integrate(controller, tables: HandTables, plant: PlantParams, theta, F_x, F
         if limit:  # the line pressure p_f that passes exactly +-q_max
             p_f = (ps.mean() + limit * q_max * ktau / (d.n * rate) if np.ndim(rate) == 0
                    else (rate @ ps + limit * q_max * ktau) / rate.sum())
-            Pm, drive, q = p_f - p_r, p_f - ps, limit * q_max
+            Pm, drive, q = pump_pressure(p_f, V, d, tables.reservoir_pressure), p_f - ps, limit * q_max
         rec_theta[k] = theta
         rec[k] = Pm, P_cmd, V, limit
         theta = theta + (dt / ktau) * drive

@@ -38,6 +38,7 @@ from scipy.optimize import brentq
 from . import contact, grasp_fem, hand, kinematics
 from .design import HandDesign
 from .errors import InputError
+from .reservoir import oil_volume, pressure as p_r
 
 #: tolerance of the fast solve (Newton step, relative on the unknowns) and of the slow path's brentq [MPa]
 _XTOL, _PTOL = 1e-13, 1e-13
@@ -79,7 +80,12 @@ def reservoir_pressure(theta, design: HandDesign, reservoir: bool = True):
     """p_r [MPa] at the oil the n fingers take at bend theta [rad] (0 without the reservoir)."""
     if not reservoir:
         return 0.0 * np.asarray(theta, float)
-    return hand._reservoir_pressure(hand.check_theta(theta), design)
+    return p_r(oil_volume(hand.check_theta(theta), design), design)
+
+
+def _pump(P, theta, design: HandDesign, reservoir: bool):
+    """The pump pressure [MPa] at cavity pressure P with the fingers at bend theta [rad]."""
+    return hand.pump_pressure_at_bend(P, hand.check_theta(theta), design) if reservoir else P
 
 
 def _residuals(Z, k: int, depth: float, radius: float, weight: float, target: str, value: float,
@@ -110,7 +116,7 @@ def _residuals(Z, k: int, depth: float, radius: float, weight: float, target: st
     if target == "F_v":
         cond = F_v - value
     elif target == "P_pump":
-        cond = P - reservoir_pressure(q.sum(axis=1), design, reservoir) - value
+        cond = _pump(P, q.sum(axis=1), design, reservoir) - value
     elif target == "gap":  # pad ``value`` just touches the object: where one pad stops holding it alone
         cond = contact.pad_gaps(q, C, radius, design)[:, int(value)]
     else:
@@ -275,7 +281,7 @@ def _snap_below(k: int, corner: bool, z0, j: int, design: HandDesign, diameter_m
         above = grasp_fem.grasp_state(design, diameter_mm, end.P_cavity + SNAP_PROBE, mass_kg)
     except InputError:
         return None
-    P_pump = above.P - float(reservoir_pressure(above.theta, design, reservoir))
+    P_pump = float(_pump(above.P, above.theta, design, reservoir))
     # a snap: the bend jumps (a continuous change of pad moves it by ~1e-6 rad over SNAP_PROBE)
     return end if P_pump > value and abs(above.theta - end.theta) > 1e2 * SNAP_PROBE else None
 
@@ -308,7 +314,7 @@ def _held(k: int, solved, design: HandDesign, reservoir: bool) -> Hold | None:
         return None
     q = _hinges(z, k, design.n_s)
     theta, P = float(np.sum(q)), float(z[-1])
-    return Hold(P, float(P - reservoir_pressure(theta, design, reservoir)), F_v, theta, k, True)
+    return Hold(P, float(_pump(P, theta, design, reservoir)), F_v, theta, k, True)
 
 
 def _solve_on_pad(k: int, design: HandDesign, diameter_mm: float, depth: float, mass_kg: float, target: str,
@@ -348,7 +354,7 @@ def _condition(target: str, value: float, design: HandDesign, reservoir: bool):
     if target == "F_v":
         return lambda theta, P, F_v: F_v - value
     if target == "P_pump":
-        return lambda theta, P, F_v: P - float(reservoir_pressure(theta, design, reservoir)) - value
+        return lambda theta, P, F_v: float(_pump(P, theta, design, reservoir)) - value
     raise ValueError(target)
 
 
@@ -423,7 +429,7 @@ def slow_hold(design: HandDesign, diameter_mm: float, mass_kg: float, target: st
             step *= 2.0
         else:
             s = state(P)
-    return Hold(float(P), float(P - reservoir_pressure(s.theta, design, reservoir)), s.F_v, s.theta,
+    return Hold(float(P), float(_pump(P, s.theta, design, reservoir)), s.F_v, s.theta,
                 s.link, False)
 
 
@@ -569,5 +575,5 @@ def _end_on_pad(k: int, j: int, z0, design: HandDesign, diameter_mm: float, dept
 
 def _hold_of(s: grasp_fem.GraspState, design: HandDesign, reservoir: bool, edge: str) -> Hold:
     """The Hold of grasp state s (found by stepping ``grasp_state``: the slow path's)."""
-    return Hold(s.P, float(s.P - reservoir_pressure(s.theta, design, reservoir)), s.F_v, s.theta, s.link,
+    return Hold(s.P, float(_pump(s.P, s.theta, design, reservoir)), s.F_v, s.theta, s.link,
                 False, edge)

@@ -24,9 +24,10 @@ import math
 
 import numpy as np
 
-from . import finger, reservoir
+from . import finger
 from .design import HandDesign
 from .errors import InputError
+from .reservoir import oil_volume, pump_pressure
 
 #: bend angles the reduced model accepts [rad]: a finger bent back by 90 deg up to curled by 180 deg
 THETA_RANGE = (-0.5 * math.pi, math.pi)
@@ -60,12 +61,17 @@ def pressure(theta, design: HandDesign, reservoir: bool = True):
     if reservoir:
         if theta.size:
             design.check_volume(float(np.max(theta)))
-        P = P - _reservoir_pressure(theta, design)
+        P = pump_pressure_at_bend(P, theta, design)
     return P
 
 
-def _reservoir_pressure(theta, design: HandDesign):
-    return reservoir.pressure(reservoir.oil_volume(theta, design), design)
+def pump_pressure_at_bend(P_cavity, theta, design: HandDesign, reservoir: bool = True):
+    """The pump pressure [MPa] of the cavity pressure P_cavity [MPa] with the fingers at bend
+    theta [rad]: :func:`reduced.reservoir.pump_pressure` at the oil left (15); P_cavity itself
+    without the reservoir."""
+    if not reservoir:
+        return P_cavity
+    return pump_pressure(P_cavity, oil_volume(theta, design), design)
 
 
 def bend_angle(P, design: HandDesign, reservoir: bool = True):

@@ -207,7 +207,7 @@ def equilibrium(P, F_x, F_y, tables: HandTables, theta0=None, *, tol=1e-10, max_
     dp28, djx, djy, dpr = tables.slopes
     for _ in range(max_iter):
         V = tables.volume(theta)
-        r = P + tables.reservoir_pressure(V) - tables.static_pressure(theta, F_x, F_y)
+        r = P - reservoir.pump_pressure(tables.static_pressure(theta, F_x, F_y), V, d, tables.reservoir_pressure)
         if np.max(np.abs(r)) < tol:
             return theta
         ks = (np.interp(theta, tables.theta, dp28)

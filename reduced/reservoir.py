@@ -154,6 +154,19 @@ def pressure(V, design: HandDesign):
     return model(design.reservoir_model)(np.asarray(V, float), design)
 
 
+def oil_left(dQ, design: HandDesign):
+    """Oil left in the reservoir [mm^3] once each of the n fingers has taken dQ [mm^3]: V0 - n dQ."""
+    return design.V0 - design.n * np.asarray(dQ, float)
+
+
+def pump_pressure(P_cavity, V, design: HandDesign, p_r=None):
+    """The pump's pressure [MPa]: the fingers' cavity pressure P_cavity [MPa] less the
+    reservoir's p_r at the oil left V [mm^3] (:func:`oil_volume` at a bend, :func:`oil_left`
+    after an FEM finger's dQ). ``p_r``: the reservoir as a function V -> p_r [MPa] -- an FEM
+    sheet's path, a plant's table; default the design's reservoir model (:func:`pressure`)."""
+    return P_cavity - (pressure(V, design) if p_r is None else p_r(V))
+
+
 def state(V, design: HandDesign) -> dict:
     """The reservoir at oil volume V [mm^3]: its pressure ``p_reservoir_MPa`` (any model) and,
     for the ellipse model only, the apex height ``h_mm`` (14) and sheet stretch ``lambda_r``
