@@ -251,14 +251,15 @@ def weight_vector(a: GraspState, b: GraspState) -> np.ndarray:
     return dq / dq.sum()
 
 
-def grasp_weights(model: GraspModel, P: float, dP: float) -> WeightResult:
-    """Contact states at P and P + dP [MPa] and the weight vector between them."""
+def grasp_weights(model: GraspModel, P: float, dP: float, start: GraspState | None = None) -> WeightResult:
+    """Contact states at P and P + dP [MPa] and the weight vector between them (the state at P
+    continued from ``start``, a converged state nearby, if given)."""
     if not P > 0 or not dP > 0:
         raise InputError("pressure_MPa", (P, dP), "P and dP must be positive")
     t0 = time.perf_counter()
     a = None
     try:
-        a = model.solve(P)
+        a = model.solve(P, start=start)
         b = model.solve(P + dP, start=a)
     except NotConverged as err:  # what was reached, for the caller to save: ``.states``, ``.model``
         err.model = model
