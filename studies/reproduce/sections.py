@@ -23,29 +23,21 @@ from softhand.studies.reproduce.section import Context, Section, md_table
 # ---------------------------------------------------------------------- Fig. 7, reduced
 def fig7_reduced(ctx: Context, outdir: Path):
     """Eq. (27) with and (28) without reservoir over 0-90 deg; the reservoir's offset."""
-    from softhand.reduced import hand
+    from softhand.studies.curve import at_angles, at_pressures, plot_curve
 
     d = ctx.design
     theta_deg = np.arange(0.0, 90.0 + 1e-9, 1.0)
-    theta = np.radians(theta_deg)
-    P, P0 = hand.pressure(theta, d, reservoir=True), hand.pressure(theta, d, reservoir=False)
+    rows = at_angles(theta_deg, d)
+    P, P0 = (np.array([r[k] for r in rows]) for k in ("P_MPa", "P_no_reservoir_MPa"))
     offset = P0 - P
-    write_csv(outdir / "fig7_reduced.csv", [
-        {"theta_deg": t, "P_MPa": p, "P_no_reservoir_MPa": q} for t, p, q in zip(theta_deg, P, P0)])
+    write_csv(outdir / "fig7_reduced.csv", rows, ["theta_deg", "P_MPa", "P_no_reservoir_MPa"])
     pressures = np.round(np.arange(0.0, 0.8 + 1e-9, 0.1), 10)
-    by_p = _angles_at(pressures, d)
+    by_p = at_pressures(pressures, d, strict=False)
     write_csv(outdir / "fig7_reduced_by_pressure.csv", by_p)
-    P_fem, why = _pressure_fem_reservoir(theta, d)
-    fig, (ax,) = figure()
-    ax.plot(P, theta_deg, "-", label="eq. (27), with reservoir")
-    ax.plot(P0, theta_deg, ":", label="eq. (28), without reservoir")
-    if P_fem is not None:
-        ax.plot(P_fem, theta_deg, "--", label="eq. (27), FEM-calibrated reservoir")
-    ax.set(xlabel="pump pressure P [MPa]", ylabel="bend angle θ [deg]", xlim=(-0.15, None),
-           title="Fig. 7 analogue: reduced model")
-    ax.grid(alpha=0.3)
-    ax.legend()
-    save_figure(fig, outdir / "fig7_reduced.png")
+    P_fem, why = _pressure_fem_reservoir(np.radians(theta_deg), d)
+    plot_curve(outdir / "fig7_reduced.png", d, rows, title="Fig. 7 analogue: reduced model", markers=False,
+               extra=[] if P_fem is None else [("eq. (27), FEM-calibrated reservoir", P_fem, theta_deg)],
+               xlim=(-0.15, None))
     numbers = {"offset_mean_MPa": float(offset.mean()), "offset_min_MPa": float(offset.min()),
                "offset_max_MPa": float(offset.max()), "P_at_0deg_MPa": float(P[0]),
                "P_at_90deg_MPa": float(P[-1])}
@@ -85,23 +77,6 @@ def _fem_reservoir_note(P0, P_fem, why) -> str:
     return (f"With the FEM-calibrated reservoir model (`reservoir_model = \"fem\"`) the "
             f"offset is {offset.mean():.4f} MPa on average ({offset.min():.4f} to "
             f"{offset.max():.4f} MPa).")
-
-
-def _angles_at(pressures, design) -> list[dict]:
-    """θ(P) with and without reservoir; None where P is outside the model's range."""
-    from softhand.reduced import hand
-    from softhand.reduced.errors import InputError
-
-    rows = []
-    for P in pressures:
-        row = {"P_MPa": float(P)}
-        for key, res in (("theta_deg", True), ("theta_no_reservoir_deg", False)):
-            try:
-                row[key] = float(np.degrees(hand.bend_angle(P, design, reservoir=res)))
-            except InputError:
-                row[key] = float("nan")
-        rows.append(row)
-    return rows
 
 
 # ---------------------------------------------------------------------- Table II, reduced
