@@ -319,8 +319,11 @@ def design_from_dict(values: dict, base: HandDesign | None = None, *, source: st
 
 
 def load_design(path: str | Path | None = None) -> HandDesign:
-    """Read a design TOML file (keys as in ``studies/designs/paper.toml``); None: the paper's."""
-    path = Path(path) if path is not None else PAPER_DESIGN_FILE
+    """Read a design TOML file (keys as in ``studies/designs/paper.toml``); None: the paper's
+    (Table I, :class:`HandDesign`'s defaults)."""
+    if path is None:
+        return HandDesign()
+    path = Path(path)
     values = read_toml(path, "--design", "a design TOML file")
     table = values.get("finger_table")
     if isinstance(table, str) and table and not Path(table).is_absolute():
