@@ -18,7 +18,7 @@ from pathlib import Path
 import numpy as np
 
 from softhand.reduced import hand, reservoir, rubber
-from softhand.reduced.design import load_design
+from softhand.reduced.design_files import load_design
 from softhand.reduced.material_fit import fit_material, read_test_data
 
 MU0 = 1.15

@@ -94,7 +94,7 @@ def read_measurements(path: str | Path) -> Measurements:
 
 def read_rows(path: Path) -> tuple[list[str], list[tuple[int, list[str]]]]:
     """Header cells and (line number, cells) of the data rows; comments and blank lines skipped."""
-    from .design import read_input_file
+    from .inputfiles import read_input_file
 
     data = read_input_file(path, "--data", "a CSV file")
     try:

@@ -40,19 +40,15 @@ import dataclasses
 import hashlib
 import json
 import math
-import os
-import warnings
 from dataclasses import dataclass
 from pathlib import Path
 
 from . import rubber
-from .design_rules import BOUNDS, CONSISTENCY, check_model, in_bounds, is_number
+from .design_rules import BOUNDS, CONSISTENCY, check_model, in_bounds
 from .errors import InputError
-from .inputfiles import MAX_FILE_BYTES, read_input_file, read_toml
 
 __all__ = ["RESERVOIR_MODELS", "FINGER_MODELS", "PAPER_DESIGN_FILE", "HandDesign", "PUBLIC_KEYS",
-           "PARTS", "BOUNDS", "CONSISTENCY", "design_from_dict", "hinges_for", "MAX_FILE_BYTES",
-           "read_input_file", "read_toml", "load_design"]
+           "KEY_OF", "MODULUS_OF", "PARTS", "BOUNDS", "CONSISTENCY"]
 
 #: Reservoir models the reduced layer knows; extended when a new one is added.
 RESERVOIR_MODELS = ("ellipse", "fem")
@@ -107,7 +103,7 @@ class HandDesign:
     # ------------------------------------------------------------------ validation
     def validate(self) -> None:
         """Raise :class:`InputError` naming the first bad field (bounds: :data:`BOUNDS`)."""
-        for name, key in _KEY_OF.items():
+        for name, key in KEY_OF.items():
             if key in BOUNDS:
                 in_bounds(key, _to_public(name, getattr(self, name)))
         for name in ("n", "n_s"):
@@ -129,16 +125,6 @@ class HandDesign:
                      "ellipse")
         check_model("finger_model", self.finger_model, FINGER_MODELS, self.finger_is_neo_hookean,
                      "finger", "tube", self.finger_material, "paper")
-
-    def check_volume(self, theta_max: float) -> None:
-        """Raise if V0 cannot supply the oil the fingers take at bend ``theta_max`` [rad] (eq. (15))."""
-        from .finger import oil_taken  # the finger model's Q(theta) - Q(0); finger imports design
-
-        needed = self.n * float(oil_taken(theta_max, self))
-        if needed >= self.V0:
-            raise InputError("V0_mm3", self.V0,
-                             f"must exceed the {needed:.0f} mm^3 the fingers take at "
-                             f"{math.degrees(theta_max):.1f} deg")
 
     # ------------------------------------------------------------------ derived
     @property
@@ -175,7 +161,7 @@ class HandDesign:
     def to_dict(self) -> dict:
         """Public (unit-suffixed) keys -> values, as in a design TOML file; a part with a
         material table adds ``{"finger": {"material": {"model": ..., parameters}}}``."""
-        out = {key: _to_public(name, getattr(self, name)) for name, key in _KEY_OF.items()}
+        out = {key: _to_public(name, getattr(self, name)) for name, key in KEY_OF.items()}
         for part in PARTS:
             if getattr(self, f"{part}_material") is not None:
                 material = getattr(self, f"{part}_rubber")
@@ -201,18 +187,17 @@ class HandDesign:
 
 
 #: dataclass field -> public TOML key (with unit)
-_KEY_OF = {
+KEY_OF = {
     "theta0": "theta0_deg", "l0": "l0_mm", "a": "a_mm", "b": "b_mm", "d": "d_mm",
     "R": "R_mm", "t": "t_mm", "V0": "V0_mm3", "n": "n", "n_s": "n_s",
     "mu_sf": "mu_sf_MPa", "mu_sr": "mu_sr_MPa", "hinge_s": "hinge_s_mm",
     "base_offset": "base_offset_mm", "g": "g_N_per_kg", "reservoir_model": "reservoir_model",
     "finger_model": "finger_model", "tie_width": "tie_width_mm", "finger_table": "finger_table",
 }
-_FIELD_OF = {key: name for name, key in _KEY_OF.items()}
-PUBLIC_KEYS = tuple(_KEY_OF.values())
+PUBLIC_KEYS = tuple(KEY_OF.values())
 #: parts that may carry a ``[<part>.material]`` table, and the modulus key it sets
 PARTS = ("finger", "reservoir")
-_MODULUS_OF = {"finger": "mu_sf", "reservoir": "mu_sr"}
+MODULUS_OF = {"finger": "mu_sf", "reservoir": "mu_sr"}
 
 
 def _scaled(material, mu0: float) -> rubber.Rubber:
@@ -225,109 +210,9 @@ def _is_neo_hookean(material) -> bool:
     return material is None or isinstance(material, rubber.NeoHookean)
 
 
-def _material_changes(part: str, table, source: str, values: dict) -> dict:
-    """Changes of the design fields from a ``[<part>.material]`` table."""
-    if not isinstance(table, dict) or set(table) != {"material"} or not isinstance(table["material"], dict):
-        raise InputError(f"{source}: {part}", table, f"must hold only a [{part}.material] table")
-    params = dict(table["material"])
-    model = params.pop("model", None)
-    if not isinstance(model, str):
-        raise InputError(f"{source}: {part}.material.model", model,
-                         f"must be one of {', '.join(rubber.MODELS)}")
-    material = rubber.from_parameters(model, params, source=f"{source}: {part}.material")
-    name = _MODULUS_OF[part]
-    given = values.get(_KEY_OF[name])
-    if given is not None:  # overridden, but still a value of the file: a bad one is bad input
-        try:
-            in_bounds(_KEY_OF[name], given)
-        except InputError as exc:
-            raise exc.renamed(f"{source}: {_KEY_OF[name]}") from None
-    if is_number(given) and not math.isclose(given, material.mu0, rel_tol=1e-9):
-        warnings.warn(f"{source}: {_KEY_OF[name]} = {given} is overridden by [{part}.material], "
-                      f"whose initial shear modulus is {material.mu0:.6g} MPa")
-    return {f"{part}_material": material, name: material.mu0}
-
-
 def _to_public(name: str, value):
     if name == "theta0":
         return math.degrees(value)
     if name == "hinge_s":
         return list(value)
     return value
-
-
-def _from_public(key: str, value):
-    """Convert one public (TOML) value to the internal field value, checking its type."""
-    name = _FIELD_OF[key]
-    default = HandDesign.__dataclass_fields__[name].default
-    if name == "hinge_s":
-        if not isinstance(value, list) or not all(is_number(v) for v in value):
-            raise InputError(key, value, "must be a list of numbers [mm]")
-        return tuple(float(v) for v in value)
-    if isinstance(default, str):
-        if not isinstance(value, str):
-            raise InputError(key, value, "must be a string")
-        return value
-    if isinstance(default, int) and not isinstance(default, bool):
-        if not isinstance(value, int) or isinstance(value, bool):
-            raise InputError(key, value, "must be a whole number")
-        return value
-    if not is_number(value):
-        raise InputError(key, value, "must be a number")
-    return math.radians(value) if name == "theta0" else float(value)
-
-
-def hinges_for(base: HandDesign, l0: float, n_s: int) -> tuple[float, ...]:
-    """Hinge positions [mm] for a tube of length l0 with n_s hinges: the base's scaled with l0
-    (equal links stay equal), or equal links when the number of hinges changes."""
-    if n_s == base.n_s:
-        return tuple(s * l0 / base.l0 for s in base.hinge_s)
-    return tuple(l0 * k / (n_s + 1) for k in range(1, n_s + 1))
-
-
-def design_from_dict(values: dict, base: HandDesign | None = None, *, source: str = "design") -> HandDesign:
-    """A design from public keys (as in TOML), over ``base`` (default: the paper's). Without
-    ``hinge_s_mm``, a new ``l0_mm`` scales the base's hinge positions with it and a new ``n_s``
-    spaces the hinges equally."""
-    base = base if base is not None else HandDesign()
-    changes = {}
-    for key, value in values.items():
-        if key in PARTS:
-            continue
-        if key not in _FIELD_OF:
-            raise InputError(f"{source}: {key}", value,
-                             f"unknown key; allowed: {', '.join(PUBLIC_KEYS)}, "
-                             "[finger.material], [reservoir.material]")
-        changes[_FIELD_OF[key]] = _from_public(key, value)
-    if "hinge_s" not in changes and ("l0" in changes or "n_s" in changes):
-        changes["hinge_s"] = hinges_for(base, changes.get("l0", base.l0), changes.get("n_s", base.n_s))
-    for part in PARTS:
-        if part in values:
-            changes.update(_material_changes(part, values[part], source, values))
-    design = dataclasses.replace(base, **changes)
-    if changes.get("finger_table"):
-        if design.finger_model != "fem":  # the table would be unused
-            raise InputError(f"{source}: finger_table", values["finger_table"], f"is the table of "
-                             f"finger_model = 'fem'; this design's finger_model is {design.finger_model!r}")
-        from . import finger
-
-        try:  # read and fitted now (cached per file), not where a run first uses it
-            finger.check_data(design)
-        except InputError as exc:
-            raise exc.renamed(f"{source}: finger_table") from None
-    return design
-
-
-def load_design(path: str | Path | None = None) -> HandDesign:
-    """Read a design TOML file (keys as in ``studies/designs/paper.toml``); None: the paper's
-    (Table I, :class:`HandDesign`'s defaults)."""
-    if path is None:
-        return HandDesign()
-    path = Path(path)
-    values = read_toml(path, "--design", "a design TOML file")
-    table = values.get("finger_table")
-    if isinstance(table, str) and table and not Path(table).is_absolute():
-        # relative to the file; absolute without touching the file system (a link loop or a NUL
-        # in the name is the table reader's one line to say)
-        values["finger_table"] = os.path.abspath(path.parent / table)
-    return design_from_dict(values, source=path.name)

@@ -192,6 +192,15 @@ class FingerFunctions:
 _MODELS: dict[str, FingerFunctions] = {}
 
 
+def check_volume(design: HandDesign, theta_max: float) -> None:
+    """Raise if V0 cannot supply the oil the fingers take at bend ``theta_max`` [rad] (eq. (15))."""
+    needed = design.n * float(oil_taken(theta_max, design))
+    if needed >= design.V0:
+        raise InputError("V0_mm3", design.V0,
+                         f"must exceed the {needed:.0f} mm^3 the fingers take at "
+                         f"{math.degrees(theta_max):.1f} deg")
+
+
 def check_data(design: HandDesign) -> None:
     """The design's finger model's own data (its calibration table) read and checked now, not
     where a run first uses it: InputError naming it."""

@@ -24,7 +24,8 @@ from scipy.optimize import least_squares
 
 from .csvdata import Measurements
 from .lsq import Diagnosis, FitOptions, diagnose, jacobian
-from .design import PUBLIC_KEYS, HandDesign, design_from_dict
+from .design import PUBLIC_KEYS, HandDesign
+from .design_files import design_from_dict
 from .errors import InputError
 
 #: public design keys a fit may vary (numbers; not counts, lists or names)

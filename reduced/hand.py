@@ -60,7 +60,7 @@ def pressure(theta, design: HandDesign, reservoir: bool = True):
     P = finger_pressure(theta, design)
     if reservoir:
         if theta.size:
-            design.check_volume(float(np.max(theta)))
+            finger.check_volume(design, float(np.max(theta)))
         P = pump_pressure_at_bend(P, theta, design)
     return P
 

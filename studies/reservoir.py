@@ -22,6 +22,7 @@ from pathlib import Path
 import numpy as np
 
 from softhand.fem.hand.reservoir import ReservoirResult, SheetModel, inflate
+from softhand.reduced import finger
 from softhand.reduced import reservoir as ellipse
 from softhand.reduced.design import HandDesign
 from softhand.reduced.errors import InputError
@@ -156,7 +157,7 @@ def run(study: ReservoirStudy, *, progress=None) -> ReservoirStudyResult:
     """Inflate the sheet through the requested volumes and the operating range; compare."""
     d = study.design
     dV = stroke_volume(d, study.theta_max)
-    d.check_volume(study.theta_max)
+    finger.check_volume(d, study.theta_max)
     requested = np.asarray(study.volumes_mm3 or (d.V0 - dV, d.V0, d.V0 + 2000.0), dtype=float)
     grid = np.linspace(d.V0 - dV, d.V0, study.n_range)
     volumes = np.concatenate([requested, grid])

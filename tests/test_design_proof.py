@@ -5,7 +5,7 @@ import json
 
 import pytest
 
-from softhand.reduced.design import load_design
+from softhand.reduced.design_files import load_design
 from softhand.studies.design import optimise as design_opt
 from softhand.studies.design.task import task_from_dict
 from test_design_task import CI_TASK, CI_TASK_TOML, _write

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from softhand.reduced import finger, grasp, grasp_fem, hand, kinematics
-from softhand.reduced.design import load_design
+from softhand.reduced.design_files import load_design
 from softhand.reduced.errors import InputError
 from softhand.studies.design import optimise as design_opt
 from softhand.studies.design.task import load_task, task_from_dict

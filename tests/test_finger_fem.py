@@ -196,7 +196,7 @@ def test_a_design_file_names_its_own_table_relative_to_itself(tmp_path):
     relative to the design file; the CLI's error for a design outside it is one line, exit 2."""
     from softhand.studies.cli.main import main
     from softhand.studies.calibration.finger_table import write_design_with_table
-    from softhand.reduced.design import load_design
+    from softhand.reduced.design_files import load_design
 
     path, designs, _ = _synthetic_table(tmp_path)
     toml = write_design_with_table(designs[1], path)

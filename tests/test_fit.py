@@ -144,7 +144,7 @@ def test_gent_relation_limits_and_paper_value():
 # ---------------------------------------------------------------- the reduced model
 from softhand.reduced import hand  # noqa: E402
 from softhand.reduced.fit import make_predictor  # noqa: E402
-from softhand.reduced.design import design_from_dict  # noqa: E402
+from softhand.reduced.design_files import design_from_dict  # noqa: E402
 
 TRUTH = {"V0_mm3": 15000.0, "mu_sf_MPa": 1.30}
 P_PAPER = np.repeat(np.round(np.arange(0.0, 0.85, 0.1), 2), 4)  # 0..0.8 MPa, four fingers
@@ -223,7 +223,7 @@ def test_v0_without_reservoir_is_flagged():
 import json  # noqa: E402
 from pathlib import Path  # noqa: E402
 
-from softhand.reduced.design import load_design  # noqa: E402
+from softhand.reduced.design_files import load_design  # noqa: E402
 from softhand.studies.cli.main import main  # noqa: E402
 
 EXAMPLES = Path(__file__).resolve().parent.parent / "studies" / "data"

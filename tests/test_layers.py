@@ -97,11 +97,6 @@ def test_the_checks_see_a_violation(tmp_path):
     assert set(imports("softhand.reduced.mod", path, top_level_only=True)) >= {"softhand.reduced.design"}
 
 
-#: cycles through imports inside functions that are known and accepted: the design's stroke
-#: check asks the finger model for its oil volume, and the finger model takes a design
-LAZY_CYCLES = {frozenset({"softhand.reduced.design", "softhand.reduced.finger"})}
-
-
 def test_no_cycles_through_lazy_imports_either():
     graph = {name: {t for t in imports(name, path) if t in ALL and t != name}
              for name, path in ALL.items()}
@@ -116,4 +111,4 @@ def test_no_cycles_through_lazy_imports_either():
 
     reach = {name: reachable(name) for name in graph}
     cycles = {frozenset({n} | {m for m in reach[n] if n in reach[m]}) for n in graph if n in reach[n]}
-    assert cycles <= LAZY_CYCLES, sorted(sorted(c) for c in cycles - LAZY_CYCLES)
+    assert not cycles, sorted(sorted(c) for c in cycles)

@@ -174,7 +174,7 @@ def test_the_one_pad_grasp_ends_where_the_grasp_fem_touches_with_a_second_pad(da
     lies between, on the FEM's holding pad, with the FEM's second pad the one touching, and its
     F_v within 10 % of the FEM's there."""
     from softhand.reduced import grasp_hold
-    from softhand.reduced.design import design_from_dict
+    from softhand.reduced.design_files import design_from_dict
 
     design = grasp_fem.fem_finger(design_from_dict(data["design"], DESIGN, source="stored")) \
         if data["design"] else DESIGN

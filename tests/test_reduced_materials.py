@@ -9,7 +9,8 @@ import pytest
 from scipy import integrate
 
 from softhand.reduced import finger, hand, reservoir, rubber
-from softhand.reduced.design import HandDesign, design_from_dict, load_design
+from softhand.reduced.design import HandDesign
+from softhand.reduced.design_files import design_from_dict, load_design
 from softhand.reduced.errors import InputError
 from softhand.studies.cli.main import main
 

@@ -70,7 +70,7 @@ def test_control_kind_keeps_the_studys_numbers(tmp_path):
 # ---------------------------------------------------------------- fit
 def test_fit_result_is_what_the_verb_prints_and_writes(tmp_path):
     from softhand.reduced.csvdata import read_measurements
-    from softhand.reduced.design import load_design
+    from softhand.reduced.design_files import load_design
     from softhand.studies.fit import FitStudy, run
 
     data = ROOT / "studies" / "data" / "example_bending.csv"

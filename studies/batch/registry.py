@@ -10,6 +10,7 @@ import importlib
 import math
 from dataclasses import dataclass
 
+from softhand.reduced import finger
 from softhand.reduced.design import HandDesign
 from softhand.reduced.errors import InputError
 from softhand.reduced.grasp import MAX_WEIGHT
@@ -104,13 +105,13 @@ def _push_before_end(params: dict, design: HandDesign, src: str) -> None:
 
 def _enough_oil(params: dict, design: HandDesign, src: str) -> None:
     if "theta_deg" in params and params["theta_deg"] > 0:
-        design.check_volume(math.radians(params["theta_deg"]))
+        finger.check_volume(design, math.radians(params["theta_deg"]))
 
 
 def _oil_to_theta_max(params: dict, design: HandDesign, src: str) -> None:
     """The reservoir holds the oil the fingers take up to the stroke's end (default: the
     design's own), checked at load time as the curve kind checks its angles."""
-    design.check_volume(math.radians(params.get("theta_max_deg", 90.0)))  # the kind's default
+    finger.check_volume(design, math.radians(params.get("theta_max_deg", 90.0)))  # the kind's default
 
 
 def _paper_weights_fit(params: dict, design: HandDesign, src: str) -> None:

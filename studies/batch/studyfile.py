@@ -47,7 +47,9 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from softhand.reduced import reservoir
-from softhand.reduced.design import PUBLIC_KEYS, HandDesign, design_from_dict, load_design, read_toml
+from softhand.reduced.design import PUBLIC_KEYS, HandDesign
+from softhand.reduced.design_files import design_from_dict, load_design
+from softhand.reduced.inputfiles import read_toml
 from softhand.reduced.errors import InputError
 from softhand.studies.io.values import parse_values
 from softhand.studies.batch.registry import ENTRY_POINT_GROUP, KINDS, MAX_CASES, Kind, Num, NumList, all_kinds, \

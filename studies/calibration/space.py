@@ -36,7 +36,9 @@ from pathlib import Path
 
 import numpy as np
 
-from softhand.reduced.design import HandDesign, load_design
+from softhand.reduced.design import HandDesign
+
+from softhand.reduced.design_files import load_design
 from softhand.reduced.errors import InputError
 from softhand.studies.batch.registry import check_path_end
 from softhand.studies.batch.studyfile import _NAME_RE
@@ -112,7 +114,7 @@ MAX_PRESSURES = 50
 
 def load_space(path: str | Path) -> DesignSpace:
     """Read and validate a design-space TOML file (see the module docstring)."""
-    from softhand.reduced.design import read_toml
+    from softhand.reduced.inputfiles import read_toml
 
     path = Path(path)
     doc = read_toml(path, "--space", "a design-space TOML file")

@@ -7,7 +7,9 @@ import sys
 
 import numpy as np
 
-from softhand.reduced.design import HandDesign, load_design
+from softhand.reduced.design import HandDesign
+
+from softhand.reduced.design_files import load_design
 from softhand.reduced.errors import InputError
 from softhand.studies.io.files import json_text
 # the value lists' reader and limits, for the verbs (study files read values the same way)

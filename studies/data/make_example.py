@@ -22,7 +22,7 @@ from pathlib import Path
 
 import numpy as np
 
-from softhand.reduced.design import design_from_dict, load_design
+from softhand.reduced.design_files import design_from_dict, load_design
 from softhand.reduced import paper
 from softhand.reduced.grasp import angle_at
 from softhand.reduced.hand import bend_angle

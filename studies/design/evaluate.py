@@ -42,7 +42,8 @@ from typing import NamedTuple
 import numpy as np
 
 from softhand.reduced import contact, finger, grasp, grasp_hold, hand, reservoir
-from softhand.reduced.design import HandDesign, design_from_dict, hinges_for
+from softhand.reduced.design import HandDesign
+from softhand.reduced.design_files import design_from_dict, hinges_for
 from softhand.reduced.errors import InputError
 from softhand.studies.design.task import Task
 
@@ -138,7 +139,7 @@ def _number(x: float) -> float | None:
 
 def design_at(task: Task, x) -> HandDesign:
     """The base design with the free keys set to x (public units); l0 scales the hinges
-    (:func:`reduced.design.design_from_dict`)."""
+    (:func:`reduced.design_files.design_from_dict`)."""
     values = {key: float(v) for (key, _, _), v in zip(task.free, np.asarray(x, dtype=float))}
     return design_from_dict(values, task.base, source="free")
 

@@ -41,7 +41,11 @@ import os
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from softhand.reduced.design import BOUNDS, PAPER_DESIGN_FILE, PUBLIC_KEYS, HandDesign, design_from_dict, load_design, read_toml
+from softhand.reduced.design import BOUNDS, PAPER_DESIGN_FILE, PUBLIC_KEYS, HandDesign
+
+from softhand.reduced.design_files import design_from_dict, load_design
+
+from softhand.reduced.inputfiles import read_toml
 from softhand.reduced.errors import InputError
 
 #: design keys the optimiser may vary; "l0_mm" scales the hinge positions with the tube

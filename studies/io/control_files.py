@@ -27,7 +27,7 @@ def read_disturbance(path: str | Path, t_end: float | None = None):
     """The push profile of a ``t_s,force_N`` CSV file as a function of t [s]; InputError on bad
     files, and on a profile that starts at or after ``t_end`` [s] (the run would not see it)."""
     path = Path(path)
-    from softhand.reduced.design import read_input_file
+    from softhand.reduced.inputfiles import read_input_file
 
     data = read_input_file(path, "--disturbance", "a CSV file t_s,force_N")
     try:

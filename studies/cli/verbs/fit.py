@@ -84,7 +84,7 @@ def _start_from_shore_a(design, keys, shore_a):
     """The fitted moduli's start from a Shore A hardness (Gent's relation), named --shore-a."""
     if shore_a is None:
         return design
-    from softhand.reduced.design import design_from_dict
+    from softhand.reduced.design_files import design_from_dict
     from softhand.reduced.errors import InputError
     from softhand.reduced.materials_data import shear_modulus_from_shore_a
 
