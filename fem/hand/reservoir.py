@@ -119,10 +119,6 @@ class ReservoirResult:
     newton_iterations: int
     wall_time: float  #: [s]
 
-    def pressure_at(self, V):
-        """The sheet's p(V) [MPa] along its path, linear between converged states (exact at them)."""
-        return np.interp(V, self.path_volume, self.path_pressure)
-
 
 def surface_nodes(solid, u, z0):
     """(r0, r, z) [mm] of the nodes of the reference surface z = z0, sorted by r0: reference

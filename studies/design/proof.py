@@ -60,6 +60,12 @@ class _Past(Exception):
     """Raised by the free-bend callback once the finger has bent past the grasp angle."""
 
 
+def sheet_pressure(sheet):
+    """The sheet FEM's p(V) [MPa] along its path from flat to V0, linear between its converged
+    states (exact at them; steps <= R^2 t / 2): the reservoir of :func:`reduced.reservoir.pump_pressure`."""
+    return lambda V: np.interp(V, sheet.path_volume, sheet.path_pressure)
+
+
 def free_bend(finger, theta_g: float, options: ProofOptions) -> dict:
     """The free finger FEM up to theta_g [rad]: cavity pressure, dQ, stretch at theta_g."""
     from softhand.fem.hand.finger import solve_pressures
@@ -195,7 +201,7 @@ def margin(model, sheet, best, ev: Evaluation, task: Task, options: ProofOptions
         return V
 
     def pump(state):  # the hand's pump pressure: the cavity's less the reservoir's at the oil left
-        return float(reservoir.pump_pressure(state.P, oil_left(state), design, sheet.pressure_at))
+        return float(reservoir.pump_pressure(state.P, oil_left(state), design, sheet_pressure(sheet)))
 
     def row(state):
         return {"pump_pressure_MPa": pump(state), "cavity_pressure_MPa": state.P, "F_v_N": state.F_v,
@@ -352,10 +358,10 @@ def prove(ev: Evaluation, task: Task, options: ProofOptions = ProofOptions(), *,
     fs = finger.state(best.y, best.P)
     V_grasp = float(reservoir.oil_left(fs.dQ, design))
     # the sheet's path from flat to V0 passes V_grasp (steps <= R^2 t / 2): interpolated
-    p_grasp = float(sheet.pressure_at(V_grasp))
+    p_grasp = float(sheet_pressure(sheet)(V_grasp))
     first = g["first"]
     fem = {
-        "P_grasp_MPa": float(reservoir.pump_pressure(best.P, V_grasp, design, sheet.pressure_at)),
+        "P_grasp_MPa": float(reservoir.pump_pressure(best.P, V_grasp, design, sheet_pressure(sheet))),
         "P_contact_MPa": float(reservoir.pump_pressure(bend["P_finger_MPa"], V_contact, design, at_contact)),
         "P_finger_at_contact_MPa": bend["P_finger_MPa"],
         "theta_touch_deg": touch,
