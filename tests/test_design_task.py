@@ -463,19 +463,19 @@ def test_a_design_run_stopped_mid_proof_leaves_none_of_its_files(tmp_path, monke
     earlier run's result.json that no longer matched it. The earlier record goes when a run
     starts, the stopped run's files (design, VTK) when it stops; other files stay."""
     from softhand.studies.cli import main as cli
-    from softhand.studies.cli.verbs import design as design_verb
+    from softhand.studies.design import workflow
 
     task, out = _write(tmp_path, CI_TASK_TOML), tmp_path / "out"
     out.mkdir()
     (out / "result.json").write_text('{"design_file": "design.toml"}\n')  # an earlier run's record
     (out / "notes.txt").write_text("mine\n")
 
-    def stopped_proof(ev, task, args, out, say):
+    def stopped_proof(ev, task, mesh_size_mm, out, say):
         (out / "grasp").mkdir()
         (out / "grasp" / "step_0.vtu").write_text("half a VTK")
         raise KeyboardInterrupt
 
-    monkeypatch.setattr(design_verb, "_prove", stopped_proof)
+    monkeypatch.setattr(workflow, "prove_on_meshes", stopped_proof)
     assert cli.main(["design", "--task", str(task), "--out", str(out), "--seed", "3"]) == 130
     assert sorted(p.name for p in out.iterdir()) == ["notes.txt"]
     fresh = tmp_path / "fresh" / "out"  # a folder the stopped run made goes too
@@ -516,12 +516,12 @@ def test_proven_says_in_one_word_what_the_exit_code_says(tmp_path, monkeypatch, 
     "feasible" (the reduced model's word) stayed true, so a script reading it took an unproven
     design. The proof itself is stood in for: its FEM is tested in test_design_fem.py."""
     from softhand.studies.cli import main as cli
-    from softhand.studies.cli.verbs import design as design_verb
+    from softhand.studies.design import workflow
 
     def proof(result, *rest):
         return result if outcome == "met" else {**result, "fem_report": "the FEM failed"}
 
-    monkeypatch.setattr(design_verb, "_prove_and_correct", proof)
+    monkeypatch.setattr(workflow, "prove_and_correct", proof)
     task, out = _write(tmp_path, CI_TASK_TOML), tmp_path / "out"
     argv = ["design", "--task", str(task), "--out", str(out), "--seed", "3", "--no-progress"]
     assert cli.main(argv + (["--no-fem"] if outcome == "no fem" else [])) == code
