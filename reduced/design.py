@@ -43,6 +43,8 @@ import math
 from dataclasses import dataclass
 from pathlib import Path
 
+from softhand import reduced as reduced_layer
+
 from . import rubber
 from .design_rules import BOUNDS, CONSISTENCY, check_model, in_bounds
 from .errors import InputError
@@ -55,7 +57,8 @@ RESERVOIR_MODELS = ("ellipse", "fem")
 #: Finger models the reduced layer knows: the paper's eqs. (2), (5), (10), or FEM-calibrated.
 FINGER_MODELS = ("paper", "fem")
 
-PAPER_DESIGN_FILE = Path(__file__).resolve().parent.parent / "studies" / "designs" / "paper.toml"
+#: the paper TOML among the study files, beside the reduced layer (the repository, or the installed package)
+PAPER_DESIGN_FILE = Path(reduced_layer.__file__).resolve().parent.parent / "studies" / "designs" / "paper.toml"
 
 
 @dataclass(frozen=True)

@@ -216,7 +216,7 @@ def register_model(name: str, functions: FingerFunctions) -> None:
 
 def model(name: str) -> FingerFunctions:
     """The registered finger model ``name`` (imports reduced.finger_<name> on first use)."""
-    return lookup(_MODELS, name, module=f"{__package__}.finger_{name}", field="finger_model")
+    return lookup(_MODELS, name, module=f"softhand.reduced.finger_{name}", field="finger_model")
 
 
 def energy(theta, design: HandDesign):

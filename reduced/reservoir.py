@@ -146,7 +146,7 @@ def register_model(name: str, pressure_fn: PressureFn) -> None:
 
 def model(name: str) -> PressureFn:
     """The registered pressure function of reservoir model ``name`` (imports reduced.reservoir_<name>)."""
-    return lookup(_MODELS, name, module=f"{__package__}.reservoir_{name}", field="reservoir_model")
+    return lookup(_MODELS, name, module=f"softhand.reduced.reservoir_{name}", field="reservoir_model")
 
 
 def pressure(V, design: HandDesign):
