@@ -1,0 +1,1 @@
+"""The paper's equations: kinematics, finger, reservoir, grasp, contact and the free hand."""
