@@ -24,7 +24,7 @@ def tangent(path: Path) -> None:
     """Write the benchmark tangent K and right-hand side b to ``path`` (npz)."""
     from softhand.fem.hand.finger import FingerModel, FingerOptions
     from softhand.fem.linsolve import make_solver
-    from softhand.reduced.design import HandDesign
+    from softhand.reduced.vocabulary.design import HandDesign
 
     model = FingerModel(HandDesign(), FingerOptions())
     y = model.constraint.zero()

@@ -30,8 +30,8 @@ from dataclasses import replace
 from pathlib import Path
 
 from softhand.fem.hand.finger import FingerModel, FingerOptions, solve_pressures
-from softhand.reduced.design import HandDesign
-from softhand.reduced.errors import InputError
+from softhand.reduced.vocabulary.design import HandDesign
+from softhand.reduced.vocabulary.errors import InputError
 from softhand.studies.verification.convergence import richardson
 from softhand.studies.io.files import write_json
 

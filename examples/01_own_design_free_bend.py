@@ -7,8 +7,8 @@ import math
 
 import numpy as np
 
-from softhand.reduced import finger, hand
-from softhand.reduced.design_files import load_design
+from softhand.reduced.equations import finger, hand
+from softhand.reduced.vocabulary.design_files import load_design
 
 paper = load_design()                      # studies/designs/paper.toml: Table I
 mine = paper.replace(a=3.5, b=4.0, d=12.0)  # a thinner tube, closer to the hinge plate

@@ -8,8 +8,8 @@ import math
 
 from scipy.optimize import brentq
 
-from softhand.reduced import hand, reservoir
-from softhand.reduced.design_files import load_design
+from softhand.reduced.equations import hand, reservoir
+from softhand.reduced.vocabulary.design_files import load_design
 
 design = load_design()
 target = 0.08  # [MPa]

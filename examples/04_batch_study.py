@@ -7,8 +7,8 @@ built from a dict: a kind, a design, sweep axes combined as a product. Results g
 import math
 import tempfile
 
-from softhand.reduced import hand
-from softhand.reduced.design_files import load_design
+from softhand.reduced.equations import hand
+from softhand.reduced.vocabulary.design_files import load_design
 from softhand.studies.batch.runner import index_rows, run_study
 from softhand.studies.batch.studyfile import study_from_dict
 

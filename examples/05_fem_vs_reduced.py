@@ -8,7 +8,7 @@ balance: the stored energy equals the work the oil did on the way, W = int P dQ.
 import numpy as np
 
 from softhand.fem.hand.finger import FingerOptions
-from softhand.reduced.design_files import load_design
+from softhand.reduced.vocabulary.design_files import load_design
 from softhand.studies.bending import BendingStudy, run
 
 design = load_design()

@@ -14,8 +14,8 @@ import math
 
 import numpy as np
 
-from softhand.reduced import contact, grasp, kinematics
-from softhand.reduced.design_files import load_design
+from softhand.reduced.equations import contact, grasp, kinematics
+from softhand.reduced.vocabulary.design_files import load_design
 
 design = load_design()
 D, mass = 210.0, 2.0                                   # object diameter [mm], mass [kg]

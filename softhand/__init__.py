@@ -19,6 +19,6 @@ if not (_Path(__file__).parent / "fem").is_dir() and (_root / "fem" / "__init__.
     __path__.append(str(_root))
 del _Path, _root
 
-from softhand.reduced.versions import package_version as _package_version  # noqa: E402
+from softhand.reduced.vocabulary.versions import package_version as _package_version  # noqa: E402
 
 __version__ = _package_version()  # "unknown" in a source tree that is not installed

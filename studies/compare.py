@@ -22,9 +22,10 @@ from pathlib import Path
 import numpy as np
 
 from softhand.fem.hand.reservoir import SheetModel, inflate
-from softhand.reduced import hand, paper
-from softhand.reduced import reservoir as ellipse
-from softhand.reduced.design import HandDesign
+from softhand.reduced.equations import hand
+from softhand.reduced.vocabulary import paper
+from softhand.reduced.equations import reservoir as ellipse
+from softhand.reduced.vocabulary.design import HandDesign
 
 
 @dataclass(frozen=True)

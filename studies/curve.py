@@ -8,14 +8,14 @@ from __future__ import annotations
 
 import numpy as np
 
-from softhand.reduced import hand, reservoir
-from softhand.reduced.design import HandDesign
-from softhand.reduced.errors import InputError
+from softhand.reduced.equations import hand, reservoir
+from softhand.reduced.vocabulary.design import HandDesign
+from softhand.reduced.vocabulary.errors import InputError
 
 
 def at_angles(theta_deg, design: HandDesign) -> list[dict]:
     """Per bend angle [deg]: P with / without reservoir [MPa], the reservoir's V [mm^3] and
-    :func:`reduced.reservoir.state` (p_r; h, lambda_r for the ellipse model)."""
+    :func:`reduced.equations.reservoir.state` (p_r; h, lambda_r for the ellipse model)."""
     theta_deg = np.atleast_1d(np.asarray(theta_deg, float))
     theta = hand.check_theta(np.radians(theta_deg))
     V = reservoir.oil_volume(theta, design)

@@ -16,7 +16,8 @@ from pathlib import Path
 
 import numpy as np
 
-from softhand.reduced import grasp, paper
+from softhand.reduced.equations import grasp
+from softhand.reduced.vocabulary import paper
 from softhand.studies.weights import WeightsCase, finger_options, reduced_F_v, state_row
 
 

@@ -2,7 +2,7 @@
 
 :func:`state` -- pump pressure, bend angle, mass and a weight vector w -> F_x (25), F_y (24),
 F_v (29) in N and kgf, with the free finger's pressure at that angle; :func:`state_fem` -- the
-same state by the calibrated finger in equilibrium against the object (:mod:`reduced.grasp_fem`).
+same state by the calibrated finger in equilibrium against the object (:mod:`reduced.calibrated.grasp_fem`).
 ``softhand grasp`` and the batch kind ``grasp`` only choose the inputs. Axes and signs:
 docs/conventions.md (F_v > 0: the finger squeezes).
 """
@@ -12,7 +12,7 @@ import math
 
 import numpy as np
 
-from softhand.reduced import grasp, hand
+from softhand.reduced.equations import grasp, hand
 
 
 def state(P: float, theta_deg: float, mass: float, w, design) -> dict:
@@ -28,7 +28,7 @@ def state(P: float, theta_deg: float, mass: float, w, design) -> dict:
 
 def state_fem(P: float, theta_deg: float, mass: float, diameter: float, design) -> dict:
     """One grasp state by the FEM-informed model at pump pressure P [MPa] -> the flat result."""
-    from softhand.reduced import grasp_fem
+    from softhand.reduced.calibrated import grasp_fem
 
     theta = math.radians(theta_deg)
     fem = grasp_fem.fem_finger(design)

@@ -22,10 +22,10 @@ from pathlib import Path
 import numpy as np
 
 from softhand.fem.hand.reservoir import ReservoirResult, SheetModel, inflate
-from softhand.reduced import finger
-from softhand.reduced import reservoir as ellipse
-from softhand.reduced.design import HandDesign
-from softhand.reduced.errors import InputError
+from softhand.reduced.equations import finger
+from softhand.reduced.equations import reservoir as ellipse
+from softhand.reduced.vocabulary.design import HandDesign
+from softhand.reduced.vocabulary.errors import InputError
 from softhand.studies.calibration.tables import write_table, written_by
 
 __all__ = ["ReservoirStudy", "ReservoirStudyResult", "run", "stroke_volume", "COLUMNS"]
@@ -169,7 +169,7 @@ def run(study: ReservoirStudy, *, progress=None) -> ReservoirStudyResult:
 
 
 def calibration_rows(model: SheetModel, *, v_max: float = 1.75, n: int = 71, progress=None) -> list:
-    """FEM table for :mod:`reduced.reservoir_fem`: v = V/R³ in [0, v_max] on n points, with
+    """FEM table for :mod:`reduced.calibrated.reservoir_fem`: v = V/R³ in [0, v_max] on n points, with
     τ = t/R, p̃ = pR/(μt), W̃ = W/(μtR²), h̃ = h/R."""
     R, t, mu = model.R, model.t, model.mu
     v = np.linspace(0.0, v_max, n)[1:]
@@ -182,7 +182,7 @@ def calibration_rows(model: SheetModel, *, v_max: float = 1.75, n: int = 71, pro
 
 def calibration_provenance(models: list, command: str) -> list[str]:
     """The reservoir table's provenance lines: who wrote it, and each sheet model's mesh."""
-    head = [written_by("FEM calibration of reduced/reservoir_fem.py"), command]
+    head = [written_by("FEM calibration of reduced/calibrated/reservoir_fem.py"), command]
     for m in models:
         head.append(f"model: R={m.R} mm, t={m.t} mm (tau=t/R={m.t / m.R:.6g}), mu={m.mu} MPa, "
                     f"kappa/mu={m.kappa_ratio}, Q2/P1disc, {m.n_radial} x {m.n_thick} elements "
@@ -191,7 +191,7 @@ def calibration_provenance(models: list, command: str) -> list[str]:
     return head
 
 
-#: the reservoir table's columns (:mod:`reduced.reservoir_fem`)
+#: the reservoir table's columns (:mod:`reduced.calibrated.reservoir_fem`)
 CALIBRATION_COLUMNS = ("tau", "v", "p_tilde", "W_tilde", "h_tilde")
 
 

@@ -3,10 +3,10 @@ import math
 
 import pytest
 
-from softhand.reduced import finger
-from softhand.reduced.design import PUBLIC_KEYS, HandDesign
-from softhand.reduced.design_files import design_from_dict, load_design
-from softhand.reduced.errors import InputError
+from softhand.reduced.equations import finger
+from softhand.reduced.vocabulary.design import PUBLIC_KEYS, HandDesign
+from softhand.reduced.vocabulary.design_files import design_from_dict, load_design
+from softhand.reduced.vocabulary.errors import InputError
 
 
 def test_paper_file_is_table_one():

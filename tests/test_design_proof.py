@@ -5,7 +5,7 @@ import json
 
 import pytest
 
-from softhand.reduced.design_files import load_design
+from softhand.reduced.vocabulary.design_files import load_design
 from softhand.studies.design import optimise as design_opt
 from softhand.studies.design.task import task_from_dict
 from test_design_task import CI_TASK, CI_TASK_TOML, _write
@@ -39,7 +39,7 @@ def test_the_proof_mesh_follows_the_wall():
 
 
 def test_a_failed_proof_mesh_is_retried_on_the_next_finer_one(monkeypatch):
-    from softhand.reduced.errors import InputError, MeshRejected
+    from softhand.reduced.vocabulary.errors import InputError, MeshRejected
     from softhand.studies.design import workflow
     from softhand.studies.design import proof
 
@@ -86,7 +86,7 @@ def test_a_proof_mesh_too_large_for_the_optimum_is_not_retried_finer(monkeypatch
     """The box's smallest finger fitted the memory, the optimum's does not: no finer mesh is
     tried (it would be larger still) and the report asks for a coarser one."""
 
-    from softhand.reduced.errors import MeshTooLarge
+    from softhand.reduced.vocabulary.errors import MeshTooLarge
     from softhand.studies.design import workflow
     from softhand.studies.design import proof
 
@@ -109,7 +109,7 @@ def test_the_proof_mesh_is_bounded_on_the_boxs_thinnest_shortest_tube(monkeypatc
     not that corner is a valid design (d below a + b there), and the finest mesh the proof may
     try: the bound of a uniform gmsh tube of that size."""
     from softhand.fem.hand import finger_options as fo
-    from softhand.reduced.errors import MeshTooLarge
+    from softhand.reduced.vocabulary.errors import MeshTooLarge
     from softhand.studies.design import proof
 
     seen = []

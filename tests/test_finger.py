@@ -8,8 +8,8 @@ import pytest
 from softhand.fem.constraints import ChainConstraint
 from softhand.fem.hand.finger import FingerModel, FingerOptions, ring_width, solve_pressures, to_hand_frame
 from softhand.fem.newton import NewtonOptions
-from softhand.reduced import hand, kinematics
-from softhand.reduced.design import HandDesign
+from softhand.reduced.equations import hand, kinematics
+from softhand.reduced.vocabulary.design import HandDesign
 
 DESIGN = HandDesign()
 CI = FingerOptions(mesher="gmsh", mesh_size=6.0, edge_ratio=1.0, mesh_refine=0)  # uniform, 9.7k unknowns; theta ~3 % low (docs)

@@ -1,7 +1,7 @@
 r"""The grasp FEM: the finger FEM of :mod:`fem.finger` closing on a rigid object.
 
 The object (diameter D) is centred on the hand's axis, at depth ``depth`` below the palm
-(the hand frame of :mod:`reduced.kinematics`: x outward, y down, the finger base on the
+(the hand frame of :mod:`reduced.equations.kinematics`: x outward, y down, the finger base on the
 hinge plate at (``base_offset``, 0)). By default (:func:`default_depth`) the hand comes
 down over the object until the object's top is ``palm_gap`` below the palm, or -- for
 objects too big to pass between the open fingers -- until the open fingers' pads are
@@ -36,8 +36,8 @@ from softhand.fem.hand.finger import FingerModel
 from softhand.fem.hand.frame import hand_frame, to_finger_frame
 from softhand.fem.linsolve import make_solver
 from softhand.fem.newton import NewtonOptions, NotConverged, PathOptions, solve_path
-from softhand.reduced.design import HandDesign
-from softhand.reduced.errors import InputError
+from softhand.reduced.vocabulary.design import HandDesign
+from softhand.reduced.vocabulary.errors import InputError
 
 
 @dataclass(frozen=True)

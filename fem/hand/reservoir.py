@@ -29,7 +29,7 @@ import numpy as np
 
 from softhand.fem.axisym import AxisymSolid, RevolvedVolume
 from softhand.fem.hyperelastic import rubber_law
-from softhand.reduced.rubber import NeoHookean, Rubber
+from softhand.reduced.materials.rubber import NeoHookean, Rubber
 from softhand.fem.volume_path import PathOptions, follow_volume, volume_path_options
 from softhand.meshes.reservoir import sheet_mesh
 
@@ -47,12 +47,12 @@ class SheetModel:
     n_radial: int = 40  #: Q2 elements along the radius
     n_thick: int = 2  #: Q2 elements through the thickness
     clamp_ratio: float = 3.0  #: radial element size at the axis / at the clamp
-    #: the rubber's strain energy (:mod:`reduced.rubber`; scaled to mu); None: Neo-Hookean
+    #: the rubber's strain energy (:mod:`reduced.materials.rubber`; scaled to mu); None: Neo-Hookean
     material: Rubber | None = None
 
     @classmethod
     def from_design(cls, design, **mesh) -> "SheetModel":
-        """Geometry and material of a :class:`reduced.design.HandDesign`; mesh keywords as given."""
+        """Geometry and material of a :class:`reduced.vocabulary.design.HandDesign`; mesh keywords as given."""
         material = None if design.reservoir_is_neo_hookean else design.reservoir_rubber
         return cls(R=design.R, t=design.t, mu=design.mu_sr, material=material, **mesh)
 

@@ -9,8 +9,8 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
-from softhand.reduced.design import HandDesign
-from softhand.reduced.errors import InputError
+from softhand.reduced.vocabulary.design import HandDesign
+from softhand.reduced.vocabulary.errors import InputError
 
 
 def curve(params: dict, design: HandDesign, outdir: Path) -> dict:
@@ -35,7 +35,7 @@ def grasp(params: dict, design: HandDesign, outdir: Path) -> dict:
 
     ``weights`` (n_s numbers) or ``diameter_mm`` (the paper's presets, 180 or 240).
     """
-    from softhand.reduced.grasp import check_weights, weights_for_diameter
+    from softhand.reduced.equations.grasp import check_weights, weights_for_diameter
     from softhand.studies.grasp import state
 
     if "weights" in params:

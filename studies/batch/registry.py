@@ -10,10 +10,10 @@ import importlib
 import math
 from dataclasses import dataclass
 
-from softhand.reduced import finger
-from softhand.reduced.design import HandDesign
-from softhand.reduced.errors import InputError
-from softhand.reduced.grasp import MAX_WEIGHT
+from softhand.reduced.equations import finger
+from softhand.reduced.vocabulary.design import HandDesign
+from softhand.reduced.vocabulary.errors import InputError
+from softhand.reduced.equations.grasp import MAX_WEIGHT
 
 
 @dataclass(frozen=True)
@@ -65,7 +65,7 @@ def _grasp_weights(params: dict, design: HandDesign, src: str) -> None:
         raise InputError(f"{src}: diameter_mm", params["diameter_mm"], "give weights or diameter_mm, not both")
     if "weights" not in params:
         return
-    from softhand.reduced.grasp import projected_jacobian
+    from softhand.reduced.equations.grasp import projected_jacobian
 
     w = params["weights"]
     if len(w) != design.n_s:
@@ -87,7 +87,7 @@ def finger_mesh_fits(params: dict, design: HandDesign, src: str) -> None:
     without meshing): one line when the study is read, not a case failing after the others ran."""
     from softhand.fem.hand.finger import finger_tube
     from softhand.fem.hand.finger_options import check_size, mesh_options
-    from softhand.reduced.errors import MeshTooLarge
+    from softhand.reduced.vocabulary.errors import MeshTooLarge
 
     options = mesh_options(params.get("mesh_size_mm"), params.get("axial_size_mm"))
     try:
@@ -118,7 +118,7 @@ def _paper_weights_fit(params: dict, design: HandDesign, src: str) -> None:
     """Without ``weights``, the case takes the paper's w for its diameter: the design needs its
     number of hinges (as ``softhand control`` / ``grasp`` refuse it up front)."""
     if "weights" not in params:
-        from softhand.reduced.grasp import weights_for_diameter
+        from softhand.reduced.equations.grasp import weights_for_diameter
 
         try:
             weights_for_diameter(params.get("diameter_mm", 180.0), design)
@@ -162,7 +162,7 @@ def _pressure_reached(params: dict, design: HandDesign, src: str) -> None:
     """A pressure the design's free hand reaches (its range depends on the design): the reduced
     model's inverse, at load time, not as a failed case."""
     if "pressure_mpa" in params:
-        from softhand.reduced import hand
+        from softhand.reduced.equations import hand
 
         try:
             hand.bend_angles(params["pressure_mpa"], design)

@@ -20,7 +20,7 @@ optionally fixed parameters and a mesh size::
     mass_kg = 2.0
 
 A sweep axis is either a parameter of the kind or a public design key
-(:data:`reduced.design.PUBLIC_KEYS`). Every error is one line naming the field.
+(:data:`reduced.vocabulary.design.PUBLIC_KEYS`). Every error is one line naming the field.
 
 A study file is data: its kind is a *name*, looked up in the built-in :data:`KINDS` and in
 the ``softhand.kinds`` entry-point group of installed packages (:func:`all_kinds`); no
@@ -46,11 +46,11 @@ import re
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from softhand.reduced import reservoir
-from softhand.reduced.design import PUBLIC_KEYS, HandDesign
-from softhand.reduced.design_files import design_from_dict, load_design
-from softhand.reduced.inputfiles import read_toml
-from softhand.reduced.errors import InputError
+from softhand.reduced.equations import reservoir
+from softhand.reduced.vocabulary.design import PUBLIC_KEYS, HandDesign
+from softhand.reduced.vocabulary.design_files import design_from_dict, load_design
+from softhand.reduced.vocabulary.inputfiles import read_toml
+from softhand.reduced.vocabulary.errors import InputError
 from softhand.studies.io.values import parse_values
 from softhand.studies.batch.registry import ENTRY_POINT_GROUP, KINDS, MAX_CASES, Kind, Num, NumList, all_kinds, \
     resolve_kind

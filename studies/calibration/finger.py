@@ -8,7 +8,7 @@ Each design is one case of the batch runner (:mod:`softhand.studies.batch.runner
 FEM of :mod:`softhand.studies.bending` on the default (layered) mesh at the pressures, and on
 until ``theta_target_deg`` in steps of at most ``p_step_mpa`` while P <= ``p_max_mpa``.
 The finished cases become the nondimensional rows of
-``reduced/data/finger_fem.csv`` (see :mod:`softhand.reduced.finger_fem`); :mod:`softhand.studies.calibration.finger_table`
+``reduced/calibrated/data/finger_fem.csv`` (see :mod:`softhand.reduced.calibrated.finger_fem`); :mod:`softhand.studies.calibration.finger_table`
 writes it and checks a table against held-out designs.
 """
 from __future__ import annotations
@@ -17,8 +17,8 @@ import math
 from dataclasses import dataclass
 from pathlib import Path
 
-from softhand.reduced.design import HandDesign
-from softhand.reduced.errors import InputError
+from softhand.reduced.vocabulary.design import HandDesign
+from softhand.reduced.vocabulary.errors import InputError
 from softhand.studies.batch.studyfile import Study
 from softhand.studies.calibration.space import _PATH_KEYS, VARIABLES, DesignSpace, finger_design
 

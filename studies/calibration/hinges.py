@@ -1,4 +1,4 @@
-"""The hinge table of :mod:`reduced.grasp_fem` from the finger FEM: each hinge's oil per radian at
+"""The hinge table of :mod:`reduced.calibrated.grasp_fem` from the finger FEM: each hinge's oil per radian at
 fixed pressure, A_j(theta) = dV/d theta_hat_j.
 
 On the grasp FEM's mesh, the free finger at each pressure P of ``PRESSURES`` (bend theta_free(P));
@@ -9,7 +9,7 @@ angles (a Maxwell relation of the finger's potential E(q, P), dE/dP = -V). At P 
 straight finger's. Written nondimensionally against the hinge's bend theta = n_s theta_hat_j:
 a_j = A_j / (a^2 pi d). Run::
 
-    python -m softhand.studies.calibration.hinges --out reduced/data/grasp_hinges.csv
+    python -m softhand.studies.calibration.hinges --out reduced/calibrated/data/grasp_hinges.csv
 """
 from __future__ import annotations
 
@@ -19,7 +19,7 @@ import sys
 
 import numpy as np
 
-from softhand.reduced.design import HandDesign
+from softhand.reduced.vocabulary.design import HandDesign
 from softhand.studies.calibration import tables
 from softhand.studies.io.files import write_atomic
 
@@ -58,7 +58,7 @@ def table_text(design: HandDesign, mesh_size_mm: float | None = None, command: s
     model = FingerModel(design, finger_options(h))
     theta, A = volume_rates(model)
     a = A / (design.a ** 2 * math.pi * design.d)
-    head = [tables.written_by("FEM hinge table of reduced/grasp_fem.py"),
+    head = [tables.written_by("FEM hinge table of reduced/calibrated/grasp_fem.py"),
             command,
             f"model: finger FEM (fem/hand/finger.py) of the paper's design (Table I) on the grasp mesh "
             f"(h = {h:g} mm, {model.ndofs} unknowns); free states at P = {', '.join(f'{p:g}' for p in PRESSURES)} MPa, "

@@ -36,10 +36,10 @@ from pathlib import Path
 
 import numpy as np
 
-from softhand.reduced.design import HandDesign
+from softhand.reduced.vocabulary.design import HandDesign
 
-from softhand.reduced.design_files import load_design
-from softhand.reduced.errors import InputError
+from softhand.reduced.vocabulary.design_files import load_design
+from softhand.reduced.vocabulary.errors import InputError
 from softhand.studies.batch.registry import check_path_end
 from softhand.studies.batch.studyfile import _NAME_RE
 
@@ -68,7 +68,7 @@ class DesignSpace:
     #: (point, pressures): one design run on this mesh and on the default one, to correct the
     #: table for the mesh (see studies.finger_table.mesh_correction); None: no correction
     mesh_pair: tuple | None = None
-    prior: str = "paper"  #: the physics the table's residual is taken against (reduced.finger_fem.PRIORS)
+    prior: str = "paper"  #: the physics the table's residual is taken against (reduced.calibrated.finger_fem.PRIORS)
 
     def designs(self) -> list[HandDesign]:
         return [finger_design(p, self.base) for p in self.points]
@@ -114,7 +114,7 @@ MAX_PRESSURES = 50
 
 def load_space(path: str | Path) -> DesignSpace:
     """Read and validate a design-space TOML file (see the module docstring)."""
-    from softhand.reduced.inputfiles import read_toml
+    from softhand.reduced.vocabulary.inputfiles import read_toml
 
     path = Path(path)
     doc = read_toml(path, "--space", "a design-space TOML file")
@@ -170,7 +170,7 @@ def load_space(path: str | Path) -> DesignSpace:
                              f"must be 2 to {MAX_PRESSURES} increasing numbers in [{lo:g}, {hi:g}] MPa")
         pair = (_point(pair, {k: (0.0, math.inf) for k in VARIABLES}, f"{src}: mesh_pair"),
                 tuple(float(p) for p in pressures_pair))
-    from softhand.reduced.finger_fem import PRIORS
+    from softhand.reduced.calibrated.finger_fem import PRIORS
     prior = doc.get("prior", "paper")
     if prior not in PRIORS:
         raise InputError(f"{src}: prior", prior, f"must be one of {', '.join(PRIORS)}")
@@ -242,7 +242,7 @@ def _point(table, box: dict, where: str) -> dict:
 
 def single_design_space(path: str | Path) -> DesignSpace:
     """The design space of one design file (its own box), for a table of that design alone."""
-    from softhand.reduced.finger_fem import groups_of
+    from softhand.reduced.calibrated.finger_fem import groups_of
 
     design = load_design(path)
     groups_of(design)  # 5 equal hinges, or one error line

@@ -2,7 +2,7 @@
 
 A table is ``#`` provenance lines (who wrote it, when, at which commit, by which command, with
 which model and mesh), a header row and rows of numbers; it is written atomically, so a table
-is whole or absent. :func:`softhand.reduced.inputfiles.read_number_table` is its one reader.
+is whole or absent. :func:`softhand.reduced.vocabulary.inputfiles.read_number_table` is its one reader.
 """
 from __future__ import annotations
 

@@ -7,10 +7,10 @@ import sys
 
 import numpy as np
 
-from softhand.reduced.design import HandDesign
+from softhand.reduced.vocabulary.design import HandDesign
 
-from softhand.reduced.design_files import load_design
-from softhand.reduced.errors import InputError
+from softhand.reduced.vocabulary.design_files import load_design
+from softhand.reduced.vocabulary.errors import InputError
 from softhand.studies.io.files import json_text
 # the value lists' reader and limits, for the verbs (study files read values the same way)
 from softhand.studies.io.values import MAX_FEM_POINTS, MAX_POINTS, MOST_FEM_POINTS, MOST_POINTS, NUMBER_LIST, \
@@ -58,7 +58,7 @@ def add_progress_option(parser: argparse.ArgumentParser) -> None:
 
 def design_from_args(args) -> HandDesign:
     """The design of ``--design`` (the paper's without it), its V0 one its sheet can hold."""
-    from softhand.reduced.reservoir import check_holds
+    from softhand.reduced.equations.reservoir import check_holds
 
     design = load_design(args.design)
     check_holds(design.V0, design)

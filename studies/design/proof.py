@@ -37,7 +37,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 from scipy.interpolate import PchipInterpolator
 
-from softhand.reduced import hand, reservoir
+from softhand.reduced.equations import hand, reservoir
 from softhand.studies.design.optimise import Evaluation
 from softhand.studies.design.task import Task
 
@@ -62,7 +62,7 @@ class _Past(Exception):
 
 def sheet_pressure(sheet):
     """The sheet FEM's p(V) [MPa] along its path from flat to V0, linear between its converged
-    states (exact at them; steps <= R^2 t / 2): the reservoir of :func:`reduced.reservoir.pump_pressure`."""
+    states (exact at them; steps <= R^2 t / 2): the reservoir of :func:`reduced.equations.reservoir.pump_pressure`."""
     return lambda V: np.interp(V, sheet.path_volume, sheet.path_pressure)
 
 
@@ -233,8 +233,8 @@ def margin(model, sheet, best, ev: Evaluation, task: Task, options: ProofOptions
 def _touch(bend: dict, ev: Evaluation, task: Task) -> float | None:
     """The bend [deg] at which the FEM finger, closing with its own hinge shares (at theta_g),
     touches the object in the reduced model's geometry (None: it does not reach it)."""
-    from softhand.reduced import contact
-    from softhand.reduced.errors import InputError
+    from softhand.reduced.equations import contact
+    from softhand.reduced.vocabulary.errors import InputError
 
     try:
         theta, _ = contact.contact_angle(task.diameter, ev.design, depth=ev.depth, w=bend["hinge_share"])

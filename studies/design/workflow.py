@@ -11,7 +11,7 @@ from pathlib import Path
 
 import numpy as np
 
-from softhand.reduced.errors import MeshRejected, MeshTooLarge
+from softhand.reduced.vocabulary.errors import MeshRejected, MeshTooLarge
 from softhand.studies.design import optimise as design_opt
 from softhand.studies.design import proof
 from softhand.studies.io.files import replaced_outputs, write_atomic, write_json

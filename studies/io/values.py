@@ -8,8 +8,8 @@ import math
 
 import numpy as np
 
-from softhand.reduced.errors import InputError
-from softhand.reduced.inputfiles import plain_float
+from softhand.reduced.vocabulary.errors import InputError
+from softhand.reduced.vocabulary.inputfiles import plain_float
 
 #: most values one range or list may give: reduced-model verbs, and FEM runs (one solve each),
 #: unless --max-cases says otherwise; and the most --max-cases may allow

@@ -27,10 +27,10 @@ from dataclasses import dataclass
 from datetime import datetime, timezone
 from pathlib import Path
 
-from softhand.reduced import finger
-from softhand.reduced import paper
-from softhand.reduced.design import HandDesign
-from softhand.reduced.errors import InputError
+from softhand.reduced.equations import finger
+from softhand.reduced.vocabulary import paper
+from softhand.reduced.vocabulary.design import HandDesign
+from softhand.reduced.vocabulary.errors import InputError
 from softhand.studies.io.files import write_atomic, write_csv
 from softhand.studies.reproduce.section import Context, Section
 from softhand.studies.batch.runner import FAILED, RESULT, code_version, commit, execute_case, outcome_record

@@ -4,7 +4,7 @@ Each builder ``build(ctx, outdir) -> (markdown, numbers)`` calls the owning libr
 function, writes its CSV/PNG/VTK files into ``outdir`` and returns the Markdown body
 (links relative to ``outdir``) and its headline numbers. No printing; no CLI calls.
 The FEM sections live in :mod:`studies.reproduce.fem_sections`; the paper's numbers they
-compare with come from :mod:`reduced.paper`.
+compare with come from :mod:`reduced.vocabulary.paper`.
 """
 from __future__ import annotations
 
@@ -16,7 +16,7 @@ from pathlib import Path
 import numpy as np
 
 from softhand.studies.io.files import figure, save_figure, write_csv
-from softhand.reduced import paper
+from softhand.reduced.vocabulary import paper
 from softhand.studies.reproduce.section import Context, Section, md_table
 
 
@@ -62,7 +62,7 @@ pressure the charged sheet already bends the fingers a little.
 
 def _pressure_fem_reservoir(theta, design):
     """(eq. (27) with the FEM-calibrated reservoir model, None) or (None, why not)."""
-    from softhand.reduced import hand
+    from softhand.reduced.equations import hand
 
     try:
         return hand.pressure(theta, design.replace(reservoir_model="fem"), reservoir=True), None
@@ -82,7 +82,7 @@ def _fem_reservoir_note(P0, P_fem, why) -> str:
 # ---------------------------------------------------------------------- Table II, reduced
 def table2_reduced(ctx: Context, outdir: Path):
     """F_v by eqs. (24), (25), (29) at the three (P, θ) of Table II, m = 2 kg, 180 mm w."""
-    from softhand.reduced.grasp import KGF, WeightSumWarning, check_weights, grasp_forces
+    from softhand.reduced.equations.grasp import KGF, WeightSumWarning, check_weights, grasp_forces
 
     d = ctx.design
     w_paper = np.asarray(paper.WEIGHTS[180.0])
@@ -126,7 +126,7 @@ def _ordering_verdict(F_b: float, F_c: float) -> str:
 # ---------------------------------------------------------------------- Fig. 8, reduced
 def fig8_reduced(ctx: Context, outdir: Path):
     """F_v(θ) by eq. (25), (29) at the paper's pressures for 2 kg/180 mm and 6 kg/240 mm."""
-    from softhand.reduced.grasp import KGF, WeightSumWarning, angle_at, grasp_forces
+    from softhand.reduced.equations.grasp import KGF, WeightSumWarning, angle_at, grasp_forces
 
     d = ctx.design
     theta_deg = np.arange(0.0, 90.0 + 1e-9, 1.0)
@@ -230,11 +230,11 @@ In the paper the pressure drops under the push ({paper.TABLE_II['b_push_pressure
 
 REDUCED_SECTIONS: list[Section] = [
     Section("fig7_reduced", "Fig. 7: pressure and bend angle, reduced model",
-            ("softhand.reduced.hand:pressure",), fig7_reduced),
+            ("softhand.reduced.equations.hand:pressure",), fig7_reduced),
     Section("table2_reduced", "Table II: grasping force, reduced model",
-            ("softhand.reduced.grasp:grasp_forces", "softhand.reduced.paper:TABLE_II"), table2_reduced),
+            ("softhand.reduced.equations.grasp:grasp_forces", "softhand.reduced.vocabulary.paper:TABLE_II"), table2_reduced),
     Section("fig8_reduced", "Fig. 8 analogue: grasping force against bend angle",
-            ("softhand.reduced.grasp:angle_at",), fig8_reduced),
+            ("softhand.reduced.equations.grasp:angle_at",), fig8_reduced),
     Section("table2_control", "Table II: angle control vs pressure control, simulated",
             ("softhand.studies.control:run", "softhand.studies.control:ControlStudy"), table2_control),
     Section("fig10_control", "Fig. 10 analogue: angle control under a push",

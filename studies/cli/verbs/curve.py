@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from softhand.reduced.design import HandDesign
+from softhand.reduced.vocabulary.design import HandDesign
 from softhand.studies import curve
 from softhand.studies.cli.args import MAX_POINTS, MOST_POINTS, add_design_option, add_json_option, \
     add_max_cases_option, design_from_args, max_cases, parse_values, print_json, print_table, require_finite
@@ -40,7 +40,7 @@ def rows_at_pressures(P: np.ndarray, design: HandDesign) -> list[dict]:
 
 
 def run(args) -> int:
-    from softhand.reduced.errors import InputError
+    from softhand.reduced.vocabulary.errors import InputError
 
     limit = max_cases(args, MAX_POINTS, MOST_POINTS)
     design = design_from_args(args)

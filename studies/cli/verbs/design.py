@@ -14,7 +14,7 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
-from softhand.reduced.errors import InputError, MeshTooLarge
+from softhand.reduced.vocabulary.errors import InputError, MeshTooLarge
 from softhand.studies.cli.args import add_json_option, add_progress_option, print_json, print_table
 from softhand.studies.design.summary import knee_line, margin_lines, relative_difference
 

@@ -6,13 +6,13 @@ maximum (if the path passes one) and the verdict over the operating range (V0 - 
 ``--plot``: profiles, p(V) of both models, and the hand's P(theta) with both reservoir
 models. ``--out DIR``: result.json (rows, verdict, wet-surface profiles z(r) and mid-surface
 stretches per volume, the whole p(V), W(V) path), rows.csv, VTK of the deformed sheet per
-volume (r–z and revolved to 3D); see :class:`studies.reservoir.ReservoirStudyResult`. ``--write-calibration FILE.csv``: the table of ``reduced/reservoir_fem.py``.
+volume (r–z and revolved to 3D); see :class:`studies.reservoir.ReservoirStudyResult`. ``--write-calibration FILE.csv``: the table of ``reduced/calibrated/reservoir_fem.py``.
 """
 from __future__ import annotations
 
 from pathlib import Path
 
-from softhand.reduced.errors import InputError
+from softhand.reduced.vocabulary.errors import InputError
 from softhand.studies.cli.args import MAX_FEM_POINTS, MOST_FEM_POINTS, add_design_option, add_json_option, \
     add_max_cases_option, add_progress_option, design_from_args, max_cases, parse_values, print_json, print_table
 from softhand.studies.io.files import replaced_outputs, write_outputs
@@ -52,7 +52,7 @@ def _study(args):
         if min(volumes) < low or max(volumes) > high:
             raise InputError("--volume-mm3", args.volume_mm3,
                              f"volumes must be in [{low:.4g}, {high:.4g}] mm^3 (1e-4 V0 .. 100 V0)")
-        from softhand.reduced.reservoir import check_holds
+        from softhand.reduced.equations.reservoir import check_holds
 
         check_holds(max(volumes), design, "--volume-mm3")
     return ReservoirStudy(design=design, volumes_mm3=volumes, n_radial=args.n_radial,

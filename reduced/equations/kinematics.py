@@ -29,7 +29,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .design import HandDesign
+from softhand.reduced.vocabulary.design import HandDesign
 
 
 def hinge_angles(theta, w):

@@ -1,7 +1,7 @@
-r"""The FEM-informed grasp (:mod:`reduced.grasp_fem`) posed for a design: the pump pressure that
+r"""The FEM-informed grasp (:mod:`reduced.calibrated.grasp_fem`) posed for a design: the pump pressure that
 holds the object with a given F_v, and F_v at a given pump pressure, each by one solve.
 
-:func:`reduced.grasp_fem.grasp_state` finds the finger's equilibrium at one cavity pressure P.
+:func:`reduced.calibrated.grasp_fem.grasp_state` finds the finger's equilibrium at one cavity pressure P.
 A design question fixes something else -- F_v (the pressure that holds the object) or the
 pump's pressure (the force it gives) -- and a root finder on P around ``grasp_state`` costs a
 dozen equilibria. Here P is one more unknown of the same equilibrium: with pad k touching
@@ -11,7 +11,7 @@ z = (q_1..q_k, q_d, N, P) solve
 .. math:: M_j(q, P) - N\,\partial_j g_k - T_j = 0 \ (j \le k), \quad M_{k+1}(q, P) = 0,
           \quad g_k(q) = 0, \quad c(q, N, P) = 0,
 
-(M_{k+1} = 0 is P_free(n_s q_d) = P: the distal hinges as the free finger's), the first three exactly :func:`reduced.grasp_fem.grasp_state`'s equations, and the last the
+(M_{k+1} = 0 is P_free(n_s q_d) = P: the distal hinges as the free finger's), the first three exactly :func:`reduced.calibrated.grasp_fem.grasp_state`'s equations, and the last the
 design's condition: F_v(q, N) = F_req, or P - p_r(theta) = P_pump, the pump pressure being the
 cavity's less the reservoir's pressure at the oil the fingers have taken at the bend theta =
 sum q (as ``softhand grasp --model fem`` and eq. (27)). The answer is accepted if it is the
@@ -35,10 +35,11 @@ from typing import NamedTuple
 import numpy as np
 from scipy.optimize import brentq
 
-from . import contact, grasp_fem, hand, kinematics
-from .design import HandDesign
-from .errors import InputError
-from .reservoir import oil_volume, pressure as p_r
+from softhand.reduced.equations import contact, hand, kinematics
+from softhand.reduced.calibrated import grasp_fem
+from softhand.reduced.vocabulary.design import HandDesign
+from softhand.reduced.vocabulary.errors import InputError
+from softhand.reduced.equations.reservoir import oil_volume, pressure as p_r
 
 #: tolerance of the fast solve (Newton step, relative on the unknowns) and of the slow path's brentq [MPa]
 _XTOL, _PTOL = 1e-13, 1e-13
@@ -91,7 +92,7 @@ def _pump(P, theta, design: HandDesign, reservoir: bool):
 def _residuals(Z, k: int, depth: float, radius: float, weight: float, target: str, value: float,
                design: HandDesign, reservoir: bool, corner: bool = False):
     """The module's equations at a batch of unknowns Z (B, m + 2), m = k held hinges (+ 1 for the
-    distal ones) -> (residuals (B, m + 2), F_v (B,)); :func:`reduced.grasp_fem.grasp_state`'s
+    distal ones) -> (residuals (B, m + 2), F_v (B,)); :func:`reduced.calibrated.grasp_fem.grasp_state`'s
     equilibrium with pad k touching (``corner``: with its far end, the hinge it shares with pad
     k+1), written for many states at once."""
     n_s, m = design.n_s, Z.shape[1] - 2
@@ -154,7 +155,7 @@ def fast_hold(design: HandDesign, diameter_mm: float, mass_kg: float, target: st
               reservoir: bool = True) -> Hold | None:
     """The grasp with F_v = value [N] (``target="F_v"``) or pump pressure value [MPa]
     (``target="P_pump"``), by one Newton solve of the module's equations from the contact; None
-    if that solve fails or is not the state :func:`reduced.grasp_fem.grasp_state` reaches (see
+    if that solve fails or is not the state :func:`reduced.calibrated.grasp_fem.grasp_state` reaches (see
     module doc).
 
     A pump pressure well above contact often presses a later pad than the one that touched
@@ -345,7 +346,7 @@ def _hinges(z, k: int, n_s: int) -> np.ndarray:
 
 def _largest_pressure(design: HandDesign) -> float:
     """The largest cavity pressure [MPa] either path answers at: the free finger's at (nearly)
-    its largest bend, where :func:`reduced.grasp_fem.grasp_state` stops."""
+    its largest bend, where :func:`reduced.calibrated.grasp_fem.grasp_state` stops."""
     return float(hand.finger_pressure(0.999 * hand.THETA_RANGE[1], design))
 
 
@@ -361,7 +362,7 @@ def _condition(target: str, value: float, design: HandDesign, reservoir: bool):
 def slow_hold(design: HandDesign, diameter_mm: float, mass_kg: float, target: str, value: float, *,
               reservoir: bool = True) -> Hold:
     """The same grasp as :func:`fast_hold`, by brentq on the cavity pressure around
-    :func:`reduced.grasp_fem.grasp_state` (from the contact pressure up to the free finger's
+    :func:`reduced.calibrated.grasp_fem.grasp_state` (from the contact pressure up to the free finger's
     pressure at its largest bend). Where one pad stops holding the object alone before the
     condition is met, the end is solved for (:func:`one_pad_end`'s way) and the refusal
     names it: its cavity and pump pressures and F_v."""
@@ -477,7 +478,7 @@ def one_pad_end(design: HandDesign, diameter_mm: float, mass_kg: float, *, reser
     not reach): the start is the state of pad k (its face, then its far end) at that pump
     pressure (as :func:`fast_hold`) in which pad j is inside the object, for the pads k in
     turn; the end is kept if it is
-    :func:`reduced.grasp_fem.grasp_state`'s state at its pressure and ``grasp_state`` has none
+    :func:`reduced.calibrated.grasp_fem.grasp_state`'s state at its pressure and ``grasp_state`` has none
     :data:`END_PROBE` above it (a pad change is not an end). Otherwise ``grasp_state`` is
     stepped up through the slow path's grid (:func:`_grid`) until it has no state and the end
     found between (:func:`_end_between`)."""

@@ -1,5 +1,5 @@
-r"""Least squares shared by the design fit (:mod:`reduced.fit`) and the material fit
-(:mod:`reduced.material_fit`): options, the finite-difference Jacobian, and what the
+r"""Least squares shared by the design fit (:mod:`reduced.fitting.fit`) and the material fit
+(:mod:`reduced.materials.material_fit`): options, the finite-difference Jacobian, and what the
 Jacobian at the optimum says about the parameters.
 
 Uncertainty, with :math:`J = \partial r / \partial p` at the optimum (central

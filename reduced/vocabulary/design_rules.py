@@ -1,11 +1,11 @@
-"""What values a :class:`reduced.design.HandDesign` may take: one table of bounds per public
+"""What values a :class:`reduced.vocabulary.design.HandDesign` may take: one table of bounds per public
 key, the checks between fields, and the model-name check (each raises one
-:class:`reduced.errors.InputError` naming the field)."""
+:class:`reduced.vocabulary.errors.InputError` naming the field)."""
 from __future__ import annotations
 
 import math
 
-from .errors import InputError
+from softhand.reduced.vocabulary.errors import InputError
 
 __all__ = ["BOUNDS", "CONSISTENCY", "check_model", "in_bounds", "is_number"]
 

@@ -1,11 +1,11 @@
 """The calibration table of the finger model ``"fem"``: its CSV format, reading and checks.
 
-``reduced/data/finger_fem.csv`` (or a table of one design made by ``softhand calibrate finger
+``reduced/calibrated/data/finger_fem.csv`` (or a table of one design made by ``softhand calibrate finger
 --design``) holds the finger FEM's (theta, P/mu_sf, Delta Q/a^3) at sampled designs, after
 comment lines with its provenance, the groups' calibrated ranges (``# range:``) and the fit
 (``# fit: prior=rings, kernel=cubic, features=lb ld lL lt s2`` for an interpolant
 over many designs; ``# fit: prior=rings, p_terms=s2 lb th, q_terms=lt th`` for least squares
-in named terms; in older tables polynomial degrees ``design_degree=D, theta_degree=T``); :mod:`softhand.reduced.finger_fem` fits
+in named terms; in older tables polynomial degrees ``design_degree=D, theta_degree=T``); :mod:`softhand.reduced.calibrated.finger_fem` fits
 and uses it.
 """
 from __future__ import annotations
@@ -16,9 +16,9 @@ from pathlib import Path
 
 import numpy as np
 
-from .errors import InputError
-from .finger_fem_terms import KERNEL_FEATURES, MAX_FACTORS, check_terms, legacy_terms
-from .inputfiles import plain_float, read_number_table
+from softhand.reduced.vocabulary.errors import InputError
+from softhand.reduced.calibrated.finger_fem_terms import KERNEL_FEATURES, MAX_FACTORS, check_terms, legacy_terms
+from softhand.reduced.vocabulary.inputfiles import plain_float, read_number_table
 
 TABLE_FILE = Path(__file__).resolve().parent / "data" / "finger_fem.csv"
 #: the nondimensional groups, in table column order

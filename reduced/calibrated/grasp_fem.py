@@ -11,13 +11,13 @@ and drops the tip assumption:
   dM_j/dP = -A_j, A_j = dV/d theta_hat_j the oil the hinge draws per radian *at fixed P*.
   With A_j a function of the hinge's bend theta_j = n_s theta_hat_j alone, and M_j = 0 on
   the free curve P_free(theta) of the calibrated finger (``finger_model = "fem"``,
-  :mod:`reduced.finger_fem`; it bends its equal hinges equally),
+  :mod:`reduced.calibrated.finger_fem`; it bends its equal hinges equally),
 
   .. math:: M_j = -A_j(\theta_j)\,\big(P - P_{free}(\theta_j)\big), \qquad
             E_j = \int_0^{\hat\theta_j} M_j .
 
   A_j is measured by the finger FEM with its hinges locked by springs
-  (``reduced/data/grasp_hinges.csv``, written by ``python -m
+  (``reduced/calibrated/data/grasp_hinges.csv``, written by ``python -m
   softhand.studies.calibration.hinges``): 1.77 a^2 pi d for a straight hinge, 1.17 a^2 pi d
   from a bend of 4.8 deg on (hinges 1-4; the tip hinge 1.31 and 1.10), against dQ/dtheta =
   1.86 a^2 pi d of the free finger, which includes the tube's swelling with P. Piecewise
@@ -25,7 +25,7 @@ and drops the tip assumption:
   the paper's design (Table I): other designs reuse its A_j / (a^2 pi d) with their own
   free curve. Without this, the free finger's W_f and Q split equally over the hinges, the
   contact force of a finger held by the object low on it comes out 50 % too large.
-* **The contact where it is** (:mod:`reduced.contact`, the grasp FEM's geometry): the
+* **The contact where it is** (:mod:`reduced.equations.contact`, the grasp FEM's geometry): the
   object's force on pad k at its closest point x*, F = -N nu + T t_k (normal force N along
   the outward normal -nu, the weight share T = m g / n along the link, as in the grasp FEM).
 * **Virtual work hinge by hinge** (eq. (1) with every hinge free, not only along w):
@@ -53,10 +53,10 @@ from typing import NamedTuple
 import numpy as np
 from scipy.optimize import brentq, root
 
-from . import contact, hand, kinematics
-from .design import HandDesign
-from .errors import InputError
-from .inputfiles import read_number_table
+from softhand.reduced.equations import contact, hand, kinematics
+from softhand.reduced.vocabulary.design import HandDesign
+from softhand.reduced.vocabulary.errors import InputError
+from softhand.reduced.vocabulary.inputfiles import read_number_table
 
 #: a pad other than the touching one penetrating by more than this [mm] moves the contact there
 _PENETRATION = 1e-6
@@ -189,7 +189,7 @@ def _solve_link(P, depth, radius, link, weight, q0, design, corner=False):
 def grasp_state(design: HandDesign, diameter_mm: float, P: float, mass_kg: float = 0.0, *,
                 depth_mm: float | None = None) -> GraspState:
     """The finger at cavity pressure P [MPa] closing on the object (diameter [mm], mass [kg])
-    at depth [mm] (default: the grasp FEM's placement, :func:`reduced.contact.object_depth`)."""
+    at depth [mm] (default: the grasp FEM's placement, :func:`reduced.equations.contact.object_depth`)."""
     design = fem_finger(design)
     depth = contact.object_depth(diameter_mm, design) if depth_mm is None else float(depth_mm)
     radius, weight = 0.5 * float(diameter_mm), float(mass_kg) * design.g / design.n

@@ -1,13 +1,13 @@
 r"""A simulated hydraulic hand: one pump, one reservoir, n fingers with their own loads.
 
-The plant the angle controller of :mod:`reduced.control` runs on. Its statics are the
+The plant the angle controller of :mod:`reduced.dynamics.control` runs on. Its statics are the
 reduced model's (eqs. (25), (27), (28)); its dynamics are the simplest ones consistent
 with them. Nothing here is in the paper except the statics; every other number is a
 documented parameter of :class:`PlantParams`.
 
 Statics, finger by finger. Eq. (25) is the hand's virtual-work balance. With the
 reservoir term written as its gauge pressure (``mu_sr zeta_r = -n a^2 pi d p_r(V)``,
-:mod:`reduced.hand`) it splits into one balance per finger j, all fingers sharing the
+:mod:`reduced.equations.hand`) it splits into one balance per finger j, all fingers sharing the
 finger-side pressure p_f = P + p_r(V) behind the pump:
 
 .. math:: a^2\pi d\,(P + p_r(V)) + F_{x,j} J_x\mathbf w + F_{y,j} J_y\mathbf w
@@ -19,7 +19,7 @@ finger j is in equilibrium when P + p_r(V) equals its *static pressure*
 
 .. math:: p^s_j(\theta_j) = p_{28}(\theta_j) - \frac{F_{x,j}J_x\mathbf w + F_{y,j}J_y\mathbf w}{a^2\pi d},
 
-with p_28 the no-reservoir pressure (28) of :func:`reduced.hand.finger_pressure`.
+with p_28 the no-reservoir pressure (28) of :func:`reduced.equations.hand.finger_pressure`.
 
 Dynamics. The pump, with its own pressure regulation, sets the differential pressure P
 between the finger line and the reservoir; the motor makes it a first-order lag
@@ -45,11 +45,11 @@ part is shared equally, like the weight: F_y,j = (mg + F sin(elevation)) / n. Th
 horizontal part presses the object against the fingers it points to: it is split,
 non-negatively, onto the outward directions of the two fingers that bracket its azimuth
 (fingers sit at azimuths 2 pi j / n) and acts on them as an outward tip force F_x,j
-(the sign convention of :mod:`reduced.grasp`: the object pushes the pad outward). The
+(the sign convention of :mod:`reduced.equations.grasp`: the object pushes the pad outward). The
 other fingers feel no horizontal force (frictionless contact, no adhesion). So a
 horizontal push bends the fingers unequally.
 
-Another finger model (``design.finger_model``, :mod:`reduced.finger`) replaces a^2 pi d by
+Another finger model (``design.finger_model``, :mod:`reduced.equations.finger`) replaces a^2 pi d by
 that finger's dQ/dtheta at theta_j and a^2 pi d theta_j by its Q(theta_j) - Q(0) throughout.
 
 Sensors. Angles and pressure are sampled every ``1 / sample_hz`` s (zero-order hold to
@@ -67,10 +67,10 @@ from functools import cached_property
 
 import numpy as np
 
-from . import finger, hand, reservoir
-from .design import HandDesign
-from .errors import InputError
-from .grasp import PAPER_WEIGHTS, projected_jacobian
+from softhand.reduced.equations import finger, hand, reservoir
+from softhand.reduced.vocabulary.design import HandDesign
+from softhand.reduced.vocabulary.errors import InputError
+from softhand.reduced.equations.grasp import PAPER_WEIGHTS, projected_jacobian
 
 #: angles the tables cover [rad]; a loaded finger may open past 0
 TABLE_RANGE = (math.radians(-45.0), math.radians(150.0))

@@ -6,8 +6,8 @@ Eq. (25) with F_x = F_y = 0 gives, for n fingers sharing one pump and one reserv
                     = \frac{\mu_{sf}\zeta_f(\theta)}{a^2\pi d} - p_r(V(\theta))   \quad (27)
 
 since mu_sr zeta_r / (n a^2 pi d) = -p_r(V(theta)) (dV/dtheta = -n a^2 pi d); the second form
-works for every reservoir model of :mod:`reduced.reservoir`. Without reservoir (28) the last
-term is absent. For any finger model of :mod:`reduced.finger` (W_f, Q of one finger) the
+works for every reservoir model of :mod:`reduced.equations.reservoir`. Without reservoir (28) the last
+term is absent. For any finger model of :mod:`reduced.equations.finger` (W_f, Q of one finger) the
 same balance P n dQ/dtheta = d(n W_f + W_r)/dtheta reads P = (dW_f/dtheta)/(dQ/dtheta) -
 p_r(V0 - n (Q(theta) - Q(0))); the paper's model gives (27), (28) as printed. P is the pump's differential pressure: with the reservoir P(0) < 0, i.e. at
 zero pump pressure the charged sheet already bends the fingers a little (reported, not clipped).
@@ -24,10 +24,10 @@ import math
 
 import numpy as np
 
-from . import finger
-from .design import HandDesign
-from .errors import InputError
-from .reservoir import oil_volume, pump_pressure
+from softhand.reduced.equations import finger
+from softhand.reduced.vocabulary.design import HandDesign
+from softhand.reduced.vocabulary.errors import InputError
+from softhand.reduced.equations.reservoir import oil_volume, pump_pressure
 
 #: bend angles the reduced model accepts [rad]: a finger bent back by 90 deg up to curled by 180 deg
 THETA_RANGE = (-0.5 * math.pi, math.pi)
@@ -47,7 +47,7 @@ def check_theta(theta) -> np.ndarray:
 
 def finger_pressure(theta, design: HandDesign):
     """Eq. (28): P = mu_sf zeta_f / (a^2 pi d) [MPa], the hand without reservoir, theta [rad];
-    for another rubber mu_sf zeta_f is dW_f/dtheta (:func:`reduced.finger.finger_force`); for any
+    for another rubber mu_sf zeta_f is dW_f/dtheta (:func:`reduced.equations.finger.finger_force`); for any
     finger model P = (dW_f/dtheta) / (dQ/dtheta)."""
     if design.finger_model == "paper":  # as printed, bit for bit
         return finger.finger_force(theta, design) / (design.a**2 * math.pi * design.d)
@@ -67,7 +67,7 @@ def pressure(theta, design: HandDesign, reservoir: bool = True):
 
 def pump_pressure_at_bend(P_cavity, theta, design: HandDesign, reservoir: bool = True):
     """The pump pressure [MPa] of the cavity pressure P_cavity [MPa] with the fingers at bend
-    theta [rad]: :func:`reduced.reservoir.pump_pressure` at the oil left (15); P_cavity itself
+    theta [rad]: :func:`reduced.equations.reservoir.pump_pressure` at the oil left (15); P_cavity itself
     without the reservoir."""
     if not reservoir:
         return P_cavity

@@ -1,7 +1,7 @@
 r"""Incompressible rubber: strain energies W(lambda1, lambda2, lambda3) and their derivatives.
 
 One place for the hyperelastic models (their common interface, the test modes and the
-invariants in :mod:`reduced.rubber_base`), pure NumPy and vectorised over any array shape.
+invariants in :mod:`reduced.materials.rubber_base`), pure NumPy and vectorised over any array shape.
 The reduced model evaluates them on its kinematics (finger: lambda, 1, 1/lambda;
 reservoir: lambda, lambda, 1/lambda^2); ``softhand material fit`` on the test modes; the
 FEM (:mod:`fem.materials`) builds its isochoric stress and tangent tensors from the
@@ -39,8 +39,8 @@ from dataclasses import dataclass, fields
 
 import numpy as np
 
-from .errors import InputError
-from .rubber_base import _PUBLIC, MODES, InvariantRubber, Rubber, invariants, stretches
+from softhand.reduced.vocabulary.errors import InputError
+from softhand.reduced.materials.rubber_base import _PUBLIC, MODES, InvariantRubber, Rubber, invariants, stretches
 
 __all__ = ["MODES", "Rubber", "InvariantRubber", "invariants", "stretches", "drucker_check", "NeoHookean",
            "MooneyRivlin", "Yeoh", "Gent", "Ogden", "MODELS", "parameter_names", "canonical_model",

@@ -1,5 +1,5 @@
 r"""Running the hand under control: the 2-DOF angle controller (eqs. (30), (31)) or pressure
-control (:mod:`reduced.controllers`) on the plant, the runs' numbers, and the flexibility test.
+control (:mod:`reduced.dynamics.controllers`) on the plant, the runs' numbers, and the flexibility test.
 
 Angle control (Fig. 9). All fingers hang on one pump, so the controlled variable is the
 mean finger angle; the pump pressure command is
@@ -7,7 +7,7 @@ mean finger angle; the pump pressure command is
 .. math:: P_{ref} = f(\theta_{ref}) + K_p\theta_e + K_i\int\theta_e\,dt, \qquad
           \theta_e = \theta_{ref} - \frac1n\sum_{j=1}^n\theta_j   \quad (30), (31)
 
-with the feedforward f = eq. (27) of the *nominal* design (:func:`reduced.hand.pressure`),
+with the feedforward f = eq. (27) of the *nominal* design (:func:`reduced.equations.hand.pressure`),
 evaluated once. It runs at the sensor rate with the integral as a forward-Euler sum. Anti-
 windup by conditional integration (clamping): the integral is frozen while P_ref is clipped
 to the pump's range [P_min, P_max], or while the pump is at its flow limit, whenever the
@@ -17,7 +17,7 @@ Pressure control holds a constant P_ref: the pump's own regulation does the rest
 
 Flexibility (Table II). Three states, the grasping force F_v estimated in each as the paper
 does, from a pressure and the mean angle by (25) with F_y = mg/n and (29)
-(:func:`reduced.grasp.grasp_forces`):
+(:func:`reduced.equations.grasp.grasp_forces`):
 
 * (a) angle control, no push: P_a, theta_a, the mean over the last ``window`` s before it;
 * (b) pressure control holding P_a, push: P_b, theta_b, the last ``window`` s of the push;
@@ -34,13 +34,13 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .controllers import AngleController, Gains, PressureController, default_gains
-from .design import HandDesign
-from .errors import InputError
-from .grasp import grasp_forces
-from .paper import TABLE_II as PAPER_TABLE_II
-from .plant import HandTables, PlantParams, Push, equilibrium
-from .reservoir import pump_pressure
+from softhand.reduced.dynamics.controllers import AngleController, Gains, PressureController, default_gains
+from softhand.reduced.vocabulary.design import HandDesign
+from softhand.reduced.vocabulary.errors import InputError
+from softhand.reduced.equations.grasp import grasp_forces
+from softhand.reduced.vocabulary.paper import TABLE_II as PAPER_TABLE_II
+from softhand.reduced.dynamics.plant import HandTables, PlantParams, Push, equilibrium
+from softhand.reduced.equations.reservoir import pump_pressure
 
 __all__ = ["Gains", "default_gains", "AngleController", "PressureController", "Simulation",
            "initial_state", "simulate", "Summary", "ramp", "push_interval", "summarize",

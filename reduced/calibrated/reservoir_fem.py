@@ -9,7 +9,7 @@ Neo-Hookean sheet of radius R, thickness t and modulus μ has
 
 and the dependence on τ = t/R is the bending share (mostly the clamp's boundary layer;
 measured close to linear in τ: p̃ at V0 is 1.435, 1.463, 1.512 for τ = 1/48, 1/24, 1/12).
-The file ``reduced/data/reservoir_fem.csv`` holds :math:`\tilde W, \tilde p, \tilde h = h/R`
+The file ``reduced/calibrated/data/reservoir_fem.csv`` holds :math:`\tilde W, \tilde p, \tilde h = h/R`
 on the same v grid at τ = 1/24 (Table I) and τ = 1/12, with its provenance in the header;
 this model rescales them to the design's R, t, μ_sr and interpolates linearly in τ
 (extrapolates outside [1/24, 1/12]; at τ = 1/48 that is within 0.5 %, see
@@ -18,7 +18,7 @@ the values W̃ and slopes p̃, and p̃ its derivative, so p = dW/dV holds exactl
 model (energy-consistent, p continuous). Above the table's last volume p̃ continues
 linearly (W̃ quadratically); V <= 0 is an error, as in the ellipse model.
 
-NumPy only; registered as ``"fem"`` in :mod:`reduced.reservoir`.
+NumPy only; registered as ``"fem"`` in :mod:`reduced.equations.reservoir`.
 """
 from __future__ import annotations
 
@@ -27,10 +27,10 @@ from pathlib import Path
 
 import numpy as np
 
-from .design import HandDesign
-from .errors import InputError
-from .inputfiles import read_number_table
-from .reservoir import register_model
+from softhand.reduced.vocabulary.design import HandDesign
+from softhand.reduced.vocabulary.errors import InputError
+from softhand.reduced.vocabulary.inputfiles import read_number_table
+from softhand.reduced.equations.reservoir import register_model
 
 __all__ = ["TABLE_FILE", "table", "pressure", "strain_energy", "height"]
 

@@ -6,9 +6,9 @@ virtual-work balance (1) becomes eq. (25):
 .. math:: P n a^2 \pi d + n F_x J_x w + m g J_y w = n \mu_{sf}\zeta_f(\theta) + \mu_{sr}\zeta_r(\theta),
 
 i.e. n a^2 pi d (f(theta) - P) = n F_x J_x w + m g J_y w with f the free-hand pressure (27)
-(:func:`reduced.hand.pressure`). Given (P, theta, m, w) it is solved for F_x; F_y = m g / n
+(:func:`reduced.equations.hand.pressure`). Given (P, theta, m, w) it is solved for F_x; F_y = m g / n
 (24); the normal force on the finger pad is F_v = F_x cos(theta - theta0) + F_y sin(theta - theta0)
-(29). Signs and axes: :mod:`reduced.kinematics` (x outward, y down; F is the object's force
+(29). Signs and axes: :mod:`reduced.equations.kinematics` (x outward, y down; F is the object's force
 on the finger; F_v > 0 while the finger squeezes the object).
 
 The inverses users need, both at a prescribed normal force F_v (default 0, the limit where
@@ -19,7 +19,7 @@ the finger just stops pressing on the object):
 * :func:`angle_at`: the bend angle reached at pump pressure P under the same load -- the
   inverse of :func:`pressure_to_hold` in theta.
 
-The paper's two weight vectors ship as :data:`PAPER_WEIGHTS` (from :mod:`reduced.paper`); the 180 mm one sums to 1.40,
+The paper's two weight vectors ship as :data:`PAPER_WEIGHTS` (from :mod:`reduced.vocabulary.paper`); the 180 mm one sums to 1.40,
 violating (23): :func:`check_weights` warns and can normalise.
 """
 from __future__ import annotations
@@ -30,10 +30,10 @@ from typing import NamedTuple
 
 import numpy as np
 
-from . import finger, hand
-from .design import HandDesign
-from .errors import InputError
-from .paper import WEIGHTS as PAPER_WEIGHTS
+from softhand.reduced.equations import finger, hand
+from softhand.reduced.vocabulary.design import HandDesign
+from softhand.reduced.vocabulary.errors import InputError
+from softhand.reduced.vocabulary.paper import WEIGHTS as PAPER_WEIGHTS
 
 #: newtons per kilogram-force (standard gravity, by definition of the kgf)
 KGF = 9.80665

@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import importlib
 
-from .errors import InputError
+from softhand.reduced.vocabulary.errors import InputError
 
 
 def lookup(models: dict, name: str, *, module: str, field: str):

@@ -1,7 +1,7 @@
 r"""Where the closing finger meets an object: placement, contact angle, rolling weight vector.
 
 The object is a circle of diameter D in the bending plane, centred on the hand's axis at
-depth ``depth`` below the palm (the hand frame of :mod:`reduced.kinematics`: x outward,
+depth ``depth`` below the palm (the hand frame of :mod:`reduced.equations.kinematics`: x outward,
 y down). Link k grasps with its *pad*, the segment of the hinge plate between its two
 joints, facing the hand's axis (the inward normal -n_out = -(cos alpha_k, sin alpha_k)).
 Its gap is the distance from the centre C to the closest pad point minus D/2; a pad whose
@@ -33,9 +33,9 @@ import math
 import numpy as np
 from scipy.optimize import brentq
 
-from . import kinematics
-from .design import HandDesign
-from .errors import InputError
+from softhand.reduced.equations import kinematics
+from softhand.reduced.vocabulary.design import HandDesign
+from softhand.reduced.vocabulary.errors import InputError
 
 #: placement of the object, as in the grasp FEM (fem.grasp.GraspOptions) [mm]
 PALM_GAP, CLEARANCE = 10.0, 2.0

@@ -1,4 +1,4 @@
-"""The interface of the incompressible rubber models of :mod:`reduced.rubber`: W and its
+"""The interface of the incompressible rubber models of :mod:`reduced.materials.rubber`: W and its
 principal-stretch derivatives, the test modes (uniaxial, equibiaxial, pure shear) with their
 nominal stresses, Drucker stability, and the chain rule of the invariant models W(I1, I2).
 """
@@ -8,7 +8,7 @@ from dataclasses import fields, replace
 
 import numpy as np
 
-from .errors import InputError
+from softhand.reduced.vocabulary.errors import InputError
 
 __all__ = ["MODES", "Rubber", "stretches", "InvariantRubber", "invariants"]
 

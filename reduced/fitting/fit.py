@@ -1,7 +1,7 @@
 r"""Calibrate design parameters to measurements: bounded nonlinear least squares.
 
-Given measured points (:class:`~reduced.csvdata.Measurements`) and a model that predicts
-the measured quantity from a :class:`~reduced.design.HandDesign`, find the named public
+Given measured points (:class:`~reduced.fitting.csvdata.Measurements`) and a model that predicts
+the measured quantity from a :class:`~reduced.vocabulary.design.HandDesign`, find the named public
 design parameters :math:`p` (e.g. ``V0_mm3``, ``mu_sf_MPa``) that minimise
 
 .. math:: S(p) = \sum_i r_i(p)^2, \qquad r_i = y_i^{model}(p) - y_i^{measured}
@@ -10,7 +10,7 @@ in the data's own units (degrees for free bending, newtons for grasp forces), as
 paper does for V0 (section III-B). Parameters are scaled by their starting values,
 :math:`x = p / p_0`, so the optimiser sees numbers of order one.
 
-Uncertainty and identifiability: :mod:`reduced.lsq` (standard errors, correlations, the
+Uncertainty and identifiability: :mod:`reduced.fitting.lsq` (standard errors, correlations, the
 parameter combinations the data cannot see); nothing is returned silently.
 """
 from __future__ import annotations
@@ -22,11 +22,11 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.optimize import least_squares
 
-from .csvdata import Measurements
-from .lsq import Diagnosis, FitOptions, diagnose, jacobian
-from .design import PUBLIC_KEYS, HandDesign
-from .design_files import design_from_dict
-from .errors import InputError
+from softhand.reduced.fitting.csvdata import Measurements
+from softhand.reduced.fitting.lsq import Diagnosis, FitOptions, diagnose, jacobian
+from softhand.reduced.vocabulary.design import PUBLIC_KEYS, HandDesign
+from softhand.reduced.vocabulary.design_files import design_from_dict
+from softhand.reduced.vocabulary.errors import InputError
 
 #: public design keys a fit may vary (numbers; not counts, lists or names)
 FITTABLE = ("theta0_deg", "l0_mm", "a_mm", "b_mm", "d_mm", "R_mm", "t_mm", "V0_mm3",
@@ -178,7 +178,7 @@ def make_predictor(data: Measurements, model: str = "reduced", *, reservoir: boo
     from ``weights`` (n_s numbers); a w whose sum is not 1 warns (eq. (23)), or is scaled to
     sum 1 with ``normalise``.
     """
-    from . import grasp, hand
+    from softhand.reduced.equations import grasp, hand
 
     if model not in MODELS:
         raise InputError("--model", model, f"allowed: {', '.join(MODELS)}")
@@ -200,7 +200,7 @@ def make_predictor(data: Measurements, model: str = "reduced", *, reservoir: boo
 
 def _weight_groups(data: Measurements, weights, design: HandDesign, normalise: bool):
     """[(w, row mask)]: one weight vector per object diameter, or ``weights`` for all rows."""
-    from .grasp import check_weights, weights_for_diameter
+    from softhand.reduced.equations.grasp import check_weights, weights_for_diameter
 
     if data.diameter is None:
         if weights is None:

@@ -14,7 +14,7 @@ with the analytic chain rule d lambda_r / d theta = L'(h) / (2R) * 3 / (2 pi R^2
 The reservoir's gauge pressure is p_r(V) = dW_r/dV, hence
 mu_sr zeta_r(theta) / (n a^2 pi d) = -p_r(V(theta)).
 
-Other rubber (``design.reservoir_rubber``, :mod:`reduced.rubber`): the same equi-biaxial
+Other rubber (``design.reservoir_rubber``, :mod:`reduced.materials.rubber`): the same equi-biaxial
 membrane kinematics (lambda_r, lambda_r, 1/lambda_r^2) give W_r = W(lambda_r, lambda_r,
 lambda_r^-2) pi R^2 t and p_r = (dW/dlambda_r)(d lambda_r/dV) pi R^2 t, where dW/dlambda_r is
 twice the equibiaxial nominal stress; for Neo-Hookean 2 mu (lambda - lambda^-5), eq. (18).
@@ -34,10 +34,10 @@ from typing import Callable
 
 import numpy as np
 
-from .design import HandDesign
-from .errors import InputError
-from .registry import lookup
-from .finger import oil_taken
+from softhand.reduced.vocabulary.design import HandDesign
+from softhand.reduced.vocabulary.errors import InputError
+from softhand.reduced.vocabulary.registry import lookup
+from softhand.reduced.equations.finger import oil_taken
 
 PressureFn = Callable[[np.ndarray, HandDesign], np.ndarray]
 _MODELS: dict[str, PressureFn] = {}
@@ -146,7 +146,7 @@ def register_model(name: str, pressure_fn: PressureFn) -> None:
 
 def model(name: str) -> PressureFn:
     """The registered pressure function of reservoir model ``name`` (imports reduced.reservoir_<name>)."""
-    return lookup(_MODELS, name, module=f"softhand.reduced.reservoir_{name}", field="reservoir_model")
+    return lookup(_MODELS, name, module=f"softhand.reduced.calibrated.reservoir_{name}", field="reservoir_model")
 
 
 def pressure(V, design: HandDesign):

@@ -15,7 +15,7 @@ Ambiguities of the paper resolved here (see ``docs/conventions.md``):
 
 Rubber. The paper's rubber is Neo-Hookean with the shear moduli ``mu_sf_MPa`` (finger)
 and ``mu_sr_MPa`` (reservoir sheet). A design file may give another strain energy per
-part (:mod:`reduced.rubber`) as a table::
+part (:mod:`reduced.materials.rubber`) as a table::
 
     [finger.material]
     model = "yeoh"            # neo-hookean | mooney-rivlin | yeoh | gent | ogden
@@ -45,9 +45,9 @@ from pathlib import Path
 
 from softhand import reduced as reduced_layer
 
-from . import rubber
-from .design_rules import BOUNDS, CONSISTENCY, check_model, in_bounds
-from .errors import InputError
+from softhand.reduced.materials import rubber
+from softhand.reduced.vocabulary.design_rules import BOUNDS, CONSISTENCY, check_model, in_bounds
+from softhand.reduced.vocabulary.errors import InputError
 
 __all__ = ["RESERVOIR_MODELS", "FINGER_MODELS", "PAPER_DESIGN_FILE", "HandDesign", "PUBLIC_KEYS",
            "KEY_OF", "MODULUS_OF", "PARTS", "BOUNDS", "CONSISTENCY"]

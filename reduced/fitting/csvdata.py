@@ -10,7 +10,7 @@ Two kinds of data, told apart by their columns:
 Lines starting with ``#`` are comments (a data file should say where it came from).
 Inside, angles are in radians (``theta``); degrees only in the file. Every problem
 (no such file, empty file, unknown or missing column, text in a number, a row with the
-wrong number of cells) is an :class:`~reduced.errors.InputError` naming the file, the
+wrong number of cells) is an :class:`~reduced.vocabulary.errors.InputError` naming the file, the
 line and the column.
 """
 from __future__ import annotations
@@ -21,8 +21,8 @@ from pathlib import Path
 
 import numpy as np
 
-from .errors import InputError
-from .inputfiles import csv_cells, plain_float
+from softhand.reduced.vocabulary.errors import InputError
+from softhand.reduced.vocabulary.inputfiles import csv_cells, plain_float
 
 #: column -> what it holds (unit in the name)
 COLUMNS = {
@@ -94,7 +94,7 @@ def read_measurements(path: str | Path) -> Measurements:
 
 def read_rows(path: Path) -> tuple[list[str], list[tuple[int, list[str]]]]:
     """Header cells and (line number, cells) of the data rows; comments and blank lines skipped."""
-    from .inputfiles import read_input_file
+    from softhand.reduced.vocabulary.inputfiles import read_input_file
 
     data = read_input_file(path, "--data", "a CSV file")
     try:

@@ -1,4 +1,4 @@
-"""The controllers of the hand's pump (see :mod:`reduced.control`, which runs them on the plant).
+"""The controllers of the hand's pump (see :mod:`reduced.dynamics.control`, which runs them on the plant).
 
 :class:`AngleController` is the 2-DOF angle controller of eqs. (30), (31): feedforward
 f(theta_ref) (eq. (27) of the nominal design) + PI on the mean finger angle, with anti-windup
@@ -11,9 +11,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from . import hand
-from .design import HandDesign
-from .plant import HandTables, PlantParams
+from softhand.reduced.equations import hand
+from softhand.reduced.vocabulary.design import HandDesign
+from softhand.reduced.dynamics.plant import HandTables, PlantParams
 
 __all__ = ["Gains", "default_gains", "AngleController", "PressureController"]
 

@@ -11,7 +11,7 @@ The physics already known carries most of it: the paper's eq. (28) for P (the ta
 ``prior``: ``"paper"``, or ``"rings"``: eq. (28) with the tube stretching only over its untied
 length l0 - 6 w, the finger FEM's kinematic bound, see :func:`prior_pressure`), and for the oil
 the kinematic a^2 pi d theta of eq. (2) (the tube's axis lengthens by d theta) plus the tube's
-own dilation under pressure, a^3 kappa P / mu_sf. The table ``reduced/data/finger_fem.csv``
+own dilation under pressure, a^3 kappa P / mu_sf. The table ``reduced/calibrated/data/finger_fem.csv``
 holds the FEM's (theta, P/mu, Delta Q/a^3) at the sampled designs; this model fits
 
 .. math:: y = \ln\frac{P_{FEM}}{P_{prior}}, \qquad
@@ -47,12 +47,12 @@ from typing import NamedTuple
 
 import numpy as np
 
-from . import finger
-from .finger_curves import Curves, energy_curves
-from .design import HandDesign
-from .errors import InputError
-from .finger_fem_terms import KernelFit, term_matrix
-from .finger_fem_table import COLUMNS, GROUPS, LABELS, PRIORS, TABLE_FILE, Table, table_error, read_table
+from softhand.reduced.equations import finger
+from softhand.reduced.calibrated.finger_curves import Curves, energy_curves
+from softhand.reduced.vocabulary.design import HandDesign
+from softhand.reduced.vocabulary.errors import InputError
+from softhand.reduced.calibrated.finger_fem_terms import KernelFit, term_matrix
+from softhand.reduced.calibrated.finger_fem_table import COLUMNS, GROUPS, LABELS, PRIORS, TABLE_FILE, Table, table_error, read_table
 
 __all__ = ["TABLE_FILE", "GROUPS", "COLUMNS", "PRIORS", "Table", "read_table", "check_table", "groups_of",
            "curves", "FEM"]

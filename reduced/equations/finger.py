@@ -13,7 +13,7 @@ Kevlar windings keep lambda_2 = 1 and the rubber is incompressible, so lambda_3 
 .. math:: W_f = \int \frac{\mu_{sf}}{2}(\lambda_f^2 + \lambda_f^{-2} - 2)\, l_0 \rho\, dr\, d\phi,
           \qquad \frac{dW_f}{d\theta} = \mu_{sf}\,\zeta_f(\theta)   \quad (9), (10).
 
-Other rubber (``design.finger_rubber``, :mod:`reduced.rubber`): the same kinematics
+Other rubber (``design.finger_rubber``, :mod:`reduced.materials.rubber`): the same kinematics
 lambda_1 = lambda_f, lambda_2 = 1, lambda_3 = 1/lambda_f (pure shear, planar tension) give
 
 .. math:: W_f = \int \hat W(\lambda_f)\, l_0 \rho\, dr\, d\phi, \qquad
@@ -51,9 +51,9 @@ from typing import Callable
 
 import numpy as np
 
-from .design import HandDesign
-from .errors import InputError
-from .registry import lookup
+from softhand.reduced.vocabulary.design import HandDesign
+from softhand.reduced.vocabulary.errors import InputError
+from softhand.reduced.vocabulary.registry import lookup
 
 #: Gauss-Legendre orders across the wall (r) and around the tube (phi, half turn); the
 #: relative quadrature error is below 1e-11 for -pi/2 <= theta <= pi (tests/test_reduced_finger.py).
@@ -216,7 +216,7 @@ def register_model(name: str, functions: FingerFunctions) -> None:
 
 def model(name: str) -> FingerFunctions:
     """The registered finger model ``name`` (imports reduced.finger_<name> on first use)."""
-    return lookup(_MODELS, name, module=f"softhand.reduced.finger_{name}", field="finger_model")
+    return lookup(_MODELS, name, module=f"softhand.reduced.calibrated.finger_{name}", field="finger_model")
 
 
 def energy(theta, design: HandDesign):

@@ -3,15 +3,15 @@ Fig. 7's reservoir offset, the Fig. 8 grasps and Table II.
 
 Everything a study compares with the paper is read from here; numbers are exactly as
 printed (the 180 mm weight vector sums to 1.40, violating eq. (23); see
-:func:`reduced.grasp.check_weights`).
+:func:`reduced.equations.grasp.check_weights`).
 """
 from __future__ import annotations
 
 from typing import NamedTuple
 
-from .design import PAPER_DESIGN_FILE, HandDesign
+from softhand.reduced.vocabulary.design import PAPER_DESIGN_FILE, HandDesign
 
-#: Table I is stored once, as :class:`~reduced.design.HandDesign`'s defaults (each field says
+#: Table I is stored once, as :class:`~reduced.vocabulary.design.HandDesign`'s defaults (each field says
 #: where the paper is silent); this TOML file spells the same design out for users, and a test
 #: keeps the two equal
 TABLE_I_FILE = PAPER_DESIGN_FILE

@@ -1,5 +1,5 @@
 """Designs from TOML files and dicts: the public keys (units in the names) to a checked
-:class:`~reduced.design.HandDesign`.
+:class:`~reduced.vocabulary.design.HandDesign`.
 
 Every design built from a file or a study's keys passes :func:`design_from_dict`, which also
 reads and fits a design's own finger calibration table at once (so a bad table is one line
@@ -14,11 +14,12 @@ import os
 import warnings
 from pathlib import Path
 
-from . import finger, rubber
-from .design import KEY_OF, MODULUS_OF, PARTS, PUBLIC_KEYS, HandDesign
-from .design_rules import in_bounds, is_number
-from .errors import InputError
-from .inputfiles import read_toml
+from softhand.reduced.equations import finger
+from softhand.reduced.materials import rubber
+from softhand.reduced.vocabulary.design import KEY_OF, MODULUS_OF, PARTS, PUBLIC_KEYS, HandDesign
+from softhand.reduced.vocabulary.design_rules import in_bounds, is_number
+from softhand.reduced.vocabulary.errors import InputError
+from softhand.reduced.vocabulary.inputfiles import read_toml
 
 __all__ = ["design_from_dict", "hinges_for", "load_design"]
 

@@ -27,7 +27,7 @@ from __future__ import annotations
 
 import math
 
-from .errors import InputError
+from softhand.reduced.vocabulary.errors import InputError
 
 #: Shore A readings this module accepts: the type A scale is 0..100 and Gent's relation is
 #: singular at 100; below ~10 and above ~90 the standard recommends other durometer types.

@@ -1,5 +1,5 @@
 """Small input files read safely: a regular file of at most MAX_FILE_BYTES, or TOML; anything
-else is one :class:`reduced.errors.InputError` line naming the option."""
+else is one :class:`reduced.vocabulary.errors.InputError` line naming the option."""
 from __future__ import annotations
 
 import csv
@@ -11,7 +11,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from .errors import InputError
+from softhand.reduced.vocabulary.errors import InputError
 
 __all__ = ["MAX_FILE_BYTES", "MAX_NESTING", "NumberTable", "csv_cells", "nesting_depth", "plain_float",
            "read_input_file", "read_number_table", "read_toml"]

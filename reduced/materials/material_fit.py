@@ -1,4 +1,4 @@
-r"""Fit a rubber model (:mod:`reduced.rubber`) to nominal stress vs stretch test data.
+r"""Fit a rubber model (:mod:`reduced.materials.rubber`) to nominal stress vs stretch test data.
 
 Data: a CSV file with the columns ``mode`` (``uniaxial``, ``equibiaxial``, ``pure-shear``;
 any mix), ``stretch`` [-] and ``stress_MPa`` (nominal stress: force per reference area,
@@ -6,7 +6,7 @@ in the stretched direction); ``lambda`` and ``nominal_stress_MPa`` are accepted 
 names of the last two, ``biaxial``, ``planar`` (and ``ut``, ``et``, ``ps``) of the modes.
 Lines starting with ``#`` are comments.
 
-Refused (one :class:`~reduced.errors.InputError`), as no rubber test gives them: a stretch
+Refused (one :class:`~reduced.vocabulary.errors.InputError`), as no rubber test gives them: a stretch
 outside :data:`STRETCH_LIMITS`, a stress beyond :data:`MAX_STRESS` MPa, data whose largest
 stress is below :data:`MIN_STRESS` MPa, a stress of the wrong sign (negative in tension,
 positive in compression, nonzero at stretch 1) beyond :data:`SIGN_SCATTER` of the largest,
@@ -22,13 +22,13 @@ NH, Mooney-Rivlin and Yeoh are linear in their parameters: solved directly. Gent
 Ogden are fitted by :func:`scipy.optimize.least_squares` from several starts (Ogden:
 exponents on a grid, the moduli for each by linear least squares; Gent: locking
 parameters on a grid) and refined. Standard errors and correlations come from the
-Jacobian at the optimum as in :func:`reduced.lsq.diagnose`: Cov = S/(N - k) (J^T J)^{-1}.
+Jacobian at the optimum as in :func:`reduced.fitting.lsq.diagnose`: Cov = S/(N - k) (J^T J)^{-1}.
 Ogden's terms are reported in ascending alpha_p (W does not depend on their order). A
 standard error never drops below :data:`PRECISION` of its parameter's scale: with
 data without scatter the statistical error is round-off, the solver's precision is not.
 
 Drucker stability (incompressible): the Hessian of W in the log strains
-(:meth:`reduced.rubber.Rubber.drucker_hessian`) must be positive definite. It is checked
+(:meth:`reduced.materials.rubber.Rubber.drucker_hessian`) must be positive definite. It is checked
 in uniaxial, equibiaxial and pure-shear deformation at stretches over a stated range
 (tension above 1, compression below), by default 1/lambda_max .. lambda_max of the data.
 """
@@ -41,11 +41,11 @@ from pathlib import Path
 import numpy as np
 from scipy.optimize import least_squares
 
-from . import rubber
-from .csvdata import read_rows
-from .errors import InputError
-from .inputfiles import plain_float
-from .lsq import FitOptions, diagnose, jacobian
+from softhand.reduced.materials import rubber
+from softhand.reduced.fitting.csvdata import read_rows
+from softhand.reduced.vocabulary.errors import InputError
+from softhand.reduced.vocabulary.inputfiles import plain_float
+from softhand.reduced.fitting.lsq import FitOptions, diagnose, jacobian
 
 #: ``--model`` -> (rubber model, Ogden terms)
 FIT_MODELS = {"neo-hookean": ("neo-hookean", 0), "mooney-rivlin": ("mooney-rivlin", 0),
