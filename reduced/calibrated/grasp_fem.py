@@ -59,7 +59,7 @@ from softhand.reduced.vocabulary.errors import InputError
 from softhand.reduced.vocabulary.inputfiles import read_number_table
 
 #: a pad other than the touching one penetrating by more than this [mm] moves the contact there
-_PENETRATION = 1e-6
+PENETRATION = 1e-6
 #: the finger FEM's locked-hinge volume rates A_j(theta) (written by ``python -m softhand.studies.calibration.hinges``)
 HINGE_TABLE = Path(__file__).resolve().parent / "data" / "grasp_hinges.csv"
 #: the equilibrium's tolerance (scipy hybr, relative on the unknowns)
@@ -214,7 +214,7 @@ def grasp_state(design: HandDesign, diameter_mm: float, P: float, mass_kg: float
         gaps = contact.pad_gaps(q, (0.0, depth), radius, design)
         seen.add(link)
         gaps[link + (1 if corner else 0)] = gaps[link] = np.inf
-        if np.min(gaps) >= -_PENETRATION:
+        if np.min(gaps) >= -PENETRATION:
             if N < 0.0:  # the pad would pull on the object: it does not touch
                 return _state(P, depth, q_free, -1, 0.0, weight, design)
             return _state(P, depth, q, link, N, weight, design, corner)

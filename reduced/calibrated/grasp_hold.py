@@ -253,7 +253,7 @@ def _pad_solves(pads, n_s: int, solve):
         if corner and not next_in:
             continue
         solved = solve(k, corner)
-        next_in = solved is not None and k < n_s and solved[1][k + 1] < -grasp_fem._PENETRATION
+        next_in = solved is not None and k < n_s and solved[1][k + 1] < -grasp_fem.PENETRATION
         yield k, corner, solved
 
 
@@ -311,7 +311,7 @@ def _held(k: int, solved, design: HandDesign, reservoir: bool) -> Hold | None:
     """The Hold of :func:`_solve_on_pad`'s solution with pad k touching, None if it is not
     acceptable (N < 0, another pad in the object)."""
     z, gaps, F_v = solved
-    if z[-2] < 0.0 or np.min(gaps) < -grasp_fem._PENETRATION:
+    if z[-2] < 0.0 or np.min(gaps) < -grasp_fem.PENETRATION:
         return None
     q = _hinges(z, k, design.n_s)
     theta, P = float(np.sum(q)), float(z[-1])
@@ -549,7 +549,7 @@ def _nearest_pad(k: int, gaps) -> int:
     touches it where the one-pad state of pad k ends; pad k+1 only if it does more than
     share pad k's far end (a corner contact: both at gap 0)."""
     gaps = np.array(gaps, float)
-    if k + 1 < len(gaps) and abs(gaps[k + 1]) <= grasp_fem._PENETRATION:
+    if k + 1 < len(gaps) and abs(gaps[k + 1]) <= grasp_fem.PENETRATION:
         gaps[k + 1] = np.inf
     return int(np.argmin(gaps))
 

@@ -40,7 +40,7 @@ from dataclasses import dataclass, fields
 import numpy as np
 
 from softhand.reduced.vocabulary.errors import InputError
-from softhand.reduced.materials.rubber_base import _PUBLIC, MODES, InvariantRubber, Rubber, invariants, stretches
+from softhand.reduced.materials.rubber_base import MODES, PUBLIC_NAMES, InvariantRubber, Rubber, invariants, stretches
 
 __all__ = ["MODES", "Rubber", "InvariantRubber", "invariants", "stretches", "drucker_check", "NeoHookean",
            "MooneyRivlin", "Yeoh", "Gent", "Ogden", "MODELS", "parameter_names", "canonical_model",
@@ -194,7 +194,7 @@ def parameter_names(model: str, terms: int = 3) -> tuple[str, ...]:
     if model == "ogden":
         return tuple(k for p in range(1, terms + 1) for k in (f"mu{p}_MPa", f"alpha{p}"))
     cls = _model_class(model)
-    return tuple(_PUBLIC[f.name] for f in fields(cls))
+    return tuple(PUBLIC_NAMES[f.name] for f in fields(cls))
 
 
 _MODEL_ALIASES = {"neohookean": "neo-hookean", "nh": "neo-hookean", "mooneyrivlin": "mooney-rivlin",
@@ -253,7 +253,7 @@ def from_parameters(model: str, values: dict, *, source: str = "material") -> Ru
             raise InputError(f"{source}.alpha", alphas, "Ogden exponents must be nonzero")
         rubber = Ogden(tuple(mus), tuple(alphas))
     else:
-        field_of = {v: k for k, v in _PUBLIC.items()}
+        field_of = {v: k for k, v in PUBLIC_NAMES.items()}
         rubber = cls(**{field_of[k]: float(v) for k, v in values.items()})
     if not rubber.mu0 > 0:
         raise InputError(f"{source}", rubber.parameters(),

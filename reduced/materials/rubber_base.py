@@ -10,11 +10,11 @@ import numpy as np
 
 from softhand.reduced.vocabulary.errors import InputError
 
-__all__ = ["MODES", "Rubber", "stretches", "InvariantRubber", "invariants"]
+__all__ = ["MODES", "PUBLIC_NAMES", "Rubber", "stretches", "InvariantRubber", "invariants"]
 
 #: dataclass field -> public parameter name
-_PUBLIC = {"mu": "mu_MPa", "C10": "C10_MPa", "C01": "C01_MPa", "C20": "C20_MPa",
-           "C30": "C30_MPa", "Jm": "Jm"}
+PUBLIC_NAMES = {"mu": "mu_MPa", "C10": "C10_MPa", "C01": "C01_MPa", "C20": "C20_MPa",
+                "C30": "C30_MPa", "Jm": "Jm"}
 
 MODES = ("uniaxial", "equibiaxial", "pure-shear")
 
@@ -27,12 +27,12 @@ class Rubber:
     # -- parameters ----------------------------------------------------------------------
     def parameters(self) -> dict:
         """Public name -> value."""
-        return {_PUBLIC[f.name]: float(getattr(self, f.name)) for f in fields(self)}
+        return {PUBLIC_NAMES[f.name]: float(getattr(self, f.name)) for f in fields(self)}
 
     def scaled(self, factor: float) -> "Rubber":
         """The same shape of W with every modulus [MPa] times ``factor``."""
         return replace(self, **{f.name: factor * getattr(self, f.name) for f in fields(self)
-                                if _PUBLIC[f.name].endswith("_MPa")})
+                                if PUBLIC_NAMES[f.name].endswith("_MPa")})
 
     @property
     def mu0(self) -> float:

@@ -252,7 +252,7 @@ def commit(final: Path, record: dict, files: dict) -> Path:
     return final
 
 
-def _remove_leftovers(sdir: Path, key: str) -> None:
+def remove_leftovers(sdir: Path, key: str) -> None:
     """Temporary folders of case ``key`` a killed run left (only its claim holder calls this)."""
     for tmp in sdir.glob(f".{key}.*.tmp"):
         shutil.rmtree(tmp, ignore_errors=True)

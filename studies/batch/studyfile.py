@@ -60,7 +60,8 @@ __all__ = ["KINDS", "MAX_CASES", "Kind", "Num", "NumList", "Study", "all_kinds",
 
 
 _TOP_KEYS = ("kind", "name", "description", "design", "mesh_size_mm", "sweep", "params")
-_NAME_RE = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_.-]*$")
+#: what a study's (and a design space's) name may be: it names a results folder
+NAME_RE = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_.-]*$")
 
 
 @dataclass(frozen=True)
@@ -106,7 +107,7 @@ def study_from_dict(doc: dict, *, path: Path | None = None, max_cases: int = MAX
             raise InputError(f"{src}: {key}", doc[key], f"unknown key; allowed: {', '.join(_TOP_KEYS)}")
     kind = _kind(doc.get("kind"), src)
     name = doc.get("name", path.stem if path else None)
-    if not isinstance(name, str) or not _NAME_RE.match(name) or len(name) > 100:
+    if not isinstance(name, str) or not NAME_RE.match(name) or len(name) > 100:
         given = "" if "name" in doc else (" (the study's results folder is named after its file "
                                           "unless the file sets name = \"...\")")
         raise InputError(f"{src}: name", name, "must be a string of at most 100 letters, digits, '_', "

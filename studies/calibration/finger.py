@@ -20,7 +20,7 @@ from pathlib import Path
 from softhand.reduced.vocabulary.design import HandDesign
 from softhand.reduced.vocabulary.errors import InputError
 from softhand.studies.batch.studyfile import Study
-from softhand.studies.calibration.space import _PATH_KEYS, VARIABLES, DesignSpace, finger_design
+from softhand.studies.calibration.space import PATH_KEYS, VARIABLES, DesignSpace, finger_design
 
 @dataclass(frozen=True)
 class SpaceStudy(Study):
@@ -90,7 +90,7 @@ def design_cases(space: DesignSpace) -> list[tuple[dict, HandDesign]]:
     shared = space_params(space)
     cases = []
     for p, d in zip(space.points, space.designs()):
-        params = {**shared, **{k: p[k] for k in _PATH_KEYS if k in p}}
+        params = {**shared, **{k: p[k] for k in PATH_KEYS if k in p}}
         if "axial_size_mm" in params and not resolves_gap(d, params["axial_size_mm"]):
             del params["axial_size_mm"]
         cases.append((params, d))

@@ -41,12 +41,12 @@ from softhand.reduced.vocabulary.design import HandDesign
 from softhand.reduced.vocabulary.design_files import load_design
 from softhand.reduced.vocabulary.errors import InputError
 from softhand.studies.batch.registry import check_path_end
-from softhand.studies.batch.studyfile import _NAME_RE
+from softhand.studies.batch.studyfile import NAME_RE
 
 #: the dimensional variables of a design space, in this order
 VARIABLES = ("a_mm", "b_mm", "d_mm", "l0_mm", "tie_width_mm")
 #: load-path parameters a [[design]] table may set for itself
-_PATH_KEYS = ("p_max_mpa", "p_step_mpa")
+PATH_KEYS = ("p_max_mpa", "p_step_mpa")
 _KEYS = ("name", "lhs", "seed", "pressures_mpa", "theta_target_deg", "p_max_mpa", "p_step_mpa",
          "space", "design", "base_design", "mesh_size_mm", "axial_size_mm", "mesh_pair", "prior")
 
@@ -123,7 +123,7 @@ def load_space(path: str | Path) -> DesignSpace:
         if key not in _KEYS:
             raise InputError(f"{src}: {key}", doc[key], f"unknown key; allowed: {', '.join(_KEYS)}")
     name = doc.get("name", path.stem)
-    if not isinstance(name, str) or not _NAME_RE.match(name) or len(name) > 100:
+    if not isinstance(name, str) or not NAME_RE.match(name) or len(name) > 100:
         raise InputError(f"{src}: name", name,
                          "must be a string of at most 100 letters, digits, '_', '-', '.'")
     box = _box(doc.get("space"), src)
@@ -227,13 +227,13 @@ def _box(table, src: str) -> dict:
 
 
 def _point(table, box: dict, where: str) -> dict:
-    if not isinstance(table, dict) or not set(VARIABLES) <= set(table) <= set(VARIABLES + _PATH_KEYS):
+    if not isinstance(table, dict) or not set(VARIABLES) <= set(table) <= set(VARIABLES + PATH_KEYS):
         raise InputError(where, table, f"must give {', '.join(VARIABLES)} (and optionally "
-                                       f"{', '.join(_PATH_KEYS)})")
+                                       f"{', '.join(PATH_KEYS)})")
     for key in VARIABLES:
         if not _number(table[key]) or not box[key][0] <= table[key] <= box[key][1]:
             raise InputError(f"{where}.{key}", table[key], f"must be in [{box[key][0]}, {box[key][1]}]")
-    for key in sorted(set(table) & set(_PATH_KEYS)):
+    for key in sorted(set(table) & set(PATH_KEYS)):
         lo, hi = LIMITS[key]
         if not _number(table[key]) or not lo <= table[key] <= hi:
             raise InputError(f"{where}.{key}", table[key], f"must be a number in [{lo:g}, {hi:g}] MPa")
