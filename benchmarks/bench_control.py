@@ -15,10 +15,10 @@ import time
 import timeit
 import warnings
 
-from softhand.reduced import grasp
-from softhand.reduced.control import AngleController, default_gains, flexibility, ramp, simulate
-from softhand.reduced.design import HandDesign
-from softhand.reduced.plant import HandTables, PlantParams
+from softhand.reduced.equations import grasp
+from softhand.reduced.dynamics.control import AngleController, default_gains, flexibility, ramp, simulate
+from softhand.reduced.vocabulary.design import HandDesign
+from softhand.reduced.dynamics.plant import HandTables, PlantParams
 
 
 def best(fn, repeat: int) -> tuple[float, float]:

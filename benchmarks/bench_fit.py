@@ -14,9 +14,9 @@ import warnings
 from pathlib import Path
 
 from bench_reduced import best_of  # the sibling script: best wall time after a warm-up
-from softhand.reduced.csvdata import read_measurements
-from softhand.reduced.design import HandDesign
-from softhand.reduced.fit import fit, make_predictor
+from softhand.reduced.fitting.csvdata import read_measurements
+from softhand.reduced.vocabulary.design import HandDesign
+from softhand.reduced.fitting.fit import fit, make_predictor
 
 DATA = Path(__file__).resolve().parent.parent / "studies" / "data"
 CASES = (("example_bending.csv", "V0_mm3"), ("example_bending.csv", "V0_mm3,mu_sf_MPa"),

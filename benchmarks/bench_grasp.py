@@ -14,7 +14,7 @@ import time
 
 from softhand.fem.hand.finger import FingerModel
 from softhand.fem.hand.grasp import GraspModel, grasp_weights
-from softhand.reduced.design import HandDesign
+from softhand.reduced.vocabulary.design import HandDesign
 from softhand.studies.weights import finger_options
 
 

@@ -1,4 +1,4 @@
-"""The FEM-informed grasp posed by F_v or by the pump pressure (reduced/grasp_hold.py): the
+"""The FEM-informed grasp posed by F_v or by the pump pressure (reduced/calibrated/grasp_hold.py): the
 one-solve path against the bracketing root finder on grasp_fem.grasp_state, per call.
 
 For the designs of the four example tasks' optima (the paper's, the small object's, the large
@@ -13,8 +13,8 @@ from __future__ import annotations
 import argparse
 import time
 
-from softhand.reduced import grasp_fem, grasp_hold
-from softhand.reduced.design import HandDesign
+from softhand.reduced.calibrated import grasp_fem, grasp_hold
+from softhand.reduced.vocabulary.design import HandDesign
 
 PAPER = grasp_fem.fem_finger(HandDesign(reservoir_model="fem"))
 CASES = {

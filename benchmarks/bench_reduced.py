@@ -17,8 +17,8 @@ from pathlib import Path
 
 import numpy as np
 
-from softhand.reduced import grasp, hand
-from softhand.reduced.design import HandDesign
+from softhand.reduced.equations import grasp, hand
+from softhand.reduced.vocabulary.design import HandDesign
 
 N = 100_000
 

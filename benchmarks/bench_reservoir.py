@@ -14,7 +14,7 @@ import scipy.sparse as sp
 
 from softhand.fem.linsolve import make_solver
 from softhand.fem.hand.reservoir import SheetModel, inflate
-from softhand.reduced.design import HandDesign
+from softhand.reduced.vocabulary.design import HandDesign
 
 MESHES = ((20, 1), (40, 2), (80, 2), (40, 4), (80, 4))
 

@@ -1,7 +1,7 @@
 """Factorisation time of the sparse direct solvers on the finger FEM's tangent (38k unknowns).
 
 The tangent of the default finger mesh after half a Newton step at 0.3 MPa, evaluated at
-0.4 MPa, factorised by each backend of :mod:`fem.linsolve` that is installed (PARDISO,
+0.4 MPa, factorised by each backend of :mod:`softhand.fem.linsolve` that is installed (PARDISO,
 UMFPACK, QDLDL, SuperLU) and by cholespy if importable, each in its own process with a
 time limit. Prints seconds per factorisation and the relative residual of one solve.
 
@@ -24,7 +24,7 @@ def tangent(path: Path) -> None:
     """Write the benchmark tangent K and right-hand side b to ``path`` (npz)."""
     from softhand.fem.hand.finger import FingerModel, FingerOptions
     from softhand.fem.linsolve import make_solver
-    from softhand.reduced.design import HandDesign
+    from softhand.reduced.vocabulary.design import HandDesign
 
     model = FingerModel(HandDesign(), FingerOptions())
     y = model.constraint.zero()

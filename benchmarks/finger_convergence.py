@@ -1,7 +1,7 @@
 """Mesh convergence of the finger's bend angle theta(0.8 MPa) on nested mesh families.
 
 ``--family layered`` (the default mesh's family): the layered mesh of
-:func:`meshes.finger.layered_tube_mesh` with the cross-section fixed (4 sectors, 5 wall
+:func:`softhand.meshes.finger.layered_tube_mesh` with the cross-section fixed (4 sectors, 5 wall
 layers from 0.2 mm) and axial slices of 5 / 2.5 / 1.25 / 0.625 mm at levels 0-3: every
 level splits each slice of the one before in two (the ring edges and the cavity end are
 cuts of every level), nothing else changes. The cross-section's share of the error is
@@ -30,8 +30,8 @@ from dataclasses import replace
 from pathlib import Path
 
 from softhand.fem.hand.finger import FingerModel, FingerOptions, solve_pressures
-from softhand.reduced.design import HandDesign
-from softhand.reduced.errors import InputError
+from softhand.reduced.vocabulary.design import HandDesign
+from softhand.reduced.vocabulary.errors import InputError
 from softhand.studies.verification.convergence import richardson
 from softhand.studies.io.files import write_json
 

@@ -17,9 +17,10 @@ from pathlib import Path
 
 import numpy as np
 
-from softhand.reduced import hand, reservoir, rubber
-from softhand.reduced.design import load_design
-from softhand.reduced.material_fit import fit_material, read_test_data
+from softhand.reduced.equations import hand, reservoir
+from softhand.reduced.materials import rubber
+from softhand.reduced.vocabulary.design_files import load_design
+from softhand.reduced.materials.material_fit import fit_material, read_test_data
 
 MU0 = 1.15
 PRESSURES = (0.5, 1.0, 1.5, 2.0)

@@ -10,9 +10,9 @@ from __future__ import annotations
 import time
 from pathlib import Path
 
-from softhand.reduced import rubber
-from softhand.reduced.material_fit import FIT_MODELS, fit_material, read_test_data
-from softhand.reduced.rubber import drucker_check
+from softhand.reduced.materials import rubber
+from softhand.reduced.materials.material_fit import FIT_MODELS, fit_material, read_test_data
+from softhand.reduced.materials.rubber import drucker_check
 
 DATA = Path(__file__).resolve().parent.parent / "studies" / "data" / "treloar1944.csv"
 KGF_CM2 = 0.0980665  #: MPa

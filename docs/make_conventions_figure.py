@@ -14,9 +14,9 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from softhand.reduced.design import HandDesign  # noqa: E402
-from softhand.reduced.grasp import PAPER_WEIGHTS  # noqa: E402
-from softhand.reduced.kinematics import hinge_angles, joint_positions, link_angles  # noqa: E402
+from softhand.reduced.vocabulary.design import HandDesign  # noqa: E402
+from softhand.reduced.equations.grasp import PAPER_WEIGHTS  # noqa: E402
+from softhand.reduced.equations.kinematics import hinge_angles, joint_positions, link_angles  # noqa: E402
 from softhand.studies.io.files import save_figure  # noqa: E402
 
 

@@ -2,7 +2,7 @@
 Your own finger design, bent by the pump: eq. (28) without and eq. (27) with the reservoir
 ==========================================================================================
 
-A design is a frozen :class:`~softhand.reduced.design.HandDesign`; start from the paper's Table I and change what
+A design is a frozen :class:`~softhand.reduced.vocabulary.design.HandDesign`; start from the paper's Table I and change what
 you change in your mould. Angles are radians inside the code, degrees only at the edges.
 """
 import math

@@ -1,4 +1,4 @@
-r"""Nearly incompressible rubber of any :mod:`softhand.reduced.rubber` model as an FEM law.
+r"""Nearly incompressible rubber of any :mod:`softhand.reduced.materials.rubber` model as an FEM law.
 
 The strain energy is split into an isochoric and a volumetric part,
 
@@ -34,7 +34,7 @@ import numpy as np
 
 from softhand.fem import kinematics as kin
 from softhand.fem.materials import Law, SplitLaw, Volumetric
-from softhand.reduced import rubber as rubber_models
+from softhand.reduced.materials import rubber as rubber_models
 
 #: relative gap of two principal stretches below which the coincident limit is used
 COINCIDENT = 1e-6
@@ -47,7 +47,7 @@ def _eye4(ndim_batch):
 
 @dataclass(frozen=True)
 class IsochoricRubber(Law):
-    """The isochoric part W(J^{-1/3} lambda_i) of a :mod:`softhand.reduced.rubber` model."""
+    """The isochoric part W(J^{-1/3} lambda_i) of a :mod:`softhand.reduced.materials.rubber` model."""
 
     material: rubber_models.Rubber
 
@@ -181,7 +181,7 @@ def _pair_coefficients(lam, Phi1, Phi2):
 
 @dataclass(frozen=True)
 class RubberLaw(SplitLaw):
-    """W(J^{-1/3} lambda_i) + kappa/2 (J - 1)^2: any :mod:`softhand.reduced.rubber` model, split for the
+    """W(J^{-1/3} lambda_i) + kappa/2 (J - 1)^2: any :mod:`softhand.reduced.materials.rubber` model, split for the
     mean-dilatation solids (``kappa`` default 1000 mu0, as :class:`softhand.fem.materials.NeoHookean`)."""
 
     material: rubber_models.Rubber

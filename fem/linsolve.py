@@ -23,7 +23,7 @@ import warnings
 
 from softhand.fem import threads
 from softhand.fem.linsolve_backends import (REFINE_MAX, REFINE_RTOL, LinearSolver, PardisoSolver,
-                                            QdldlSolver, SuperLUSolver, UmfpackSolver, _pardiso_handle)
+                                            QdldlSolver, SuperLUSolver, UmfpackSolver, pardiso_handle)
 
 __all__ = ["METHODS", "PRECISIONS", "available", "make_solver", "LinearSolver", "PardisoSolver",
            "UmfpackSolver", "QdldlSolver", "SuperLUSolver", "REFINE_RTOL", "REFINE_MAX"]
@@ -39,7 +39,7 @@ def available() -> list[str]:
     """Backends importable here, fastest first."""
     out = []
     try:
-        _pardiso_handle()  # raises ImportError when the MKL runtime is missing
+        pardiso_handle()  # raises ImportError when the MKL runtime is missing
         out.append("pardiso")
     except (ImportError, OSError):
         pass

@@ -26,7 +26,7 @@ REFINE_RTOL = 1e-10  #: mixed precision: relative residual the refinement must r
 REFINE_MAX = 8  #: mixed precision: refinement steps before falling back to double
 
 
-def _pardiso_handle(**kwargs):
+def pardiso_handle(**kwargs):
     """A new pypardiso solver. pypardiso looks for MKL by a recursive glob of the environment
     (0.2-0.3 s, 80 000 entries here) unless PYPARDISO_MKL_RT names the library: it is looked
     for first where the MKL wheels put it (``_wheel_mkl_rt()``), and the first handle's
@@ -139,7 +139,7 @@ class PardisoSolver(LinearSolver):
         self._upper = None
 
     def _handle(self, precision):
-        ps = _pardiso_handle(mtype=-2 if self.symmetric else 11)
+        ps = pardiso_handle(mtype=-2 if self.symmetric else 11)
         if precision == "mixed":  # explicit iparm (iparm[0] = 1) for the single-precision factor
             settings = {1: 2, 9: 8, 10: 0, 12: 0} if self.symmetric else {1: 2, 9: 13, 10: 1, 12: 1}
             ps.iparm[0], ps.iparm[27] = 1, 1  # user settings; single precision (a, b, x float32)

@@ -55,7 +55,7 @@ def mesh_key(geometry: Geometry, params, *, size: float, order: int, refine: int
 
 
 def _softhand_version() -> str:
-    from softhand.reduced.versions import package_version
+    from softhand.reduced.vocabulary.versions import package_version
 
     return package_version()
 

@@ -21,7 +21,7 @@ import numpy as np
 import skfem
 
 from softhand.meshes.atomic import atomic_path
-from softhand.reduced.errors import InputError
+from softhand.reduced.vocabulary.errors import InputError
 
 #: meshio cell type -> (scikit-fem mesh class, meshio facet types that bound it)
 _VOLUME_TYPES = {

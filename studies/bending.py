@@ -29,10 +29,10 @@ import numpy as np
 
 from softhand.fem.hand.finger import FingerModel, FingerOptions, FingerState, SweepStats, ring_width, solve_pressures
 from softhand.fem.newton import NotConverged
-from softhand.reduced import finger as reduced_finger
-from softhand.reduced import hand
-from softhand.reduced.design import HandDesign
-from softhand.reduced.errors import InputError
+from softhand.reduced.equations import finger as reduced_finger
+from softhand.reduced.equations import hand
+from softhand.reduced.vocabulary.design import HandDesign
+from softhand.reduced.vocabulary.errors import InputError
 
 if TYPE_CHECKING:
     from softhand.studies.compare import WholeHandResult

@@ -22,9 +22,10 @@ from pathlib import Path
 import numpy as np
 
 from softhand.fem.hand.reservoir import SheetModel, inflate
-from softhand.reduced import hand, paper
-from softhand.reduced import reservoir as ellipse
-from softhand.reduced.design import HandDesign
+from softhand.reduced.equations import hand
+from softhand.reduced.vocabulary import paper
+from softhand.reduced.equations import reservoir as ellipse
+from softhand.reduced.vocabulary.design import HandDesign
 
 
 @dataclass(frozen=True)
@@ -59,7 +60,7 @@ def whole_hand(rows: list[dict], design: HandDesign, **sheet_mesh) -> WholeHandR
     """Per bending row (P_MPa, theta_deg, dQ_mm3): the hand's pump pressure from the FEM
     finger + FEM reservoir, and eq. (27) at the same theta."""
     dQ = np.array([r["dQ_mm3"] for r in rows])
-    V = design.V0 - design.n * dQ
+    V = ellipse.oil_left(dQ, design)
     wet = V > 0  # beyond, the fingers would take more oil than the reservoir holds: no hand
     if not wet.all():
         warnings.warn(f"the {design.n} FEM fingers take more oil than V0 = {design.V0:g} mm^3 from "
@@ -67,15 +68,17 @@ def whole_hand(rows: list[dict], design: HandDesign, **sheet_mesh) -> WholeHandR
     sheet = inflate(SheetModel.from_design(design, **sheet_mesh), np.append(V[wet], design.V0))
     p_res = np.full(V.size, math.nan)
     p_res[wet] = [s.pressure for s in sheet.states[:-1]]
+    P_hand = ellipse.pump_pressure(np.array([r["P_MPa"] for r in rows]), V, design,
+                                   p_r=lambda _: p_res)  # the sheet FEM at each row's oil left
     out = []
-    for r, v, pr in zip(rows, V, p_res):
+    for r, v, pr, P in zip(rows, V, p_res, P_hand):
         theta = math.radians(r["theta_deg"])
         out.append({
             "theta_deg": r["theta_deg"],
             "P_finger_fem_MPa": r["P_MPa"],
             "V_mm3": float(v),
             "p_reservoir_fem_MPa": float(pr),
-            "P_hand_fem_MPa": r["P_MPa"] - float(pr),
+            "P_hand_fem_MPa": float(P),
             "P_hand_eq27_MPa": float(hand.pressure(theta, design, reservoir=True)) if v > 0 else math.nan,
             "P_finger_eq28_MPa": float(hand.pressure(theta, design, reservoir=False)),
         })

@@ -1,8 +1,8 @@
 """The control study: angle control (eqs. (30), (31)) against pressure control under a push.
 
-:func:`run` simulates the hand (:mod:`softhand.reduced.plant`) holding the object under angle control
+:func:`run` simulates the hand (:mod:`softhand.reduced.dynamics.plant`) holding the object under angle control
 to ``theta_ref`` with a push on the object, then under pressure control at the pressure angle
-control held just before the push (:func:`softhand.reduced.control.flexibility`), and returns a
+control held just before the push (:func:`softhand.reduced.dynamics.control.flexibility`), and returns a
 :class:`ControlResult` that summarises (both runs, Table II's three states, the gains, the
 plant), writes (the time series at the sensor rate and summary.json) and plots (Fig. 10)
 itself. ``softhand control``, the batch kind ``control`` and the ``table2_control`` and
@@ -15,11 +15,11 @@ import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from softhand.reduced import grasp
-from softhand.reduced.control import FlexibilityResult, flexibility, ramp
-from softhand.reduced.controllers import Gains, default_gains
-from softhand.reduced.design import HandDesign
-from softhand.reduced.plant import HandTables, PlantParams, Push
+from softhand.reduced.equations import grasp
+from softhand.reduced.dynamics.control import FlexibilityResult, flexibility, ramp
+from softhand.reduced.dynamics.controllers import Gains, default_gains
+from softhand.reduced.vocabulary.design import HandDesign
+from softhand.reduced.dynamics.plant import HandTables, PlantParams, Push
 
 #: the files :meth:`ControlResult.write` writes
 FILES = ("control_angle.csv", "control_pressure.csv", "summary.json")
@@ -60,7 +60,7 @@ class ControlStudy:
         return read_disturbance(self.disturbance, t_end=self.t_end_s)
 
     def gains(self, w) -> Gains:
-        """kp, ki as given, the missing ones from the plant (:func:`softhand.reduced.controllers.default_gains`)."""
+        """kp, ki as given, the missing ones from the plant (:func:`softhand.reduced.dynamics.controllers.default_gains`)."""
         g = default_gains(HandTables(self.design, w), self.plant)
         return Gains(g.kp if self.kp is None else self.kp, g.ki if self.ki is None else self.ki,
                      anti_windup=self.anti_windup)
@@ -133,7 +133,7 @@ def summary_dict(s) -> dict:
 
 
 def run(study: ControlStudy) -> ControlResult:
-    """Angle control with the push, then pressure control (:func:`softhand.reduced.control.flexibility`)."""
+    """Angle control with the push, then pressure control (:func:`softhand.reduced.dynamics.control.flexibility`)."""
     w = study.weights()
     gains = study.gains(w)
     plant_design = study.design.replace(mu_sf=study.plant_mu_scale * study.design.mu_sf,

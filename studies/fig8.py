@@ -16,7 +16,8 @@ from pathlib import Path
 
 import numpy as np
 
-from softhand.reduced import grasp, paper
+from softhand.reduced.equations import grasp
+from softhand.reduced.vocabulary import paper
 from softhand.studies.weights import WeightsCase, finger_options, reduced_F_v, state_row
 
 
@@ -82,7 +83,7 @@ class Fig8Result:
 def run(study: Fig8Study) -> Fig8Result:
     """At each depth the pressures in turn; each point a FEM contact state with its own w."""
     from softhand.fem.hand.finger import FingerModel
-    from softhand.fem.hand.grasp import GraspModel, weight_vector
+    from softhand.fem.hand.grasp import GraspModel, grasp_weights
 
     case = study.case
     finger = FingerModel(case.design, finger_options(case.mesh_size_mm))
@@ -92,9 +93,8 @@ def run(study: Fig8Study) -> Fig8Result:
         model = GraspModel(finger, case.diameter_mm, mass=case.mass_kg, depth=base + offset)
         state = None
         for P in sorted(study.pressures_mpa):
-            state = model.solve(P, start=state)
-            upper = model.solve(P + case.dP_mpa, start=state)
-            w = weight_vector(state, upper)
+            pair = grasp_weights(model, P, case.dP_mpa, start=state)
+            state, w = pair.state, pair.w
             rows.append({"depth_mm": model.depth, "w": w.tolist(),
                          **state_row(state, w, case.mass_kg, case.design),
                          "F_v_reduced_paper_w_N": paper_w_F_v(state.P, state.theta, case)})

@@ -2,7 +2,7 @@
 
 :func:`run` fits the public design keys of a :class:`FitStudy` to the measured points
 (free-bending angles through eq. (27) or (28), or grasping forces through eqs. (24), (25),
-(29); :mod:`softhand.reduced.fit`) and returns a :class:`FitStudyResult` that summarises (values,
+(29); :mod:`softhand.reduced.fitting.fit`) and returns a :class:`FitStudyResult` that summarises (values,
 standard errors, correlation, errors, every identifiability note), writes the calibrated
 design (a TOML file every verb reads with ``--design``) and plots itself (data against the
 fitted model, residuals). ``softhand fit`` only reads its options and prints.
@@ -12,9 +12,9 @@ from __future__ import annotations
 import warnings
 from dataclasses import dataclass, field
 
-from softhand.reduced.csvdata import Measurements
-from softhand.reduced.design import HandDesign
-from softhand.reduced.fit import FitResult, fit, make_predictor
+from softhand.reduced.fitting.csvdata import Measurements
+from softhand.reduced.vocabulary.design import HandDesign
+from softhand.reduced.fitting.fit import FitResult, fit, make_predictor
 
 
 @dataclass(frozen=True)

@@ -2,7 +2,7 @@
 
 :func:`state` -- pump pressure, bend angle, mass and a weight vector w -> F_x (25), F_y (24),
 F_v (29) in N and kgf, with the free finger's pressure at that angle; :func:`state_fem` -- the
-same state by the calibrated finger in equilibrium against the object (:mod:`softhand.reduced.grasp_fem`).
+same state by the calibrated finger in equilibrium against the object (:mod:`softhand.reduced.calibrated.grasp_fem`).
 ``softhand grasp`` and the batch kind ``grasp`` only choose the inputs. Axes and signs:
 docs/conventions.md (F_v > 0: the finger squeezes).
 """
@@ -12,7 +12,7 @@ import math
 
 import numpy as np
 
-from softhand.reduced import grasp, hand
+from softhand.reduced.equations import grasp, hand
 
 
 def state(P: float, theta_deg: float, mass: float, w, design) -> dict:
@@ -28,15 +28,16 @@ def state(P: float, theta_deg: float, mass: float, w, design) -> dict:
 
 def state_fem(P: float, theta_deg: float, mass: float, diameter: float, design) -> dict:
     """One grasp state by the FEM-informed model at pump pressure P [MPa] -> the flat result."""
-    from softhand.reduced import grasp_fem
+    from softhand.reduced.calibrated import grasp_fem
 
     theta = math.radians(theta_deg)
     fem = grasp_fem.fem_finger(design)
-    P_cavity = P + float(hand.pressure(theta, fem, reservoir=False) - hand.pressure(theta, fem))
+    P_free = float(hand.pressure(theta, fem))  # the pump pressure of the free finger at theta
+    P_cavity = P + float(hand.finger_pressure(theta, fem)) - P_free  # the same reservoir offset at P
     s = grasp_fem.grasp_state_at_angle(design, diameter, P_cavity, theta, mass)
     return {"P_MPa": P, "theta_deg": theta_deg, "mass_kg": mass,
             "F_x_N": float(s.F[0]), "F_y_N": float(s.F[1]), "F_v_N": s.F_v, "F_v_kgf": s.F_v / grasp.KGF,
             "model": "fem", "diameter_mm": diameter, "P_cavity_MPa": P_cavity,
             "contact_link": s.link, "contact_force_N": s.N, "contact_point_mm": s.point.tolist() if s.link >= 0 else None,
             "depth_mm": s.depth, "hinge_deg": np.degrees(s.q).tolist(),
-            "P_free_MPa": float(hand.pressure(theta, fem))}
+            "P_free_MPa": P_free}

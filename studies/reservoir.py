@@ -16,14 +16,17 @@ and a fully bent finger.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
 
 from softhand.fem.hand.reservoir import ReservoirResult, SheetModel, inflate
-from softhand.reduced import reservoir as ellipse
-from softhand.reduced.design import HandDesign
+from softhand.reduced.equations import finger
+from softhand.reduced.equations import reservoir as ellipse
+from softhand.reduced.vocabulary.design import HandDesign
+from softhand.reduced.vocabulary.errors import InputError
+from softhand.studies.calibration.tables import write_table, written_by
 
 __all__ = ["ReservoirStudy", "ReservoirStudyResult", "run", "stroke_volume", "COLUMNS"]
 
@@ -154,7 +157,7 @@ def run(study: ReservoirStudy, *, progress=None) -> ReservoirStudyResult:
     """Inflate the sheet through the requested volumes and the operating range; compare."""
     d = study.design
     dV = stroke_volume(d, study.theta_max)
-    d.check_volume(study.theta_max)
+    finger.check_volume(d, study.theta_max)
     requested = np.asarray(study.volumes_mm3 or (d.V0 - dV, d.V0, d.V0 + 2000.0), dtype=float)
     grid = np.linspace(d.V0 - dV, d.V0, study.n_range)
     volumes = np.concatenate([requested, grid])
@@ -166,7 +169,7 @@ def run(study: ReservoirStudy, *, progress=None) -> ReservoirStudyResult:
 
 
 def calibration_rows(model: SheetModel, *, v_max: float = 1.75, n: int = 71, progress=None) -> list:
-    """FEM table for :mod:`softhand.reduced.reservoir_fem`: v = V/R³ in [0, v_max] on n points, with
+    """FEM table for :mod:`softhand.reduced.calibrated.reservoir_fem`: v = V/R³ in [0, v_max] on n points, with
     τ = t/R, p̃ = pR/(μt), W̃ = W/(μtR²), h̃ = h/R."""
     R, t, mu = model.R, model.t, model.mu
     v = np.linspace(0.0, v_max, n)[1:]
@@ -177,16 +180,33 @@ def calibration_rows(model: SheetModel, *, v_max: float = 1.75, n: int = 71, pro
     return rows
 
 
-def calibration_csv(models: list, rows: list, provenance: str) -> str:
-    """The calibration table (one block of rows per sheet model) as CSV text with a
-    provenance header (``#`` lines)."""
-    head = [f"# {line}" for line in provenance.splitlines()]
+def calibration_provenance(models: list, command: str) -> list[str]:
+    """The reservoir table's provenance lines: who wrote it, and each sheet model's mesh."""
+    head = [written_by("FEM calibration of reduced/calibrated/reservoir_fem.py"), command]
     for m in models:
-        head.append(f"# model: R={m.R} mm, t={m.t} mm (tau=t/R={m.t / m.R:.6g}), mu={m.mu} MPa, "
+        head.append(f"model: R={m.R} mm, t={m.t} mm (tau=t/R={m.t / m.R:.6g}), mu={m.mu} MPa, "
                     f"kappa/mu={m.kappa_ratio}, Q2/P1disc, {m.n_radial} x {m.n_thick} elements "
                     f"(clamp ratio {m.clamp_ratio})")
-    head.append("# tau = t/R, v = V/R^3, p_tilde = p R/(mu t), W_tilde = W/(mu t R^2), h_tilde = h/R")
-    lines = ["tau,v,p_tilde,W_tilde,h_tilde"]
-    lines += [f"{r['tau']:.10g},{r['v']:.6g},{r['p_tilde']:.10g},{r['W_tilde']:.10g},"
-              f"{r['h_tilde']:.10g}" for r in rows]
-    return "\n".join(head + lines) + "\n"
+    head.append("tau = t/R, v = V/R^3, p_tilde = p R/(mu t), W_tilde = W/(mu t R^2), h_tilde = h/R")
+    return head
+
+
+#: the reservoir table's columns (:mod:`softhand.reduced.calibrated.reservoir_fem`)
+CALIBRATION_COLUMNS = ("tau", "v", "p_tilde", "W_tilde", "h_tilde")
+
+
+def write_calibration(study: ReservoirStudy, path) -> int:
+    """FEM tables at the design's thickness t and at 2t (twice the layers: same element shape),
+    written to ``path`` with their provenance; the number of rows."""
+    if not study.design.reservoir_is_neo_hookean:
+        raise InputError("--write-calibration", str(path), "the calibration table of the 'fem' "
+                         "reservoir model is for a Neo-Hookean sheet; this design's sheet is "
+                         f"{study.design.reservoir_material.model}")
+    thin = study.model()
+    thick = replace(thin, t=2 * thin.t, n_thick=2 * thin.n_thick)
+    rows = calibration_rows(thin) + calibration_rows(thick)
+    command = (f"softhand reservoir --write-calibration {Path(path).name} "
+               f"--n-radial {thin.n_radial} --n-thick {thin.n_thick}")
+    write_table(path, calibration_provenance([thin, thick], command), CALIBRATION_COLUMNS,
+                [[r[c] for c in CALIBRATION_COLUMNS] for r in rows], {"v": ".6g"})
+    return len(rows)

@@ -26,9 +26,9 @@ from pathlib import Path
 
 import numpy as np
 
-from softhand.reduced import grasp
-from softhand.reduced.design import HandDesign
-from softhand.reduced.errors import InputError
+from softhand.reduced.equations import grasp
+from softhand.reduced.vocabulary.design import HandDesign
+from softhand.reduced.vocabulary.errors import InputError
 from softhand.studies.io.files import json_text, jsonable, write_json
 
 #: bump when the FEM or the result's fields change, to invalidate cached results
@@ -58,7 +58,7 @@ class WeightsCase:
 
 
 def _package_version() -> str:
-    from softhand.reduced.versions import package_version
+    from softhand.reduced.vocabulary.versions import package_version
 
     return package_version()
 
@@ -176,8 +176,8 @@ def _untouched_said(case: WeightsCase, result: dict) -> dict:
 
 def _reduced_contact(case: WeightsCase, depth: float | None) -> str:
     """Where the reduced model's free finger touches the object, as a hint (or nothing)."""
-    from softhand.reduced import contact, hand
-    from softhand.reduced.errors import InputError
+    from softhand.reduced.equations import contact, hand
+    from softhand.reduced.vocabulary.errors import InputError
 
     try:
         theta, _ = contact.contact_angle(case.diameter_mm, case.design, depth=depth)

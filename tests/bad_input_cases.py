@@ -165,7 +165,7 @@ EXTRA_FILES = {
 
 def _table(fit_line: str) -> str:
     """The package's finger table with its '# fit:' line replaced."""
-    from softhand.reduced.finger_fem_table import TABLE_FILE
+    from softhand.reduced.calibrated.finger_fem_table import TABLE_FILE
 
     return "\n".join(fit_line if line.startswith("# fit:") else line
                      for line in TABLE_FILE.read_text().splitlines()) + "\n"

@@ -41,7 +41,7 @@ class ThickSphere:
     n_radial: int = 1  #: Q2 elements through the wall
     n_polar: int = 8  #: Q2 elements from the pole to the equator
     pressure_space: str = "P1"  #: dilatation/pressure space per element, "P1" or "P0"
-    #: a :mod:`softhand.reduced.rubber` model (its initial shear modulus replaces mu); None: Neo-Hookean
+    #: a :mod:`softhand.reduced.materials.rubber` model (its initial shear modulus replaces mu); None: Neo-Hookean
     material: object = None
 
     @property
@@ -58,7 +58,7 @@ def closed_form_pressure(lambda_a, A: float, B: float, mu: float):
 
 
 def closed_form_pressure_general(lambda_a, A: float, B: float, material):
-    r"""Exact p [MPa] of an incompressible thick sphere of any :mod:`softhand.reduced.rubber` model:
+    r"""Exact p [MPa] of an incompressible thick sphere of any :mod:`softhand.reduced.materials.rubber` model:
 
     .. math:: p = \int_{\lambda_b}^{\lambda_a} \frac{\hat W'(\lambda)}{\lambda^3 - 1}\,d\lambda,
               \qquad \hat W(\lambda) = W(\lambda, \lambda, \lambda^{-2}),

@@ -52,8 +52,8 @@ from softhand.fem.loads import CavityVolume
 from softhand.fem.mapping import folded_elements
 from softhand.fem.solid import Solid
 from softhand.meshes.finger import FingerTube
-from softhand.reduced.design import HandDesign
-from softhand.reduced.errors import MeshRejected
+from softhand.reduced.vocabulary.design import HandDesign
+from softhand.reduced.vocabulary.errors import MeshRejected
 
 __all__ = ["FingerModel", "FingerOptions", "FingerState", "SweepStats", "WindingFibers",
            "ring_width", "solve_pressures", "tie_bands", "to_hand_frame"]

@@ -9,8 +9,8 @@ from skfem.quadrature import get_quadrature
 from skfem.refdom import RefTet
 
 from softhand.meshes.finger import FingerTube, finger_tube_mesh, layered_tets, layered_tube_mesh
-from softhand.reduced.design import HandDesign
-from softhand.reduced.errors import InputError, MeshTooLarge
+from softhand.reduced.vocabulary.design import HandDesign
+from softhand.reduced.vocabulary.errors import InputError, MeshTooLarge
 
 TIES = ("ring", "full")
 MESHERS = ("layered", "gmsh")

@@ -1,4 +1,4 @@
-"""The finger frame and the hand frame of :mod:`softhand.reduced.kinematics`, both ways.
+"""The finger frame and the hand frame of :mod:`softhand.reduced.equations.kinematics`, both ways.
 
 Finger frame: x along the finger axis, the hinge plate at y = +d. The hinge plate's base
 point (0, d) is the hand frame's (base_offset, 0); the finger axis x is the base link's
@@ -11,7 +11,7 @@ import math
 
 import numpy as np
 
-from softhand.reduced.design import HandDesign
+from softhand.reduced.vocabulary.design import HandDesign
 
 
 def hand_frame(design: HandDesign) -> tuple[np.ndarray, np.ndarray]:

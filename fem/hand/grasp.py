@@ -1,7 +1,7 @@
 r"""The grasp FEM: the finger FEM of :mod:`softhand.fem.hand.finger` closing on a rigid object.
 
 The object (diameter D) is centred on the hand's axis, at depth ``depth`` below the palm
-(the hand frame of :mod:`softhand.reduced.kinematics`: x outward, y down, the finger base on the
+(the hand frame of :mod:`softhand.reduced.equations.kinematics`: x outward, y down, the finger base on the
 hinge plate at (``base_offset``, 0)). By default (:func:`default_depth`) the hand comes
 down over the object until the object's top is ``palm_gap`` below the palm, or -- for
 objects too big to pass between the open fingers -- until the open fingers' pads are
@@ -36,8 +36,8 @@ from softhand.fem.hand.finger import FingerModel
 from softhand.fem.hand.frame import hand_frame, to_finger_frame
 from softhand.fem.linsolve import make_solver
 from softhand.fem.newton import NewtonOptions, NotConverged, PathOptions, solve_path
-from softhand.reduced.design import HandDesign
-from softhand.reduced.errors import InputError
+from softhand.reduced.vocabulary.design import HandDesign
+from softhand.reduced.vocabulary.errors import InputError
 
 
 @dataclass(frozen=True)
@@ -251,14 +251,15 @@ def weight_vector(a: GraspState, b: GraspState) -> np.ndarray:
     return dq / dq.sum()
 
 
-def grasp_weights(model: GraspModel, P: float, dP: float) -> WeightResult:
-    """Contact states at P and P + dP [MPa] and the weight vector between them."""
+def grasp_weights(model: GraspModel, P: float, dP: float, start: GraspState | None = None) -> WeightResult:
+    """Contact states at P and P + dP [MPa] and the weight vector between them (the state at P
+    continued from ``start``, a converged state nearby, if given)."""
     if not P > 0 or not dP > 0:
         raise InputError("pressure_MPa", (P, dP), "P and dP must be positive")
     t0 = time.perf_counter()
     a = None
     try:
-        a = model.solve(P)
+        a = model.solve(P, start=start)
         b = model.solve(P + dP, start=a)
     except NotConverged as err:  # what was reached, for the caller to save: ``.states``, ``.model``
         err.model = model

@@ -29,7 +29,7 @@ import numpy as np
 
 from softhand.fem.axisym import AxisymSolid, RevolvedVolume
 from softhand.fem.hyperelastic import rubber_law
-from softhand.reduced.rubber import NeoHookean, Rubber
+from softhand.reduced.materials.rubber import NeoHookean, Rubber
 from softhand.fem.volume_path import PathOptions, follow_volume, volume_path_options
 from softhand.meshes.reservoir import sheet_mesh
 
@@ -47,12 +47,12 @@ class SheetModel:
     n_radial: int = 40  #: Q2 elements along the radius
     n_thick: int = 2  #: Q2 elements through the thickness
     clamp_ratio: float = 3.0  #: radial element size at the axis / at the clamp
-    #: the rubber's strain energy (:mod:`softhand.reduced.rubber`; scaled to mu); None: Neo-Hookean
+    #: the rubber's strain energy (:mod:`softhand.reduced.materials.rubber`; scaled to mu); None: Neo-Hookean
     material: Rubber | None = None
 
     @classmethod
     def from_design(cls, design, **mesh) -> "SheetModel":
-        """Geometry and material of a :class:`softhand.reduced.design.HandDesign`; mesh keywords as given."""
+        """Geometry and material of a :class:`softhand.reduced.vocabulary.design.HandDesign`; mesh keywords as given."""
         material = None if design.reservoir_is_neo_hookean else design.reservoir_rubber
         return cls(R=design.R, t=design.t, mu=design.mu_sr, material=material, **mesh)
 
@@ -132,7 +132,8 @@ def surface_nodes(solid, u, z0):
     return r0, r0 + u[rdofs[on]], X[1, zdofs[on]] + u[zdofs[on]]
 
 
-def _state(model: SheetModel, solid, s) -> SheetState:
+def sheet_state(model: SheetModel, solid, s) -> SheetState:
+    """The sheet at the path state ``s`` (volume, pressure, energy, u): its profile and stretches."""
     _, r, z = surface_nodes(solid, s.u, 0.0)
     r0m, rm, zm = surface_nodes(solid, s.u, model.t / 2)
     arc = np.hypot(np.gradient(rm, r0m), np.gradient(zm, r0m))
@@ -164,7 +165,7 @@ def inflate(model: SheetModel, volumes, *, options: PathOptions | None = None,
     options = options or volume_path_options(max_step=0.5 * model.R**2 * model.t, atol=atol)
     hits, path = follow_volume(solid, volume, fixed, targets, options=options,
                                volume_scale=model.R**2 * model.t, progress=progress)
-    states = [_state(model, solid, s) for s in hits]
+    states = [sheet_state(model, solid, s) for s in hits]
     by_request = np.empty(volumes.size, dtype=object)
     by_request[order] = [states[i] for i in inverse]
     V = np.array([s.volume for s in path])

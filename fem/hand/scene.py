@@ -1,7 +1,7 @@
 r"""The scene of a result, as named VTK blocks: what a person needs to see to understand it.
 
 A finger state (free bending or a grasp) becomes, in the hand frame of
-:mod:`softhand.reduced.kinematics` (x outward, y down, z normal to the bending plane; the
+:mod:`softhand.reduced.equations.kinematics` (x outward, y down, z normal to the bending plane; the
 modelled finger's bending plane is z = 0):
 
 * ``tube``: the rubber tube, the computed half (z >= 0) and its mirror image (z <= 0,

@@ -12,7 +12,7 @@ Sub-packages (dependencies point down; ``tests/project/test_layers.py`` enforces
 They are the repository's top-level folders fem/, reduced/, meshes/ and studies/; installed
 (``pip install -e .``), they import under this one name only.
 """
-from softhand.reduced.versions import package_version
+from softhand.reduced.vocabulary.versions import package_version
 
 __version__ = package_version()  # "unknown" when the package is not installed
 del package_version

@@ -24,8 +24,8 @@ from pathlib import Path
 
 import numpy as np
 
-from softhand.reduced.design import HandDesign
-from softhand.reduced.versions import package_version
+from softhand.reduced.vocabulary.design import HandDesign
+from softhand.reduced.vocabulary.versions import package_version
 from softhand.studies.batch.studyfile import Study, resolve_kind
 from softhand.studies.io.files import finite_or_none, write_json
 
@@ -92,7 +92,7 @@ def own_study_dir(study: Study, results_root: str | Path = "results", *, write: 
     """The study's folder, after checking it holds no study of another kind under the same
     name (whose index.csv and report this one would overwrite); ``write``: record this kind
     there (a run, a report). InputError naming the study's name."""
-    from softhand.reduced.errors import InputError
+    from softhand.reduced.vocabulary.errors import InputError
     from softhand.studies.io.files import check_output_tree
 
     sdir = study_dir(study, results_root)
@@ -252,7 +252,7 @@ def commit(final: Path, record: dict, files: dict) -> Path:
     return final
 
 
-def _remove_leftovers(sdir: Path, key: str) -> None:
+def remove_leftovers(sdir: Path, key: str) -> None:
     """Temporary folders of case ``key`` a killed run left (only its claim holder calls this)."""
     for tmp in sdir.glob(f".{key}.*.tmp"):
         shutil.rmtree(tmp, ignore_errors=True)

@@ -16,7 +16,7 @@ import os
 import socket
 import traceback
 
-from softhand.reduced.errors import InputError
+from softhand.reduced.vocabulary.errors import InputError
 from softhand.studies.batch.cases import execute_case
 from softhand.studies.batch.pool import thread_share
 from softhand.studies.batch.studyfile import Study

@@ -9,8 +9,8 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
-from softhand.reduced.design import HandDesign
-from softhand.reduced.errors import InputError
+from softhand.reduced.vocabulary.design import HandDesign
+from softhand.reduced.vocabulary.errors import InputError
 
 
 def curve(params: dict, design: HandDesign, outdir: Path) -> dict:
@@ -19,18 +19,15 @@ def curve(params: dict, design: HandDesign, outdir: Path) -> dict:
     ``theta_deg`` -> P_MPa, P_no_reservoir_MPa, V_mm3, p_reservoir_MPa (+ h_mm, lambda_r: ellipse model);
     ``pressure_mpa`` -> theta_deg, theta_no_reservoir_deg (the inverse).
     """
-    from softhand.reduced import hand, reservoir
+    from softhand.studies.curve import at_angles, at_pressures
 
     if ("theta_deg" in params) == ("pressure_mpa" in params):
         raise InputError("curve", sorted(params), "give exactly one of theta_deg, pressure_mpa")
     if "theta_deg" in params:
-        theta = math.radians(params["theta_deg"])
-        V = reservoir.oil_volume(theta, design)
-        return {"P_MPa": hand.pressure(theta, design, reservoir=True),
-                "P_no_reservoir_MPa": hand.pressure(theta, design, reservoir=False),
-                "V_mm3": V, **{k: float(v) for k, v in reservoir.state(V, design).items()}}
-    theta, theta_free = hand.bend_angles(params["pressure_mpa"], design)
-    return {"theta_deg": math.degrees(theta), "theta_no_reservoir_deg": math.degrees(theta_free)}
+        row = at_angles(params["theta_deg"], design)[0]
+        return {k: v for k, v in row.items() if k != "theta_deg"}
+    row = at_pressures(params["pressure_mpa"], design)[0]
+    return {k: row[k] for k in ("theta_deg", "theta_no_reservoir_deg")}
 
 
 def grasp(params: dict, design: HandDesign, outdir: Path) -> dict:
@@ -38,7 +35,7 @@ def grasp(params: dict, design: HandDesign, outdir: Path) -> dict:
 
     ``weights`` (n_s numbers) or ``diameter_mm`` (the paper's presets, 180 or 240).
     """
-    from softhand.reduced.grasp import check_weights, weights_for_diameter
+    from softhand.reduced.equations.grasp import check_weights, weights_for_diameter
     from softhand.studies.grasp import state
 
     if "weights" in params:

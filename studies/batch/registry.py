@@ -10,9 +10,10 @@ import importlib
 import math
 from dataclasses import dataclass
 
-from softhand.reduced.design import HandDesign
-from softhand.reduced.errors import InputError
-from softhand.reduced.grasp import MAX_WEIGHT
+from softhand.reduced.equations import finger
+from softhand.reduced.vocabulary.design import HandDesign
+from softhand.reduced.vocabulary.errors import InputError
+from softhand.reduced.equations.grasp import MAX_WEIGHT
 
 
 @dataclass(frozen=True)
@@ -64,7 +65,7 @@ def _grasp_weights(params: dict, design: HandDesign, src: str) -> None:
         raise InputError(f"{src}: diameter_mm", params["diameter_mm"], "give weights or diameter_mm, not both")
     if "weights" not in params:
         return
-    from softhand.reduced.grasp import projected_jacobian
+    from softhand.reduced.equations.grasp import projected_jacobian
 
     w = params["weights"]
     if len(w) != design.n_s:
@@ -86,7 +87,7 @@ def finger_mesh_fits(params: dict, design: HandDesign, src: str) -> None:
     without meshing): one line when the study is read, not a case failing after the others ran."""
     from softhand.fem.hand.finger import finger_tube
     from softhand.fem.hand.finger_options import check_size, mesh_options
-    from softhand.reduced.errors import MeshTooLarge
+    from softhand.reduced.vocabulary.errors import MeshTooLarge
 
     options = mesh_options(params.get("mesh_size_mm"), params.get("axial_size_mm"))
     try:
@@ -104,20 +105,20 @@ def _push_before_end(params: dict, design: HandDesign, src: str) -> None:
 
 def _enough_oil(params: dict, design: HandDesign, src: str) -> None:
     if "theta_deg" in params and params["theta_deg"] > 0:
-        design.check_volume(math.radians(params["theta_deg"]))
+        finger.check_volume(design, math.radians(params["theta_deg"]))
 
 
 def _oil_to_theta_max(params: dict, design: HandDesign, src: str) -> None:
     """The reservoir holds the oil the fingers take up to the stroke's end (default: the
     design's own), checked at load time as the curve kind checks its angles."""
-    design.check_volume(math.radians(params.get("theta_max_deg", 90.0)))  # the kind's default
+    finger.check_volume(design, math.radians(params.get("theta_max_deg", 90.0)))  # the kind's default
 
 
 def _paper_weights_fit(params: dict, design: HandDesign, src: str) -> None:
     """Without ``weights``, the case takes the paper's w for its diameter: the design needs its
     number of hinges (as ``softhand control`` / ``grasp`` refuse it up front)."""
     if "weights" not in params:
-        from softhand.reduced.grasp import weights_for_diameter
+        from softhand.reduced.equations.grasp import weights_for_diameter
 
         try:
             weights_for_diameter(params.get("diameter_mm", 180.0), design)
@@ -161,7 +162,7 @@ def _pressure_reached(params: dict, design: HandDesign, src: str) -> None:
     """A pressure the design's free hand reaches (its range depends on the design): the reduced
     model's inverse, at load time, not as a failed case."""
     if "pressure_mpa" in params:
-        from softhand.reduced import hand
+        from softhand.reduced.equations import hand
 
         try:
             hand.bend_angles(params["pressure_mpa"], design)

@@ -37,7 +37,7 @@ from pathlib import Path
 from softhand.studies.batch.cases import (FAILED, RESULT, Case, case_key, case_state, code_version,  # noqa: F401
                                           commit, commit_case, execute_case, outcome_record,
                                           own_study_dir, package_versions, plan, read_case, study_dir,
-                                          _remove_leftovers)
+                                          remove_leftovers)
 from softhand.studies.batch.claims import Claims
 from softhand.studies.batch.index import index_rows, other_sources, status, write_index  # noqa: F401
 from softhand.studies.batch.studyfile import Study
@@ -131,7 +131,7 @@ def _claimed(sdir: Path, todo: list[Case], claims: Claims, fresh: bool, deferred
             summary.not_run -= 1
             bar.update(1)
             continue
-        _remove_leftovers(sdir, case.key)
+        remove_leftovers(sdir, case.key)
         yield case
 
 

@@ -20,7 +20,7 @@ optionally fixed parameters and a mesh size::
     mass_kg = 2.0
 
 A sweep axis is either a parameter of the kind or a public design key
-(:data:`softhand.reduced.design.PUBLIC_KEYS`). Every error is one line naming the field.
+(:data:`softhand.reduced.vocabulary.design.PUBLIC_KEYS`). Every error is one line naming the field.
 
 A study file is data: its kind is a *name*, looked up in the built-in :data:`~softhand.studies.batch.registry.KINDS` and in
 the ``softhand.kinds`` entry-point group of installed packages (:func:`~softhand.studies.batch.registry.all_kinds`); no
@@ -46,10 +46,12 @@ import re
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from softhand.reduced import reservoir
-from softhand.reduced.design import PUBLIC_KEYS, HandDesign, design_from_dict, load_design, read_toml
-from softhand.reduced.errors import InputError
-from softhand.studies.cli.args import parse_values
+from softhand.reduced.equations import reservoir
+from softhand.reduced.vocabulary.design import PUBLIC_KEYS, HandDesign
+from softhand.reduced.vocabulary.design_files import design_from_dict, load_design
+from softhand.reduced.vocabulary.inputfiles import read_toml
+from softhand.reduced.vocabulary.errors import InputError
+from softhand.studies.io.values import parse_values
 from softhand.studies.batch.registry import ENTRY_POINT_GROUP, KINDS, MAX_CASES, Kind, Num, NumList, all_kinds, \
     resolve_kind
 
@@ -58,7 +60,8 @@ __all__ = ["KINDS", "MAX_CASES", "Kind", "Num", "NumList", "Study", "all_kinds",
 
 
 _TOP_KEYS = ("kind", "name", "description", "design", "mesh_size_mm", "sweep", "params")
-_NAME_RE = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_.-]*$")
+#: what a study's (and a design space's) name may be: it names a results folder
+NAME_RE = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_.-]*$")
 
 
 @dataclass(frozen=True)
@@ -104,7 +107,7 @@ def study_from_dict(doc: dict, *, path: Path | None = None, max_cases: int = MAX
             raise InputError(f"{src}: {key}", doc[key], f"unknown key; allowed: {', '.join(_TOP_KEYS)}")
     kind = _kind(doc.get("kind"), src)
     name = doc.get("name", path.stem if path else None)
-    if not isinstance(name, str) or not _NAME_RE.match(name) or len(name) > 100:
+    if not isinstance(name, str) or not NAME_RE.match(name) or len(name) > 100:
         given = "" if "name" in doc else (" (the study's results folder is named after its file "
                                           "unless the file sets name = \"...\")")
         raise InputError(f"{src}: name", name, "must be a string of at most 100 letters, digits, '_', "

@@ -8,7 +8,7 @@ Each design is one case of the batch runner (:mod:`softhand.studies.batch.runner
 FEM of :mod:`softhand.studies.bending` on the default (layered) mesh at the pressures, and on
 until ``theta_target_deg`` in steps of at most ``p_step_mpa`` while P <= ``p_max_mpa``.
 The finished cases become the nondimensional rows of
-``reduced/data/finger_fem.csv`` (see :mod:`softhand.reduced.finger_fem`); :mod:`softhand.studies.calibration.finger_table`
+``reduced/calibrated/data/finger_fem.csv`` (see :mod:`softhand.reduced.calibrated.finger_fem`); :mod:`softhand.studies.calibration.finger_table`
 writes it and checks a table against held-out designs.
 """
 from __future__ import annotations
@@ -17,10 +17,10 @@ import math
 from dataclasses import dataclass
 from pathlib import Path
 
-from softhand.reduced.design import HandDesign
-from softhand.reduced.errors import InputError
+from softhand.reduced.vocabulary.design import HandDesign
+from softhand.reduced.vocabulary.errors import InputError
 from softhand.studies.batch.studyfile import Study
-from softhand.studies.calibration.space import _PATH_KEYS, VARIABLES, DesignSpace, finger_design
+from softhand.studies.calibration.space import PATH_KEYS, VARIABLES, DesignSpace, finger_design
 
 @dataclass(frozen=True)
 class SpaceStudy(Study):
@@ -90,7 +90,7 @@ def design_cases(space: DesignSpace) -> list[tuple[dict, HandDesign]]:
     shared = space_params(space)
     cases = []
     for p, d in zip(space.points, space.designs()):
-        params = {**shared, **{k: p[k] for k in _PATH_KEYS if k in p}}
+        params = {**shared, **{k: p[k] for k in PATH_KEYS if k in p}}
         if "axial_size_mm" in params and not resolves_gap(d, params["axial_size_mm"]):
             del params["axial_size_mm"]
         cases.append((params, d))

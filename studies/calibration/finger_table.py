@@ -2,23 +2,23 @@
 
 :func:`write_table` turns the ``finger_bend`` cases of a design space
 (:mod:`softhand.studies.calibration.finger`) into the nondimensional CSV of
-:mod:`softhand.reduced.finger_fem` with its provenance (code version, mesh, date, command);
+:mod:`softhand.reduced.calibrated.finger_fem` with its provenance (code version, mesh, date, command);
 :func:`heldout_rows` compares the calibrated model with FEM cases it was not built from.
 """
 from __future__ import annotations
 
 import math
-from datetime import datetime, timezone
 from pathlib import Path
 
 import numpy as np
 from scipy.interpolate import PchipInterpolator
 
-from softhand.reduced import finger, hand
-from softhand.reduced.design import HandDesign
-from softhand.reduced.finger_fem import COLUMNS, GROUPS, groups_of
+from softhand.reduced.equations import finger, hand
+from softhand.reduced.vocabulary.design import HandDesign
+from softhand.reduced.calibrated.finger_fem import COLUMNS, GROUPS, groups_of
 from softhand.studies.calibration.finger import MIN_GAP_SLICES
 from softhand.studies.calibration.space import DesignSpace, VARIABLES, finger_design
+from softhand.studies.calibration.tables import table_text, written_by
 from softhand.studies.io.files import write_atomic
 
 
@@ -54,14 +54,14 @@ KERNEL = "cubic"
 def choose_fit(rows: list[dict], ranges: dict, prior: str) -> tuple[str, list[str]]:
     """The '# fit:' line's items after the prior for ``rows``, and a provenance note. With
     KERNEL_MIN_DESIGNS designs or more: the cubic radial-basis interpolant over the five
-    features of :data:`~softhand.reduced.finger_fem_terms.KERNEL_FEATURES` (per design a line in theta; exact at the designs).
+    features of :data:`~softhand.reduced.calibrated.finger_fem_terms.KERNEL_FEATURES` (per design a line in theta; exact at the designs).
     It was chosen by leave-one-design-out error of theta on the 41-design table (rms / worst,
     ``benchmarks/finger_loo.py``): cubic 1.33 / 6.4 %, thin-plate spline 1.62 / 9.0 %, linear
     2.02 / 12.9 % (dQ: 0.87 / 4.5, 0.75 / 2.3, 0.80 / 2.7 %); on the earlier 31-design table,
     least squares in terms linear in the features had twice the spline's error in y and 3x
     in ln kappa, quadratic terms 6x. With fewer designs: least squares in the varying groups'
     linear terms and theta (theta only if the designs are too few)."""
-    from softhand.reduced.finger_fem_terms import KERNEL_FEATURES, legacy_terms
+    from softhand.reduced.calibrated.finger_fem_terms import KERNEL_FEATURES, legacy_terms
 
     n_designs = len({r["design"] for r in rows})
     if n_designs >= KERNEL_MIN_DESIGNS:
@@ -77,7 +77,7 @@ def choose_fit(rows: list[dict], ranges: dict, prior: str) -> tuple[str, list[st
 
 def table_csv(rows: list[dict], ranges: dict, provenance: list[str], fit: str,
               prior: str = "paper") -> str:
-    """The calibration CSV of :mod:`softhand.reduced.finger_fem`: provenance, range and fit lines, rows."""
+    """The calibration CSV of :mod:`softhand.reduced.calibrated.finger_fem`: provenance, range and fit lines, rows."""
     lines = [f"# {line}" for line in provenance]
     lines.append("# groups: b_a = b/a, d_a = d/a, link_a = (l0/6)/a, tie_link = tie width/(l0/6); "
                  "theta [rad]; p_tilde = P/mu_sf; q_tilde = dQ/a^3 (one finger)")
@@ -91,7 +91,6 @@ def table_csv(rows: list[dict], ranges: dict, provenance: list[str], fit: str,
 
 def provenance_lines(command: str, results: list[tuple[HandDesign, dict]], records: list[dict]) -> list[str]:
     """Who wrote the table, when, with which code and mesh."""
-    from softhand.studies.cli.verbs.reservoir import _git_commit
     from softhand.studies.batch.runner import code_version
 
     code = code_version()
@@ -100,8 +99,8 @@ def provenance_lines(command: str, results: list[tuple[HandDesign, dict]], recor
             for r in records}
     dofs = sorted((r.get("mesh") or {}).get("dofs", 0) for r in records)
     wall = sum((r.get("solver") or {}).get("wall_time_s", 0.0) for r in records)
-    return [f"FEM calibration of reduced/finger_fem.py, written {datetime.now(timezone.utc):%Y-%m-%d %H:%M} "
-            f"UTC at commit {_git_commit()} (softhand {code['softhand']}, sources {code['source_sha256']}) by",
+    return [written_by("FEM calibration of reduced/calibrated/finger_fem.py",
+                       f" (softhand {code['softhand']}, sources {code['source_sha256']})"),
             command,
             f"model: finger FEM (fem/hand/finger.py), FingerOptions, mesher {', '.join(sorted(mesh))}, "
             f"{dofs[0]}..{dofs[-1]} unknowns; {len(results)} designs, {wall / 60:.1f} min of solver wall time"]
@@ -197,7 +196,7 @@ def _whole_hand_errors(design: HandDesign, numbers: dict, table) -> np.ndarray:
     """P_hand of the models "fem" minus finger FEM + sheet FEM [MPa], per FEM point with P > 0."""
     import warnings
 
-    from softhand.reduced.errors import InputError
+    from softhand.reduced.vocabulary.errors import InputError
     from softhand.studies.compare import whole_hand
 
     fem = [{"P_MPa": P, "theta_deg": t, "dQ_mm3": q}
@@ -223,7 +222,7 @@ def leave_one_out(path: str | Path | None = None) -> list[dict]:
     the groups do not see)."""
     import tempfile
 
-    from softhand.reduced.finger_fem import TABLE_FILE, read_table
+    from softhand.reduced.calibrated.finger_fem import TABLE_FILE, read_table
 
     table = read_table(path or TABLE_FILE)
     r = table.rows

@@ -1,4 +1,4 @@
-"""The hinge table of :mod:`softhand.reduced.grasp_fem` from the finger FEM: each hinge's oil per radian at
+"""The hinge table of :mod:`softhand.reduced.calibrated.grasp_fem` from the finger FEM: each hinge's oil per radian at
 fixed pressure, A_j(theta) = dV/d theta_hat_j.
 
 On the grasp FEM's mesh, the free finger at each pressure P of ``PRESSURES`` (bend theta_free(P));
@@ -9,18 +9,19 @@ angles (a Maxwell relation of the finger's potential E(q, P), dE/dP = -V). At P 
 straight finger's. Written nondimensionally against the hinge's bend theta = n_s theta_hat_j:
 a_j = A_j / (a^2 pi d). Run::
 
-    python -m softhand.studies.calibration.hinges --out reduced/data/grasp_hinges.csv
+    python -m softhand.studies.calibration.hinges --out reduced/calibrated/data/grasp_hinges.csv
 """
 from __future__ import annotations
 
 import argparse
 import math
 import sys
-from datetime import datetime, timezone
 
 import numpy as np
 
-from softhand.reduced.design import HandDesign
+from softhand.reduced.vocabulary.design import HandDesign
+from softhand.studies.calibration import tables
+from softhand.studies.io.files import write_atomic
 
 #: torsion spring locking each hinge, on the half model [N mm/rad] (~1e4 times the finger's)
 SPRING = 1e7
@@ -51,23 +52,21 @@ def volume_rates(model, pressures=PRESSURES, dP: float = DP):
 def table_text(design: HandDesign, mesh_size_mm: float | None = None, command: str = "") -> str:
     """The CSV: provenance lines, then theta, a_1..a_n (hinge bends theta_free(P) / 1 per row)."""
     from softhand.fem.hand.finger import FingerModel
-    from softhand.studies.cli.verbs.reservoir import _git_commit
     from softhand.studies.weights import MESH_SIZE, finger_options
 
     h = MESH_SIZE if mesh_size_mm is None else mesh_size_mm
     model = FingerModel(design, finger_options(h))
     theta, A = volume_rates(model)
     a = A / (design.a ** 2 * math.pi * design.d)
-    head = [f"# FEM hinge table of reduced/grasp_fem.py, written {datetime.now(timezone.utc):%Y-%m-%d %H:%M} UTC "
-            f"at commit {_git_commit()} by",
-            f"# {command}",
-            f"# model: finger FEM (fem/hand/finger.py) of the paper's design (Table I) on the grasp mesh "
+    head = [tables.written_by("FEM hinge table of reduced/calibrated/grasp_fem.py"),
+            command,
+            f"model: finger FEM (fem/hand/finger.py) of the paper's design (Table I) on the grasp mesh "
             f"(h = {h:g} mm, {model.ndofs} unknowns); free states at P = {', '.join(f'{p:g}' for p in PRESSURES)} MPa, "
             f"hinges locked by springs of {SPRING:g} N mm/rad (half model), P + {DP:g} MPa",
-            "# theta = the free bend at that P [rad] (a hinge's bend n_s theta_hat); a_j = A_j/(a^2 pi d), "
-            "A_j = dV/d theta_hat_j at fixed P",
-            ",".join(["theta", *(f"a_{j}" for j in range(1, design.n_s + 1))])]
-    return "\n".join(head + [",".join(f"{v:.10g}" for v in (t, *r)) for t, r in zip(theta, a)]) + "\n"
+            "theta = the free bend at that P [rad] (a hinge's bend n_s theta_hat); a_j = A_j/(a^2 pi d), "
+            "A_j = dV/d theta_hat_j at fixed P"]
+    columns = ["theta", *(f"a_{j}" for j in range(1, design.n_s + 1))]
+    return tables.table_text(head, columns, [(t, *r) for t, r in zip(theta, a)])
 
 
 def main(argv=None) -> int:
@@ -77,8 +76,7 @@ def main(argv=None) -> int:
     args = parser.parse_args(argv)
     command = "python -m softhand.studies.calibration.hinges " + " ".join(sys.argv[1:] if argv is None else argv)
     text = table_text(HandDesign(), args.mesh_size_mm, command)
-    with open(args.out, "w") as f:
-        f.write(text)
+    write_atomic(args.out, text)
     return 0
 
 

@@ -36,15 +36,17 @@ from pathlib import Path
 
 import numpy as np
 
-from softhand.reduced.design import HandDesign, load_design
-from softhand.reduced.errors import InputError
+from softhand.reduced.vocabulary.design import HandDesign
+
+from softhand.reduced.vocabulary.design_files import load_design
+from softhand.reduced.vocabulary.errors import InputError
 from softhand.studies.batch.registry import check_path_end
-from softhand.studies.batch.studyfile import _NAME_RE
+from softhand.studies.batch.studyfile import NAME_RE
 
 #: the dimensional variables of a design space, in this order
 VARIABLES = ("a_mm", "b_mm", "d_mm", "l0_mm", "tie_width_mm")
 #: load-path parameters a [[design]] table may set for itself
-_PATH_KEYS = ("p_max_mpa", "p_step_mpa")
+PATH_KEYS = ("p_max_mpa", "p_step_mpa")
 _KEYS = ("name", "lhs", "seed", "pressures_mpa", "theta_target_deg", "p_max_mpa", "p_step_mpa",
          "space", "design", "base_design", "mesh_size_mm", "axial_size_mm", "mesh_pair", "prior")
 
@@ -66,7 +68,7 @@ class DesignSpace:
     #: (point, pressures): one design run on this mesh and on the default one, to correct the
     #: table for the mesh (see studies.finger_table.mesh_correction); None: no correction
     mesh_pair: tuple | None = None
-    prior: str = "paper"  #: the physics the table's residual is taken against (reduced.finger_fem.PRIORS)
+    prior: str = "paper"  #: the physics the table's residual is taken against (reduced.calibrated.finger_fem.PRIORS)
 
     def designs(self) -> list[HandDesign]:
         return [finger_design(p, self.base) for p in self.points]
@@ -112,7 +114,7 @@ MAX_PRESSURES = 50
 
 def load_space(path: str | Path) -> DesignSpace:
     """Read and validate a design-space TOML file (see the module docstring)."""
-    from softhand.reduced.design import read_toml
+    from softhand.reduced.vocabulary.inputfiles import read_toml
 
     path = Path(path)
     doc = read_toml(path, "--space", "a design-space TOML file")
@@ -121,7 +123,7 @@ def load_space(path: str | Path) -> DesignSpace:
         if key not in _KEYS:
             raise InputError(f"{src}: {key}", doc[key], f"unknown key; allowed: {', '.join(_KEYS)}")
     name = doc.get("name", path.stem)
-    if not isinstance(name, str) or not _NAME_RE.match(name) or len(name) > 100:
+    if not isinstance(name, str) or not NAME_RE.match(name) or len(name) > 100:
         raise InputError(f"{src}: name", name,
                          "must be a string of at most 100 letters, digits, '_', '-', '.'")
     box = _box(doc.get("space"), src)
@@ -168,7 +170,7 @@ def load_space(path: str | Path) -> DesignSpace:
                              f"must be 2 to {MAX_PRESSURES} increasing numbers in [{lo:g}, {hi:g}] MPa")
         pair = (_point(pair, {k: (0.0, math.inf) for k in VARIABLES}, f"{src}: mesh_pair"),
                 tuple(float(p) for p in pressures_pair))
-    from softhand.reduced.finger_fem import PRIORS
+    from softhand.reduced.calibrated.finger_fem import PRIORS
     prior = doc.get("prior", "paper")
     if prior not in PRIORS:
         raise InputError(f"{src}: prior", prior, f"must be one of {', '.join(PRIORS)}")
@@ -225,13 +227,13 @@ def _box(table, src: str) -> dict:
 
 
 def _point(table, box: dict, where: str) -> dict:
-    if not isinstance(table, dict) or not set(VARIABLES) <= set(table) <= set(VARIABLES + _PATH_KEYS):
+    if not isinstance(table, dict) or not set(VARIABLES) <= set(table) <= set(VARIABLES + PATH_KEYS):
         raise InputError(where, table, f"must give {', '.join(VARIABLES)} (and optionally "
-                                       f"{', '.join(_PATH_KEYS)})")
+                                       f"{', '.join(PATH_KEYS)})")
     for key in VARIABLES:
         if not _number(table[key]) or not box[key][0] <= table[key] <= box[key][1]:
             raise InputError(f"{where}.{key}", table[key], f"must be in [{box[key][0]}, {box[key][1]}]")
-    for key in sorted(set(table) & set(_PATH_KEYS)):
+    for key in sorted(set(table) & set(PATH_KEYS)):
         lo, hi = LIMITS[key]
         if not _number(table[key]) or not lo <= table[key] <= hi:
             raise InputError(f"{where}.{key}", table[key], f"must be a number in [{lo:g}, {hi:g}] MPa")
@@ -240,7 +242,7 @@ def _point(table, box: dict, where: str) -> dict:
 
 def single_design_space(path: str | Path) -> DesignSpace:
     """The design space of one design file (its own box), for a table of that design alone."""
-    from softhand.reduced.finger_fem import groups_of
+    from softhand.reduced.calibrated.finger_fem import groups_of
 
     design = load_design(path)
     groups_of(design)  # 5 equal hinges, or one error line

@@ -18,7 +18,7 @@ import sys
 import tempfile
 from pathlib import Path
 
-from softhand.reduced.errors import InputError
+from softhand.reduced.vocabulary.errors import InputError
 
 #: picture suffixes of matplotlib's writers (--plot) and of the 3D renderer (inspect --out)
 PLOT_SUFFIXES = (".png", ".pdf", ".svg", ".jpg", ".jpeg", ".eps", ".ps", ".tif", ".tiff", ".webp")

@@ -8,7 +8,7 @@ Each verb lives in ``studies/cli/verbs/<verb>.py`` and defines
 
 Verb modules are imported only when their verb is called, so ``softhand curve``
 never pays for importing the FEM stack. Bad input anywhere (an
-:class:`softhand.reduced.errors.InputError`, or an argparse error) becomes one line on
+:class:`softhand.reduced.vocabulary.errors.InputError`, or an argparse error) becomes one line on
 stderr and exit code 2.
 """
 from __future__ import annotations
@@ -21,9 +21,9 @@ import signal
 import sys
 import warnings
 
-from softhand.reduced.errors import InputError, short
-from softhand.reduced.inputfiles import plain_float
-from softhand.reduced.versions import package_version
+from softhand.reduced.vocabulary.errors import InputError, short
+from softhand.reduced.vocabulary.inputfiles import plain_float
+from softhand.reduced.vocabulary.versions import package_version
 
 #: verb -> module under studies.commands; the order is the order of ``--help``.
 VERBS = (

@@ -22,10 +22,10 @@ from pathlib import Path
 
 import numpy as np
 
-from softhand.reduced.design import design_from_dict, load_design
-from softhand.reduced import paper
-from softhand.reduced.grasp import angle_at
-from softhand.reduced.hand import bend_angle
+from softhand.reduced.vocabulary.design_files import design_from_dict, load_design
+from softhand.reduced.vocabulary import paper
+from softhand.reduced.equations.grasp import angle_at
+from softhand.reduced.equations.hand import bend_angle
 from softhand.studies.io.files import write_atomic
 
 HERE = Path(__file__).resolve().parent

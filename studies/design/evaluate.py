@@ -1,9 +1,9 @@
 r"""A design judged on the reduced model for a task: grasp angle, pressures, forces, constraints.
 
-For a design the task's object is placed as in the grasp FEM (:func:`softhand.reduced.contact.object_depth`),
+For a design the task's object is placed as in the grasp FEM (:func:`softhand.reduced.equations.contact.object_depth`),
 the finger closes with equal hinge angles until a pad touches (the **grasp angle** theta_g,
-:func:`softhand.reduced.contact.contact_angle`), and the virtual displacement w is the rolling motion
-that keeps that pad on the object (:func:`softhand.reduced.contact.rolling_weights`). Then
+:func:`softhand.reduced.equations.contact.contact_angle`), and the virtual displacement w is the rolling motion
+that keeps that pad on the object (:func:`softhand.reduced.equations.contact.rolling_weights`). Then
 :func:`grasp_relation`, the one place where a design's F_v is computed, gives
 
 * ``P_grasp``: the pump pressure at which each finger presses with the required F_v;
@@ -12,7 +12,7 @@ that keeps that pad on the object (:func:`softhand.reduced.contact.rolling_weigh
   at the highest pump pressure it answers for, if that is below the limit: where a second
   pad touches the object);
 
-for ``finger_model = "fem"`` by the FEM-informed grasp (:mod:`softhand.reduced.grasp_hold`: the
+for ``finger_model = "fem"`` by the FEM-informed grasp (:mod:`softhand.reduced.calibrated.grasp_hold`: the
 calibrated finger in equilibrium hinge by hinge against the object, the reservoir's pressure
 at the oil taken), for the paper's finger model by eqs. (25), (29) at theta_g with the
 rolling w. The tube's peak principal stretch is eq. (8), 1 + (d + a + b) theta / l0 (the outer
@@ -27,9 +27,9 @@ pump pressure (at most the pump's limit), the open hand passes the object and at
 off) does not reach into the object's place (the free hand's pump pressure at the grasp angle,
 P_contact >= 0, so P_grasp >= 0 too: the pump pushes oil into the fingers), the sheet is thin
 enough for the membrane models of the reservoir (t/R <=
-:data:`softhand.reduced.reservoir.MAX_THICKNESS_RATIO`), and the finger model's calibrated range when
+:data:`softhand.reduced.equations.reservoir.MAX_THICKNESS_RATIO`), and the finger model's calibrated range when
 it has one. The whole model's P(theta) and theta(P) are those of
-``design.finger_model``/``design.reservoir_model`` through :mod:`softhand.reduced.hand`, so another
+``design.finger_model``/``design.reservoir_model`` through :mod:`softhand.reduced.equations.hand`, so another
 finger model changes the answer by a design key alone.
 """
 from __future__ import annotations
@@ -41,9 +41,11 @@ from typing import NamedTuple
 
 import numpy as np
 
-from softhand.reduced import contact, finger, grasp, grasp_hold, hand, reservoir
-from softhand.reduced.design import HandDesign, design_from_dict, hinges_for
-from softhand.reduced.errors import InputError
+from softhand.reduced.equations import contact, finger, grasp, hand, reservoir
+from softhand.reduced.calibrated import grasp_hold
+from softhand.reduced.vocabulary.design import HandDesign
+from softhand.reduced.vocabulary.design_files import design_from_dict, hinges_for
+from softhand.reduced.vocabulary.errors import InputError
 from softhand.studies.design.task import Task
 
 
@@ -138,7 +140,7 @@ def _number(x: float) -> float | None:
 
 def design_at(task: Task, x) -> HandDesign:
     """The base design with the free keys set to x (public units); l0 scales the hinges
-    (:func:`softhand.reduced.design.design_from_dict`)."""
+    (:func:`softhand.reduced.vocabulary.design_files.design_from_dict`)."""
     values = {key: float(v) for (key, _, _), v in zip(task.free, np.asarray(x, dtype=float))}
     return design_from_dict(values, task.base, source="free")
 
@@ -247,7 +249,7 @@ class GraspRelation(NamedTuple):
     F_at_limit: float  #: F_v at the pump limit (or at P_margin, see edge) [N]; nan: not asked (see grasp_relation)
     theta_hold: float  #: the finger's bend when it presses with the required F_v [rad]
     P_margin: float    #: the pump pressure of F_at_limit: the limit, or where the FEM-informed grasp ends [MPa]
-    edge: str = ""     #: why P_margin is below the limit (:attr:`softhand.reduced.grasp_hold.Hold.edge`), or ""
+    edge: str = ""     #: why P_margin is below the limit (:attr:`softhand.reduced.calibrated.grasp_hold.Hold.edge`), or ""
     no_grasp: str = ""  #: why P_grasp is inf (the required F_v not reached by the FEM-informed grasp), or ""
     F_reached: float = math.nan  #: with no_grasp: F_v where the FEM-informed grasp ends (how far it comes) [N]
 
@@ -262,7 +264,7 @@ def asks_force_at_limit(design: HandDesign, task: Task) -> bool:
 
 def grasp_relation(design: HandDesign, task: Task, theta: float, w, theta_open: float) -> GraspRelation:
     """The design's pump pressure <-> normal force F_v at the grasp angle theta [rad]: for
-    ``finger_model = "fem"`` the FEM-informed grasp (:mod:`softhand.reduced.grasp_hold`), else eqs. (25),
+    ``finger_model = "fem"`` the FEM-informed grasp (:mod:`softhand.reduced.calibrated.grasp_hold`), else eqs. (25),
     (29) with the rolling w. The one place where the design's F_v is computed."""
     if design.finger_model == "fem":
         return _fem_relation(design, task, theta, theta_open)
@@ -282,7 +284,7 @@ def _fem_relation(design: HandDesign, task: Task, theta: float, theta_open: floa
     limit only for the "margin" objective (for "pressure" the pump-pressure constraint on
     P_grasp is the same condition, F_v growing with the pump pressure: nan). Where the
     FEM-informed grasp ends below the pump limit (a second pad touches the object, the finger
-    reaches its largest bend: :func:`softhand.reduced.grasp_hold.at_pump`) F_v is the one there, at the
+    reaches its largest bend: :func:`softhand.reduced.calibrated.grasp_hold.at_pump`) F_v is the one there, at the
     highest pump pressure the model answers for, and ``edge`` says why."""
     P_contact = float(hand.pressure(theta, design))
     P_open = float(hand.pressure(theta_open, design)) if math.isfinite(theta_open) else -math.inf
@@ -309,7 +311,7 @@ def calibrated_range(design: HandDesign) -> list[Constraint]:
     none for the paper's model."""
     if getattr(design, "finger_model", "paper") == "paper":
         return []
-    from softhand.reduced import finger_fem
+    from softhand.reduced.calibrated import finger_fem
 
     table = _finger_table(design.finger_table or str(finger_fem.TABLE_FILE))
     groups = finger_fem.groups_of(design)
@@ -323,6 +325,6 @@ def calibrated_range(design: HandDesign) -> list[Constraint]:
 
 @lru_cache(maxsize=4)
 def _finger_table(path: str):
-    from softhand.reduced import finger_fem
+    from softhand.reduced.calibrated import finger_fem
 
     return finger_fem.read_table(path)

@@ -23,7 +23,7 @@ from typing import Callable
 import numpy as np
 from scipy.optimize import NonlinearConstraint, differential_evolution, minimize
 
-from softhand.reduced.errors import InputError
+from softhand.reduced.vocabulary.errors import InputError
 from softhand.studies.design.evaluate import Constraint, Evaluation, design_at, evaluate, unanswered
 from softhand.studies.design.task import Task
 
@@ -217,7 +217,7 @@ def binding(ev: Evaluation, tol: float = 1e-4) -> list[Constraint]:
 
 def open_span(design) -> float:
     """The tips' span [mm] of the straight hand (every hinge at 0), the widest it opens."""
-    from softhand.reduced import kinematics
+    from softhand.reduced.equations import kinematics
 
     return float(2.0 * kinematics.tip_position(np.zeros(design.n_s), design)[0])
 

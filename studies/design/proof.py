@@ -37,7 +37,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 from scipy.interpolate import PchipInterpolator
 
-from softhand.reduced import hand
+from softhand.reduced.equations import hand, reservoir
 from softhand.studies.design.optimise import Evaluation
 from softhand.studies.design.task import Task
 
@@ -58,6 +58,12 @@ class ProofOptions:
 
 class _Past(Exception):
     """Raised by the free-bend callback once the finger has bent past the grasp angle."""
+
+
+def sheet_pressure(sheet):
+    """The sheet FEM's p(V) [MPa] along its path from flat to V0, linear between its converged
+    states (exact at them; steps <= R^2 t / 2): the reservoir of :func:`softhand.reduced.equations.reservoir.pump_pressure`."""
+    return lambda V: np.interp(V, sheet.path_volume, sheet.path_pressure)
 
 
 def free_bend(finger, theta_g: float, options: ProofOptions) -> dict:
@@ -187,7 +193,7 @@ def margin(model, sheet, best, ev: Evaluation, task: Task, options: ProofOptions
 
     def oil_left(state):
         if id(state) not in oil:
-            oil[id(state)] = (state, design.V0 - design.n * finger.dQ(state.y))
+            oil[id(state)] = (state, float(reservoir.oil_left(finger.dQ(state.y), design)))
         V = oil[id(state)][1]
         if not V > 0:
             raise RuntimeError(f"grasp FEM: the fingers take all the oil (V0 = {design.V0:.0f} mm^3) "
@@ -195,7 +201,7 @@ def margin(model, sheet, best, ev: Evaluation, task: Task, options: ProofOptions
         return V
 
     def pump(state):  # the hand's pump pressure: the cavity's less the reservoir's at the oil left
-        return state.P - float(np.interp(oil_left(state), sheet.path_volume, sheet.path_pressure))
+        return float(reservoir.pump_pressure(state.P, oil_left(state), design, sheet_pressure(sheet)))
 
     def row(state):
         return {"pump_pressure_MPa": pump(state), "cavity_pressure_MPa": state.P, "F_v_N": state.F_v,
@@ -227,8 +233,8 @@ def margin(model, sheet, best, ev: Evaluation, task: Task, options: ProofOptions
 def _touch(bend: dict, ev: Evaluation, task: Task) -> float | None:
     """The bend [deg] at which the FEM finger, closing with its own hinge shares (at theta_g),
     touches the object in the reduced model's geometry (None: it does not reach it)."""
-    from softhand.reduced import contact
-    from softhand.reduced.errors import InputError
+    from softhand.reduced.equations import contact
+    from softhand.reduced.vocabulary.errors import InputError
 
     try:
         theta, _ = contact.contact_angle(task.diameter, ev.design, depth=ev.depth, w=bend["hinge_share"])
@@ -330,7 +336,7 @@ def prove(ev: Evaluation, task: Task, options: ProofOptions = ProofOptions(), *,
     bend = free_bend(finger, ev.theta_grasp, options)
     touch = _touch(bend, ev, task)
     say("reservoir sheet FEM at the oil left at contact")
-    V_contact = design.V0 - design.n * bend["dQ_mm3"]
+    V_contact = float(reservoir.oil_left(bend["dQ_mm3"], design))
     if not V_contact > 0:
         raise RuntimeError(f"the FEM fingers take {design.n * bend['dQ_mm3']:.0f} mm^3 of oil to reach "
                            f"the grasp angle, more than V0 = {design.V0:.0f} mm^3 (eq. (2) says "
@@ -338,8 +344,9 @@ def prove(ev: Evaluation, task: Task, options: ProofOptions = ProofOptions(), *,
     sheet_model = SheetModel.from_design(design, **options.sheet)
     sheet = inflate(sheet_model, [V_contact, design.V0])
     p_contact = sheet.states[0].pressure
+    at_contact = lambda _: p_contact  # noqa: E731 -- the sheet FEM solved at exactly that oil
     model = GraspModel(finger, task.diameter, mass=task.mass)
-    P_cav = ev.P_grasp + p_contact  # the predicted pump pressure with the FEM reservoir
+    P_cav = ev.P_grasp + p_contact  # the cavity pressure of the predicted pump pressure, FEM reservoir
     P_touch = bend["P_finger_MPa"] + 0.5 * options.dP_mpa  # just past the FEM's contact
     P_start = max(P_cav, P_touch)
     say(f"grasp FEM from the cavity pressure {P_start:.4g} MPa (object depth {model.depth:.1f} mm)")
@@ -349,13 +356,13 @@ def prove(ev: Evaluation, task: Task, options: ProofOptions = ProofOptions(), *,
                      ev.F_v, options, say)
     best = g["best"]
     fs = finger.state(best.y, best.P)
-    V_grasp = design.V0 - design.n * fs.dQ
+    V_grasp = float(reservoir.oil_left(fs.dQ, design))
     # the sheet's path from flat to V0 passes V_grasp (steps <= R^2 t / 2): interpolated
-    p_grasp = float(np.interp(V_grasp, sheet.path_volume, sheet.path_pressure))
+    p_grasp = float(sheet_pressure(sheet)(V_grasp))
     first = g["first"]
     fem = {
-        "P_grasp_MPa": best.P - p_grasp,
-        "P_contact_MPa": bend["P_finger_MPa"] - p_contact,
+        "P_grasp_MPa": float(reservoir.pump_pressure(best.P, V_grasp, design, sheet_pressure(sheet))),
+        "P_contact_MPa": float(reservoir.pump_pressure(bend["P_finger_MPa"], V_contact, design, at_contact)),
         "P_finger_at_contact_MPa": bend["P_finger_MPa"],
         "theta_touch_deg": touch,
         "reservoir_pressure_at_contact_MPa": p_contact,

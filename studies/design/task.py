@@ -32,7 +32,7 @@ A task designs on the FEM-calibrated models (``finger_model = "fem"``, ``reservo
 FEM proof checks. With the packaged finger table, the free bounds are clipped to the box the
 table was calibrated on (:data:`CALIBRATED_SPACE`, its ``[space]``); the table's group ranges
 are the optimiser's constraints (:func:`softhand.studies.design.evaluate.calibrated_range`).
-Every mistake is one :class:`~softhand.reduced.errors.InputError` naming the key.
+Every mistake is one :class:`~softhand.reduced.vocabulary.errors.InputError` naming the key.
 """
 from __future__ import annotations
 
@@ -41,8 +41,12 @@ import os
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from softhand.reduced.design import BOUNDS, PAPER_DESIGN_FILE, PUBLIC_KEYS, HandDesign, design_from_dict, load_design, read_toml
-from softhand.reduced.errors import InputError
+from softhand.reduced.vocabulary.design import BOUNDS, PAPER_DESIGN_FILE, PUBLIC_KEYS, HandDesign
+
+from softhand.reduced.vocabulary.design_files import design_from_dict, load_design
+
+from softhand.reduced.vocabulary.inputfiles import read_toml
+from softhand.reduced.vocabulary.errors import InputError
 
 #: design keys the optimiser may vary; "l0_mm" scales the hinge positions with the tube
 FREE_KEYS = ("a_mm", "b_mm", "d_mm", "l0_mm", "R_mm", "t_mm", "V0_mm3", "tie_width_mm")

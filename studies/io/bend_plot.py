@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from softhand.reduced import hand
+from softhand.reduced.equations import hand
 from softhand.studies.io.files import figure, save_figure
 
 

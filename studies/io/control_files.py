@@ -11,15 +11,15 @@ from pathlib import Path
 
 import numpy as np
 
-from softhand.reduced.errors import InputError
-from softhand.reduced.inputfiles import csv_cells, plain_float
+from softhand.reduced.vocabulary.errors import InputError
+from softhand.reduced.vocabulary.inputfiles import csv_cells, plain_float
 from softhand.studies.io.files import save_figure
 
 DISTURBANCE_HEADER = ("t_s", "force_N")
 #: allowed push force [N], of ``--push-N`` and of a disturbance file's rows
 PUSH_LIMITS_N = (-1000.0, 1000.0)
 #: the quiet time before any push [s]: the window the summary measures the hold in
-#: (:func:`softhand.reduced.control.summarize`), as for --push-at-s
+#: (:func:`softhand.reduced.dynamics.control.summarize`), as for --push-at-s
 QUIET_S = 1.0
 
 
@@ -27,7 +27,7 @@ def read_disturbance(path: str | Path, t_end: float | None = None):
     """The push profile of a ``t_s,force_N`` CSV file as a function of t [s]; InputError on bad
     files, and on a profile that starts at or after ``t_end`` [s] (the run would not see it)."""
     path = Path(path)
-    from softhand.reduced.design import read_input_file
+    from softhand.reduced.vocabulary.inputfiles import read_input_file
 
     data = read_input_file(path, "--disturbance", "a CSV file t_s,force_N")
     try:
@@ -86,7 +86,7 @@ def series_rows(sim, every: int) -> list[dict]:
 
 def plot_fig10(path, result, mode: str, theta_ref_deg: float) -> None:
     """Fig. 10 (c), (d): each finger's angle and the mean, the pump pressure and the push against
-    time, for the ``mode`` run of :func:`softhand.reduced.control.flexibility`'s ``result``, the other
+    time, for the ``mode`` run of :func:`softhand.reduced.dynamics.control.flexibility`'s ``result``, the other
     mode dotted."""
     import matplotlib
     matplotlib.use("Agg")

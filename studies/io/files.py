@@ -109,7 +109,7 @@ def check_output_tree(folder: str | Path, field: str, *, files=(), folders=()) -
     that a run writes are each of their kind or not there yet (a file where a folder goes
     fails its first write after the computation, a folder where a file goes its last); the
     folder's ancestors are folders. InputError naming ``field`` and the path otherwise."""
-    from softhand.reduced.errors import InputError
+    from softhand.reduced.vocabulary.errors import InputError
 
     folder = Path(folder)
     for ancestor in (folder, *folder.parents):

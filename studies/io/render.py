@@ -24,7 +24,7 @@ import numpy as np
 import pyvista as pv
 
 from softhand.meshes.atomic import atomic_path
-from softhand.reduced.errors import InputError
+from softhand.reduced.vocabulary.errors import InputError
 from softhand.studies.io.scene_read import field_names, field_values, load_scene
 from softhand.studies.io.render_style import (VIEWS, body_name, camera, clim_of, colour_label, default_field,
                                    default_png, has_display, title_of)

@@ -12,7 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
-from softhand.reduced.errors import InputError
+from softhand.reduced.vocabulary.errors import InputError
 
 #: blocks that are the deformable body, in order of preference
 BODIES = ("tube", "sheet")

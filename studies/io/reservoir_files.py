@@ -7,7 +7,7 @@ from pathlib import Path
 
 import numpy as np
 
-from softhand.reduced import hand, reservoir
+from softhand.reduced.equations import hand, reservoir
 from softhand.studies.io.files import figure, save_figure
 
 

@@ -13,7 +13,7 @@ from pathlib import Path
 import numpy as np
 import pyvista as pv
 
-from softhand.reduced.errors import InputError
+from softhand.reduced.vocabulary.errors import InputError
 from softhand.studies.io.render_style import step_index
 
 __all__ = ["SUFFIXES", "field_names", "field_values", "load_scene"]

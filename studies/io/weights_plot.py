@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from softhand.reduced.grasp import KGF
+from softhand.reduced.equations.grasp import KGF
 
 
 def _pyplot():

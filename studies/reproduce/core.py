@@ -27,9 +27,10 @@ from dataclasses import dataclass
 from datetime import datetime, timezone
 from pathlib import Path
 
-from softhand.reduced import paper
-from softhand.reduced.design import HandDesign
-from softhand.reduced.errors import InputError
+from softhand.reduced.equations import finger
+from softhand.reduced.vocabulary import paper
+from softhand.reduced.vocabulary.design import HandDesign
+from softhand.reduced.vocabulary.errors import InputError
 from softhand.studies.io.files import write_atomic, write_csv
 from softhand.studies.reproduce.section import Context, Section
 from softhand.studies.batch.runner import FAILED, RESULT, code_version, commit, execute_case, outcome_record
@@ -92,7 +93,7 @@ def check_design(design: HandDesign) -> None:
     """InputError naming the design's key if a section could not run for ``design``: its
     reservoir supplies the fingers up to THETA_MAX_DEG, and it has a hinge for each weight of
     the paper's weight vectors w, which the Table II and Fig. 8 sections use."""
-    design.check_volume(math.radians(THETA_MAX_DEG))
+    finger.check_volume(design, math.radians(THETA_MAX_DEG))
     hinges = len(paper.WEIGHTS[180.0])
     if design.n_s != hinges:
         raise InputError("n_s", design.n_s, f"must be {hinges}: the report's Table II and Fig. 8 sections "

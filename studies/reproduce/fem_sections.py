@@ -12,7 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
-from softhand.reduced import paper
+from softhand.reduced.vocabulary import paper
 from softhand.studies.io.files import figure, save_figure, write_csv
 from softhand.studies.reproduce.section import Context, Section, md_table
 

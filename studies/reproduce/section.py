@@ -10,7 +10,7 @@ from typing import Callable
 
 import numpy as np
 
-from softhand.reduced.design import HandDesign
+from softhand.reduced.vocabulary.design import HandDesign
 
 
 @dataclass(frozen=True)

@@ -4,7 +4,7 @@ Each builder ``build(ctx, outdir) -> (markdown, numbers)`` calls the owning libr
 function, writes its CSV/PNG/VTK files into ``outdir`` and returns the Markdown body
 (links relative to ``outdir``) and its headline numbers. No printing; no CLI calls.
 The FEM sections live in :mod:`softhand.studies.reproduce.fem_sections`; the paper's numbers they
-compare with come from :mod:`softhand.reduced.paper`.
+compare with come from :mod:`softhand.reduced.vocabulary.paper`.
 """
 from __future__ import annotations
 
@@ -16,36 +16,28 @@ from pathlib import Path
 import numpy as np
 
 from softhand.studies.io.files import figure, save_figure, write_csv
-from softhand.reduced import paper
+from softhand.reduced.vocabulary import paper
 from softhand.studies.reproduce.section import Context, Section, md_table
 
 
 # ---------------------------------------------------------------------- Fig. 7, reduced
 def fig7_reduced(ctx: Context, outdir: Path):
     """Eq. (27) with and (28) without reservoir over 0-90 deg; the reservoir's offset."""
-    from softhand.reduced import hand
+    from softhand.studies.curve import at_angles, at_pressures, plot_curve
 
     d = ctx.design
     theta_deg = np.arange(0.0, 90.0 + 1e-9, 1.0)
-    theta = np.radians(theta_deg)
-    P, P0 = hand.pressure(theta, d, reservoir=True), hand.pressure(theta, d, reservoir=False)
+    rows = at_angles(theta_deg, d)
+    P, P0 = (np.array([r[k] for r in rows]) for k in ("P_MPa", "P_no_reservoir_MPa"))
     offset = P0 - P
-    write_csv(outdir / "fig7_reduced.csv", [
-        {"theta_deg": t, "P_MPa": p, "P_no_reservoir_MPa": q} for t, p, q in zip(theta_deg, P, P0)])
+    write_csv(outdir / "fig7_reduced.csv", rows, ["theta_deg", "P_MPa", "P_no_reservoir_MPa"])
     pressures = np.round(np.arange(0.0, 0.8 + 1e-9, 0.1), 10)
-    by_p = _angles_at(pressures, d)
+    by_p = at_pressures(pressures, d, strict=False)
     write_csv(outdir / "fig7_reduced_by_pressure.csv", by_p)
-    P_fem, why = _pressure_fem_reservoir(theta, d)
-    fig, (ax,) = figure()
-    ax.plot(P, theta_deg, "-", label="eq. (27), with reservoir")
-    ax.plot(P0, theta_deg, ":", label="eq. (28), without reservoir")
-    if P_fem is not None:
-        ax.plot(P_fem, theta_deg, "--", label="eq. (27), FEM-calibrated reservoir")
-    ax.set(xlabel="pump pressure P [MPa]", ylabel="bend angle θ [deg]", xlim=(-0.15, None),
-           title="Fig. 7 analogue: reduced model")
-    ax.grid(alpha=0.3)
-    ax.legend()
-    save_figure(fig, outdir / "fig7_reduced.png")
+    P_fem, why = _pressure_fem_reservoir(np.radians(theta_deg), d)
+    plot_curve(outdir / "fig7_reduced.png", d, rows, title="Fig. 7 analogue: reduced model", markers=False,
+               extra=[] if P_fem is None else [("eq. (27), FEM-calibrated reservoir", P_fem, theta_deg)],
+               xlim=(-0.15, None))
     numbers = {"offset_mean_MPa": float(offset.mean()), "offset_min_MPa": float(offset.min()),
                "offset_max_MPa": float(offset.max()), "P_at_0deg_MPa": float(P[0]),
                "P_at_90deg_MPa": float(P[-1])}
@@ -70,7 +62,7 @@ pressure the charged sheet already bends the fingers a little.
 
 def _pressure_fem_reservoir(theta, design):
     """(eq. (27) with the FEM-calibrated reservoir model, None) or (None, why not)."""
-    from softhand.reduced import hand
+    from softhand.reduced.equations import hand
 
     try:
         return hand.pressure(theta, design.replace(reservoir_model="fem"), reservoir=True), None
@@ -87,27 +79,10 @@ def _fem_reservoir_note(P0, P_fem, why) -> str:
             f"{offset.max():.4f} MPa).")
 
 
-def _angles_at(pressures, design) -> list[dict]:
-    """θ(P) with and without reservoir; None where P is outside the model's range."""
-    from softhand.reduced import hand
-    from softhand.reduced.errors import InputError
-
-    rows = []
-    for P in pressures:
-        row = {"P_MPa": float(P)}
-        for key, res in (("theta_deg", True), ("theta_no_reservoir_deg", False)):
-            try:
-                row[key] = float(np.degrees(hand.bend_angle(P, design, reservoir=res)))
-            except InputError:
-                row[key] = float("nan")
-        rows.append(row)
-    return rows
-
-
 # ---------------------------------------------------------------------- Table II, reduced
 def table2_reduced(ctx: Context, outdir: Path):
     """F_v by eqs. (24), (25), (29) at the three (P, θ) of Table II, m = 2 kg, 180 mm w."""
-    from softhand.reduced.grasp import KGF, WeightSumWarning, check_weights, grasp_forces
+    from softhand.reduced.equations.grasp import KGF, WeightSumWarning, check_weights, grasp_forces
 
     d = ctx.design
     w_paper = np.asarray(paper.WEIGHTS[180.0])
@@ -151,7 +126,7 @@ def _ordering_verdict(F_b: float, F_c: float) -> str:
 # ---------------------------------------------------------------------- Fig. 8, reduced
 def fig8_reduced(ctx: Context, outdir: Path):
     """F_v(θ) by eq. (25), (29) at the paper's pressures for 2 kg/180 mm and 6 kg/240 mm."""
-    from softhand.reduced.grasp import KGF, WeightSumWarning, angle_at, grasp_forces
+    from softhand.reduced.equations.grasp import KGF, WeightSumWarning, angle_at, grasp_forces
 
     d = ctx.design
     theta_deg = np.arange(0.0, 90.0 + 1e-9, 1.0)
@@ -255,11 +230,11 @@ In the paper the pressure drops under the push ({paper.TABLE_II['b_push_pressure
 
 REDUCED_SECTIONS: list[Section] = [
     Section("fig7_reduced", "Fig. 7: pressure and bend angle, reduced model",
-            ("softhand.reduced.hand:pressure",), fig7_reduced),
+            ("softhand.reduced.equations.hand:pressure",), fig7_reduced),
     Section("table2_reduced", "Table II: grasping force, reduced model",
-            ("softhand.reduced.grasp:grasp_forces", "softhand.reduced.paper:TABLE_II"), table2_reduced),
+            ("softhand.reduced.equations.grasp:grasp_forces", "softhand.reduced.vocabulary.paper:TABLE_II"), table2_reduced),
     Section("fig8_reduced", "Fig. 8 analogue: grasping force against bend angle",
-            ("softhand.reduced.grasp:angle_at",), fig8_reduced),
+            ("softhand.reduced.equations.grasp:angle_at",), fig8_reduced),
     Section("table2_control", "Table II: angle control vs pressure control, simulated",
             ("softhand.studies.control:run", "softhand.studies.control:ControlStudy"), table2_control),
     Section("fig10_control", "Fig. 10 analogue: angle control under a push",

@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import math
 
-from softhand.reduced.errors import InputError
+from softhand.reduced.vocabulary.errors import InputError
 
 
 def richardson(coarse: float, medium: float, fine: float, ratio: float = 2.0) -> tuple[float, float]:

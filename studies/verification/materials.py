@@ -8,7 +8,7 @@ boundary conditions, stretched by lambda along x:
 * pure shear: x prescribed (lambda), y held (lambda_2 = 1), z free;
 
 nominal stress from the reaction against the incompressible closed form of
-:mod:`softhand.reduced.rubber`. The state is homogeneous (exact in P2), so what remains is the
+:mod:`softhand.reduced.materials.rubber`. The state is homogeneous (exact in P2), so what remains is the
 compressibility of the FEM material: kappa = 1e4 mu0 changes the stress by O(mu0/kappa),
 measured 2.7e-5 to 2.7e-4 relative; tolerance 1e-3.
 
@@ -31,7 +31,7 @@ from scipy.optimize import minimize_scalar
 from softhand.fem.hand.balloon import ThickSphere, closed_form_pressure_general, inflate_sphere
 from softhand.fem.hyperelastic import rubber_law
 from softhand.fem.solid import Solid
-from softhand.reduced import rubber
+from softhand.reduced.materials import rubber
 from softhand.studies.verification.registry import Check
 from softhand.studies.verification.solid import Problem, keep_map
 

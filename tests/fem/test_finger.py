@@ -8,9 +8,8 @@ import pytest
 from softhand.fem.constraints import ChainConstraint
 from softhand.fem.hand.finger import FingerModel, FingerOptions, ring_width, solve_pressures, to_hand_frame
 from softhand.fem.newton import NewtonOptions
-from softhand.reduced import hand, kinematics
-from softhand.reduced.design import HandDesign
-from conftest import CI_FINGER, CI_MESH_ARGS
+from softhand.reduced.equations import hand, kinematics
+from softhand.reduced.vocabulary.design import HandDesign
 
 DESIGN = HandDesign()
 CI = FingerOptions(**CI_FINGER)

@@ -10,7 +10,7 @@ from softhand.fem.hand.finger import FingerModel, FingerOptions
 from softhand.fem.hand.grasp import GraspModel, GraspOptions, default_depth, pads_of, weight_vector
 from softhand.fem.linsolve import make_solver
 from softhand.fem.newton import NewtonOptions, newton
-from softhand.reduced.design import HandDesign
+from softhand.reduced.vocabulary.design import HandDesign
 from softhand.studies.cli.main import main
 from softhand.studies.weights import interpolate
 from conftest import COARSEST_FINGER
@@ -238,7 +238,7 @@ def test_the_placement_check_needs_no_mesh_and_agrees_with_the_default_depth(dia
 
     from softhand.fem.constraints import PlanarChain
     from softhand.fem.hand.grasp import _open_gap, check_placement
-    from softhand.reduced.errors import InputError
+    from softhand.reduced.vocabulary.errors import InputError
 
     d, options = HandDesign(), GraspOptions()
     pads = pads_of(PlanarChain(np.c_[d.hinge_s, np.full(d.n_s, d.d)]), d, options)

@@ -1,5 +1,5 @@
 """FEM laws of every rubber model: stress = dpsi/dF, tangent = dP/dF (finite differences),
-NH reproduced exactly, the isochoric/volumetric split, homogeneous modes vs reduced/rubber.py."""
+NH reproduced exactly, the isochoric/volumetric split, homogeneous modes vs reduced/materials/rubber.py."""
 import numpy as np
 import pytest
 from scipy.optimize import brentq
@@ -7,7 +7,7 @@ from scipy.optimize import brentq
 from softhand.fem import kinematics as kin
 from softhand.fem.hyperelastic import IsochoricRubber, RubberLaw, rubber_law
 from softhand.fem.materials import NeoHookean, NeoHookeanIsochoric, Sum, Volumetric
-from softhand.reduced import rubber
+from softhand.reduced.materials import rubber
 from test_materials import F_BATCH, fd_derivative
 
 MODELS = {
@@ -92,7 +92,7 @@ def test_thick_sphere_pressure_for_any_model():
 
 def test_reservoir_sheet_takes_the_designs_material():
     from softhand.fem.hand.reservoir import SheetModel
-    from softhand.reduced.design import HandDesign
+    from softhand.reduced.vocabulary.design import HandDesign
 
     mr = rubber.MooneyRivlin(0.46, 0.115)
     model = SheetModel.from_design(HandDesign().replace(reservoir_material=mr, mu_sr=mr.mu0), n_radial=4,

@@ -8,9 +8,9 @@ import pytest
 
 from softhand.fem.hand.reservoir import SheetModel, inflate
 from softhand.fem.volume_path import PathState, follow_volume, volume_path_options
-from softhand.reduced import hand, reservoir
-from softhand.reduced import reservoir_fem
-from softhand.reduced.design import HandDesign
+from softhand.reduced.equations import hand, reservoir
+from softhand.reduced.calibrated import reservoir_fem
+from softhand.reduced.vocabulary.design import HandDesign
 from softhand.studies.cli.main import main
 from softhand.studies.reservoir import ReservoirStudy, run, stroke_volume
 from conftest import CI_SHEET

@@ -10,7 +10,7 @@ from matplotlib.image import imread
 from softhand.fem.hand.finger import FingerModel, FingerOptions
 from softhand.fem.io import SceneSeries
 from softhand.fem.hand.scene import finger_scene, link_boxes, to_hand
-from softhand.reduced.design import HandDesign
+from softhand.reduced.vocabulary.design import HandDesign
 from softhand.studies.cli.main import main
 from softhand.studies.io.render import animate, describe, inspect, load_scene
 from conftest import COARSEST_FINGER

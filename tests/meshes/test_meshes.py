@@ -8,7 +8,7 @@ import skfem
 from softhand.meshes import cache, gmsh_io
 from softhand.meshes.convert import read_mesh
 from softhand.meshes.tube import Tube, tube_mesh
-from softhand.reduced.errors import InputError
+from softhand.reduced.vocabulary.errors import InputError
 
 
 @pytest.fixture(autouse=True)
@@ -241,8 +241,8 @@ def test_a_finger_mesh_with_folded_elements_is_refused_before_its_fem():
     0.05 MPa; the uniform 10 mm mesh gives 1.1 deg). The uniform 4 mm mesh, with slivers of
     negative det J at a few vertices and the right bend (docs/finger.md), is kept."""
     from softhand.fem.hand.finger import FingerModel, FingerOptions
-    from softhand.reduced.design import HandDesign
-    from softhand.reduced.errors import MeshRejected
+    from softhand.reduced.vocabulary.design import HandDesign
+    from softhand.reduced.vocabulary.errors import MeshRejected
 
     with pytest.raises(InputError, match="fold over themselves") as info:
         FingerModel(HandDesign(), FingerOptions(mesher="gmsh", mesh_size=10.0, edge_ratio=0.5, mesh_refine=0))
@@ -261,7 +261,7 @@ def test_layered_tets_counts_the_layered_mesh_without_building_it(kw):
 
 
 def _thin_walled():
-    from softhand.reduced.design import HandDesign
+    from softhand.reduced.vocabulary.design import HandDesign
 
     return HandDesign(a=6.0, b=3.0, d=10.0, l0=200.0)
 
@@ -277,7 +277,7 @@ def test_least_unknowns_is_a_lower_bound_of_the_finger_fem(design, options):
     refuses only meshes at least that large); the layered one is within 25 %."""
     from softhand.fem.hand.finger import FingerModel, FingerOptions
     from softhand.fem.hand.finger_options import least_unknowns
-    from softhand.reduced.design import HandDesign
+    from softhand.reduced.vocabulary.design import HandDesign
 
     design = HandDesign() if design == "paper" else _thin_walled()
     model = FingerModel(design, FingerOptions(**options))
@@ -293,8 +293,8 @@ def test_a_mesh_too_large_for_the_memory_is_refused_before_meshing(monkeypatch):
     layered mesh (>= 277 000) does not; nothing is meshed (gmsh is not called)."""
     from softhand.fem.hand import finger_options as fo
     from softhand.fem.hand.finger import FingerModel, FingerOptions, finger_tube
-    from softhand.reduced.design import HandDesign
-    from softhand.reduced.errors import MeshRejected
+    from softhand.reduced.vocabulary.design import HandDesign
+    from softhand.reduced.vocabulary.errors import MeshRejected
 
     assert fo.most_unknowns(fo.MEASURED_PEAK_BYTES) == fo.MEASURED_UNKNOWNS
     assert fo.most_unknowns(1e9) == pytest.approx(553_820 / 14.9 ** 0.75, abs=1)

@@ -1,7 +1,7 @@
-"""The simulated hand and its controllers (reduced/plant.py, reduced/control.py).
+"""The simulated hand and its controllers (reduced/dynamics/plant.py, reduced/dynamics/control.py).
 
 References that are not the simulation itself: the reduced model's own statics
-(eq. (27) via reduced.hand, eq. (25) via reduced.grasp, eq. (2) via reduced.finger),
+(eq. (27) via reduced.equations.hand, eq. (25) via reduced.equations.grasp, eq. (2) via reduced.equations.finger),
 vector identities of the push split, and the same run with a feature switched off.
 """
 import json
@@ -11,13 +11,13 @@ import warnings
 import numpy as np
 import pytest
 
-from softhand.reduced import finger, grasp, hand
-from softhand.reduced.control import (AngleController, Gains, PressureController, default_gains,
+from softhand.reduced.equations import finger, grasp, hand
+from softhand.reduced.dynamics.control import (AngleController, Gains, PressureController, default_gains,
                              flexibility, initial_state, push_interval, ramp, simulate,
                              summarize)
-from softhand.reduced.design import HandDesign
-from softhand.reduced.errors import InputError
-from softhand.reduced.plant import HandTables, PlantParams, Push, equilibrium
+from softhand.reduced.vocabulary.design import HandDesign
+from softhand.reduced.vocabulary.errors import InputError
+from softhand.reduced.dynamics.plant import HandTables, PlantParams, Push, equilibrium
 from softhand.studies.cli.main import main
 
 W180 = grasp.PAPER_WEIGHTS[180.0]
@@ -68,7 +68,7 @@ def test_push_interval_ends_with_the_full_push(tables):
 
 def test_equilibrium_is_the_grasp_relation(tables):
     """Per-finger statics summed = eq. (25): with equal loads the static angle needs exactly
-    reduced.grasp.pressure_to_hold's P. Tolerance 1e-5 MPa: linear tables at 0.05 deg."""
+    reduced.equations.grasp.pressure_to_hold's P. Tolerance 1e-5 MPa: linear tables at 0.05 deg."""
     mass, down = 2.0, 6.0  # the weight plus a straight-down push, shared equally
     F_y = (mass * DESIGN.g + down) / DESIGN.n
     for P in (0.3, 1.0, 1.6):
@@ -81,7 +81,7 @@ def test_equilibrium_is_the_grasp_relation(tables):
 
 def test_small_pressure_step_is_a_first_order_lag(tables):
     """Free hand, a 0.02 MPa step with an instant pump: theta follows 1 - exp(-t/tau) with
-    tau = k_bar tau_f / f'(theta0), f'(theta0) the slope of eq. (27) (reduced.hand, central
+    tau = k_bar tau_f / f'(theta0), f'(theta0) the slope of eq. (27) (reduced.equations.hand, central
     differences). 1 % bounds the Euler error (dt/tau ~ 0.3 %) and the step's curvature."""
     plant = PlantParams(tau_m=1e-6)
     theta0 = float(initial_state(tables, 0.0)[0])

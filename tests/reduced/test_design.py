@@ -3,8 +3,10 @@ import math
 
 import pytest
 
-from softhand.reduced.design import PUBLIC_KEYS, HandDesign, design_from_dict, load_design
-from softhand.reduced.errors import InputError
+from softhand.reduced.equations import finger
+from softhand.reduced.vocabulary.design import PUBLIC_KEYS, HandDesign
+from softhand.reduced.vocabulary.design_files import design_from_dict, load_design
+from softhand.reduced.vocabulary.errors import InputError
 
 
 def test_paper_file_is_table_one():
@@ -42,9 +44,9 @@ def test_bad_input_names_the_field(values, field):
 
 def test_volume_check():
     d = HandDesign(V0=1000.0)
-    d.check_volume(math.radians(10))  # 4*pi*16*15*0.17 = 526 mm^3 < 1000
+    finger.check_volume(d, math.radians(10))  # 4*pi*16*15*0.17 = 526 mm^3 < 1000
     with pytest.raises(InputError, match="V0_mm3"):
-        d.check_volume(math.radians(90))
+        finger.check_volume(d, math.radians(90))
 
 
 def test_bad_files(tmp_path):

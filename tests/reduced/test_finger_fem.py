@@ -5,9 +5,10 @@ import numpy as np
 import pytest
 from scipy.integrate import quad
 
-from softhand.reduced import finger, finger_fem, hand, reservoir
-from softhand.reduced.design import HandDesign
-from softhand.reduced.errors import InputError
+from softhand.reduced.equations import finger, hand, reservoir
+from softhand.reduced.calibrated import finger_fem
+from softhand.reduced.vocabulary.design import HandDesign
+from softhand.reduced.vocabulary.errors import InputError
 from softhand.studies.calibration.space import finger_design
 from softhand.studies.calibration.finger_table import table_csv
 
@@ -196,7 +197,7 @@ def test_a_design_file_names_its_own_table_relative_to_itself(tmp_path):
     relative to the design file; the CLI's error for a design outside it is one line, exit 2."""
     from softhand.studies.cli.main import main
     from softhand.studies.calibration.finger_table import write_design_with_table
-    from softhand.reduced.design import load_design
+    from softhand.reduced.vocabulary.design_files import load_design
 
     path, designs, _ = _synthetic_table(tmp_path)
     toml = write_design_with_table(designs[1], path)
@@ -240,7 +241,7 @@ def test_a_cli_warning_is_one_line():
 def _kernel_table(tmp_path, truth, name, n=14, seed=4):
     """A table of n random designs in the box whose rows follow truth(groups, theta) -> (y, ln kappa)
     over the rings prior, with the kernel fit's '# fit:' line."""
-    from softhand.reduced.finger_fem_terms import KERNEL_FEATURES
+    from softhand.reduced.calibrated.finger_fem_terms import KERNEL_FEATURES
 
     rng = np.random.default_rng(seed)
     rows = []
@@ -264,7 +265,7 @@ def test_kernel_fit_is_exact_at_its_designs_and_for_linear_residuals(tmp_path):
     """The thin-plate-spline fit carries a linear polynomial, so a residual linear in the
     features (and theta) is reproduced at any design, not only the table's; a nonlinear one
     is reproduced at the table's designs (an interpolant) and only approximated between."""
-    from softhand.reduced.finger_fem_terms import BASE
+    from softhand.reduced.calibrated.finger_fem_terms import BASE
 
     def linear(g, th):
         return (0.1 - 0.05 * BASE["lb"](g, th) + 0.02 * BASE["s2"](g, th) + 0.03 * th,

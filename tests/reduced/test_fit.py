@@ -1,4 +1,4 @@
-"""Calibration (reduced.fit, reduced.csvdata, reduced.materials_data, softhand fit).
+"""Calibration (reduced.fitting.fit, reduced.fitting.csvdata, reduced.materials.materials_data, softhand fit).
 
 Independent checks: a model linear in its parameters, where ordinary least squares gives
 the exact estimate and covariance; synthetic data from known parameters plus noise, where
@@ -9,11 +9,11 @@ import math
 import numpy as np
 import pytest
 
-from softhand.reduced.csvdata import Measurements, read_measurements
-from softhand.reduced.design import HandDesign
-from softhand.reduced.errors import InputError
-from softhand.reduced.fit import FitOptions, check_params, diagnose, fit
-from softhand.reduced.materials_data import shear_modulus_from_shore_a, young_modulus_gent
+from softhand.reduced.fitting.csvdata import Measurements, read_measurements
+from softhand.reduced.vocabulary.design import HandDesign
+from softhand.reduced.vocabulary.errors import InputError
+from softhand.reduced.fitting.fit import FitOptions, check_params, diagnose, fit
+from softhand.reduced.materials.materials_data import shear_modulus_from_shore_a, young_modulus_gent
 
 
 # ---------------------------------------------------------------- a model linear in p
@@ -142,9 +142,9 @@ def test_gent_relation_limits_and_paper_value():
 
 
 # ---------------------------------------------------------------- the reduced model
-from softhand.reduced import hand  # noqa: E402
-from softhand.reduced.fit import make_predictor  # noqa: E402
-from softhand.reduced.design import design_from_dict  # noqa: E402
+from softhand.reduced.equations import hand  # noqa: E402
+from softhand.reduced.fitting.fit import make_predictor  # noqa: E402
+from softhand.reduced.vocabulary.design_files import design_from_dict  # noqa: E402
 
 TRUTH = {"V0_mm3": 15000.0, "mu_sf_MPa": 1.30}
 P_PAPER = np.repeat(np.round(np.arange(0.0, 0.85, 0.1), 2), 4)  # 0..0.8 MPa, four fingers
@@ -223,7 +223,7 @@ def test_v0_without_reservoir_is_flagged():
 import json  # noqa: E402
 from pathlib import Path  # noqa: E402
 
-from softhand.reduced.design import load_design  # noqa: E402
+from softhand.reduced.vocabulary.design_files import load_design  # noqa: E402
 from softhand.studies.cli.main import main  # noqa: E402
 
 EXAMPLES = Path(__file__).resolve().parents[2] / "studies" / "data"

@@ -1,12 +1,13 @@
-"""softhand.reduced.grasp_hold: the one-solve grasp (F_v or pump pressure given) against the
+"""softhand.reduced.calibrated.grasp_hold: the one-solve grasp (F_v or pump pressure given) against the
 bracketing root finder on grasp_fem.grasp_state, and the state it finds is grasp_state's."""
 import math
 
 import numpy as np
 import pytest
 
-from softhand.reduced import grasp_fem, grasp_hold, hand
-from softhand.reduced.design import HandDesign
+from softhand.reduced.calibrated import grasp_fem, grasp_hold
+from softhand.reduced.equations import hand
+from softhand.reduced.vocabulary.design import HandDesign
 
 PAPER = grasp_fem.fem_finger(HandDesign(reservoir_model="fem"))
 #: (design, diameter, mass, F_v [N], pump pressure [MPa]): pad 2 (the paper's task), pad 3 after a
@@ -95,7 +96,7 @@ def test_a_force_one_pad_cannot_give_is_refused_at_the_end_of_one_pad(monkeypatc
     same failing pressures again (21 equilibria); now the end is solved for, and the refusal
     names it: the cavity pressure where grasp_state stops having a state (bisection on that; to
     the message's six digits), and F_v there."""
-    from softhand.reduced.errors import InputError
+    from softhand.reduced.vocabulary.errors import InputError
 
     state = grasp_fem.grasp_state
     calls = _count_states(monkeypatch)
@@ -130,7 +131,7 @@ def test_both_paths_stop_where_the_free_finger_has_no_pressure():
     """Above the free finger's pressure at its largest bend (4.0 MPa here) the FEM-calibrated curve
     has no state for grasp_state: the slow path refuses, and the fast path, whose equations go
     on, gives no answer there either (it gave F_v = 93 N at 4.5 MPa)."""
-    from softhand.reduced.errors import InputError
+    from softhand.reduced.vocabulary.errors import InputError
 
     top = grasp_hold._largest_pressure(TIP_HOLD)
     assert 3.9 < top < 4.1
@@ -145,7 +146,7 @@ def test_a_fast_iterate_outside_the_models_does_not_end_the_hold(monkeypatch):
     """A small reservoir: a Newton iterate on the first pad takes more oil than the reservoir
     holds (InputError from the reservoir model), which ended the design's evaluation; now that
     pad gives no answer and the next one, which holds the object, does: the slow path's state."""
-    from softhand.reduced.errors import InputError
+    from softhand.reduced.vocabulary.errors import InputError
 
     design = PAPER.replace(a=5.2, b=5.3, d=17.9, R=27.5, t=1.1, V0=5600.0, tie_width=14.1, l0=180.0)
     raised, newton = [], grasp_hold._newton
@@ -201,7 +202,7 @@ def test_a_pump_pressure_beyond_the_one_pad_region_is_refused_at_once(monkeypatc
     cavity pressure is at least the pump's (the reservoir's pressure is not negative), where one
     pad no longer holds the object alone: refused after that one equilibrium (the bracket
     halved down to the edge, ~0.5 s). A scan of the one-pad states confirms: none reaches 4 MPa."""
-    from softhand.reduced.errors import InputError
+    from softhand.reduced.vocabulary.errors import InputError
 
     state = grasp_fem.grasp_state
     calls = _count_states(monkeypatch)
@@ -221,7 +222,7 @@ def test_a_pump_pressure_beyond_the_one_pad_region_is_refused_at_once(monkeypatc
 def _existence_edge(design, diameter, mass, lo, hi, tol=1e-8):
     """The cavity pressure where grasp_state stops having a state, by plain bisection on whether it
     has one (lo: it has, hi: it has not)."""
-    from softhand.reduced.errors import InputError
+    from softhand.reduced.vocabulary.errors import InputError
 
     while hi - lo > tol:
         mid = 0.5 * (lo + hi)

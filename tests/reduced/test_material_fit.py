@@ -4,8 +4,8 @@ import json
 import numpy as np
 import pytest
 
-from softhand.reduced import material_fit as mf
-from softhand.reduced import rubber
+from softhand.reduced.materials import material_fit as mf
+from softhand.reduced.materials import rubber
 from softhand.studies.cli.main import main
 
 TRUTH = {
@@ -77,7 +77,7 @@ def test_cli_json_on_treloar(capsys, tmp_path):
     assert set(report["parameters"]) == set(report["std_errors"]) == {"C10_MPa", "C20_MPa", "C30_MPa"}
     assert set(report["rms_error_by_mode"]) == set(rubber.MODES)
     assert report["n_points_by_mode"] == {"uniaxial": 24, "equibiaxial": 16, "pure-shear": 13}
-    from softhand.reduced.design import load_design
+    from softhand.reduced.vocabulary.design_files import load_design
 
     design = load_design(out)
     assert design.finger_rubber.parameters() == pytest.approx(report["parameters"])

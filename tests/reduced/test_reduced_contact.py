@@ -1,4 +1,4 @@
-"""softhand.reduced.contact: pad gaps and placement against the grasp FEM's own geometry (fem.contact,
+"""softhand.reduced.equations.contact: pad gaps and placement against the grasp FEM's own geometry (fem.contact,
 another frame and code), gap gradients against finite differences, contact angle, rolling w."""
 
 import numpy as np
@@ -7,9 +7,9 @@ import pytest
 from softhand.fem.constraints import PlanarChain
 from softhand.fem.contact import Circle, gaps
 from softhand.fem.hand.grasp import GraspOptions, default_depth, pads_of, to_finger_frame
-from softhand.reduced import contact, kinematics
-from softhand.reduced.design import HandDesign
-from softhand.reduced.errors import InputError
+from softhand.reduced.equations import contact, kinematics
+from softhand.reduced.vocabulary.design import HandDesign
+from softhand.reduced.vocabulary.errors import InputError
 
 DESIGN = HandDesign()
 

@@ -3,8 +3,8 @@ import numpy as np
 import pytest
 from scipy.integrate import quad
 
-from softhand.reduced import finger
-from softhand.reduced.design import HandDesign
+from softhand.reduced.equations import finger
+from softhand.reduced.vocabulary.design import HandDesign
 
 D = HandDesign()
 ANGLES = np.array([0.05, 0.3, 0.8, np.pi / 2, np.pi, -0.4, -np.pi / 2])

@@ -5,10 +5,10 @@ import warnings
 import numpy as np
 import pytest
 
-from softhand.reduced import finger, grasp, hand, reservoir
-from softhand.reduced import kinematics as kin
-from softhand.reduced.design import HandDesign
-from softhand.reduced.errors import InputError
+from softhand.reduced.equations import finger, grasp, hand, reservoir
+from softhand.reduced.equations import kinematics as kin
+from softhand.reduced.vocabulary.design import HandDesign
+from softhand.reduced.vocabulary.errors import InputError
 
 D = HandDesign()
 W180 = np.array(grasp.PAPER_WEIGHTS[180.0])

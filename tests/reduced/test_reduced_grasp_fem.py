@@ -1,4 +1,4 @@
-"""softhand.reduced.grasp_fem: the energy's gradient by differences, the lever law on one link in
+"""softhand.reduced.calibrated.grasp_fem: the energy's gradient by differences, the lever law on one link in
 closed form, virtual work of the contact force by differences of positions, the angle mode,
 and agreement with stored grasp FEM states (tests/data/grasp_fem_states.json)."""
 import json
@@ -8,9 +8,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from softhand.reduced import contact, grasp, grasp_fem, hand, kinematics
-from softhand.reduced.design import HandDesign
-from softhand.reduced.errors import InputError
+from softhand.reduced.equations import contact, grasp, hand, kinematics
+from softhand.reduced.calibrated import grasp_fem
+from softhand.reduced.vocabulary.design import HandDesign
+from softhand.reduced.vocabulary.errors import InputError
 from softhand.studies.cli.main import main
 
 DESIGN = grasp_fem.fem_finger(HandDesign())
@@ -170,11 +171,11 @@ def test_the_one_pad_grasp_ends_where_the_grasp_fem_touches_with_a_second_pad(da
     """The paper's hand on 180 mm at 1 kg: the grasp FEM holds the object with pad 3 alone up to
     2.8 MPa and touches it with the tip pad 5 too from 2.9 MPa on (stored states); the
     low-pressure task's optimum at a 4 MPa pump: pad 3 alone up to 3.55 MPa, the tip pad too
-    from 3.6 MPa. The reduced model's end of the one-pad grasp (reduced.grasp_hold.one_pad_end)
+    from 3.6 MPa. The reduced model's end of the one-pad grasp (reduced.calibrated.grasp_hold.one_pad_end)
     lies between, on the FEM's holding pad, with the FEM's second pad the one touching, and its
     F_v within 10 % of the FEM's there."""
-    from softhand.reduced import grasp_hold
-    from softhand.reduced.design import design_from_dict
+    from softhand.reduced.calibrated import grasp_hold
+    from softhand.reduced.vocabulary.design_files import design_from_dict
 
     design = grasp_fem.fem_finger(design_from_dict(data["design"], DESIGN, source="stored")) \
         if data["design"] else DESIGN

@@ -4,9 +4,9 @@ import math
 import numpy as np
 import pytest
 
-from softhand.reduced import finger, hand, reservoir
-from softhand.reduced.design import HandDesign
-from softhand.reduced.errors import InputError
+from softhand.reduced.equations import finger, hand, reservoir
+from softhand.reduced.vocabulary.design import HandDesign
+from softhand.reduced.vocabulary.errors import InputError
 
 D = HandDesign()
 THETA = np.radians([-80.0, -10.0, 0.0, 5.0, 30.0, 50.0, 90.0, 170.0])

@@ -4,8 +4,8 @@ import math
 import numpy as np
 import pytest
 
-from softhand.reduced import kinematics as kin
-from softhand.reduced.design import HandDesign
+from softhand.reduced.equations import kinematics as kin
+from softhand.reduced.vocabulary.design import HandDesign
 
 D = HandDesign()
 

@@ -8,9 +8,11 @@ import numpy as np
 import pytest
 from scipy import integrate
 
-from softhand.reduced import finger, hand, reservoir, rubber
-from softhand.reduced.design import HandDesign, design_from_dict, load_design
-from softhand.reduced.errors import InputError
+from softhand.reduced.equations import finger, hand, reservoir
+from softhand.reduced.materials import rubber
+from softhand.reduced.vocabulary.design import HandDesign
+from softhand.reduced.vocabulary.design_files import design_from_dict, load_design
+from softhand.reduced.vocabulary.errors import InputError
 from softhand.studies.cli.main import main
 
 MR = rubber.MooneyRivlin(0.5, 0.075)

@@ -3,9 +3,9 @@ import numpy as np
 import pytest
 from scipy.special import ellipe
 
-from softhand.reduced import reservoir
-from softhand.reduced.design import HandDesign
-from softhand.reduced.errors import InputError
+from softhand.reduced.equations import reservoir
+from softhand.reduced.vocabulary.design import HandDesign
+from softhand.reduced.vocabulary.errors import InputError
 
 D = HandDesign()
 THETA = np.radians([-60.0, 0.0, 20.0, 45.0, 90.0, 150.0])

@@ -1,9 +1,9 @@
-"""Strain energies of reduced/rubber.py: derivatives vs finite differences, closed forms."""
+"""Strain energies of reduced/materials/rubber.py: derivatives vs finite differences, closed forms."""
 import numpy as np
 import pytest
 
-from softhand.reduced import rubber
-from softhand.reduced.errors import InputError
+from softhand.reduced.materials import rubber
+from softhand.reduced.vocabulary.errors import InputError
 
 MODELS = [
     rubber.NeoHookean(0.6),

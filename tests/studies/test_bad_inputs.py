@@ -11,7 +11,7 @@ from pathlib import Path
 import pytest
 
 from bad_input_cases import EXTRA_FILES, replay_cases
-from softhand.reduced.design import BOUNDS, HandDesign
+from softhand.reduced.vocabulary.design import BOUNDS, HandDesign
 from softhand.studies.cli.main import main
 
 # ---------------------------------------------------------------- input files of the cases
@@ -394,7 +394,7 @@ def test_bad_input_is_one_line_exit_2_and_nothing_written(argv, scratch, capsys)
 
 
 def test_every_number_of_a_design_has_bounds():
-    """A new numeric design key needs a line in reduced.design.BOUNDS."""
+    """A new numeric design key needs a line in reduced.vocabulary.design.BOUNDS."""
     numeric = [k for k, v in HandDesign().to_dict().items()
                if isinstance(v, (int, float)) and not isinstance(v, bool)]
     assert set(numeric) <= set(BOUNDS)
@@ -412,8 +412,8 @@ def test_every_number_of_a_design_has_bounds():
 def test_a_deeply_dotted_key_is_refused_before_the_parser_reads_it(text, tmp_path, monkeypatch):
     """tomllib takes time quadratic in a dotted key's parts (20 000 parts: 1-8 s, 400 000 in a
     1 MB file: about an hour); such a key is refused by a scan of the text, without parsing."""
-    from softhand.reduced import inputfiles
-    from softhand.reduced.errors import InputError
+    from softhand.reduced.vocabulary import inputfiles
+    from softhand.reduced.vocabulary.errors import InputError
 
     path = tmp_path / "d.toml"
     path.write_text(text)
@@ -425,7 +425,7 @@ def test_a_deeply_dotted_key_is_refused_before_the_parser_reads_it(text, tmp_pat
 def test_dotted_keys_within_the_nesting_limit_are_read(tmp_path):
     """Sixteen parts (the limit) in a key and a header's inner key; dots after commas inside
     strings and comments are not keys."""
-    from softhand.reduced import inputfiles
+    from softhand.reduced.vocabulary import inputfiles
 
     key = ".".join(f"k{i}" for i in range(16))
     path = tmp_path / "d.toml"

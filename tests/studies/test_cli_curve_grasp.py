@@ -5,9 +5,9 @@ import math
 import numpy as np
 import pytest
 
-from softhand.reduced import grasp, hand
-from softhand.reduced.design import HandDesign
-from softhand.reduced.errors import InputError
+from softhand.reduced.equations import grasp, hand
+from softhand.reduced.vocabulary.design import HandDesign
+from softhand.reduced.vocabulary.errors import InputError
 from softhand.studies.cli.main import main
 
 D = HandDesign()
@@ -169,7 +169,7 @@ def test_the_pressures_of_a_curve_are_those_both_models_reach():
     """P -> theta answers with and without the reservoir, or names the pressures both reach:
     the larger of the two lower ends, the smaller of the upper ones (each end a pressure its
     model reaches, eq. (27) / (28) at the end of its bend range)."""
-    from softhand.reduced import hand
+    from softhand.reduced.equations import hand
 
     d = HandDesign()
     (lo_r, hi_r), (lo_f, hi_f) = hand.pressure_span(d, True), hand.pressure_span(d, False)

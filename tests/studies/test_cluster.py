@@ -81,7 +81,7 @@ def test_an_unreachable_scheduler_is_told_at_once_and_a_live_one_is_joined():
 
     from dask.distributed import LocalCluster
 
-    from softhand.reduced.errors import InputError
+    from softhand.reduced.vocabulary.errors import InputError
     from softhand.studies.batch.cluster import close_cluster, open_cluster
 
     with pytest.raises(InputError, match="no host 'nowhere.invalid'"):

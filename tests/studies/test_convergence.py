@@ -1,7 +1,7 @@
 """Richardson extrapolation against sequences with a known limit and order."""
 import pytest
 
-from softhand.reduced.errors import InputError
+from softhand.reduced.vocabulary.errors import InputError
 from softhand.studies.verification.convergence import richardson
 
 

@@ -6,7 +6,8 @@ from dataclasses import replace
 
 import pytest
 
-from softhand.reduced import grasp_hold, hand
+from softhand.reduced.calibrated import grasp_hold
+from softhand.reduced.equations import hand
 from softhand.studies.design import optimise as design_opt
 from softhand.studies.design.proof import ProofOptions, prove
 from softhand.studies.design.task import load_task, task_from_dict

@@ -5,7 +5,7 @@ import json
 
 import pytest
 
-from softhand.reduced.design import load_design
+from softhand.reduced.vocabulary.design_files import load_design
 from softhand.studies.design import optimise as design_opt
 from softhand.studies.design.task import task_from_dict
 from test_design_task import CI_TASK, CI_TASK_TOML, _write
@@ -39,10 +39,8 @@ def test_the_proof_mesh_follows_the_wall():
 
 
 def test_a_failed_proof_mesh_is_retried_on_the_next_finer_one(monkeypatch):
-    from types import SimpleNamespace
-
-    from softhand.reduced.errors import InputError, MeshRejected
-    from softhand.studies.cli.verbs import design as verb
+    from softhand.reduced.vocabulary.errors import InputError, MeshRejected
+    from softhand.studies.design import workflow
     from softhand.studies.design import proof
 
     tried, works = [], 6.0
@@ -58,22 +56,22 @@ def test_a_failed_proof_mesh_is_retried_on_the_next_finer_one(monkeypatch):
     monkeypatch.setattr(proof, "prove", prove)
     task = task_from_dict({**CI_TASK, "fem": {"mesh_size_mm": 10.0}})
     ev = design_opt.evaluate(task.base, task)
-    fem = verb._prove(ev, task, SimpleNamespace(mesh_size_mm=None), None, lambda text: None)
+    fem = workflow.prove_on_meshes(ev, task, None, None, lambda text: None)
     assert tried == [10.0, 6.0] and fem["P_grasp_MPa"] == 0.5
     assert fem["failed_meshes"][0]["mesh_size_mm"] == 10.0
     tried.clear()
-    fem = verb._prove(ev, task, SimpleNamespace(mesh_size_mm=6.0), None, lambda text: None)
+    fem = workflow.prove_on_meshes(ev, task, 6.0, None, lambda text: None)
     assert tried == [6.0] and "failed_meshes" not in fem
     tried.clear()
     works = 4.0  # a thin wall: the 10 and 6 mm meshes stall, 4 mm bends it
-    fem = verb._prove(ev, task, SimpleNamespace(mesh_size_mm=None), None, lambda text: None)
+    fem = workflow.prove_on_meshes(ev, task, None, None, lambda text: None)
     assert tried == [10.0, 6.0, 4.0] and [m["mesh_size_mm"] for m in fem["failed_meshes"]] == [10.0, 6.0]
     tried.clear()
     works = 3.0  # none works: the last error, every mesh named
-    fem = verb._prove(ev, task, SimpleNamespace(mesh_size_mm=None), None, lambda text: None)
+    fem = workflow.prove_on_meshes(ev, task, None, None, lambda text: None)
     assert tried == [10.0, 6.0, 4.0] and "error" in fem and len(fem["failed_meshes"]) == 3
     tried.clear()
-    fem = verb._prove(ev, task, SimpleNamespace(mesh_size_mm=3.5), None, lambda text: None)
+    fem = workflow.prove_on_meshes(ev, task, 3.5, None, lambda text: None)
     assert tried == [3.5]  # a finer mesh of the user's is the only one
 
     def refuses(*args, **kwargs):
@@ -81,16 +79,15 @@ def test_a_failed_proof_mesh_is_retried_on_the_next_finer_one(monkeypatch):
 
     monkeypatch.setattr(proof, "prove", refuses)
     with pytest.raises(InputError):  # any other bad input is the user's: it ends the run
-        verb._prove(ev, task, SimpleNamespace(mesh_size_mm=None), None, lambda text: None)
+        workflow.prove_on_meshes(ev, task, None, None, lambda text: None)
 
 
 def test_a_proof_mesh_too_large_for_the_optimum_is_not_retried_finer(monkeypatch):
     """The box's smallest finger fitted the memory, the optimum's does not: no finer mesh is
     tried (it would be larger still) and the report asks for a coarser one."""
-    from types import SimpleNamespace
 
-    from softhand.reduced.errors import MeshTooLarge
-    from softhand.studies.cli.verbs import design as verb
+    from softhand.reduced.vocabulary.errors import MeshTooLarge
+    from softhand.studies.design import workflow
     from softhand.studies.design import proof
 
     tried = []
@@ -102,7 +99,7 @@ def test_a_proof_mesh_too_large_for_the_optimum_is_not_retried_finer(monkeypatch
     monkeypatch.setattr(proof, "prove", prove)
     task = task_from_dict({**CI_TASK, "fem": {"mesh_size_mm": 10.0}})
     ev = design_opt.evaluate(task.base, task)
-    fem = verb._prove(ev, task, SimpleNamespace(mesh_size_mm=None), None, lambda text: None)
+    fem = workflow.prove_on_meshes(ev, task, None, None, lambda text: None)
     assert tried == [10.0] and fem["too_large"]
     assert "try --mesh-size-mm with a coarser mesh" in proof.fem_report(fem, ev)
 
@@ -112,7 +109,7 @@ def test_the_proof_mesh_is_bounded_on_the_boxs_thinnest_shortest_tube(monkeypatc
     not that corner is a valid design (d below a + b there), and the finest mesh the proof may
     try: the bound of a uniform gmsh tube of that size."""
     from softhand.fem.hand import finger_options as fo
-    from softhand.reduced.errors import MeshTooLarge
+    from softhand.reduced.vocabulary.errors import MeshTooLarge
     from softhand.studies.design import proof
 
     seen = []
@@ -225,18 +222,21 @@ def test_the_fem_margin_is_printed_with_the_pads_on_the_object(capsys):
     and where the FEM did not reach the limit."""
     from types import SimpleNamespace
 
-    from softhand.studies.cli.verbs.design import _print_margin
+    from softhand.studies.design.summary import margin_lines
+
+    def print_margin(fem, task):  # what softhand design prints
+        print(*margin_lines(fem, task), sep="\n")
 
     at = {"F_v_N": 40.19, "pump_pressure_MPa": 2.8143, "cavity_pressure_MPa": 2.861,
           "links_in_contact": [3], "predicted_F_v_N": 38.13}
     limit = {"F_v_N": 43.16, "margin_N": 28.45, "links_in_contact": [3, 5]}
-    _print_margin({"margin": at, "at_pump_limit": limit}, SimpleNamespace(max_pressure=3.2))
+    print_margin({"margin": at, "at_pump_limit": limit}, SimpleNamespace(max_pressure=3.2))
     out = capsys.readouterr().out.splitlines()
     assert out == ["# FEM margin: F_v 40.19 N at the pump pressure 2.814 MPa (cavity 2.861 MPa, on the "
                    "object: link 3 (0 = base)), predicted 38.13 N",
                    "# FEM at the pump limit 3.2 MPa, beyond the reduced model's one-pad grasp: F_v 43.16 N, "
                    "margin 28.45 N (on the object: links 3, 5 (0 = base))"]
-    _print_margin({"margin": at, "at_pump_limit": {"error": "Newton stopped at P = 3.1 MPa"}},
+    print_margin({"margin": at, "at_pump_limit": {"error": "Newton stopped at P = 3.1 MPa"}},
                   SimpleNamespace(max_pressure=3.2))
     assert capsys.readouterr().out.splitlines()[1] == \
         "# FEM at the pump limit 3.2 MPa: not reached (Newton stopped at P = 3.1 MPa)"
@@ -303,7 +303,10 @@ def test_a_margin_the_grasp_fem_does_not_reach_is_reported_not_raised(capsys):
     from types import SimpleNamespace
 
     import numpy as np
-    from softhand.studies.cli.verbs.design import _print_margin
+    from softhand.studies.design.summary import margin_lines
+
+    def print_margin(fem, task):  # what softhand design prints
+        print(*margin_lines(fem, task), sep="\n")
     from softhand.studies.design.proof import ProofOptions, margin
 
     sheet = SimpleNamespace(path_volume=np.array([0.0, 30000.0]), path_pressure=np.array([0.0, 0.3]))
@@ -313,7 +316,7 @@ def test_a_margin_the_grasp_fem_does_not_reach_is_reported_not_raised(capsys):
                          F_v_at_limit=50.0), task, ProofOptions())
     assert states == [] and out == {"margin": {"error": "Newton stopped at P = 1 MPa on the way to 1.08 MPa",
                               "predicted_F_v_N": 50.0, "below_pump_limit": ""}}
-    _print_margin(out, task)
+    print_margin(out, task)
     assert capsys.readouterr().out == ("# FEM margin: not computed (Newton stopped at P = 1 MPa on the way to "
                                        "1.08 MPa); predicted F_v 50 N\n")
     # past the reduced margin, on the way to the pump limit: the margin stands, the limit is reported
@@ -325,7 +328,7 @@ def test_a_margin_the_grasp_fem_does_not_reach_is_reported_not_raised(capsys):
 
 
 def test_the_knee_line_gives_the_fem_margin_where_the_proof_has_one():
-    from softhand.studies.cli.verbs.design import _knee_line
+    from softhand.studies.design.summary import knee_line as _knee_line
 
     knee = {"predicted": {"P_grasp_MPa": 0.52, "F_v_N": 9.81, "margin_N": 4.13},
             "fem": {"P_grasp_MPa": 0.53, "F_v_N": 9.41}, "design_file": "knee/design.toml"}

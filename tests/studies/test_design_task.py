@@ -7,9 +7,10 @@ import math
 import numpy as np
 import pytest
 
-from softhand.reduced import finger, grasp, grasp_fem, hand, kinematics
-from softhand.reduced.design import load_design
-from softhand.reduced.errors import InputError
+from softhand.reduced.equations import finger, grasp, hand, kinematics
+from softhand.reduced.calibrated import grasp_fem
+from softhand.reduced.vocabulary.design_files import load_design
+from softhand.reduced.vocabulary.errors import InputError
 from softhand.studies.design import optimise as design_opt
 from softhand.studies.design.task import load_task, task_from_dict
 
@@ -414,7 +415,7 @@ def test_free_values_the_design_rules_refuse_are_infeasible_points_not_errors():
 
 
 def test_all_eight_free_keys_at_their_full_bounds():
-    from softhand.reduced.design import BOUNDS
+    from softhand.reduced.vocabulary.design import BOUNDS
     from softhand.studies.design.task import FREE_KEYS
 
     free = {k: list(BOUNDS[k]) for k in FREE_KEYS}
@@ -445,8 +446,8 @@ def test_a_free_sheet_stays_a_thin_sheet_that_the_pump_pushes():
     """R, t and V0 free over their whole bounds: the optimiser had found a 50 mm thick "sheet"
     (t/R = 0.34, far outside the membrane models and the FEM tables' 1/24-1/12) whose pump
     pressure at the grasp was negative (-0.017 MPa). Both are constraints now."""
-    from softhand.reduced.design import BOUNDS
-    from softhand.reduced.reservoir import MAX_THICKNESS_RATIO
+    from softhand.reduced.vocabulary.design import BOUNDS
+    from softhand.reduced.equations.reservoir import MAX_THICKNESS_RATIO
 
     task = task_from_dict({**CI_TASK, "free": {k: list(BOUNDS[k]) for k in ("R_mm", "t_mm", "V0_mm3")}})
     thick = design_opt.evaluate(task.base.replace(R=146.06, t=49.69, V0=5.009e6), task)
@@ -463,19 +464,19 @@ def test_a_design_run_stopped_mid_proof_leaves_none_of_its_files(tmp_path, monke
     earlier run's result.json that no longer matched it. The earlier record goes when a run
     starts, the stopped run's files (design, VTK) when it stops; other files stay."""
     from softhand.studies.cli import main as cli
-    from softhand.studies.cli.verbs import design as design_verb
+    from softhand.studies.design import workflow
 
     task, out = _write(tmp_path, CI_TASK_TOML), tmp_path / "out"
     out.mkdir()
     (out / "result.json").write_text('{"design_file": "design.toml"}\n')  # an earlier run's record
     (out / "notes.txt").write_text("mine\n")
 
-    def stopped_proof(ev, task, args, out, say):
+    def stopped_proof(ev, task, mesh_size_mm, out, say):
         (out / "grasp").mkdir()
         (out / "grasp" / "step_0.vtu").write_text("half a VTK")
         raise KeyboardInterrupt
 
-    monkeypatch.setattr(design_verb, "_prove", stopped_proof)
+    monkeypatch.setattr(workflow, "prove_on_meshes", stopped_proof)
     assert cli.main(["design", "--task", str(task), "--out", str(out), "--seed", "3"]) == 130
     assert sorted(p.name for p in out.iterdir()) == ["notes.txt"]
     fresh = tmp_path / "fresh" / "out"  # a folder the stopped run made goes too
@@ -516,12 +517,12 @@ def test_proven_says_in_one_word_what_the_exit_code_says(tmp_path, monkeypatch, 
     "feasible" (the reduced model's word) stayed true, so a script reading it took an unproven
     design. The proof itself is stood in for: its FEM is tested in test_design_fem.py."""
     from softhand.studies.cli import main as cli
-    from softhand.studies.cli.verbs import design as design_verb
+    from softhand.studies.design import workflow
 
     def proof(result, *rest):
         return result if outcome == "met" else {**result, "fem_report": "the FEM failed"}
 
-    monkeypatch.setattr(design_verb, "_prove_and_correct", proof)
+    monkeypatch.setattr(workflow, "prove_and_correct", proof)
     task, out = _write(tmp_path, CI_TASK_TOML), tmp_path / "out"
     argv = ["design", "--task", str(task), "--out", str(out), "--seed", "3", "--no-progress"]
     assert cli.main(argv + (["--no-fem"] if outcome == "no fem" else [])) == code
@@ -543,9 +544,9 @@ def test_an_object_wider_than_the_open_hand_names_its_widest_span():
 
 def test_a_margin_beyond_the_one_pad_grasp_is_measured_where_it_ends():
     """A 4 MPa pump on the paper's object at 1 kg: a second pad touches it near 2.8 MPa, where the
-    FEM-informed grasp ends. The margin is F_v there (reduced.grasp_hold.at_pump), flagged, not
+    FEM-informed grasp ends. The margin is F_v there (reduced.calibrated.grasp_hold.at_pump), flagged, not
     -inf (every such design was infeasible), and F_v at the pump limit is not claimed."""
-    from softhand.reduced import grasp_hold
+    from softhand.reduced.calibrated import grasp_hold
 
     task = task_from_dict({**CI_TASK, "object": {"diameter_mm": 180.0, "mass_kg": 1.0},
                            "grasp": {"force_factor": 2.0, "objective": "margin"},
@@ -584,7 +585,7 @@ def test_a_force_one_pad_cannot_give_leaves_the_rest_of_the_evaluation_standing(
     assert "no bend opens" not in report
     # the optimiser sees how far short of F_v the finger comes (F_v where one pad stops holding
     # the object alone), not the -1e3 of a design the model has no answer for
-    from softhand.reduced import grasp_hold
+    from softhand.reduced.calibrated import grasp_hold
 
     end = grasp_hold.one_pad_end(task.base, 180.0, 20.0)
     pump = next(c for c in ev.constraints if c.name.startswith("pump_pressure"))
@@ -595,7 +596,7 @@ def test_a_force_one_pad_cannot_give_leaves_the_rest_of_the_evaluation_standing(
 def test_only_a_force_not_reached_is_reported_as_no_grasp(monkeypatch):
     """An error of another model inside the grasp (here: more oil than the reservoir holds) is
     not "F_v not reached": the design has no answer at all, as before (every pressure inf)."""
-    from softhand.reduced import grasp_hold
+    from softhand.reduced.calibrated import grasp_hold
 
     task = task_from_dict(CI_TASK)
 

@@ -4,8 +4,8 @@ from pathlib import Path
 
 import pytest
 
-from softhand.reduced import hand
-from softhand.reduced.errors import InputError
+from softhand.reduced.equations import hand
+from softhand.reduced.vocabulary.errors import InputError
 from softhand.studies.cli.main import main
 from softhand.studies.calibration.space import finger_design, load_space
 
@@ -94,7 +94,7 @@ def test_mesh_correction_scales_only_the_designs_on_longer_slices(tmp_path):
     leaves the default-mesh designs as the FEM gave them."""
     import math
 
-    from softhand.reduced.finger_fem import read_table
+    from softhand.reduced.calibrated.finger_fem import read_table
     from softhand.studies.calibration.finger import as_study, design_cases
     from softhand.studies.calibration.finger_table import write_table
 

@@ -10,10 +10,11 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from softhand.reduced import control, grasp, paper, reservoir
-from softhand.reduced.design import HandDesign
-from softhand.reduced.versions import package_version
-from conftest import CI_FINGER
+from softhand.reduced.dynamics import control
+from softhand.reduced.equations import grasp, reservoir
+from softhand.reduced.vocabulary import paper
+from softhand.reduced.vocabulary.design import HandDesign
+from softhand.reduced.vocabulary.versions import package_version
 
 ROOT = Path(__file__).resolve().parents[2]
 SOURCES = [p for layer in ("fem", "reduced", "meshes", "studies") for p in (ROOT / layer).rglob("*.py")]
@@ -37,7 +38,7 @@ def test_one_version_lookup():
     assert package_version("no-such-distribution-softhand", "not installed") == "not installed"
     callers = [p.relative_to(ROOT).as_posix() for p in SOURCES
                if re.search(r"from importlib\.metadata import[^\n]*\bversion\b", p.read_text())]
-    assert callers == ["reduced/versions.py"]
+    assert callers == ["reduced/vocabulary/versions.py"]
 
 
 @pytest.fixture(scope="module")

@@ -61,7 +61,7 @@ def quick_study(tmp_path, monkeypatch):
 
 def _check_results(study, root) -> None:
     """Every case done, with the numbers of the reduced model itself."""
-    from softhand.reduced.design import HandDesign
+    from softhand.reduced.vocabulary.design import HandDesign
     from softhand.studies.batch.kinds import curve
 
     sdir = study_dir(study, root)

@@ -49,9 +49,9 @@ def _boom(ctx, outdir):
 
 def test_missing_and_failing_sections_are_reported_and_the_others_go_on(tmp_path):
     fake = [Section("missing", "Missing", ("no_such_module_softhand",), _ok),
-            Section("attr", "Missing attribute", ("softhand.reduced.hand:no_such_function",), _ok),
+            Section("attr", "Missing attribute", ("softhand.reduced.equations.hand:no_such_function",), _ok),
             Section("boom", "Boom", (), _boom),
-            Section("fine", "Fine", ("softhand.reduced.hand",), _ok)]
+            Section("fine", "Fine", ("softhand.reduced.equations.hand",), _ok)]
     outcomes = reproduce(tmp_path, section_list=fake, progress=False)
     assert [o.status for o in outcomes] == ["not available", "not available", "failed", "done"]
     assert exit_code(outcomes) == 1

@@ -9,7 +9,7 @@ from pathlib import Path
 
 import pytest
 
-from softhand.reduced.design import HandDesign
+from softhand.reduced.vocabulary.design import HandDesign
 from softhand.studies.cli.main import main
 from softhand.studies.batch.runner import RESULT, case_key, plan, run_study, status, study_dir
 from softhand.studies.batch.studyfile import load_study

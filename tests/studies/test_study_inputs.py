@@ -5,7 +5,7 @@ import re
 
 import pytest
 
-from softhand.reduced.errors import InputError
+from softhand.reduced.vocabulary.errors import InputError
 from softhand.studies.batch.runner import RESULT, case_state, plan, read_case, run_study, study_dir
 from softhand.studies.batch.studyfile import load_study
 from softhand.studies.cli.main import main

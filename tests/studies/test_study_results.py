@@ -11,8 +11,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from softhand.reduced import grasp
-from softhand.reduced.design import HandDesign
+from softhand.reduced.equations import grasp
+from softhand.reduced.vocabulary.design import HandDesign
 from softhand.studies.cli.main import main
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -69,8 +69,8 @@ def test_control_kind_keeps_the_studys_numbers(tmp_path):
 
 # ---------------------------------------------------------------- fit
 def test_fit_result_is_what_the_verb_prints_and_writes(tmp_path):
-    from softhand.reduced.csvdata import read_measurements
-    from softhand.reduced.design import load_design
+    from softhand.reduced.fitting.csvdata import read_measurements
+    from softhand.reduced.vocabulary.design_files import load_design
     from softhand.studies.fit import FitStudy, run
 
     data = ROOT / "studies" / "data" / "example_bending.csv"

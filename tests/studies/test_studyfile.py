@@ -3,7 +3,7 @@ import math
 
 import pytest
 
-from softhand.reduced.design import HandDesign
+from softhand.reduced.vocabulary.design import HandDesign
 from softhand.studies.cli.main import main
 from softhand.studies.batch.studyfile import KINDS, load_study, resolve_kind
 

@@ -76,7 +76,7 @@ def _check(args) -> tuple[float, ...]:
     """Every numeric option in its range before any FEM work; the pressures."""
     import numpy as np
 
-    from softhand.reduced.errors import InputError
+    from softhand.reduced.vocabulary.errors import InputError
     from softhand.studies.cli.args import check_range
 
     for option, (lo, hi) in LIMITS.items():
@@ -111,7 +111,7 @@ def _peak(peak_mpa, pressures) -> float:
 
 def _options(args):
     from softhand.fem.hand.finger import FingerOptions
-    from softhand.reduced.errors import InputError
+    from softhand.reduced.vocabulary.errors import InputError
 
     mesher = args.mesher or ("gmsh" if args.mesh_size_mm is not None or args.edge_ratio is not None
                              else None)
@@ -141,7 +141,7 @@ def run(args) -> int:
     pressures = _check(args)
     design = design_from_args(args)
     if args.tie_width_mm is not None and args.tie_width_mm >= min(design.link_lengths):
-        from softhand.reduced.errors import InputError
+        from softhand.reduced.vocabulary.errors import InputError
 
         raise InputError("--tie-width-mm", args.tie_width_mm,
                          f"must be shorter than every link (shortest {min(design.link_lengths):g} mm)")

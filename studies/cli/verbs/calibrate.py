@@ -3,7 +3,7 @@
 * ``--space FILE.toml --out FILE.csv``: every design of a design space (see
   :mod:`softhand.studies.calibration.finger`) by the finger FEM, as a batch study on the runner
   (results/<name>/, resumable, ``--workers N``, ``--scheduler local|tcp://...``), then the
-  nondimensional table with its provenance (the package's is reduced/data/finger_fem.csv);
+  nondimensional table with its provenance (the package's is reduced/calibrated/data/finger_fem.csv);
 * ``--design FILE.toml --out FILE.csv``: the same for one design (any geometry with 5 equal
   hinges), and a design file FILE.toml next to the table that uses it
   (``finger_model = "fem"``, ``finger_table = "FILE.csv"``);
@@ -46,7 +46,7 @@ def configure(parser) -> None:
 
 
 def run(args) -> int:
-    from softhand.reduced.errors import InputError
+    from softhand.reduced.vocabulary.errors import InputError
     from softhand.studies.calibration import space as fc
     from softhand.studies.calibration.finger_table import write_design_with_table, write_table
 
@@ -58,7 +58,7 @@ def run(args) -> int:
         raise InputError("--table", args.table, "is the table --check compares with the FEM; --space "
                                                 "and --design write one (--out)")
     if args.table is not None:
-        from softhand.reduced.finger_fem import check_table
+        from softhand.reduced.calibrated.finger_fem import check_table
 
         try:
             check_table(args.table)  # read and fitted before any FEM
@@ -91,7 +91,7 @@ def run(args) -> int:
 def _run(space, args):
     """Run the space's FEM cases (resumable); [(design, record)] or None if some failed.
     With --finished: only the cases already done, without running any."""
-    from softhand.reduced.errors import InputError
+    from softhand.reduced.vocabulary.errors import InputError
     from softhand.studies.calibration.finger import as_study
     from softhand.studies.batch.runner import case_state, plan, read_case, run_study, study_dir
 
@@ -122,7 +122,7 @@ def _finished_only(space, results):
     """The space reduced to its designs with a result (all of them unless --finished)."""
     import dataclasses
 
-    from softhand.reduced.errors import InputError
+    from softhand.reduced.vocabulary.errors import InputError
 
     n = len(space.points)
     keep = [i for i in range(n) if results[i][1] is not None]
@@ -148,7 +148,7 @@ def _load_space(path):
 
 
 def _check(space, args) -> int:
-    from softhand.reduced.errors import InputError
+    from softhand.reduced.vocabulary.errors import InputError
     from softhand.studies.calibration.finger_table import heldout_rows
 
     results = _run(space, args)

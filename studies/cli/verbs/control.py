@@ -5,7 +5,7 @@ at ``--push-at-s``, or a force profile from ``--disturbance FILE``), and pressur
 holding the pressure angle control had just before the push. Prints the summary of the
 ``--mode`` run (settling time, steady error, P and mean angle before/during the push) and
 the grasping force in the three states of Table II next to the paper's numbers. The plant
-and its parameters: reduced/plant.py and docs/control.md. The study itself is
+and its parameters: reduced/dynamics/plant.py and docs/control.md. The study itself is
 :mod:`softhand.studies.control`; the disturbance file's format: :mod:`softhand.studies.io.control_files`.
 """
 from __future__ import annotations
@@ -14,9 +14,9 @@ import math
 import sys
 from pathlib import Path
 
-from softhand.reduced import grasp
-from softhand.reduced.errors import InputError
-from softhand.reduced.plant import PlantParams, Push
+from softhand.reduced.equations import grasp
+from softhand.reduced.vocabulary.errors import InputError
+from softhand.reduced.dynamics.plant import PlantParams, Push
 from softhand.studies.cli.args import add_design_option, add_json_option, check_range, design_from_args, \
     print_json, print_table
 from softhand.studies.io.control_files import PUSH_LIMITS_N

@@ -47,9 +47,9 @@ def configure(parser) -> None:
 
 
 def run(args) -> int:
-    from softhand.reduced.csvdata import read_measurements
-    from softhand.reduced.errors import InputError
-    from softhand.reduced.fit import check_params
+    from softhand.reduced.fitting.csvdata import read_measurements
+    from softhand.reduced.vocabulary.errors import InputError
+    from softhand.reduced.fitting.fit import check_params
     from softhand.studies.fit import FitStudy, run as run_study
     from softhand.studies.io.files import write_outputs
 
@@ -84,9 +84,9 @@ def _start_from_shore_a(design, keys, shore_a):
     """The fitted moduli's start from a Shore A hardness (Gent's relation), named --shore-a."""
     if shore_a is None:
         return design
-    from softhand.reduced.design import design_from_dict
-    from softhand.reduced.errors import InputError
-    from softhand.reduced.materials_data import shear_modulus_from_shore_a
+    from softhand.reduced.vocabulary.design_files import design_from_dict
+    from softhand.reduced.vocabulary.errors import InputError
+    from softhand.reduced.materials.materials_data import shear_modulus_from_shore_a
 
     try:
         mu = shear_modulus_from_shore_a(shore_a)
@@ -105,7 +105,7 @@ def _start_from_shore_a(design, keys, shore_a):
 
 def _weights(args, design, data):
     """w from --diameter-mm or --weights, each only where the data need it."""
-    from softhand.reduced.errors import InputError
+    from softhand.reduced.vocabulary.errors import InputError
 
     given = [(o, v) for o, v in (("--diameter-mm", args.diameter_mm), ("--weights", args.weights),
                                  ("--normalise", args.normalise or None)) if v is not None]
@@ -118,7 +118,7 @@ def _weights(args, design, data):
     if args.weights is not None and args.diameter_mm is not None:
         raise InputError("--weights", args.weights, "give --weights or --diameter-mm, not both")
     if args.diameter_mm is not None:
-        from softhand.reduced.grasp import weights_for_diameter
+        from softhand.reduced.equations.grasp import weights_for_diameter
 
         try:
             return weights_for_diameter(args.diameter_mm, design)
@@ -135,9 +135,9 @@ def _parse_bounds(text):
         return None
     import math
 
-    from softhand.reduced.design import BOUNDS
-    from softhand.reduced.errors import InputError
-    from softhand.reduced.inputfiles import plain_float
+    from softhand.reduced.vocabulary.design import BOUNDS
+    from softhand.reduced.vocabulary.errors import InputError
+    from softhand.reduced.vocabulary.inputfiles import plain_float
 
     bounds = {}
     for item in text.split(","):

@@ -8,7 +8,7 @@ new diameter runs the FEM). ``w_source`` in the output says which. Axes and sign
 docs/conventions.md (F_v > 0: the finger squeezes).
 
 ``--model fem`` (with ``--diameter-mm D``) replaces eq. (25) by the FEM-informed estimate of
-:mod:`softhand.reduced.grasp_fem`: the calibrated finger in equilibrium hinge by hinge against the
+:mod:`softhand.reduced.calibrated.grasp_fem`: the calibrated finger in equilibrium hinge by hinge against the
 object, touching where the geometry says; P is converted to the cavity pressure with the
 reservoir at theta, and the object's depth is the one that gives theta. Both are computed
 by :mod:`softhand.studies.grasp`; this verb reads the options and prints.
@@ -21,8 +21,8 @@ import warnings
 import numpy as np
 
 from softhand.fem.newton import NotConverged
-from softhand.reduced import grasp
-from softhand.reduced.errors import InputError
+from softhand.reduced.equations import grasp
+from softhand.reduced.vocabulary.errors import InputError
 from softhand.studies.cli.args import NUMBER_LIST, add_design_option, add_json_option, design_from_args, \
     parse_values, print_json, require_finite
 from softhand.studies.grasp import state, state_fem
@@ -32,7 +32,7 @@ PAPER_NAMES = {f"paper{D:g}": D for D in grasp.PAPER_WEIGHTS}
 _WEIGHT_FORMS = f"{NUMBER_LIST}, or one of {', '.join(PAPER_NAMES)}"
 
 HELP = "grasping forces F_x, F_y, F_v at a pressure, bend angle and mass (eqs. 24, 25, 29)"
-#: --model: eq. (25) as printed, or the FEM-informed estimate (reduced.grasp_fem)
+#: --model: eq. (25) as printed, or the FEM-informed estimate (reduced.calibrated.grasp_fem)
 MODELS = ("paper", "fem")
 
 

@@ -16,8 +16,8 @@ import sys
 
 import numpy as np
 
-from softhand.reduced.errors import InputError
-from softhand.reduced.inputfiles import plain_float
+from softhand.reduced.vocabulary.errors import InputError
+from softhand.reduced.vocabulary.inputfiles import plain_float
 from softhand.studies.cli.args import add_json_option, print_json, print_table
 
 HELP = "rubber models: fit Mooney-Rivlin, Yeoh, Gent, Ogden, Neo-Hookean to test data"
@@ -30,7 +30,7 @@ def configure(parser) -> None:
     fit.add_argument("--data", required=True, metavar="FILE.csv",
                      help="columns mode,stretch,stress_MPa (mode: uniaxial | equibiaxial | "
                           "pure-shear); '#' comments")
-    from softhand.reduced.material_fit import FIT_MODELS
+    from softhand.reduced.materials.material_fit import FIT_MODELS
 
     fit.add_argument("--model", required=True, metavar="|".join(FIT_MODELS),
                      help="the strain energy to fit")
@@ -44,8 +44,8 @@ def configure(parser) -> None:
 
 
 def run(args) -> int:
-    from softhand.reduced.material_fit import fit_material, read_test_data
-    from softhand.reduced.rubber import drucker_check
+    from softhand.reduced.materials.material_fit import fit_material, read_test_data
+    from softhand.reduced.materials.rubber import drucker_check
 
     data = read_test_data(args.data)
     stretch_range = _stretch_range(args.stability_range, data)
@@ -73,7 +73,7 @@ def run(args) -> int:
 
 def _stretch_range(text, data) -> tuple[float, float]:
     """``--stability-range`` LO:HI within the stretches of rubber tests (default: the data's)."""
-    from softhand.reduced.material_fit import STRETCH_LIMITS
+    from softhand.reduced.materials.material_fit import STRETCH_LIMITS
 
     if text is None:
         top = float(np.max(np.maximum(data.stretch, 1.0 / data.stretch)))

@@ -20,7 +20,7 @@ def configure(parser) -> None:
 
 
 def run(args) -> int:
-    from softhand.reduced.errors import InputError
+    from softhand.reduced.vocabulary.errors import InputError
     from softhand.studies.cli.checks import check_choices
     from softhand.studies.io.files import check_output_tree
     from softhand.studies.reproduce.core import check_design, exit_code, reproduce, sections

@@ -6,14 +6,13 @@ maximum (if the path passes one) and the verdict over the operating range (V0 - 
 ``--plot``: profiles, p(V) of both models, and the hand's P(theta) with both reservoir
 models. ``--out DIR``: result.json (rows, verdict, wet-surface profiles z(r) and mid-surface
 stretches per volume, the whole p(V), W(V) path), rows.csv, VTK of the deformed sheet per
-volume (r–z and revolved to 3D); see :class:`softhand.studies.reservoir.ReservoirStudyResult`. ``--write-calibration FILE.csv``: the table of ``reduced/reservoir_fem.py``.
+volume (r–z and revolved to 3D); see :class:`softhand.studies.reservoir.ReservoirStudyResult`. ``--write-calibration FILE.csv``: the table of ``reduced/calibrated/reservoir_fem.py``.
 """
 from __future__ import annotations
 
-import subprocess
 from pathlib import Path
 
-from softhand.reduced.errors import InputError
+from softhand.reduced.vocabulary.errors import InputError
 from softhand.studies.cli.args import MAX_FEM_POINTS, MOST_FEM_POINTS, add_design_option, add_json_option, \
     add_max_cases_option, add_progress_option, design_from_args, max_cases, parse_values, print_json, print_table
 from softhand.studies.io.files import replaced_outputs, write_outputs
@@ -53,7 +52,7 @@ def _study(args):
         if min(volumes) < low or max(volumes) > high:
             raise InputError("--volume-mm3", args.volume_mm3,
                              f"volumes must be in [{low:.4g}, {high:.4g}] mm^3 (1e-4 V0 .. 100 V0)")
-        from softhand.reduced.reservoir import check_holds
+        from softhand.reduced.equations.reservoir import check_holds
 
         check_holds(max(volumes), design, "--volume-mm3")
     return ReservoirStudy(design=design, volumes_mm3=volumes, n_radial=args.n_radial,
@@ -67,7 +66,11 @@ OUTPUT_PATTERNS = ("result.json", "rows.csv", "sheet.pvd", "sheet", "sheet_V*_rz
 def run(args) -> int:
     study = _study(args)
     if args.write_calibration:
-        return _write_calibration(study, args.write_calibration)
+        from softhand.studies.reservoir import write_calibration
+
+        count = write_calibration(study, args.write_calibration)
+        print(f"wrote {count} rows to {args.write_calibration}")
+        return 0
     from tqdm import tqdm
 
     from softhand.studies.reservoir import COLUMNS, run as run_study
@@ -106,13 +109,13 @@ FAILED_OUT = "results/reservoir"
 def _failed(exc, study, out: Path) -> int:
     """Newton gave up at the smallest volume step: the last converged state (result.json +
     the sheet's VTK) and one error line naming the volume and pressure reached; exit code 1."""
-    from softhand.fem.hand.reservoir import _state
+    from softhand.fem.hand.reservoir import sheet_state
     from softhand.studies.io.failure import save_last_converged
     from softhand.studies.io.reservoir_files import write_sheet_states
 
     model = study.model()
     solid = model.build()[0]
-    state = _state(model, solid, exc.last) if exc.last.u is not None else None
+    state = sheet_state(model, solid, exc.last) if exc.last.u is not None else None
     reached = f"V = {exc.last.volume:.6g} mm^3, p = {exc.last.pressure:.6g} MPa"
     record = {"last_converged": {"V_mm3": exc.last.volume, "p_MPa": exc.last.pressure,
                                  "W_Nmm": exc.last.energy},
@@ -123,35 +126,3 @@ def _failed(exc, study, out: Path) -> int:
         "smallest volume step)", reached, record,
         write_files=(lambda: write_sheet_states(solid, [state], out)) if state else None,
         files="sheet.pvd" if state else "")
-
-
-def _git_commit() -> str:
-    try:
-        return subprocess.run(["git", "rev-parse", "--short", "HEAD"], capture_output=True,
-                              text=True, cwd=Path(__file__).parent, check=True).stdout.strip()
-    except (OSError, subprocess.CalledProcessError):
-        return "unknown"
-
-
-def _write_calibration(study, path) -> int:
-    """FEM tables at the design's thickness t and at 2t (twice the layers: same element shape)."""
-    if not study.design.reservoir_is_neo_hookean:
-        raise InputError("--write-calibration", str(path), "the calibration table of the 'fem' "
-                         "reservoir model is for a Neo-Hookean sheet; this design's sheet is "
-                         f"{study.design.reservoir_material.model}")
-    from dataclasses import replace
-    from datetime import datetime, timezone
-
-    from softhand.studies.io.files import write_atomic
-    from softhand.studies.reservoir import calibration_csv, calibration_rows
-
-    thin = study.model()
-    thick = replace(thin, t=2 * thin.t, n_thick=2 * thin.n_thick)
-    rows = calibration_rows(thin) + calibration_rows(thick)
-    provenance = (f"FEM calibration of reduced/reservoir_fem.py, written "
-                  f"{datetime.now(timezone.utc):%Y-%m-%d %H:%M} UTC at commit {_git_commit()} by\n"
-                  f"softhand reservoir --write-calibration {Path(path).name} "
-                  f"--n-radial {thin.n_radial} --n-thick {thin.n_thick}")
-    write_atomic(path, calibration_csv([thin, thick], rows, provenance))
-    print(f"wrote {len(rows)} rows to {path}")
-    return 0

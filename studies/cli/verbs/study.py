@@ -36,7 +36,7 @@ MAX_WORKERS = 256
 
 
 def run(args) -> int:
-    from softhand.reduced.errors import InputError
+    from softhand.reduced.vocabulary.errors import InputError
     from softhand.studies.batch.studyfile import MAX_CASES, load_study
 
     if args.max_cases is not None and not 1 <= args.max_cases <= 10**7:

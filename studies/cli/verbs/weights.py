@@ -15,8 +15,8 @@ from pathlib import Path
 
 import numpy as np
 
-from softhand.reduced.errors import InputError
-from softhand.reduced.paper import FIG8
+from softhand.reduced.vocabulary.errors import InputError
+from softhand.reduced.vocabulary.paper import FIG8
 from softhand.studies.cli.args import MOST_FEM_POINTS, add_design_option, add_json_option, \
     add_max_cases_option, add_progress_option, design_from_args, max_cases, parse_values, print_json, print_table
 from softhand.studies.design.task import UPPER

@@ -1,0 +1,273 @@
+r"""FEM-informed grasping force: the finger in equilibrium against the object where it touches.
+
+Eq. (25) charges all the pressure work beyond the free curve to a force at the finger's
+*tip*, moving with the tip along w. The grasp FEM's finger touches the object with one
+link's pad, often far from the tip, and rolls on it; this model keeps what the FEM knows
+and drops the tip assumption:
+
+* **The finger, hinge by hinge.** Each hinge j carries its own energy E_j(theta_hat_j; P)
+  (no coupling between hinges, E = sum E_j). At fixed hinge angles dE/dP = -V, the oil
+  inside, so the moment holding hinge j, M_j = dE/d theta_hat_j, changes with P by
+  dM_j/dP = -A_j, A_j = dV/d theta_hat_j the oil the hinge draws per radian *at fixed P*.
+  With A_j a function of the hinge's bend theta_j = n_s theta_hat_j alone, and M_j = 0 on
+  the free curve P_free(theta) of the calibrated finger (``finger_model = "fem"``,
+  :mod:`softhand.reduced.calibrated.finger_fem`; it bends its equal hinges equally),
+
+  .. math:: M_j = -A_j(\theta_j)\,\big(P - P_{free}(\theta_j)\big), \qquad
+            E_j = \int_0^{\hat\theta_j} M_j .
+
+  A_j is measured by the finger FEM with its hinges locked by springs
+  (``reduced/calibrated/data/grasp_hinges.csv``, written by ``python -m
+  softhand.studies.calibration.hinges``): 1.77 a^2 pi d for a straight hinge, 1.17 a^2 pi d
+  from a bend of 4.8 deg on (hinges 1-4; the tip hinge 1.31 and 1.10), against dQ/dtheta =
+  1.86 a^2 pi d of the free finger, which includes the tube's swelling with P. Piecewise
+  linear in theta between the table's bends, extended linearly beyond them; the table is
+  the paper's design (Table I): other designs reuse its A_j / (a^2 pi d) with their own
+  free curve. Without this, the free finger's W_f and Q split equally over the hinges, the
+  contact force of a finger held by the object low on it comes out 50 % too large.
+* **The contact where it is** (:mod:`softhand.reduced.equations.contact`, the grasp FEM's geometry): the
+  object's force on pad k at its closest point x*, F = -N nu + T t_k (normal force N along
+  the outward normal -nu, the weight share T = m g / n along the link, as in the grasp FEM).
+* **Virtual work hinge by hinge** (eq. (1) with every hinge free, not only along w):
+
+  .. math:: \frac{\partial E}{\partial\hat\theta_j} = F\cdot\frac{\partial x^*}{\partial\hat\theta_j}
+            \quad (j = 1..n_s), \qquad g_k(\hat\theta) = 0.
+
+  Hinges beyond the touching link carry no load: they bend as the free finger's. The n_s
+  equations and the gap fix the k proximal hinge angles and N.
+
+F_v is the FEM's: the resultant F projected on the tip link's outward normal (eq. (29)).
+Two ways to pose a grasp: :func:`grasp_state` at a placement (depth; default the grasp
+FEM's), theta follows; :func:`grasp_state_at_angle` at a bend theta, the depth that gives it
+follows (the Fig. 8 states). :func:`vertical_force` is the one function to call.
+P is the finger's cavity pressure. Units: mm, N, MPa, rad.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import replace
+from functools import lru_cache
+from pathlib import Path
+from typing import NamedTuple
+
+import numpy as np
+from scipy.optimize import brentq, root
+
+from softhand.reduced.equations import contact, hand, kinematics
+from softhand.reduced.vocabulary.design import HandDesign
+from softhand.reduced.vocabulary.errors import InputError
+from softhand.reduced.vocabulary.inputfiles import read_number_table
+
+#: a pad other than the touching one penetrating by more than this [mm] moves the contact there
+PENETRATION = 1e-6
+#: the finger FEM's locked-hinge volume rates A_j(theta) (written by ``python -m softhand.studies.calibration.hinges``)
+HINGE_TABLE = Path(__file__).resolve().parent / "data" / "grasp_hinges.csv"
+#: the equilibrium's tolerance (scipy hybr, relative on the unknowns)
+_XTOL = 1e-10
+
+
+class GraspState(NamedTuple):
+    """One equilibrium of the finger against the object (physical forces, hand frame)."""
+
+    P: float            #: cavity pressure [MPa]
+    depth: float        #: object centre below the palm [mm]
+    q: np.ndarray       #: hinge angles theta_hat (n_s,) [rad]
+    link: int           #: touching pad (0 base .. n_s tip); -1: no contact
+    N: float            #: normal force of the object on the pad [N]
+    point: np.ndarray   #: contact point x* (2,) [mm]
+    F: np.ndarray       #: force of the object on the finger (2,), x out, y down [N]
+    F_v: float          #: F . n_out of the tip link (29) [N]
+
+    @property
+    def theta(self) -> float:
+        return float(np.sum(self.q))
+
+
+def fem_finger(design: HandDesign) -> HandDesign:
+    """The design with the calibrated finger (``finger_model = "fem"``; its table kept)."""
+    return design if design.finger_model == "fem" else replace(design, finger_model="fem")
+
+
+class HingeTable(NamedTuple):
+    """The finger FEM's held-hinge volume rates (:data:`HINGE_TABLE`)."""
+
+    theta: np.ndarray   #: hinge bend n_s theta_hat_j of the nodes, increasing, from 0 [rad]
+    a: np.ndarray       #: A_j / (a^2 pi d) at the nodes, (nodes, n_s)
+
+
+@lru_cache(maxsize=4)
+def read_hinge_table(path: str) -> HingeTable:
+    """The CSV written by ``python -m softhand.studies.calibration.hinges`` (columns theta, a_1..a_n)."""
+    _, columns, data = read_number_table(path, "hinge_table", "the hinge CSV of softhand.studies.calibration.hinges")
+    if columns[0] != "theta" or columns[1:] != tuple(f"a_{j}" for j in range(1, len(columns))) \
+            or len(columns) < 2 or np.any(np.diff(data[:, 0]) <= 0):
+        raise InputError("hinge_table", path, "needs the header theta,a_1,...,a_n and increasing theta")
+    return HingeTable(data[:, 0], data[:, 1:])
+
+
+def volume_rate(theta, design: HandDesign) -> np.ndarray:
+    """A_j [mm^3/rad] (n_s,): oil hinge j draws per radian at fixed pressure, at hinge bends theta
+    = n_s theta_hat (n_s,) [rad]; piecewise linear in theta, extended linearly beyond the nodes."""
+    t = read_hinge_table(str(HINGE_TABLE))
+    if t.a.shape[1] != design.n_s:
+        raise InputError("n_s", design.n_s, f"the hinge table has {t.a.shape[1]} hinges")
+    theta = np.asarray(theta, float)
+    i = np.minimum(np.maximum(np.searchsorted(t.theta, theta) - 1, 0), len(t.theta) - 2)
+    j = np.arange(design.n_s)
+    slope = (t.a[i + 1, j] - t.a[i, j]) / (t.theta[i + 1] - t.theta[i])
+    return (t.a[i, j] + slope * (theta - t.theta[i])) * design.a ** 2 * math.pi * design.d
+
+
+def hinge_moments(q, P: float, design: HandDesign) -> np.ndarray:
+    """M_j = dE/d theta_hat_j = -A_j(theta_j) (P - P_free(theta_j)) [N mm/rad] (n_s,) at hinge
+    angles q (n_s,) [rad] and cavity pressure P [MPa], theta_j = n_s q_j; P_free of finger_model "fem"."""
+    design = fem_finger(design)
+    theta = design.n_s * np.asarray(q, float)
+    return -volume_rate(theta, design) * (P - hand.finger_pressure(theta, design))
+
+
+#: Gauss-Legendre rule on [0, 1] for E, per piece between the table's nodes
+_GX, _GW = np.polynomial.legendre.leggauss(12)
+_GX, _GW = 0.5 * (_GX + 1.0), 0.5 * _GW
+
+
+def hinge_energy(q, P: float, design: HandDesign) -> float:
+    """E = sum_j int_0^q_j M_j [N mm] at hinge angles q (n_s,) [rad] (12-point Gauss on every
+    piece between the table's nodes: M is smooth there)."""
+    nodes = read_hinge_table(str(HINGE_TABLE)).theta / design.n_s
+    total = 0.0
+    for j, qj in enumerate(np.asarray(q, float)):  # n_s hinges
+        inside = np.sort(nodes[(nodes > min(qj, 0.0)) & (nodes < max(qj, 0.0))])
+        cuts = np.r_[0.0, inside if qj >= 0 else inside[::-1], qj]  # from 0 to q_j
+        x = cuts[:-1, None] + np.diff(cuts)[:, None] * _GX
+        Q = np.zeros(x.shape + (design.n_s,))
+        Q[..., j] = x
+        M = hinge_moments(Q, P, design)[..., j]
+        total += float(np.sum(M * _GW * np.diff(cuts)[:, None]))
+    return total
+
+
+def _load(q, centre, link: int, weight: float, design: HandDesign, corner: bool = False):
+    """(centre distance, dg/dq, generalised weight force (n_s,), x*, nu, tangent) of pad ``link``
+    (``corner``: touching with its far end, the hinge it shares with the next pad)."""
+    xs, nu, dx = contact.pad_motion(q, centre, link, design, end=corner)
+    alpha = kinematics.link_angles(q, design)[link]
+    t = np.array([-math.sin(alpha), math.cos(alpha)])
+    rho = float(np.linalg.norm(np.asarray(centre) - xs))  # the caller subtracts the radius
+    return rho, -dx @ nu, weight * (dx @ t), xs, nu, t
+
+
+def _state(P, depth, q, link, N, weight, design, corner=False) -> GraspState:
+    if link < 0:
+        return GraspState(P, depth, q, -1, 0.0, np.full(2, np.nan), np.zeros(2), 0.0)
+    _, _, _, xs, nu, t = _load(q, (0.0, depth), link, weight, design, corner)
+    F = -N * nu + weight * t
+    alpha = q.sum() - design.theta0
+    return GraspState(P, depth, q, link, float(N), xs, F, float(F @ [math.cos(alpha), math.sin(alpha)]))
+
+
+def _solve_link(P, depth, radius, link, weight, q0, design, corner=False):
+    """Hinges 1..link and N with pad ``link`` (its far end if ``corner``) on the object; distal
+    hinges as q0's."""
+    centre, k = (0.0, depth), link
+
+    def residual(x):
+        q = np.concatenate([x[:k], q0[k:]])
+        rho, grad, Tq, *_ = _load(q, centre, k, weight, design, corner)
+        return np.concatenate([(hinge_moments(q, P, design) - x[k] * grad - Tq)[:k], [rho - radius]])
+
+    _, grad, Tq, *_ = _load(q0, centre, k, weight, design, corner)
+    M = (hinge_moments(q0, P, design) - Tq)[:k]
+    N0 = max(float(M @ grad[:k]) / max(float(grad[:k] @ grad[:k]), 1e-12), 0.0)
+    sol = root(residual, np.concatenate([q0[:k], [N0]]), method="hybr", options={"xtol": _XTOL})
+    if not sol.success or np.max(np.abs(residual(sol.x)) / [*np.maximum(np.abs(M), 1.0), 1.0]) > 1e-7:
+        raise InputError("pressure_MPa", P, f"no equilibrium with pad {k} on the object "
+                                            f"(depth {depth:.4g} mm): {sol.message}")
+    return np.concatenate([sol.x[:k], q0[k:]]), float(sol.x[k])
+
+
+def grasp_state(design: HandDesign, diameter_mm: float, P: float, mass_kg: float = 0.0, *,
+                depth_mm: float | None = None) -> GraspState:
+    """The finger at cavity pressure P [MPa] closing on the object (diameter [mm], mass [kg])
+    at depth [mm] (default: the grasp FEM's placement, :func:`softhand.reduced.equations.contact.object_depth`)."""
+    design = fem_finger(design)
+    depth = contact.object_depth(diameter_mm, design) if depth_mm is None else float(depth_mm)
+    radius, weight = 0.5 * float(diameter_mm), float(mass_kg) * design.g / design.n
+    q_free = np.full(design.n_s, float(hand.bend_angle(P, design, reservoir=False)) / design.n_s)
+    # the free finger clear of the object has not reached it yet (or never does) -- or, bent past
+    # the angle where it first touches, it has swept through it, which the object stops
+    clear = np.min(contact.pad_gaps(q_free, (0.0, depth), radius, design)) >= 0.0
+    try:
+        theta_c, link = contact.contact_angle(diameter_mm, design, depth=depth)
+    except InputError:
+        if clear:  # it does not reach the object
+            return _state(P, depth, q_free, -1, 0.0, weight, design)
+        raise
+    if clear and float(np.sum(q_free)) < theta_c:
+        return _state(P, depth, q_free, -1, 0.0, weight, design)
+    q0 = np.concatenate([np.full(link, theta_c / design.n_s), q_free[link:]])
+    corner, seen = False, set()
+    for _ in range(design.n_s + 2):
+        if link == 0:
+            raise InputError("diameter_mm", diameter_mm, "touches the base link, which cannot press")
+        q, N = _solve_link(P, depth, radius, link, weight, q0, design, corner)
+        gaps = contact.pad_gaps(q, (0.0, depth), radius, design)
+        seen.add(link)
+        gaps[link + (1 if corner else 0)] = gaps[link] = np.inf
+        if np.min(gaps) >= -PENETRATION:
+            if N < 0.0:  # the pad would pull on the object: it does not touch
+                return _state(P, depth, q_free, -1, 0.0, weight, design)
+            return _state(P, depth, q, link, N, weight, design, corner)
+        nxt = int(np.argmin(gaps))
+        if nxt in seen and abs(nxt - link) == 1 and not corner:  # both sides of a hinge: its corner
+            link, corner = min(nxt, link), True
+        else:
+            link, corner = nxt, False
+        q0 = np.concatenate([q[:link], q_free[link:]])
+    raise InputError("diameter_mm", diameter_mm, "the contact does not settle on one pad")
+
+
+def grasp_state_at_angle(design: HandDesign, diameter_mm: float, P: float, theta: float,
+                         mass_kg: float = 0.0) -> GraspState:
+    """The finger at cavity pressure P [MPa] held at bend theta [rad] by the object: the
+    object's depth is the one at which the equilibrium bends the finger by theta. At or
+    beyond the free bend theta_free(P) the finger does not press (F_v = 0, link -1)."""
+    design = fem_finger(design)
+    theta_free = float(hand.bend_angle(P, design, reservoir=False))
+    radius = 0.5 * float(diameter_mm)
+    lo = max(contact.object_depth(diameter_mm, design, palm_gap=0.0, clearance=1e-3), radius)
+    hi = lo + 2.0 * design.l0 + diameter_mm
+    if theta >= theta_free:
+        q = np.full(design.n_s, theta_free / design.n_s)
+        return _state(P, hi, q, -1, 0.0, 0.0, design)
+    at = lambda y: grasp_state(design, diameter_mm, P, mass_kg, depth_mm=y)  # noqa: E731
+    f = lambda y: at(y).theta - theta  # noqa: E731
+    y0 = float(np.clip(contact.object_depth(diameter_mm, design), lo, hi))
+    f0, step = f(y0), 1.0
+    while f0 != 0.0:  # the root nearest the default placement: theta(depth) need not be monotone
+        a, b = max(lo, y0 - step), min(hi, y0 + step)
+        bracket = next(((x, y0) if x < y0 else (y0, x) for x in (a, b) if f(x) * f0 <= 0.0), None)
+        if bracket is not None:
+            return at(brentq(f, *bracket, xtol=1e-10))
+        if a == lo and b == hi:
+            raise InputError("theta_deg", round(math.degrees(theta), 6),
+                             f"no placement of the object holds this finger there at P = {P:g} MPa "
+                             f"(from its highest placement it bends {math.degrees(at(lo).theta):.4g} deg)")
+        step *= 2.0
+    return at(y0)
+
+
+def vertical_force(design: HandDesign, diameter_mm: float, P, theta=None, mass_kg: float = 0.0, *,
+                   depth_mm: float | None = None):
+    """F_v [N] (29) of one finger grasping the object (diameter [mm], mass [kg]) at cavity
+    pressure P [MPa]: at bend theta [rad] if given (the depth follows, :func:`grasp_state_at_angle`),
+    else at the placement depth_mm (default: the grasp FEM's, :func:`grasp_state`). P and
+    theta broadcast; a float for scalars. 0 where the finger does not touch."""
+    P, theta = np.broadcast_arrays(np.asarray(P, float), np.asarray(np.nan if theta is None else theta, float))
+    out = np.empty(P.shape)
+    for i in np.ndindex(P.shape):  # one small root solve per state
+        if np.isnan(theta[i]):
+            out[i] = grasp_state(design, diameter_mm, float(P[i]), mass_kg, depth_mm=depth_mm).F_v
+        else:
+            out[i] = grasp_state_at_angle(design, diameter_mm, float(P[i]), float(theta[i]), mass_kg).F_v
+    return float(out) if out.ndim == 0 else out

@@ -1,0 +1,1 @@
+"""Fitting design parameters to measured curves: the fit, least squares, measurement files."""

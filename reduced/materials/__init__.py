@@ -1,0 +1,1 @@
+"""Rubber: strain energies, measured data sets, fitting a material to tensile tests."""

@@ -1,0 +1,125 @@
+"""Designs from TOML files and dicts: the public keys (units in the names) to a checked
+:class:`~softhand.reduced.vocabulary.design.HandDesign`.
+
+Every design built from a file or a study's keys passes :func:`design_from_dict`, which also
+reads and fits a design's own finger calibration table at once (so a bad table is one line
+at load time, not an error deep inside a run); this is why it lives above the finger model
+and not beside the design vocabulary.
+"""
+from __future__ import annotations
+
+import dataclasses
+import math
+import os
+import warnings
+from pathlib import Path
+
+from softhand.reduced.equations import finger
+from softhand.reduced.materials import rubber
+from softhand.reduced.vocabulary.design import KEY_OF, MODULUS_OF, PARTS, PUBLIC_KEYS, HandDesign
+from softhand.reduced.vocabulary.design_rules import in_bounds, is_number
+from softhand.reduced.vocabulary.errors import InputError
+from softhand.reduced.vocabulary.inputfiles import read_toml
+
+__all__ = ["design_from_dict", "hinges_for", "load_design"]
+
+#: public TOML key -> dataclass field
+_FIELD_OF = {key: name for name, key in KEY_OF.items()}
+
+
+def _material_changes(part: str, table, source: str, values: dict) -> dict:
+    """Changes of the design fields from a ``[<part>.material]`` table."""
+    if not isinstance(table, dict) or set(table) != {"material"} or not isinstance(table["material"], dict):
+        raise InputError(f"{source}: {part}", table, f"must hold only a [{part}.material] table")
+    params = dict(table["material"])
+    model = params.pop("model", None)
+    if not isinstance(model, str):
+        raise InputError(f"{source}: {part}.material.model", model,
+                         f"must be one of {', '.join(rubber.MODELS)}")
+    material = rubber.from_parameters(model, params, source=f"{source}: {part}.material")
+    name = MODULUS_OF[part]
+    given = values.get(KEY_OF[name])
+    if given is not None:  # overridden, but still a value of the file: a bad one is bad input
+        try:
+            in_bounds(KEY_OF[name], given)
+        except InputError as exc:
+            raise exc.renamed(f"{source}: {KEY_OF[name]}") from None
+    if is_number(given) and not math.isclose(given, material.mu0, rel_tol=1e-9):
+        warnings.warn(f"{source}: {KEY_OF[name]} = {given} is overridden by [{part}.material], "
+                      f"whose initial shear modulus is {material.mu0:.6g} MPa")
+    return {f"{part}_material": material, name: material.mu0}
+
+
+def _from_public(key: str, value):
+    """Convert one public (TOML) value to the internal field value, checking its type."""
+    name = _FIELD_OF[key]
+    default = HandDesign.__dataclass_fields__[name].default
+    if name == "hinge_s":
+        if not isinstance(value, list) or not all(is_number(v) for v in value):
+            raise InputError(key, value, "must be a list of numbers [mm]")
+        return tuple(float(v) for v in value)
+    if isinstance(default, str):
+        if not isinstance(value, str):
+            raise InputError(key, value, "must be a string")
+        return value
+    if isinstance(default, int) and not isinstance(default, bool):
+        if not isinstance(value, int) or isinstance(value, bool):
+            raise InputError(key, value, "must be a whole number")
+        return value
+    if not is_number(value):
+        raise InputError(key, value, "must be a number")
+    return math.radians(value) if name == "theta0" else float(value)
+
+
+def hinges_for(base: HandDesign, l0: float, n_s: int) -> tuple[float, ...]:
+    """Hinge positions [mm] for a tube of length l0 with n_s hinges: the base's scaled with l0
+    (equal links stay equal), or equal links when the number of hinges changes."""
+    if n_s == base.n_s:
+        return tuple(s * l0 / base.l0 for s in base.hinge_s)
+    return tuple(l0 * k / (n_s + 1) for k in range(1, n_s + 1))
+
+
+def design_from_dict(values: dict, base: HandDesign | None = None, *, source: str = "design") -> HandDesign:
+    """A design from public keys (as in TOML), over ``base`` (default: the paper's). Without
+    ``hinge_s_mm``, a new ``l0_mm`` scales the base's hinge positions with it and a new ``n_s``
+    spaces the hinges equally."""
+    base = base if base is not None else HandDesign()
+    changes = {}
+    for key, value in values.items():
+        if key in PARTS:
+            continue
+        if key not in _FIELD_OF:
+            raise InputError(f"{source}: {key}", value,
+                             f"unknown key; allowed: {', '.join(PUBLIC_KEYS)}, "
+                             "[finger.material], [reservoir.material]")
+        changes[_FIELD_OF[key]] = _from_public(key, value)
+    if "hinge_s" not in changes and ("l0" in changes or "n_s" in changes):
+        changes["hinge_s"] = hinges_for(base, changes.get("l0", base.l0), changes.get("n_s", base.n_s))
+    for part in PARTS:
+        if part in values:
+            changes.update(_material_changes(part, values[part], source, values))
+    design = dataclasses.replace(base, **changes)
+    if changes.get("finger_table"):
+        if design.finger_model != "fem":  # the table would be unused
+            raise InputError(f"{source}: finger_table", values["finger_table"], f"is the table of "
+                             f"finger_model = 'fem'; this design's finger_model is {design.finger_model!r}")
+        try:  # read and fitted now (cached per file), not where a run first uses it
+            finger.check_data(design)
+        except InputError as exc:
+            raise exc.renamed(f"{source}: finger_table") from None
+    return design
+
+
+def load_design(path: str | Path | None = None) -> HandDesign:
+    """Read a design TOML file (keys as in ``studies/designs/paper.toml``); None: the paper's
+    (Table I, :class:`~softhand.reduced.vocabulary.design.HandDesign`'s defaults)."""
+    if path is None:
+        return HandDesign()
+    path = Path(path)
+    values = read_toml(path, "--design", "a design TOML file")
+    table = values.get("finger_table")
+    if isinstance(table, str) and table and not Path(table).is_absolute():
+        # relative to the file; absolute without touching the file system (a link loop or a NUL
+        # in the name is the table reader's one line to say)
+        values["finger_table"] = os.path.abspath(path.parent / table)
+    return design_from_dict(values, source=path.name)
