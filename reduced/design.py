@@ -47,7 +47,7 @@ from pathlib import Path
 
 from . import rubber
 from .design_rules import BOUNDS, CONSISTENCY, _check_model, _in_bounds, _is_number
-from .errors import InputError
+from .errors import InputError, Note
 from .inputfiles import MAX_FILE_BYTES, read_input_file, read_toml
 
 __all__ = ["RESERVOIR_MODELS", "FINGER_MODELS", "PAPER_DESIGN_FILE", "HandDesign", "PUBLIC_KEYS",
@@ -168,8 +168,12 @@ class HandDesign:
         return tuple(s1 - s0 for s0, s1 in zip(s, s[1:]))
 
     def replace(self, **changes) -> "HandDesign":
-        """A copy with some fields changed (internal units), validated."""
-        return dataclasses.replace(self, **changes)
+        """A copy with some fields changed, validated: by field name in internal units
+        (``a=3.5``, ``theta0`` in rad) or by the design file's key (``a_mm=3.5``,
+        ``theta0_deg=20``), with the file's rules (a new ``l0_mm`` scales the hinges)."""
+        public = {k: changes.pop(k) for k in list(changes) if k in _FIELD_OF}
+        design = dataclasses.replace(self, **changes)
+        return design_from_dict(public, design, source="replace") if public else design
 
     # ------------------------------------------------------------------ I/O
     def to_dict(self) -> dict:
@@ -305,6 +309,7 @@ def design_from_dict(values: dict, base: HandDesign | None = None, *, source: st
         if part in values:
             changes.update(_material_changes(part, values[part], source, values))
     design = dataclasses.replace(base, **changes)
+    _note_inherited_reservoir(values, design, base, source)
     if changes.get("finger_table"):
         if design.finger_model != "fem":  # the table would be unused
             raise InputError(f"{source}: finger_table", values["finger_table"], f"is the table of "
@@ -316,6 +321,18 @@ def design_from_dict(values: dict, base: HandDesign | None = None, *, source: st
         except InputError as exc:
             raise exc.renamed(f"{source}: finger_table") from None
     return design
+
+
+#: the reservoir's keys, sized for the base design's number of fingers
+RESERVOIR_KEYS = ("V0_mm3", "R_mm", "t_mm")
+
+
+def _note_inherited_reservoir(values: dict, design: HandDesign, base: HandDesign, source: str) -> None:
+    """A :class:`Note` when a design changes the number of fingers but keeps the base's reservoir."""
+    if design.n != base.n and not any(k in values for k in RESERVOIR_KEYS):
+        warnings.warn(f"{source}: n = {design.n} fingers share the reservoir sized for {base.n} "
+                      f"(V0_mm3 = {base.V0:g}, R_mm = {base.R:g}, t_mm = {base.t:g}, not set in "
+                      f"this design); set them to size its own", Note, stacklevel=3)
 
 
 def load_design(path: str | Path | None = None) -> HandDesign:

@@ -52,11 +52,11 @@ class WholeHandResult:
 
     def max_abs_difference_MPa(self) -> float:
         """Largest |P_hand,FEM - P_eq.(27)| over the rows [MPa]."""
-        return float(np.nanmax([abs(r["P_hand_fem_MPa"] - r["P_hand_eq27_MPa"]) for r in self.rows]))
+        return float(np.nanmax([abs(r["P_pump_fem_MPa"] - r["P_pump_eq27_MPa"]) for r in self.rows]))
 
 
 def whole_hand(rows: list[dict], design: HandDesign, **sheet_mesh) -> WholeHandResult:
-    """Per bending row (P_MPa, theta_deg, dQ_mm3): the hand's pump pressure from the FEM
+    """Per bending row (P_cavity_MPa, theta_deg, dQ_mm3): the hand's pump pressure from the FEM
     finger + FEM reservoir, and eq. (27) at the same theta."""
     dQ = np.array([r["dQ_mm3"] for r in rows])
     V = design.V0 - design.n * dQ
@@ -72,12 +72,12 @@ def whole_hand(rows: list[dict], design: HandDesign, **sheet_mesh) -> WholeHandR
         theta = math.radians(r["theta_deg"])
         out.append({
             "theta_deg": r["theta_deg"],
-            "P_finger_fem_MPa": r["P_MPa"],
+            "P_cavity_fem_MPa": r["P_cavity_MPa"],
             "V_mm3": float(v),
             "p_reservoir_fem_MPa": float(pr),
-            "P_hand_fem_MPa": r["P_MPa"] - float(pr),
-            "P_hand_eq27_MPa": float(hand.pressure(theta, design, reservoir=True)) if v > 0 else math.nan,
-            "P_finger_eq28_MPa": float(hand.pressure(theta, design, reservoir=False)),
+            "P_pump_fem_MPa": r["P_cavity_MPa"] - float(pr),
+            "P_pump_eq27_MPa": float(hand.pressure(theta, design, reservoir=True)) if v > 0 else math.nan,
+            "P_cavity_eq28_MPa": float(hand.pressure(theta, design, reservoir=False)),
         })
     return WholeHandResult(out, float(sheet.states[-1].pressure), float(ellipse.pressure(design.V0, design)),
                            int(sheet.ndofs), sheet.wall_time)

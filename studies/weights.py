@@ -78,14 +78,32 @@ def reduced_F_v(P: float, theta: float, mass: float, w, design: HandDesign) -> f
         return None
 
 
+#: eq. (25)'s F_v further than this from the FEM's, relative, is printed with why
+NOTE_RTOL = 0.1
+
+
+def reduced_note(F_v_red: float | None, F_v_fem: float, N, design: HandDesign) -> str | None:
+    """Why eq. (25)'s F_v [N] is not to be trusted where it is further than ``NOTE_RTOL`` from
+    the FEM's (N: each link's contact force [N]); None where it is close."""
+    if F_v_red is None or abs(F_v_red - F_v_fem) <= NOTE_RTOL * abs(F_v_fem):
+        return None
+    links = [k for k, n in enumerate(N) if n > 0]
+    where = f"touches link {', '.join(map(str, links))} of {design.n_s}" if links else "is not touched"
+    return (f"eq. (25) charges the pressure's work to a force at the fingertip, but the object {where}: "
+            f"its F_v is {F_v_red / F_v_fem:.3g} x the FEM's; use F_v_fem_N" if F_v_fem > 0 else
+            f"eq. (25) charges the pressure's work to a force at the fingertip, but the object {where}; "
+            "use F_v_fem_N")
+
+
 def state_row(state, w, mass: float, design: HandDesign) -> dict:
     """The reported numbers of one converged contact state (forces physical, hand frame)."""
     F_v_red = reduced_F_v(state.P, state.theta, mass, w, design)
-    return {"P_MPa": state.P, "theta_deg": math.degrees(state.theta),
+    return {"P_cavity_MPa": state.P, "theta_deg": math.degrees(state.theta),
             "hinge_deg": np.degrees(state.q).tolist(), "contact_force_N": state.N.tolist(),
             "F_x_fem_N": float(state.F[0]), "F_y_fem_N": float(state.F[1]),
             "F_v_fem_N": state.F_v, "F_v_reduced_N": F_v_red,
             "F_v_error_kgf": None if F_v_red is None else (F_v_red - state.F_v) / grasp.KGF,
+            "F_v_reduced_note": reduced_note(F_v_red, state.F_v, state.N, design),
             "max_penetration_mm": float(np.max(-state.gap[state.N > 0], initial=0.0)),
             "contact_updates": state.updates, "contact_penalty_N_per_mm": state.penalty,
             "newton_iterations": state.iterations, "factorizations": state.factorizations}
@@ -94,12 +112,12 @@ def state_row(state, w, mass: float, design: HandDesign) -> dict:
 def failed_record(case: WeightsCase, states) -> dict:
     """result.json's fields of a grasp FEM that stopped: the case and the states it reached
     (the last one's contact may not have converged: its penetration says by how much)."""
-    rows = [{"P_MPa": s.P, "theta_deg": math.degrees(s.theta), "hinge_deg": np.degrees(s.q).tolist(),
+    rows = [{"P_cavity_MPa": s.P, "theta_deg": math.degrees(s.theta), "hinge_deg": np.degrees(s.q).tolist(),
              "contact_force_N": s.N.tolist(), "F_v_fem_N": s.F_v,
              "max_penetration_mm": float(np.max(-s.gap[s.N > 0], initial=0.0))} for s in states]
-    return {"diameter_mm": case.diameter_mm, "mass_kg": case.mass_kg, "pressure_MPa": case.pressure_mpa,
+    return {"diameter_mm": case.diameter_mm, "mass_kg": case.mass_kg, "P_cavity_MPa": case.pressure_mpa,
             "dP_MPa": case.dP_mpa, "mesh_size_mm": case.mesh_size_mm,
-            "last_converged_MPa": rows[-1]["P_MPa"] if rows else 0.0, "states": rows,
+            "last_converged_P_cavity_MPa": rows[-1]["P_cavity_MPa"] if rows else 0.0, "states": rows,
             "design": case.design.to_dict()}
 
 

@@ -162,7 +162,7 @@ def test_vtk_series_of_the_contact_states(grasp180, tmp_path):
     mesh = meshio.read(tmp_path / "grasp" / "grasp_0001" / "tube.vtu")
     u = mesh.point_data["displacement_mm"]
     assert u.shape[1] == 3 and np.isfinite(u).all() and np.abs(u).max() > 1.0  # mm: the finger moved
-    assert mesh.field_data["pressure_MPa"][0] == b.P
+    assert mesh.field_data["P_cavity_MPa"][0] == b.P
 
 
 def test_scene_of_a_contact_state_holds_the_object_and_the_pad_forces(grasp180, tmp_path):

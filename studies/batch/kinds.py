@@ -16,7 +16,7 @@ from softhand.reduced.errors import InputError
 def curve(params: dict, design: HandDesign, outdir: Path) -> dict:
     """One point of the free-finger curve: eq. (27) with and (28) without reservoir.
 
-    ``theta_deg`` -> P_MPa, P_no_reservoir_MPa, V_mm3, p_reservoir_MPa (+ h_mm, lambda_r: ellipse model);
+    ``theta_deg`` -> P_pump_MPa, P_cavity_MPa (= the pump pressure without reservoir), V_mm3, p_reservoir_MPa (+ h_mm, lambda_r: ellipse model);
     ``pressure_mpa`` -> theta_deg, theta_no_reservoir_deg (the inverse).
     """
     from softhand.reduced import hand, reservoir
@@ -26,8 +26,8 @@ def curve(params: dict, design: HandDesign, outdir: Path) -> dict:
     if "theta_deg" in params:
         theta = math.radians(params["theta_deg"])
         V = reservoir.oil_volume(theta, design)
-        return {"P_MPa": hand.pressure(theta, design, reservoir=True),
-                "P_no_reservoir_MPa": hand.pressure(theta, design, reservoir=False),
+        return {"P_pump_MPa": hand.pressure(theta, design, reservoir=True),
+                "P_cavity_MPa": hand.pressure(theta, design, reservoir=False),
                 "V_mm3": V, **{k: float(v) for k, v in reservoir.state(V, design).items()}}
     theta, theta_free = hand.bend_angles(params["pressure_mpa"], design)
     return {"theta_deg": math.degrees(theta), "theta_no_reservoir_deg": math.degrees(theta_free)}

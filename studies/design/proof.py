@@ -198,7 +198,7 @@ def margin(model, sheet, best, ev: Evaluation, task: Task, options: ProofOptions
         return state.P - float(np.interp(oil_left(state), sheet.path_volume, sheet.path_pressure))
 
     def row(state):
-        return {"pump_pressure_MPa": pump(state), "cavity_pressure_MPa": state.P, "F_v_N": state.F_v,
+        return {"P_pump_MPa": pump(state), "P_cavity_MPa": state.P, "F_v_N": state.F_v,
                 "oil_left_mm3": oil_left(state),
                 "theta_deg": math.degrees(state.theta),
                 "links_in_contact": [int(k) for k in np.flatnonzero(state.N > 0)],
@@ -368,13 +368,13 @@ def prove(ev: Evaluation, task: Task, options: ProofOptions = ProofOptions(), *,
         "max_principal_stretch": fs.max_principal_stretch,
         "max_principal_stretch_at_contact": bend["max_principal_stretch"],
         "contact_force_N": best.N.tolist(),
-        "cavity_pressure_MPa": best.P,
+        "P_cavity_MPa": best.P,
         "reservoir_pressure_MPa": p_grasp,
         "reservoir_offset_MPa": sheet.states[1].pressure,
         "reservoir_pressure_maximum": sheet.pressure_max,
         "depth_mm": model.depth,
         "free_bend": bend,
-        "grasp_states": [{"P_MPa": s.P, "theta_deg": math.degrees(s.theta), "F_v_N": s.F_v}
+        "grasp_states": [{"P_cavity_MPa": s.P, "theta_deg": math.degrees(s.theta), "F_v_N": s.F_v}
                          for s in g["states"]],
         "finger_ndofs": finger.ndofs, "sheet_ndofs": sheet.ndofs,
         "mesh_size_mm": options.mesh_size_mm,

@@ -31,7 +31,7 @@ def fig7_reduced(ctx: Context, outdir: Path):
     P, P0 = hand.pressure(theta, d, reservoir=True), hand.pressure(theta, d, reservoir=False)
     offset = P0 - P
     write_csv(outdir / "fig7_reduced.csv", [
-        {"theta_deg": t, "P_MPa": p, "P_no_reservoir_MPa": q} for t, p, q in zip(theta_deg, P, P0)])
+        {"theta_deg": t, "P_pump_MPa": p, "P_cavity_MPa": q} for t, p, q in zip(theta_deg, P, P0)])
     pressures = np.round(np.arange(0.0, 0.8 + 1e-9, 0.1), 10)
     by_p = _angles_at(pressures, d)
     write_csv(outdir / "fig7_reduced_by_pressure.csv", by_p)
@@ -94,7 +94,7 @@ def _angles_at(pressures, design) -> list[dict]:
 
     rows = []
     for P in pressures:
-        row = {"P_MPa": float(P)}
+        row = {"P_pump_MPa": float(P)}
         for key, res in (("theta_deg", True), ("theta_no_reservoir_deg", False)):
             try:
                 row[key] = float(np.degrees(hand.bend_angle(P, design, reservoir=res)))
@@ -118,7 +118,7 @@ def table2_reduced(ctx: Context, outdir: Path):
             warnings.simplefilter("ignore", WeightSumWarning)  # stated in the text below
             F = grasp_forces(P, math.radians(theta_deg), 2.0, w_paper, d).F_v / KGF
         F_unit = grasp_forces(P, math.radians(theta_deg), 2.0, w_unit, d).F_v / KGF
-        rows.append({"state": state, "P_MPa": P, "theta_deg": theta_deg, "F_v_paper_kgf": F_paper,
+        rows.append({"state": state, "P_pump_MPa": P, "theta_deg": theta_deg, "F_v_paper_kgf": F_paper,
                      "F_v_kgf": float(F), "F_v_w_normalised_kgf": float(F_unit)})
     write_csv(outdir / "table2_reduced.csv", rows)
     numbers = {f"F_v_{r['state']}_kgf": r["F_v_kgf"] for r in rows}
@@ -165,7 +165,7 @@ def fig8_reduced(ctx: Context, outdir: Path):
                 F_v = grasp_forces(P, np.radians(theta_deg), mass, w, d).F_v / KGF
                 theta_free = float(np.degrees(angle_at(P, mass, w, d)))
             ax.plot(theta_deg, F_v, label=f"{P} MPa")
-            rows += [{"diameter_mm": D, "mass_kg": mass, "P_MPa": P, "theta_deg": t, "F_v_kgf": f}
+            rows += [{"diameter_mm": D, "mass_kg": mass, "P_pump_MPa": P, "theta_deg": t, "F_v_kgf": f}
                      for t, f in zip(theta_deg, F_v)]
             numbers[f"theta_F0_{D:.0f}mm_{P}MPa_deg"] = theta_free
         ax.axhline(0.0, color="k", lw=0.6)
@@ -175,7 +175,7 @@ def fig8_reduced(ctx: Context, outdir: Path):
         ax.legend(fontsize=8)
     save_figure(fig, outdir / "fig8_reduced.png")
     write_csv(outdir / "fig8_reduced.csv", rows)
-    free = [{"diameter_mm": D, "mass_kg": m, "P_MPa": P,
+    free = [{"diameter_mm": D, "mass_kg": m, "P_pump_MPa": P,
              "theta_at_F_v_0_deg": numbers[f"theta_F0_{D:.0f}mm_{P}MPa_deg"]}
             for D, m, ps, *_ in paper.FIG8 for P in ps]
     text = f"""Eq. (25) solved for F_x, with F_y = mg/n (24) and F_v by (29), against θ at the
@@ -206,12 +206,13 @@ def table2_control(ctx: Context, outdir: Path):
     """Table II by simulation: the three states of the flexibility experiment."""
     result = _flexibility(ctx)
     study = result.study
-    columns = ["state", "P_MPa", "theta_deg", "F_v_estimated_kgf", "F_v_actual_mean_N",
-               "paper_P_MPa", "paper_theta_deg", "paper_F_v_kgf"]
+    columns = ["state", "P_pump_MPa", "theta_deg", "F_v_estimated_kgf", "F_v_actual_mean_N",
+               "paper_P_pump_MPa", "paper_theta_deg", "paper_F_v_kgf"]
+    columns = [c for c in columns if c in result.rows[0]]  # the paper's columns: its own hand only
     write_csv(outdir / "table2_control.csv", result.rows)
     F = {r["state"]: r["F_v_estimated_kgf"] for r in result.rows}
     numbers = {f"F_v_{k}_kgf": v for k, v in F.items()}
-    numbers["P_a_MPa"] = result.rows[0]["P_MPa"]
+    numbers["P_a_MPa"] = result.rows[0]["P_pump_MPa"]
     verdict = "holds" if F["c_push_angle_control"] < F["b_push_pressure_control"] else "does not hold"
     text = f"""The simulated hand (reduced-model statics, pump and finger lags; the paper's
 design and 180 mm w) holds a 2 kg object under angle control at θ_ref = 50° (eqs. (30),

@@ -2,9 +2,11 @@
 
 ``--theta-deg RANGE`` gives, per angle, the pressure with and without the reservoir and the
 reservoir's state (V (15), its pressure p_r, and for the ellipse model h (14), lambda_r (16)); ``--pressure-mpa RANGE`` gives, per
-pressure, the bend angle with and without the reservoir. ``--plot FILE.png`` draws the
-analogue of the paper's Fig. 7. Only numpy and the reduced model are imported unless a plot
-is asked for.
+pump pressure, the bend angle with the reservoir, the cavity pressure there and the bend
+without the reservoir. ``--plot FILE.png`` draws the analogue of the paper's Fig. 7, titled
+with the design and the finger model. ``--model paper,fem`` computes the curve on each finger
+model, ``--compare A.toml B.toml ...`` on each design (after ``--design``'s, if given); all
+curves go on one plot. Only numpy and the reduced model are imported unless a plot is asked for.
 """
 from __future__ import annotations
 
@@ -25,86 +27,151 @@ def configure(parser) -> None:
     what.add_argument("--pressure-mpa", metavar="RANGE",
                       help="pump pressures [MPa]: start:stop:step (stop included) or a,b,c")
     parser.add_argument("--plot", metavar="FILE.png", help="draw P vs bend angle (the paper's Fig. 7)")
+    parser.add_argument("--model", metavar="paper,fem", default=None,
+                        help="finger model(s), comma-separated: paper (eqs. 10, 27) or fem (calibrated by "
+                             "the finger FEM); default: the design's own (finger_model)")
+    parser.add_argument("--compare", metavar="DESIGN.toml", nargs="+", default=None,
+                        help="curves of these designs too (after --design's, if given), on one plot")
     add_max_cases_option(parser, MAX_POINTS, MOST_POINTS)
     add_design_option(parser)
     add_json_option(parser)
 
 
 def rows_at_angles(theta_deg: np.ndarray, design: HandDesign) -> list[dict]:
-    """Per bend angle [deg]: P with / without reservoir [MPa], the reservoir's V [mm^3] and
+    """Per bend angle [deg]: the pump pressure with the reservoir and the cavity pressure (= the pump
+    pressure without reservoir) [MPa], the reservoir's V [mm^3] and
     :func:`reduced.reservoir.state` (p_r; h, lambda_r for the ellipse model)."""
     theta = hand.check_theta(np.radians(theta_deg))
     V = reservoir.oil_volume(theta, design)
-    columns = {"theta_deg": theta_deg, "P_MPa": hand.pressure(theta, design),
-               "P_no_reservoir_MPa": hand.pressure(theta, design, reservoir=False), "V_mm3": V,
+    columns = {"theta_deg": theta_deg, "P_pump_MPa": hand.pressure(theta, design),
+               "P_cavity_MPa": hand.pressure(theta, design, reservoir=False), "V_mm3": V,
                **reservoir.state(V, design)}
     return [{k: float(v[i]) for k, v in columns.items()} for i in range(len(theta_deg))]
 
 
 def rows_at_pressures(P: np.ndarray, design: HandDesign) -> list[dict]:
-    """Per pump pressure [MPa]: the free bend angle with / without reservoir [deg]."""
+    """Per pump pressure [MPa]: the free bend angle with the reservoir [deg], the cavity pressure
+    there [MPa] and the bend angle without the reservoir (pump = cavity pressure) [deg]."""
     # rounded to 1e-10 deg, far below the inverse's error (~1e-11 rad), so that an exact
     # zero prints as 0 (+ 0.0 turns -0.0 into 0.0)
-    theta, theta_free = (np.round(np.degrees(t), 10) + 0.0 for t in hand.bend_angles(P, design))
-    return [{"P_MPa": float(p), "theta_deg": float(t), "theta_no_reservoir_deg": float(u)}
-            for p, t, u in zip(P, theta, theta_free)]
+    angles = hand.bend_angles(P, design)
+    theta, theta_free = (np.round(np.degrees(t), 10) + 0.0 for t in angles)
+    # the cavity's pressure at that bend: the pump's plus the reservoir's
+    P_cavity = hand.pressure(angles[0], design, reservoir=False)
+    return [{"P_pump_MPa": float(p), "theta_deg": float(t), "P_cavity_MPa": float(c),
+             "theta_no_reservoir_deg": float(u)} for p, t, c, u in zip(P, theta, P_cavity, theta_free)]
+
+
+#: --model: the finger models a curve can be drawn on
+FINGER_MODELS = ("paper", "fem")
+
+
+def curves(args) -> list[tuple[str, HandDesign]]:
+    """(label, design) of every curve asked for: each design (``--design``, then ``--compare``'s)
+    on each finger model of ``--model`` (default: the design's own)."""
+    from argparse import Namespace
+
+    from softhand.reduced.errors import InputError
+    from softhand.studies.cli.checks import check_choices
+
+    files = [args.design] if args.design is not None or not args.compare else []
+    files += list(args.compare or [])
+    models = None
+    if args.model is not None:
+        models = tuple(m.strip() for m in args.model.split(","))
+        check_choices("--model", models, FINGER_MODELS, "finger model", shown=args.model)
+    out = []
+    for path in files:
+        design = design_from_args(Namespace(design=path))
+        for model in models or (design.finger_model,):
+            label = f"{design_name(path)}, finger model {model}"
+            if any(label == seen for seen, _ in out):
+                raise InputError("--compare", path, "names a design already compared")
+            out.append((label, design.replace(finger_model=model)))
+    return out
+
+
+def design_name(path) -> str:
+    """How a plot names a design: its file's name, or the paper's."""
+    from pathlib import Path
+
+    return "the paper's design" if path is None else Path(path).stem
 
 
 def run(args) -> int:
     from softhand.reduced.errors import InputError
 
     limit = max_cases(args, MAX_POINTS, MOST_POINTS)
-    design = design_from_args(args)
+    chosen = curves(args)
     option = "--theta-deg" if args.theta_deg is not None else "--pressure-mpa"
     values = parse_values(args.theta_deg if args.theta_deg is not None else args.pressure_mpa, option,
                           limit)
-    try:
-        rows = (rows_at_angles if args.theta_deg is not None else rows_at_pressures)(values, design)
-    except InputError as exc:  # named as the option the user typed
-        if exc.field in ("theta_deg", "pressure_MPa"):
-            raise exc.renamed(option) from None
-        raise
-    for row in rows:
-        require_finite(row, args, f"at {option} {row['theta_deg' if option == '--theta-deg' else 'P_MPa']:g}")
+    found = []
+    for label, design in chosen:
+        try:
+            rows = (rows_at_angles if args.theta_deg is not None else rows_at_pressures)(values, design)
+        except InputError as exc:  # named as the option the user typed
+            if exc.field in ("theta_deg", "pressure_MPa"):
+                raise exc.renamed(option) from None
+            raise
+        for row in rows:
+            where = row['theta_deg' if option == '--theta-deg' else 'P_pump_MPa']
+            require_finite(row, args, f"at {option} {where:g}" + (f" ({label})" if len(chosen) > 1 else ""))
+        found.append((label, design, rows))
     if args.plot:
         from softhand.studies.io.files import kept_if_unwritable
 
         with kept_if_unwritable(args.plot, "curve"):
-            plot_curve(args.plot, design, rows, by_pressure=args.theta_deg is None)
-    if args.json:
-        print_json({"rows": rows, "design": design.to_dict()})
+            plot_curves(args.plot, found, by_pressure=args.theta_deg is None)
+    if args.json and len(found) == 1:
+        print_json({"rows": found[0][2], "design": found[0][1].to_dict()})
+    elif args.json:
+        print_json({"curves": [{"label": label, "rows": rows, "design": design.to_dict()}
+                               for label, design, rows in found]})
     else:
-        print_table(rows)
+        for i, (label, _, rows) in enumerate(found):
+            if len(found) > 1:
+                print(f"{chr(10) if i else ''}# {label}")
+            print_table(rows)
     return 0
 
 
-def plot_curve(path, design: HandDesign, rows: list[dict], *, by_pressure: bool = False):
-    """Bend angle vs pump pressure with and without the reservoir (Fig. 7) over the span of
-    ``rows`` (their pressures if ``by_pressure``, else their angles) -> PNG at ``path``."""
+def _span(design: HandDesign, rows: list[dict], by_pressure: bool):
+    """(P, theta, P_free, theta_free) along the span of ``rows``: pump pressures [MPa] and
+    bends [deg] with the reservoir, then without (where pump and cavity pressure are one)."""
+    key = "P_pump_MPa" if by_pressure else "theta_deg"
+    lo, hi = min(r[key] for r in rows), max(r[key] for r in rows)
+    span = np.linspace(lo, hi, 200) if hi > lo else np.array([lo])
+    if by_pressure:
+        theta, theta_free = (np.degrees(t) for t in hand.bend_angles(span, design))
+        return span, theta, span, theta_free
+    P, P_free = (hand.pressure(np.radians(span), design, reservoir=res) for res in (True, False))
+    return P, span, P_free, span
+
+
+def plot_curves(path, found: list[tuple[str, HandDesign, list[dict]]], *, by_pressure: bool = False):
+    """Fig. 7 of each (label, design, rows) on one plot: the bend against the pump pressure with
+    the reservoir (solid) and without it (dotted), the printed rows as points -> ``path``."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
     from softhand.studies.io.files import save_figure
 
-    key = "P_MPa" if by_pressure else "theta_deg"
-    lo, hi = min(r[key] for r in rows), max(r[key] for r in rows)
-    span = np.linspace(lo, hi, 200) if hi > lo else np.array([lo])
-    if by_pressure:
-        P = P_free = span
-        theta, theta_free = (np.degrees(t) for t in hand.bend_angles(span, design))
-    else:
-        theta = theta_free = span
-        P, P_free = (hand.pressure(np.radians(span), design, reservoir=res) for res in (True, False))
-    fig, ax = plt.subplots(figsize=(5.5, 4.0))
-    ax.plot(P, theta, "-", label="with reservoir (27)")
-    ax.plot(P_free, theta_free, ":", label="without reservoir (28)")
-    ax.plot([r["P_MPa"] for r in rows], [r["theta_deg"] for r in rows], "o", ms=4,
-            label="rows printed (with reservoir)")
-    ax.set_xlabel("pump pressure P [MPa]")
+    fig, ax = plt.subplots(figsize=(6.5 if len(found) > 1 else 5.5, 4.5))
+    for k, (label, design, rows) in enumerate(found):
+        P, theta, P_free, theta_free = _span(design, rows, by_pressure)
+        colour = f"C{k % 10}"
+        one = len(found) == 1
+        ax.plot(P, theta, "-", color=colour, label="with reservoir (27)" if one else f"{label}")
+        ax.plot(P_free, theta_free, ":", color=colour, label="without reservoir (28)" if one else None)
+        ax.plot([r["P_pump_MPa"] for r in rows], [r["theta_deg"] for r in rows], "o", ms=4, color=colour,
+                label="rows printed (with reservoir)" if one else None)
+    ax.set_xlabel("pump pressure P_pump [MPa] (without reservoir: = P_cavity)")
     ax.set_ylabel("bend angle theta [deg]")
     ax.axvline(0.0, color="0.7", lw=0.8)
     ax.grid(alpha=0.3)
-    ax.legend()
-    ax.set_title("Free bending, reduced model (paper Fig. 7)")
+    ax.legend(fontsize=8 if len(found) > 1 else None)
+    ax.set_title(f"Free bending, reduced model: {found[0][0]}" if len(found) == 1 else
+                 "Free bending, reduced model: with reservoir (solid), without (dotted)", fontsize=10)
     save_figure(fig, path)

@@ -186,20 +186,36 @@ def _check_proof_size(task, args) -> None:
 
 
 def _prove(ev, task, args, out, say) -> dict:
+    """The FEM proof, with a bar of its phases (free bend, sheet, grasp states) on stderr; a
+    finger mesh that fails is retried on the next finer one, which is said as information."""
+    from tqdm import tqdm
+
     from softhand.fem.newton import NotConverged
     from softhand.studies.design.proof import ProofOptions, proof_meshes, prove
 
     failed = []
-    for size in proof_meshes(ev.design, args.mesh_size_mm if args.mesh_size_mm is not None else task.mesh_size):
-        try:  # a finger mesh that fails is retried on the next finer one
-            options = ProofOptions(mesh_size_mm=size, dP_mpa=task.dP, edge_ratio=task.edge_ratio)
-            fem = prove(ev, task, options, out=out, progress=say)
-            return {**fem, "failed_meshes": failed} if failed else fem
-        except (NotConverged, RuntimeError, MeshRejected) as exc:
-            say(f"the FEM proof on the {size:g} mm finger mesh failed: {str(exc)[:300]}")  # e.g. folded
-            failed.append({"mesh_size_mm": size, "error": str(exc)[:300]})
-            if isinstance(exc, MeshTooLarge):  # a finer mesh would be larger still
-                return {"error": failed[-1]["error"], "failed_meshes": failed, "too_large": True}
+    sizes = proof_meshes(ev.design, args.mesh_size_mm if args.mesh_size_mm is not None else task.mesh_size)
+    with tqdm(desc="FEM proof", unit="phase", file=sys.stderr, leave=False, disable=args.no_progress) as bar:
+        def phase(text):  # each line the proof says starts a phase
+            with bar.external_write_mode(file=sys.stderr):
+                say(text)
+            bar.update()
+
+        for k, size in enumerate(sizes):
+            try:
+                options = ProofOptions(mesh_size_mm=size, dP_mpa=task.dP, edge_ratio=task.edge_ratio)
+                fem = prove(ev, task, options, out=out, progress=phase)
+                return {**fem, "failed_meshes": failed} if failed else fem
+            except (NotConverged, RuntimeError, MeshRejected) as exc:
+                failed.append({"mesh_size_mm": size, "error": str(exc)[:300]})  # e.g. folded elements
+                if isinstance(exc, MeshTooLarge):  # a finer mesh would be larger still
+                    phase(f"the FEM proof on the {size:g} mm finger mesh failed: {str(exc)[:300]}")
+                    return {"error": failed[-1]["error"], "failed_meshes": failed, "too_large": True}
+                if k + 1 < len(sizes):
+                    phase(f"note: the {size:g} mm finger mesh did not serve ({str(exc)[:200]}); "
+                          f"proving on the {sizes[k + 1]:g} mm mesh instead")
+                else:
+                    phase(f"the FEM proof on the {size:g} mm finger mesh failed: {str(exc)[:300]}")
     return {"error": failed[-1]["error"], "failed_meshes": failed}
 
 
@@ -295,8 +311,8 @@ def _print_margin(fem: dict, task) -> None:
     if "error" in m:
         print(f"# FEM margin: not computed ({m['error']}); predicted F_v {m['predicted_F_v_N']:.4g} N")
         return
-    print(f"# FEM margin: F_v {m['F_v_N']:.4g} N at the pump pressure {m['pump_pressure_MPa']:.4g} MPa "
-          f"(cavity {m['cavity_pressure_MPa']:.4g} MPa, {on(m)}), predicted {m['predicted_F_v_N']:.4g} N")
+    print(f"# FEM margin: F_v {m['F_v_N']:.4g} N at the pump pressure {m['P_pump_MPa']:.4g} MPa "
+          f"(cavity {m['P_cavity_MPa']:.4g} MPa, {on(m)}), predicted {m['predicted_F_v_N']:.4g} N")
     limit = fem.get("at_pump_limit")
     if limit and "error" in limit:
         print(f"# FEM at the pump limit {task.max_pressure:g} MPa: not reached ({limit['error']})")

@@ -114,7 +114,10 @@ def run(args) -> int:
     mass = _scalar(args.mass_kg, "--mass-kg")
     if _model(args) == "fem":
         diameter = _scalar(args.diameter_mm, "--diameter-mm")
-        result = state_fem(P, theta_deg, mass, diameter, design)
+        try:
+            result = state_fem(P, theta_deg, mass, diameter, design)
+        except InputError as exc:  # named as the option the user typed
+            raise (exc.renamed("--theta-deg") if exc.field == "theta_deg" else exc) from None
         _require_finite(result, args)
         return _print(args, result)
     if args.weights is not None and args.weights.strip() not in PAPER_NAMES:
@@ -139,7 +142,7 @@ def run(args) -> int:
 
 
 def _require_finite(result: dict, args) -> None:
-    require_finite(result, args, f"at P = {result['P_MPa']:g} MPa, theta = {result['theta_deg']:g} deg")
+    require_finite(result, args, f"at P_pump = {result['P_pump_MPa']:g} MPa, theta = {result['theta_deg']:g} deg")
 
 
 def _print(args, result: dict) -> int:

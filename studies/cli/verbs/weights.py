@@ -113,7 +113,7 @@ def _failed(exc, out: Path) -> int:
 
     record = failed_record(exc.case, exc.states)
     return save_last_converged(
-        out, "weights", "grasp FEM", str(exc).split(";")[0], f"P = {record['last_converged_MPa']:.4g} MPa",
+        out, "weights", "grasp FEM", str(exc).split(";")[0], f"P_cavity = {record['last_converged_P_cavity_MPa']:.4g} MPa",
         record, write_files=lambda: write_vtk(out, exc.model, exc.states), files="grasp.pvd")
 
 
@@ -181,6 +181,7 @@ OUTPUT_PATTERNS = ("result.json", "grasp.pvd", "grasp")
 
 
 def _print_one(result: dict) -> None:
+    note = result.pop("F_v_reduced_note", None)
     width = max(map(len, result))
     for key, value in result.items():
         if isinstance(value, list):
@@ -190,6 +191,8 @@ def _print_one(result: dict) -> None:
         else:
             text = str(value)
         print(f"{key:<{width}}  {text}")
+    if note:
+        print(f"# F_v_reduced_N: {note}")
 
 
 def _sweep(args, case, diameters) -> int:
@@ -225,7 +228,7 @@ def _fig8(args, case, pressures) -> int:
     if args.json:
         print_json(summary)
     else:
-        print_table(result.rows, ["depth_mm", "P_MPa", "theta_deg", "F_v_fem_N", "F_v_reduced_N",
+        print_table(result.rows, ["depth_mm", "P_cavity_MPa", "theta_deg", "F_v_fem_N", "F_v_reduced_N",
                            "F_v_error_kgf", "w"], digits=3)
         for prefix, what in (("", "the FEM's w"), ("paper_w_", "the paper's w, normalised")):
             if summary[f"{prefix}rms_error_kgf"] is not None:
