@@ -47,7 +47,7 @@ def test_a_failed_proof_mesh_is_retried_on_the_next_finer_one(monkeypatch):
 
     tried, works = [], 6.0
 
-    def prove(ev, task, options, out=None, progress=None):
+    def prove(ev, task, options, out=None, progress=None, tick=None):
         tried.append(options.mesh_size_mm)
         if options.mesh_size_mm == 10.0:  # the FEM refuses the mesh: the proof's choice, not the user's
             raise MeshRejected("gmsh 10 mm", "has 39 curved elements that fold over themselves")
@@ -58,22 +58,22 @@ def test_a_failed_proof_mesh_is_retried_on_the_next_finer_one(monkeypatch):
     monkeypatch.setattr(proof, "prove", prove)
     task = task_from_dict({**CI_TASK, "fem": {"mesh_size_mm": 10.0}})
     ev = design_opt.evaluate(task.base, task)
-    fem = verb._prove(ev, task, SimpleNamespace(mesh_size_mm=None), None, lambda text: None)
+    fem = verb._prove(ev, task, SimpleNamespace(mesh_size_mm=None, no_progress=True), None, lambda text: None)
     assert tried == [10.0, 6.0] and fem["P_grasp_MPa"] == 0.5
     assert fem["failed_meshes"][0]["mesh_size_mm"] == 10.0
     tried.clear()
-    fem = verb._prove(ev, task, SimpleNamespace(mesh_size_mm=6.0), None, lambda text: None)
+    fem = verb._prove(ev, task, SimpleNamespace(mesh_size_mm=6.0, no_progress=True), None, lambda text: None)
     assert tried == [6.0] and "failed_meshes" not in fem
     tried.clear()
     works = 4.0  # a thin wall: the 10 and 6 mm meshes stall, 4 mm bends it
-    fem = verb._prove(ev, task, SimpleNamespace(mesh_size_mm=None), None, lambda text: None)
+    fem = verb._prove(ev, task, SimpleNamespace(mesh_size_mm=None, no_progress=True), None, lambda text: None)
     assert tried == [10.0, 6.0, 4.0] and [m["mesh_size_mm"] for m in fem["failed_meshes"]] == [10.0, 6.0]
     tried.clear()
     works = 3.0  # none works: the last error, every mesh named
-    fem = verb._prove(ev, task, SimpleNamespace(mesh_size_mm=None), None, lambda text: None)
+    fem = verb._prove(ev, task, SimpleNamespace(mesh_size_mm=None, no_progress=True), None, lambda text: None)
     assert tried == [10.0, 6.0, 4.0] and "error" in fem and len(fem["failed_meshes"]) == 3
     tried.clear()
-    fem = verb._prove(ev, task, SimpleNamespace(mesh_size_mm=3.5), None, lambda text: None)
+    fem = verb._prove(ev, task, SimpleNamespace(mesh_size_mm=3.5, no_progress=True), None, lambda text: None)
     assert tried == [3.5]  # a finer mesh of the user's is the only one
 
     def refuses(*args, **kwargs):
@@ -81,7 +81,7 @@ def test_a_failed_proof_mesh_is_retried_on_the_next_finer_one(monkeypatch):
 
     monkeypatch.setattr(proof, "prove", refuses)
     with pytest.raises(InputError):  # any other bad input is the user's: it ends the run
-        verb._prove(ev, task, SimpleNamespace(mesh_size_mm=None), None, lambda text: None)
+        verb._prove(ev, task, SimpleNamespace(mesh_size_mm=None, no_progress=True), None, lambda text: None)
 
 
 def test_a_proof_mesh_too_large_for_the_optimum_is_not_retried_finer(monkeypatch):
@@ -95,14 +95,14 @@ def test_a_proof_mesh_too_large_for_the_optimum_is_not_retried_finer(monkeypatch
 
     tried = []
 
-    def prove(ev, task, options, out=None, progress=None):
+    def prove(ev, task, options, out=None, progress=None, tick=None):
         tried.append(options.mesh_size_mm)
         raise MeshTooLarge("gmsh mesh_size=10", "has at least 900,000 unknowns; choose a coarser mesh")
 
     monkeypatch.setattr(proof, "prove", prove)
     task = task_from_dict({**CI_TASK, "fem": {"mesh_size_mm": 10.0}})
     ev = design_opt.evaluate(task.base, task)
-    fem = verb._prove(ev, task, SimpleNamespace(mesh_size_mm=None), None, lambda text: None)
+    fem = verb._prove(ev, task, SimpleNamespace(mesh_size_mm=None, no_progress=True), None, lambda text: None)
     assert tried == [10.0] and fem["too_large"]
     assert "try --mesh-size-mm with a coarser mesh" in proof.fem_report(fem, ev)
 
@@ -139,7 +139,7 @@ def test_a_fem_stretch_above_the_limit_reoptimises_with_the_fems_factor(tmp_path
 
     seen = []
 
-    def prove(ev, task, options, out=None, progress=None):
+    def prove(ev, task, options, out=None, progress=None, tick=None):
         seen.append((ev, task))
         stretch = first if len(seen) == 1 else 1 + 0.999 * (ev.stretch - 1)  # the second: as the factor says
         fem = {"max_principal_stretch": stretch, "P_grasp_MPa": ev.P_grasp, "F_v_N": ev.F_v}
@@ -183,7 +183,7 @@ def test_the_pareto_knee_goes_through_the_fem_too(tmp_path, monkeypatch, capsys)
 
     seen = []
 
-    def prove(ev, task, options, out=None, progress=None):
+    def prove(ev, task, options, out=None, progress=None, tick=None):
         seen.append((ev, out))
         fem = {"max_principal_stretch": ev.stretch, "P_grasp_MPa": ev.P_grasp, "F_v_N": ev.F_v}
         return {**fem, "constraints": fem_constraints(fem, task)}
@@ -209,7 +209,7 @@ def test_a_proof_that_fails_on_every_mesh_is_not_a_proven_design(tmp_path, monke
     from softhand.studies.cli.main import main
     from softhand.studies.design import proof
 
-    def prove(ev, task, options, out=None, progress=None):
+    def prove(ev, task, options, out=None, progress=None, tick=None):
         raise RuntimeError("free-bend FEM: Newton failed at 0.2 MPa")
 
     monkeypatch.setattr(proof, "prove", prove)

@@ -60,8 +60,9 @@ class _Past(Exception):
     """Raised by the free-bend callback once the finger has bent past the grasp angle."""
 
 
-def free_bend(finger, theta_g: float, options: ProofOptions) -> dict:
-    """The free finger FEM up to theta_g [rad]: cavity pressure, dQ, stretch at theta_g."""
+def free_bend(finger, theta_g: float, options: ProofOptions, tick=None) -> dict:
+    """The free finger FEM up to theta_g [rad]: cavity pressure, dQ, stretch at theta_g;
+    ``tick(text)`` is told each converged state's bend."""
     from softhand.fem.hand.finger import solve_pressures
     from softhand.fem.newton import NotConverged
 
@@ -71,6 +72,8 @@ def free_bend(finger, theta_g: float, options: ProofOptions) -> dict:
 
     def keep(state):
         states.append(state)
+        if tick is not None:
+            tick(f"free bend {math.degrees(state.theta):.1f} of {math.degrees(theta_g):.1f} deg")
         if state.theta > theta_g:
             raise _Past
 
@@ -314,8 +317,9 @@ def corrected_task(task: Task, ev: Evaluation, fem: dict) -> Task | None:
 
 
 def prove(ev: Evaluation, task: Task, options: ProofOptions = ProofOptions(), *, out=None,
-          progress=None) -> dict:
-    """Run the three FEM models for the evaluated design; the FEM's numbers (see module doc)."""
+          progress=None, tick=None) -> dict:
+    """Run the three FEM models for the evaluated design; the FEM's numbers (see module doc).
+    ``progress(text)`` is told each phase, ``tick(text)`` each converged free-bend state."""
     from softhand.fem.hand.finger import FingerModel
     from softhand.fem.hand.grasp import GraspModel
     from softhand.fem.hand.reservoir import SheetModel, inflate
@@ -327,7 +331,7 @@ def prove(ev: Evaluation, task: Task, options: ProofOptions = ProofOptions(), *,
     finger = FingerModel(design, replace(finger_options(options.mesh_size_mm), edge_ratio=options.edge_ratio))
     say(f"free bend FEM to the grasp angle {math.degrees(ev.theta_grasp):.2f} deg "
         f"({finger.ndofs} unknowns)")
-    bend = free_bend(finger, ev.theta_grasp, options)
+    bend = free_bend(finger, ev.theta_grasp, options, tick)
     touch = _touch(bend, ev, task)
     say("reservoir sheet FEM at the oil left at contact")
     V_contact = design.V0 - design.n * bend["dQ_mm3"]

@@ -92,10 +92,14 @@ def curves(args) -> list[tuple[str, HandDesign]]:
 
 
 def design_name(path) -> str:
-    """How a plot names a design: its file's name, or the paper's."""
+    """How a plot names a design: its file's name (with its folder's if that is all ``design``,
+    as ``softhand design`` writes it), or the paper's."""
     from pathlib import Path
 
-    return "the paper's design" if path is None else Path(path).stem
+    if path is None:
+        return "the paper's design"
+    path = Path(path)
+    return f"{path.parent.name}/{path.stem}" if path.stem == "design" and path.parent.name else path.stem
 
 
 def run(args) -> int:

@@ -199,12 +199,14 @@ def _prove(ev, task, args, out, say) -> dict:
         def phase(text):  # each line the proof says starts a phase
             with bar.external_write_mode(file=sys.stderr):
                 say(text)
+            bar.set_postfix_str("", refresh=False)
             bar.update()
 
         for k, size in enumerate(sizes):
             try:
                 options = ProofOptions(mesh_size_mm=size, dP_mpa=task.dP, edge_ratio=task.edge_ratio)
-                fem = prove(ev, task, options, out=out, progress=phase)
+                fem = prove(ev, task, options, out=out, progress=phase,
+                            tick=lambda text: bar.set_postfix_str(text))
                 return {**fem, "failed_meshes": failed} if failed else fem
             except (NotConverged, RuntimeError, MeshRejected) as exc:
                 failed.append({"mesh_size_mm": size, "error": str(exc)[:300]})  # e.g. folded elements
