@@ -170,8 +170,9 @@ class HandDesign:
     def replace(self, **changes) -> "HandDesign":
         """A copy with some fields changed, validated: by field name in internal units
         (``a=3.5``, ``theta0`` in rad) or by the design file's key (``a_mm=3.5``,
-        ``theta0_deg=20``), with the file's rules (a new ``l0_mm`` scales the hinges)."""
-        public = {k: changes.pop(k) for k in list(changes) if k in _FIELD_OF}
+        ``theta0_deg=20``), with the file's rules (a new ``l0_mm`` scales the hinges); a name
+        that is both (``n``, ``finger_model``) is the field."""
+        public = {k: changes.pop(k) for k in list(changes) if k in _FIELD_OF and k not in _KEY_OF}
         design = dataclasses.replace(self, **changes)
         return design_from_dict(public, design, source="replace") if public else design
 

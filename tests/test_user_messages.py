@@ -111,3 +111,21 @@ def test_material_fit_plot_draws_every_mode_of_the_data(tmp_path, monkeypatch, c
         assert f"{mode} data" in labels and any(t.startswith(f"{mode} fit") for t in labels)
     uniaxial_fit = next(line for line in ax.get_lines() if line.get_label().startswith("uniaxial fit"))
     assert min(uniaxial_fit.get_xdata()) == pytest.approx(0.8)  # the compression point is covered
+
+
+def test_weights_prints_eq25s_force_under_its_caveat(monkeypatch, capsys):
+    """The one-diameter table: F_v_reduced_N beside F_v_fem_N, and the line that says why it is
+    off; ``--json`` carries the same words as ``F_v_reduced_note``."""
+    from types import SimpleNamespace
+
+    from softhand.studies import weights
+    from softhand.studies.weights import reduced_note
+
+    N = [0.0, 0.0, 3.2, 0.0, 0.0, 0.0]
+    row = {"diameter_mm": 240.0, "F_v_fem_N": 4.751, "F_v_reduced_N": 87.21, "contact_force_N": N,
+           "F_v_reduced_note": reduced_note(87.21, 4.751, np.array(N), HandDesign())}
+    monkeypatch.setattr(weights, "run_case", lambda case, **kw: SimpleNamespace(summary=lambda: dict(row)))
+    assert main(["weights", "--diameter-mm", "240"]) == 0
+    out = capsys.readouterr().out.splitlines()
+    assert out[-1] == f"# F_v_reduced_N: {row['F_v_reduced_note']}" and "18.4 x the FEM's" in out[-1]
+    assert not any(line.startswith("F_v_reduced_note") for line in out)
