@@ -32,7 +32,7 @@ from softhand.reduced.errors import InputError
 from softhand.studies.io.files import json_text, jsonable, write_json
 
 #: bump when the FEM or the result's fields change, to invalidate cached results
-CACHE_FORMAT = 5  # 5: entries {format, key, sha256, result}; 4: factorisations counted; 3: the finger's windings on their own degree-5 rule, mesh graded at the ring edges
+CACHE_FORMAT = 6  # 6: the pressure named P_cavity_MPa, eq. (25)'s F_v_reduced_note; 5: entries {format, key, sha256, result}; 4: factorisations counted; 3: the finger's windings on their own degree-5 rule, mesh graded at the ring edges
 #: the default element size of the grasp FEM [mm] (docs/grasp.md: w's mesh sensitivity)
 MESH_SIZE = 6.0
 

@@ -204,6 +204,14 @@ def test_grasp_cli_takes_w_from_the_fem_or_the_paper_by_name(tmp_path, monkeypat
     assert main(base + ["--weights", "paper240"]) == 0
     out = json.loads(capsys.readouterr().out)
     assert out["w"] == pytest.approx([-0.2, 0.0, 0.1, 0.3, 0.8]) and out["w_source"].startswith("paper")
+    # where the grasp FEM's own F_v says eq. (25) with its w is off, the F_v printed comes with why
+    far = {"w": w_fem, "diameter_mm": 210.0, "P_cavity_MPa": 0.8, "theta_deg": 30.0, "F_v_fem_N": 4.0,
+           "F_v_reduced_N": 93.4, "contact_force_N": [0.0, 0.0, 3.9, 0.0, 0.0, 0.0]}
+    monkeypatch.setattr(sw, "compute", lambda case: far)
+    assert main(base + ["--diameter-mm", "210"]) == 0
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and err.startswith("softhand grasp: warning: at the grasp FEM's own state")
+    assert "touches link 2 of 5" in err and "23.4 x the FEM's" in err and "--model fem" in err
 
 
 @pytest.mark.parametrize("forces, warned", [([0.0] * 6, True), ([0.0, 0.0, 0.0, 0.0, 0.0, 1.5], False)])
