@@ -31,7 +31,7 @@ from softhand.reduced.design import HandDesign
 class WholeHandResult:
     """The hand's pump pressure from both FEMs against eq. (27), per bending row."""
 
-    rows: list                  #: theta, P_finger_fem, V, p_reservoir_fem, P_hand_fem, eqs. (27), (28)
+    rows: list                  #: theta, P_cavity_fem, V, p_reservoir_fem, P_pump_fem, eqs. (27), (28)
     offset_fem_MPa: float       #: p_r(V0), reservoir-sheet FEM
     offset_ellipse_MPa: float   #: p_r(V0), the ellipse model
     reservoir_ndofs: int

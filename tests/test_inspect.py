@@ -74,3 +74,18 @@ def test_the_side_view_draws_only_the_fingers_in_the_bending_plane(n, view, turn
     from softhand.studies.io.render_style import finger_turns
 
     assert finger_turns(n, view) == pytest.approx(turns)
+
+
+@pytest.mark.parametrize("key, shown", [("P_cavity_MPa", "P_cavity = 1.014 MPa"),
+                                        ("p_reservoir_MPa", "p_reservoir = 0.05127 MPa"),
+                                        ("pressure_MPa", "P = 0.8 MPa")])
+def test_a_pictures_title_names_its_pressure(key, shown):
+    """A finger's or grasp's scene carries its cavity pressure, the sheet's its own: the title
+    says which (a file written before the names, ``pressure_MPa``, is shown as P)."""
+    import pyvista as pv
+
+    from softhand.studies.io.render_style import title_of
+
+    block = pv.PolyData(np.zeros((1, 3)))
+    block.field_data[key] = [{"P_cavity_MPa": 1.014, "p_reservoir_MPa": 0.05127, "pressure_MPa": 0.8}[key]]
+    assert shown in title_of("grasp.pvd", [block], 0, 1)
