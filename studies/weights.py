@@ -129,9 +129,10 @@ def finger_options(mesh_size_mm: float):
     return FingerOptions(mesher="gmsh", mesh_size=mesh_size_mm, edge_ratio=0.5, edge_reach=3.0, mesh_refine=0)
 
 
-def compute(case: WeightsCase, out=None) -> dict:
+def compute(case: WeightsCase, out=None, progress=None) -> dict:
     """Run the grasp FEM for one case (no cache): the flat result; with ``out`` (a folder)
-    also the two states' fields as the VTK scene series ``grasp.pvd`` (hand, object, contact forces)."""
+    also the two states' fields as the VTK scene series ``grasp.pvd`` (hand, object, contact
+    forces); ``progress`` is called with each of the two states as it converges."""
     from softhand.fem.hand.finger import FingerModel
     from softhand.fem.hand.grasp import GraspModel, grasp_weights
     from softhand.fem.newton import NotConverged
@@ -139,7 +140,7 @@ def compute(case: WeightsCase, out=None) -> dict:
     finger = FingerModel(case.design, finger_options(case.mesh_size_mm))
     model = GraspModel(finger, case.diameter_mm, mass=case.mass_kg, depth=case.depth_mm)
     try:
-        r = grasp_weights(model, case.pressure_mpa, case.dP_mpa)
+        r = grasp_weights(model, case.pressure_mpa, case.dP_mpa, on_state=progress)
     except NotConverged as err:
         err.case = case  # which grasp stopped (the verb saves err.states)
         raise
@@ -161,7 +162,7 @@ def write_vtk(out, model, states) -> None:
         series.write(s.P, *grasp_scene(model, s))
 
 
-def weights(case: WeightsCase, *, cache: bool = True, out=None) -> dict:
+def weights(case: WeightsCase, *, cache: bool = True, out=None, progress=None) -> dict:
     """:func:`compute`, through the JSON cache keyed by :meth:`WeightsCase.key` (``cached`` says
     which); ``out``: a folder for the VTK series grasp.pvd (always computes). The result is
     returned, not written: the caller decides where it goes.
@@ -174,7 +175,8 @@ def weights(case: WeightsCase, *, cache: bool = True, out=None) -> dict:
         entry = read_entry(path, case.key())
         if entry is not None:
             return _untouched_said(case, {**entry, "cached": True})
-    result = compute(case) if out is None else compute(case, out)
+    more = {} if progress is None else {"progress": progress}  # each converged state (a bar)
+    result = compute(case, **more) if out is None else compute(case, out, **more)
     if cache:
         write_entry(path, case.key(), result)
     return _untouched_said(case, {**result, "cached": False})
@@ -233,9 +235,11 @@ class CaseResult:
                            "wall_time_s": r["wall_seconds"]}}
 
 
-def run_case(case: WeightsCase, *, cache: bool = True, out=None) -> CaseResult:
-    """:func:`weights` as a :class:`CaseResult`; ``out``: a folder for grasp.pvd (computes)."""
-    return CaseResult(case, weights(case, cache=cache, out=out), () if out is None else ("grasp.pvd",))
+def run_case(case: WeightsCase, *, cache: bool = True, out=None, progress=None) -> CaseResult:
+    """:func:`weights` as a :class:`CaseResult`; ``out``: a folder for grasp.pvd (computes);
+    ``progress``: called with each converged grasp state."""
+    return CaseResult(case, weights(case, cache=cache, out=out, progress=progress),
+                      () if out is None else ("grasp.pvd",))
 
 
 #: keys and types every cached result has

@@ -114,7 +114,7 @@ def test_weights_cli_caches_by_input(tmp_path, monkeypatch, capsys):
 
     calls = []
 
-    def fake_compute(case):
+    def fake_compute(case, out=None, progress=None):
         calls.append(case)
         return {"diameter_mm": case.diameter_mm, "w": [0.2] * 5, "w_sum": 1.0, "theta_deg": 40.0,
                 "F_v_fem_N": 3.0, "mesh_size_mm": case.mesh_size_mm, "ndofs": 10}
@@ -222,7 +222,7 @@ def test_w_of_a_finger_that_does_not_touch_the_object_is_said_to_be_no_grasps(fo
     paper's finger, eqs. (28) and the pad geometry): the warning says both."""
     import softhand.studies.weights as sw
 
-    def fake_compute(case):
+    def fake_compute(case, out=None, progress=None):
         return {"diameter_mm": case.diameter_mm, "depth_mm": 40.0, "w": [0.2] * 5, "w_sum": 1.0,
                 "theta_deg": 20.54, "F_v_fem_N": 0.0, "contact_force_N": forces,
                 "mesh_size_mm": case.mesh_size_mm, "ndofs": 10}

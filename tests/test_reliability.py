@@ -331,7 +331,7 @@ def test_a_grasp_fem_that_stops_saves_the_states_it_reached(tmp_path, monkeypatc
     monkeypatch.setattr(grasp.GraspModel, "solve", second_state_fails)
     out = tmp_path / "w"
     assert main(["weights", "--diameter-mm", "180", "--pressure-mpa", "0.8", "--mesh-size-mm", "6",
-                 "--no-cache", "--out", str(out)]) == 1
+                 "--no-cache", "--no-progress", "--out", str(out)]) == 1
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "P_cavity = 0.8 MPa" in err[0] and "Traceback" not in err[0], err
     result = json.loads((out / "result.json").read_text())

@@ -97,7 +97,7 @@ def _linear_w(D: float) -> list[float]:
 def fake_grasp_fem(tmp_path, monkeypatch):
     import softhand.studies.weights as sw
 
-    def compute(case, out=None):
+    def compute(case, out=None, progress=None):
         if out is not None:
             Path(out).mkdir(parents=True, exist_ok=True)
             (Path(out) / "grasp.pvd").write_text("<VTKFile/>")

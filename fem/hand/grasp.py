@@ -251,15 +251,20 @@ def weight_vector(a: GraspState, b: GraspState) -> np.ndarray:
     return dq / dq.sum()
 
 
-def grasp_weights(model: GraspModel, P: float, dP: float) -> WeightResult:
-    """Contact states at P and P + dP [MPa] and the weight vector between them."""
+def grasp_weights(model: GraspModel, P: float, dP: float, on_state=None) -> WeightResult:
+    """Contact states at P and P + dP [MPa] and the weight vector between them; ``on_state``
+    is called with each state as it converges (a progress bar)."""
     if not P > 0 or not dP > 0:
         raise InputError("pressure_MPa", (P, dP), "P and dP must be positive")
     t0 = time.perf_counter()
     a = None
     try:
         a = model.solve(P)
+        if on_state is not None:
+            on_state(a)
         b = model.solve(P + dP, start=a)
+        if on_state is not None:
+            on_state(b)
     except NotConverged as err:  # what was reached, for the caller to save: ``.states``, ``.model``
         err.model = model
         err.states = tuple(s for s in (a, getattr(err, "state", None)) if s is not None)

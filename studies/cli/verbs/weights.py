@@ -166,10 +166,15 @@ def _run(args) -> int:
 
 
 def _one(case, args) -> dict:
+    """One diameter's grasp FEM, with a bar of its two contact states (P, P + dP) on stderr."""
+    from tqdm import tqdm
+
     from softhand.studies.weights import run_case
 
-    with replaced_outputs(args.out, OUTPUT_PATTERNS):  # the series is written as the states converge
-        result = run_case(case, cache=not args.no_cache, out=args.out)
+    with replaced_outputs(args.out, OUTPUT_PATTERNS), \
+            tqdm(total=2, desc="grasp FEM", unit="state", file=sys.stderr, leave=False,
+                 disable=args.no_progress) as bar:  # the series is written as the states converge
+        result = run_case(case, cache=not args.no_cache, out=args.out, progress=lambda state: bar.update())
         if args.out:
             with kept_if_unwritable(Path(args.out) / "result.json", "weights"):
                 result.write(args.out)
