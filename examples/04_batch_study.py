@@ -26,9 +26,9 @@ assert first.computed == 9 and again.reused == 9
 rows = index_rows(study, results)
 for row in rows:
     print(f"mu_sf = {row['mu_sf_MPa']:.2f} MPa, theta = {row['theta_deg']:4.0f} deg: "
-          f"P = {row['P_MPa']:.4f} MPa")
+          f"P = {row['P_pump_MPa']:.4f} MPa")
 
 # Each case is the library call it stands for: eq. (27) on the swept design.
 row = next(r for r in rows if r["mu_sf_MPa"] == 1.3 and r["theta_deg"] == 45.0)
 direct = hand.pressure(math.radians(45.0), load_design().replace(mu_sf=1.3))
-assert math.isclose(row["P_MPa"], float(direct), rel_tol=1e-12)
+assert math.isclose(row["P_pump_MPa"], float(direct), rel_tol=1e-12)

@@ -19,7 +19,7 @@ pressures = tuple(np.round(np.arange(0.0, 0.81, 0.1), 10))
 result = bending.run(BendingStudy(design=design, pressures_mpa=pressures, options=ci_mesh))
 
 for r in result.rows[2::2]:
-    print(f"P = {r['P_MPa']:.1f} MPa: FEM {r['theta_deg']:6.2f} deg, eq. (28) "
+    print(f"P = {r['P_cavity_MPa']:.1f} MPa: FEM {r['theta_deg']:6.2f} deg, eq. (28) "
           f"{r['theta_reduced_deg']:6.2f} deg; dQ FEM {r['dQ_mm3']:6.1f} mm^3, eq. (2) "
           f"{r['dQ_reduced_mm3']:6.1f} mm^3")
 

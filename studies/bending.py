@@ -99,7 +99,7 @@ def row(state: FingerState, design: HandDesign) -> dict:
     theta_red = float(hand.bend_angle(state.P, design, reservoir=False)) if state.P > 0 else 0.0
     dQ_red = float(reduced_finger.Q(state.theta, design) - reduced_finger.Q(0.0, design)) / design.n
     return {
-        "P_MPa": state.P,
+        "P_cavity_MPa": state.P,
         "theta_deg": math.degrees(state.theta),
         "hinge_deg": [round(math.degrees(q), 4) for q in state.q],
         "dQ_mm3": state.dQ,
@@ -171,8 +171,8 @@ def _peak(model: FingerModel, study: BendingStudy, start: FingerState, on_state)
     except NotConverged as exc:
         failure = str(exc).split(";")[0]
     s = reached[-1]
-    return {"P_MPa": s.P, "theta_deg": math.degrees(s.theta),
+    return {"P_cavity_MPa": s.P, "theta_deg": math.degrees(s.theta),
             "max_principal_stretch": s.max_principal_stretch,
             "max_von_mises_MPa": s.max_von_mises, "radial_stretch_max": s.radial_stretch_max,
-            "max_fiber_stress_MPa": s.max_fiber_stress, "target_MPa": study.peak_mpa,
+            "max_fiber_stress_MPa": s.max_fiber_stress, "target_P_cavity_MPa": study.peak_mpa,
             "failure": failure}

@@ -32,7 +32,7 @@ from softhand.reduced.vocabulary.design import HandDesign
 class WholeHandResult:
     """The hand's pump pressure from both FEMs against eq. (27), per bending row."""
 
-    rows: list                  #: theta, P_finger_fem, V, p_reservoir_fem, P_hand_fem, eqs. (27), (28)
+    rows: list                  #: theta, P_cavity_fem, V, p_reservoir_fem, P_pump_fem, eqs. (27), (28)
     offset_fem_MPa: float       #: p_r(V0), reservoir-sheet FEM
     offset_ellipse_MPa: float   #: p_r(V0), the ellipse model
     reservoir_ndofs: int
@@ -52,12 +52,12 @@ class WholeHandResult:
         return ["hand.csv"]
 
     def max_abs_difference_MPa(self) -> float:
-        """Largest ``|P_hand,FEM - P_eq.(27)|`` over the rows [MPa]."""
-        return float(np.nanmax([abs(r["P_hand_fem_MPa"] - r["P_hand_eq27_MPa"]) for r in self.rows]))
+        """Largest ``|P_pump,FEM - P_eq.(27)|`` over the rows [MPa]."""
+        return float(np.nanmax([abs(r["P_pump_fem_MPa"] - r["P_pump_eq27_MPa"]) for r in self.rows]))
 
 
 def whole_hand(rows: list[dict], design: HandDesign, **sheet_mesh) -> WholeHandResult:
-    """Per bending row (P_MPa, theta_deg, dQ_mm3): the hand's pump pressure from the FEM
+    """Per bending row (P_cavity_MPa, theta_deg, dQ_mm3): the hand's pump pressure from the FEM
     finger + FEM reservoir, and eq. (27) at the same theta."""
     dQ = np.array([r["dQ_mm3"] for r in rows])
     V = ellipse.oil_left(dQ, design)
@@ -68,19 +68,19 @@ def whole_hand(rows: list[dict], design: HandDesign, **sheet_mesh) -> WholeHandR
     sheet = inflate(SheetModel.from_design(design, **sheet_mesh), np.append(V[wet], design.V0))
     p_res = np.full(V.size, math.nan)
     p_res[wet] = [s.pressure for s in sheet.states[:-1]]
-    P_hand = ellipse.pump_pressure(np.array([r["P_MPa"] for r in rows]), V, design,
+    P_hand = ellipse.pump_pressure(np.array([r["P_cavity_MPa"] for r in rows]), V, design,
                                    p_r=lambda _: p_res)  # the sheet FEM at each row's oil left
     out = []
     for r, v, pr, P in zip(rows, V, p_res, P_hand):
         theta = math.radians(r["theta_deg"])
         out.append({
             "theta_deg": r["theta_deg"],
-            "P_finger_fem_MPa": r["P_MPa"],
+            "P_cavity_fem_MPa": r["P_cavity_MPa"],
             "V_mm3": float(v),
             "p_reservoir_fem_MPa": float(pr),
-            "P_hand_fem_MPa": float(P),
-            "P_hand_eq27_MPa": float(hand.pressure(theta, design, reservoir=True)) if v > 0 else math.nan,
-            "P_finger_eq28_MPa": float(hand.pressure(theta, design, reservoir=False)),
+            "P_pump_fem_MPa": float(P),
+            "P_pump_eq27_MPa": float(hand.pressure(theta, design, reservoir=True)) if v > 0 else math.nan,
+            "P_cavity_eq28_MPa": float(hand.pressure(theta, design, reservoir=False)),
         })
     return WholeHandResult(out, float(sheet.states[-1].pressure), float(ellipse.pressure(design.V0, design)),
                            int(sheet.ndofs), sheet.wall_time)

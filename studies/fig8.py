@@ -59,8 +59,8 @@ class Fig8Result:
         """Per pressure (P [MPa], theta [deg], F_v [kgf]): eq. (25) with that pressure's mean FEM
         w, on 50 angles from 5 deg below to 5 deg above its points (nan where J_x w = 0)."""
         lines = []
-        for P in sorted({r["P_MPa"] for r in self.rows}):
-            pts = [r for r in self.rows if r["P_MPa"] == P]
+        for P in sorted({r["P_cavity_MPa"] for r in self.rows}):
+            pts = [r for r in self.rows if r["P_cavity_MPa"] == P]
             w = np.mean([r["w"] for r in pts], axis=0)
             theta = np.linspace(min(r["theta_deg"] for r in pts) - 5, max(r["theta_deg"] for r in pts) + 5, 50)
             F = [reduced_F_v(P, math.radians(t), self.case.mass_kg, w, self.case.design) for t in theta]

@@ -32,7 +32,7 @@ from softhand.reduced.vocabulary.errors import InputError
 from softhand.studies.io.files import json_text, jsonable, write_json
 
 #: bump when the FEM or the result's fields change, to invalidate cached results
-CACHE_FORMAT = 5  # 5: entries {format, key, sha256, result}; 4: factorisations counted; 3: the finger's windings on their own degree-5 rule, mesh graded at the ring edges
+CACHE_FORMAT = 6  # 6: the pressure named P_cavity_MPa, eq. (25)'s F_v_reduced_note; 5: entries {format, key, sha256, result}; 4: factorisations counted; 3: the finger's windings on their own degree-5 rule, mesh graded at the ring edges
 #: the default element size of the grasp FEM [mm] (docs/grasp.md: w's mesh sensitivity)
 MESH_SIZE = 6.0
 
@@ -78,14 +78,32 @@ def reduced_F_v(P: float, theta: float, mass: float, w, design: HandDesign) -> f
         return None
 
 
+#: eq. (25)'s F_v further than this from the FEM's, relative, is printed with why
+NOTE_RTOL = 0.1
+
+
+def reduced_note(F_v_red: float | None, F_v_fem: float, N, design: HandDesign) -> str | None:
+    """Why eq. (25)'s F_v [N] is not to be trusted where it is further than ``NOTE_RTOL`` from
+    the FEM's (N: each link's contact force [N]); None where it is close."""
+    if F_v_red is None or abs(F_v_red - F_v_fem) <= NOTE_RTOL * abs(F_v_fem):
+        return None
+    links = [k for k, n in enumerate(N) if n > 0]
+    where = f"touches link {', '.join(map(str, links))} of {design.n_s}" if links else "is not touched"
+    return (f"eq. (25) charges the pressure's work to a force at the fingertip, but the object {where}: "
+            f"its F_v is {F_v_red / F_v_fem:.3g} x the FEM's; use F_v_fem_N" if F_v_fem > 0 else
+            f"eq. (25) charges the pressure's work to a force at the fingertip, but the object {where}; "
+            "use F_v_fem_N")
+
+
 def state_row(state, w, mass: float, design: HandDesign) -> dict:
     """The reported numbers of one converged contact state (forces physical, hand frame)."""
     F_v_red = reduced_F_v(state.P, state.theta, mass, w, design)
-    return {"P_MPa": state.P, "theta_deg": math.degrees(state.theta),
+    return {"P_cavity_MPa": state.P, "theta_deg": math.degrees(state.theta),
             "hinge_deg": np.degrees(state.q).tolist(), "contact_force_N": state.N.tolist(),
             "F_x_fem_N": float(state.F[0]), "F_y_fem_N": float(state.F[1]),
             "F_v_fem_N": state.F_v, "F_v_reduced_N": F_v_red,
             "F_v_error_kgf": None if F_v_red is None else (F_v_red - state.F_v) / grasp.KGF,
+            "F_v_reduced_note": reduced_note(F_v_red, state.F_v, state.N, design),
             "max_penetration_mm": float(np.max(-state.gap[state.N > 0], initial=0.0)),
             "contact_updates": state.updates, "contact_penalty_N_per_mm": state.penalty,
             "newton_iterations": state.iterations, "factorizations": state.factorizations}
@@ -94,12 +112,12 @@ def state_row(state, w, mass: float, design: HandDesign) -> dict:
 def failed_record(case: WeightsCase, states) -> dict:
     """result.json's fields of a grasp FEM that stopped: the case and the states it reached
     (the last one's contact may not have converged: its penetration says by how much)."""
-    rows = [{"P_MPa": s.P, "theta_deg": math.degrees(s.theta), "hinge_deg": np.degrees(s.q).tolist(),
+    rows = [{"P_cavity_MPa": s.P, "theta_deg": math.degrees(s.theta), "hinge_deg": np.degrees(s.q).tolist(),
              "contact_force_N": s.N.tolist(), "F_v_fem_N": s.F_v,
              "max_penetration_mm": float(np.max(-s.gap[s.N > 0], initial=0.0))} for s in states]
-    return {"diameter_mm": case.diameter_mm, "mass_kg": case.mass_kg, "pressure_MPa": case.pressure_mpa,
+    return {"diameter_mm": case.diameter_mm, "mass_kg": case.mass_kg, "P_cavity_MPa": case.pressure_mpa,
             "dP_MPa": case.dP_mpa, "mesh_size_mm": case.mesh_size_mm,
-            "last_converged_MPa": rows[-1]["P_MPa"] if rows else 0.0, "states": rows,
+            "last_converged_P_cavity_MPa": rows[-1]["P_cavity_MPa"] if rows else 0.0, "states": rows,
             "design": case.design.to_dict()}
 
 
@@ -111,9 +129,10 @@ def finger_options(mesh_size_mm: float):
     return FingerOptions(mesher="gmsh", mesh_size=mesh_size_mm, edge_ratio=0.5, edge_reach=3.0, mesh_refine=0)
 
 
-def compute(case: WeightsCase, out=None) -> dict:
+def compute(case: WeightsCase, out=None, progress=None) -> dict:
     """Run the grasp FEM for one case (no cache): the flat result; with ``out`` (a folder)
-    also the two states' fields as the VTK scene series ``grasp.pvd`` (hand, object, contact forces)."""
+    also the two states' fields as the VTK scene series ``grasp.pvd`` (hand, object, contact
+    forces); ``progress`` is called with each of the two states as it converges."""
     from softhand.fem.hand.finger import FingerModel
     from softhand.fem.hand.grasp import GraspModel, grasp_weights
     from softhand.fem.newton import NotConverged
@@ -121,7 +140,7 @@ def compute(case: WeightsCase, out=None) -> dict:
     finger = FingerModel(case.design, finger_options(case.mesh_size_mm))
     model = GraspModel(finger, case.diameter_mm, mass=case.mass_kg, depth=case.depth_mm)
     try:
-        r = grasp_weights(model, case.pressure_mpa, case.dP_mpa)
+        r = grasp_weights(model, case.pressure_mpa, case.dP_mpa, on_state=progress)
     except NotConverged as err:
         err.case = case  # which grasp stopped (the verb saves err.states)
         raise
@@ -143,7 +162,7 @@ def write_vtk(out, model, states) -> None:
         series.write(s.P, *grasp_scene(model, s))
 
 
-def weights(case: WeightsCase, *, cache: bool = True, out=None) -> dict:
+def weights(case: WeightsCase, *, cache: bool = True, out=None, progress=None) -> dict:
     """:func:`compute`, through the JSON cache keyed by :meth:`WeightsCase.key` (``cached`` says
     which); ``out``: a folder for the VTK series grasp.pvd (always computes). The result is
     returned, not written: the caller decides where it goes.
@@ -156,7 +175,8 @@ def weights(case: WeightsCase, *, cache: bool = True, out=None) -> dict:
         entry = read_entry(path, case.key())
         if entry is not None:
             return _untouched_said(case, {**entry, "cached": True})
-    result = compute(case) if out is None else compute(case, out)
+    more = {} if progress is None else {"progress": progress}  # each converged state (a bar)
+    result = compute(case, **more) if out is None else compute(case, out, **more)
     if cache:
         write_entry(path, case.key(), result)
     return _untouched_said(case, {**result, "cached": False})
@@ -215,9 +235,11 @@ class CaseResult:
                            "wall_time_s": r["wall_seconds"]}}
 
 
-def run_case(case: WeightsCase, *, cache: bool = True, out=None) -> CaseResult:
-    """:func:`weights` as a :class:`CaseResult`; ``out``: a folder for grasp.pvd (computes)."""
-    return CaseResult(case, weights(case, cache=cache, out=out), () if out is None else ("grasp.pvd",))
+def run_case(case: WeightsCase, *, cache: bool = True, out=None, progress=None) -> CaseResult:
+    """:func:`weights` as a :class:`CaseResult`; ``out``: a folder for grasp.pvd (computes);
+    ``progress``: called with each converged grasp state."""
+    return CaseResult(case, weights(case, cache=cache, out=out, progress=progress),
+                      () if out is None else ("grasp.pvd",))
 
 
 #: keys and types every cached result has

@@ -251,16 +251,22 @@ def weight_vector(a: GraspState, b: GraspState) -> np.ndarray:
     return dq / dq.sum()
 
 
-def grasp_weights(model: GraspModel, P: float, dP: float, start: GraspState | None = None) -> WeightResult:
+def grasp_weights(model: GraspModel, P: float, dP: float, start: GraspState | None = None,
+                  on_state=None) -> WeightResult:
     """Contact states at P and P + dP [MPa] and the weight vector between them (the state at P
-    continued from ``start``, a converged state nearby, if given)."""
+    continued from ``start``, a converged state nearby, if given); ``on_state`` is called with
+    each state as it converges (a progress bar)."""
     if not P > 0 or not dP > 0:
         raise InputError("pressure_MPa", (P, dP), "P and dP must be positive")
     t0 = time.perf_counter()
     a = None
     try:
         a = model.solve(P, start=start)
+        if on_state is not None:
+            on_state(a)
         b = model.solve(P + dP, start=a)
+        if on_state is not None:
+            on_state(b)
     except NotConverged as err:  # what was reached, for the caller to save: ``.states``, ``.model``
         err.model = model
         err.states = tuple(s for s in (a, getattr(err, "state", None)) if s is not None)

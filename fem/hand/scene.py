@@ -18,7 +18,7 @@ modelled finger's bending plane is z = 0):
 The reservoir sheet becomes one block ``sheet``: its wet and dry surfaces revolved about
 the axis, at the reference (flat) position with the revolved ``displacement_mm``.
 
-Every block carries field data (``pressure_MPa``, and ``n_fingers`` for a finger scene,
+Every block carries field data (``P_cavity_MPa``, and ``n_fingers`` for a finger scene,
 ``volume_mm3`` for a sheet). The links and hinges are drawn with ``link_gap`` between
 neighbours and a pin radius ``pin_radius`` of this module: they are pictures, not the
 model's geometry (the model's shell is the tie of :mod:`softhand.fem.hand.finger`).
@@ -215,7 +215,7 @@ def sheet_block(solid, state, n_phi: int = 48) -> Block:
 def finger_scene(model, y, P: float) -> tuple[list[Block], dict]:
     """(blocks, field data) of a free finger at state ``y`` and pressure ``P`` [MPa]."""
     q = model.constraint.q(y)
-    return finger_blocks(model, y), {"pressure_MPa": float(P), "theta_deg": math.degrees(float(np.sum(q))),
+    return finger_blocks(model, y), {"P_cavity_MPa": float(P), "theta_deg": math.degrees(float(np.sum(q))),
                                      "n_fingers": model.design.n}
 
 
@@ -223,6 +223,6 @@ def grasp_scene(grasp, state) -> tuple[list[Block], dict]:
     """(blocks, field data) of a converged contact state of :class:`softhand.fem.hand.grasp.GraspModel`."""
     blocks = finger_blocks(grasp.finger, state.y, load=grasp.state_load(state))
     blocks.append(sphere_block([0.0, grasp.depth, 0.0], 0.5 * grasp.diameter))
-    return blocks, {"pressure_MPa": float(state.P), "theta_deg": math.degrees(state.theta),
+    return blocks, {"P_cavity_MPa": float(state.P), "theta_deg": math.degrees(state.theta),
                     "n_fingers": grasp.design.n, "diameter_mm": grasp.diameter,
                     "F_v_N": float(state.F_v)}

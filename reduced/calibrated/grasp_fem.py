@@ -251,7 +251,7 @@ def grasp_state_at_angle(design: HandDesign, diameter_mm: float, P: float, theta
             return at(brentq(f, *bracket, xtol=1e-10))
         if a == lo and b == hi:
             raise InputError("theta_deg", round(math.degrees(theta), 6),
-                             f"no placement of the object holds this finger there at P = {P:g} MPa "
+                             f"no placement of the object holds this finger there at P_cavity = {P:.4g} MPa "
                              f"(from its highest placement it bends {math.degrees(at(lo).theta):.4g} deg)")
         step *= 2.0
     return at(y0)

@@ -258,8 +258,10 @@ def _state_row(name: str, sim: Simulation, mask: np.ndarray, mass: float, w, des
     P, theta = float(np.mean(sim.P[mask])), float(np.mean(sim.theta_mean[mask]))
     estimate = float(grasp_forces(P, theta, mass, w, design).F_v)
     actual = np.mean(pad_force(sim.F_x[mask], sim.F_y[mask], sim.theta[mask], design), axis=0)
+    row = {"state": name, "P_pump_MPa": P, "theta_deg": math.degrees(theta),
+           "F_v_estimated_N": estimate, "F_v_estimated_kgf": estimate / design.g,
+           "F_v_actual_mean_N": float(np.mean(actual)), "F_v_actual_max_N": float(np.max(actual))}
+    if design != HandDesign():  # the paper's numbers are of its own hand only
+        return row
     paper = PAPER_TABLE_II[name]
-    return {"state": name, "P_MPa": P, "theta_deg": math.degrees(theta),
-            "F_v_estimated_N": estimate, "F_v_estimated_kgf": estimate / design.g,
-            "F_v_actual_mean_N": float(np.mean(actual)), "F_v_actual_max_N": float(np.max(actual)),
-            "paper_P_MPa": paper[0], "paper_theta_deg": paper[1], "paper_F_v_kgf": paper[2]}
+    return row | {"paper_P_pump_MPa": paper[0], "paper_theta_deg": paper[1], "paper_F_v_kgf": paper[2]}

@@ -2,11 +2,13 @@
 
 Two kinds of data, told apart by their columns:
 
-* **free bending** (eq. (27)): ``P_MPa, theta_deg`` and optionally ``finger``
+* **free bending** (eq. (27)): ``P_pump_MPa, theta_deg`` and optionally ``finger``
   (a label per row, e.g. 1..4: the paper measures all four fingers at each pressure);
-* **grasp** (eqs. (25), (29)): ``P_MPa, theta_deg, mass_kg, F_v_N`` and optionally
+* **grasp** (eqs. (25), (29)): ``P_pump_MPa, theta_deg, mass_kg, F_v_N`` and optionally
   ``diameter_mm`` (the object diameter, which picks the weight vector w) and ``finger``.
 
+The pressure is the pump's (with the reservoir, the cavity's less the reservoir's); a column
+``P_MPa``, its name before pressures said which, is read as ``P_pump_MPa``.
 Lines starting with ``#`` are comments (a data file should say where it came from).
 Inside, angles are in radians (``theta``); degrees only in the file. Every problem
 (no such file, empty file, unknown or missing column, text in a number, a row with the
@@ -26,7 +28,7 @@ from softhand.reduced.vocabulary.inputfiles import csv_cells, plain_float
 
 #: column -> what it holds (unit in the name)
 COLUMNS = {
-    "P_MPa": "pump pressure P [MPa]",
+    "P_pump_MPa": "pump pressure P [MPa]",
     "theta_deg": "bend angle theta of the finger [deg]",
     "finger": "finger label (optional; any whole number)",
     "mass_kg": "mass m of the grasped object [kg]",
@@ -34,10 +36,12 @@ COLUMNS = {
     "diameter_mm": "object diameter, selects the weight vector w (optional) [mm]",
 }
 #: column -> (lowest, highest) allowed value of a measurement
-LIMITS = {"P_MPa": (-5.0, 5.0), "theta_deg": (-90.0, 180.0), "mass_kg": (0.0, 100.0),
+LIMITS = {"P_pump_MPa": (-5.0, 5.0), "theta_deg": (-90.0, 180.0), "mass_kg": (0.0, 100.0),
           "F_v_N": (-1e4, 1e4), "diameter_mm": (1.0, 1000.0)}
-BENDING_COLUMNS = ("P_MPa", "theta_deg")
-GRASP_COLUMNS = ("P_MPa", "theta_deg", "mass_kg", "F_v_N")
+#: a column's earlier name -> its name
+OLD_NAMES = {"P_MPa": "P_pump_MPa"}
+BENDING_COLUMNS = ("P_pump_MPa", "theta_deg")
+GRASP_COLUMNS = ("P_pump_MPa", "theta_deg", "mass_kg", "F_v_N")
 
 
 @dataclass(frozen=True)
@@ -74,6 +78,7 @@ def read_measurements(path: str | Path) -> Measurements:
     """Read a measurement CSV (see the module docstring); raises InputError on any problem."""
     path = Path(path)
     header, rows = read_rows(path)
+    header = [OLD_NAMES.get(c, c) for c in header]
     columns = _parse_columns(path.name, header, rows)
     kind = "grasp" if "F_v_N" in columns or "mass_kg" in columns else "bending"
     required = GRASP_COLUMNS if kind == "grasp" else BENDING_COLUMNS
@@ -86,7 +91,7 @@ def read_measurements(path: str | Path) -> Measurements:
         raise InputError(f"{path.name}: columns", ",".join(header),
                          "diameter_mm belongs to grasp data (with mass_kg and F_v_N)")
     return Measurements(
-        kind=kind, P=columns["P_MPa"], theta=np.radians(columns["theta_deg"]),
+        kind=kind, P=columns["P_pump_MPa"], theta=np.radians(columns["theta_deg"]),
         finger=columns.get("finger"), mass=columns.get("mass_kg"), F_v=columns.get("F_v_N"),
         diameter=columns.get("diameter_mm"), source=path.name,
     )

@@ -46,11 +46,12 @@ from pathlib import Path
 from softhand import reduced as reduced_layer
 
 from softhand.reduced.materials import rubber
-from softhand.reduced.vocabulary.design_rules import BOUNDS, CONSISTENCY, check_model, in_bounds
+from softhand.reduced.vocabulary.design_rules import BOUNDS, CONSISTENCY, check_model, in_bounds, is_number
 from softhand.reduced.vocabulary.errors import InputError
 
 __all__ = ["RESERVOIR_MODELS", "FINGER_MODELS", "PAPER_DESIGN_FILE", "HandDesign", "PUBLIC_KEYS",
-           "KEY_OF", "MODULUS_OF", "PARTS", "BOUNDS", "CONSISTENCY"]
+           "KEY_OF", "MODULUS_OF", "PARTS", "BOUNDS", "CONSISTENCY", "FIELD_OF", "from_public", "hinges_for",
+           "field_changes"]
 
 #: Reservoir models the reduced layer knows; extended when a new one is added.
 RESERVOIR_MODELS = ("ellipse", "fem")
@@ -157,8 +158,13 @@ class HandDesign:
         return tuple(s1 - s0 for s0, s1 in zip(s, s[1:]))
 
     def replace(self, **changes) -> "HandDesign":
-        """A copy with some fields changed (internal units), validated."""
-        return dataclasses.replace(self, **changes)
+        """A copy with some fields changed, validated: by field name in internal units
+        (``a=3.5``, ``theta0`` in rad) or by the design file's key (``a_mm=3.5``,
+        ``theta0_deg=20``), with the file's rules (a new ``l0_mm`` scales the hinges); a name
+        that is both (``n``, ``finger_model``) is the field."""
+        public = {k: changes.pop(k) for k in list(changes) if k in FIELD_OF and k not in KEY_OF}
+        design = dataclasses.replace(self, **changes)
+        return dataclasses.replace(design, **field_changes(public, design, source="replace")) if public else design
 
     # ------------------------------------------------------------------ I/O
     def to_dict(self) -> dict:
@@ -220,3 +226,52 @@ def _to_public(name: str, value):
     if name == "hinge_s":
         return list(value)
     return value
+
+
+#: public TOML key -> dataclass field
+FIELD_OF = {key: name for name, key in KEY_OF.items()}
+
+
+def from_public(key: str, value):
+    """Convert one public (TOML) value to the internal field value, checking its type."""
+    name = FIELD_OF[key]
+    default = HandDesign.__dataclass_fields__[name].default
+    if name == "hinge_s":
+        if not isinstance(value, list) or not all(is_number(v) for v in value):
+            raise InputError(key, value, "must be a list of numbers [mm]")
+        return tuple(float(v) for v in value)
+    if isinstance(default, str):
+        if not isinstance(value, str):
+            raise InputError(key, value, "must be a string")
+        return value
+    if isinstance(default, int) and not isinstance(default, bool):
+        if not isinstance(value, int) or isinstance(value, bool):
+            raise InputError(key, value, "must be a whole number")
+        return value
+    if not is_number(value):
+        raise InputError(key, value, "must be a number")
+    return math.radians(value) if name == "theta0" else float(value)
+
+
+def hinges_for(base: HandDesign, l0: float, n_s: int) -> tuple[float, ...]:
+    """Hinge positions [mm] for a tube of length l0 with n_s hinges: the base's scaled with l0
+    (equal links stay equal), or equal links when the number of hinges changes."""
+    if n_s == base.n_s:
+        return tuple(s * l0 / base.l0 for s in base.hinge_s)
+    return tuple(l0 * k / (n_s + 1) for k in range(1, n_s + 1))
+
+
+def field_changes(values: dict, base: HandDesign, *, source: str = "design") -> dict:
+    """The field changes that public keys (as in TOML, units in the names; no material tables)
+    make to ``base``, each checked for its type: without ``hinge_s_mm``, a new ``l0_mm`` scales
+    the base's hinge positions with it and a new ``n_s`` spaces the hinges equally."""
+    changes = {}
+    for key, value in values.items():
+        if key not in FIELD_OF:
+            raise InputError(f"{source}: {key}", value,
+                             f"unknown key; allowed: {', '.join(PUBLIC_KEYS)}, "
+                             "[finger.material], [reservoir.material]")
+        changes[FIELD_OF[key]] = from_public(key, value)
+    if "hinge_s" not in changes and ("l0" in changes or "n_s" in changes):
+        changes["hinge_s"] = hinges_for(base, changes.get("l0", base.l0), changes.get("n_s", base.n_s))
+    return changes

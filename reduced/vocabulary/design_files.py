@@ -16,16 +16,12 @@ from pathlib import Path
 
 from softhand.reduced.equations import finger
 from softhand.reduced.materials import rubber
-from softhand.reduced.vocabulary.design import KEY_OF, MODULUS_OF, PARTS, PUBLIC_KEYS, HandDesign
+from softhand.reduced.vocabulary.design import KEY_OF, MODULUS_OF, PARTS, HandDesign, field_changes
 from softhand.reduced.vocabulary.design_rules import in_bounds, is_number
-from softhand.reduced.vocabulary.errors import InputError
+from softhand.reduced.vocabulary.errors import InputError, Note
 from softhand.reduced.vocabulary.inputfiles import read_toml
 
-__all__ = ["design_from_dict", "hinges_for", "load_design"]
-
-#: public TOML key -> dataclass field
-_FIELD_OF = {key: name for name, key in KEY_OF.items()}
-
+__all__ = ["design_from_dict", "load_design"]
 
 def _material_changes(part: str, table, source: str, values: dict) -> dict:
     """Changes of the design fields from a ``[<part>.material]`` table."""
@@ -50,55 +46,17 @@ def _material_changes(part: str, table, source: str, values: dict) -> dict:
     return {f"{part}_material": material, name: material.mu0}
 
 
-def _from_public(key: str, value):
-    """Convert one public (TOML) value to the internal field value, checking its type."""
-    name = _FIELD_OF[key]
-    default = HandDesign.__dataclass_fields__[name].default
-    if name == "hinge_s":
-        if not isinstance(value, list) or not all(is_number(v) for v in value):
-            raise InputError(key, value, "must be a list of numbers [mm]")
-        return tuple(float(v) for v in value)
-    if isinstance(default, str):
-        if not isinstance(value, str):
-            raise InputError(key, value, "must be a string")
-        return value
-    if isinstance(default, int) and not isinstance(default, bool):
-        if not isinstance(value, int) or isinstance(value, bool):
-            raise InputError(key, value, "must be a whole number")
-        return value
-    if not is_number(value):
-        raise InputError(key, value, "must be a number")
-    return math.radians(value) if name == "theta0" else float(value)
-
-
-def hinges_for(base: HandDesign, l0: float, n_s: int) -> tuple[float, ...]:
-    """Hinge positions [mm] for a tube of length l0 with n_s hinges: the base's scaled with l0
-    (equal links stay equal), or equal links when the number of hinges changes."""
-    if n_s == base.n_s:
-        return tuple(s * l0 / base.l0 for s in base.hinge_s)
-    return tuple(l0 * k / (n_s + 1) for k in range(1, n_s + 1))
-
-
 def design_from_dict(values: dict, base: HandDesign | None = None, *, source: str = "design") -> HandDesign:
     """A design from public keys (as in TOML), over ``base`` (default: the paper's). Without
     ``hinge_s_mm``, a new ``l0_mm`` scales the base's hinge positions with it and a new ``n_s``
     spaces the hinges equally."""
     base = base if base is not None else HandDesign()
-    changes = {}
-    for key, value in values.items():
-        if key in PARTS:
-            continue
-        if key not in _FIELD_OF:
-            raise InputError(f"{source}: {key}", value,
-                             f"unknown key; allowed: {', '.join(PUBLIC_KEYS)}, "
-                             "[finger.material], [reservoir.material]")
-        changes[_FIELD_OF[key]] = _from_public(key, value)
-    if "hinge_s" not in changes and ("l0" in changes or "n_s" in changes):
-        changes["hinge_s"] = hinges_for(base, changes.get("l0", base.l0), changes.get("n_s", base.n_s))
+    changes = field_changes({k: v for k, v in values.items() if k not in PARTS}, base, source=source)
     for part in PARTS:
         if part in values:
             changes.update(_material_changes(part, values[part], source, values))
     design = dataclasses.replace(base, **changes)
+    note_inherited_reservoir(values, design, base, source)
     if changes.get("finger_table"):
         if design.finger_model != "fem":  # the table would be unused
             raise InputError(f"{source}: finger_table", values["finger_table"], f"is the table of "
@@ -108,6 +66,19 @@ def design_from_dict(values: dict, base: HandDesign | None = None, *, source: st
         except InputError as exc:
             raise exc.renamed(f"{source}: finger_table") from None
     return design
+
+
+#: the reservoir's keys, sized for the base design's number of fingers
+RESERVOIR_KEYS = ("V0_mm3", "R_mm", "t_mm")
+
+
+def note_inherited_reservoir(values: dict, design: HandDesign, base: HandDesign, source: str) -> None:
+    """A :class:`~softhand.reduced.vocabulary.errors.Note` when a design changes the number of
+    fingers but keeps the base's reservoir."""
+    if design.n != base.n and not any(k in values for k in RESERVOIR_KEYS):
+        warnings.warn(f"{source}: n = {design.n} fingers share the reservoir sized for {base.n} "
+                      f"(V0_mm3 = {base.V0:g}, R_mm = {base.R:g}, t_mm = {base.t:g}, not set in "
+                      f"this design); set them to size its own", Note, stacklevel=3)
 
 
 def load_design(path: str | Path | None = None) -> HandDesign:

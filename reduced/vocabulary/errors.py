@@ -34,6 +34,11 @@ class InputError(ValueError):
         return InputError(field, self.value, self.allowed)
 
 
+class Note(UserWarning):
+    """Information the user should see, not a fault: a default a design inherits, an automatic
+    retry that worked. The CLI shows it as ``softhand VERB: note: ...``."""
+
+
 class MeshRejected(InputError):
     """A mesh the FEM refuses before solving (elements inverted or folded, a map it cannot
     invert): bad input when the user chose it; a caller that chose the mesh itself (the design

@@ -16,7 +16,7 @@ from softhand.reduced.vocabulary.errors import InputError
 def curve(params: dict, design: HandDesign, outdir: Path) -> dict:
     """One point of the free-finger curve: eq. (27) with and (28) without reservoir.
 
-    ``theta_deg`` -> P_MPa, P_no_reservoir_MPa, V_mm3, p_reservoir_MPa (+ h_mm, lambda_r: ellipse model);
+    ``theta_deg`` -> P_pump_MPa, P_cavity_MPa (= the pump pressure without reservoir), V_mm3, p_reservoir_MPa (+ h_mm, lambda_r: ellipse model);
     ``pressure_mpa`` -> theta_deg, theta_no_reservoir_deg (the inverse).
     """
     from softhand.studies.curve import at_angles, at_pressures

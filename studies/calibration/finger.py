@@ -122,13 +122,19 @@ def load_path(theta_08: float, space: dict) -> list[float]:
     return [round(last + (P_end - last) * k / n, 4) for k in range(1, n + 1)]
 
 
+def cavity_pressures(numbers: dict) -> list:
+    """The cavity pressures [MPa] of a ``finger_bend`` case's numbers (``P_cavity_MPa``; cases
+    finished before the pressures were named ``P_MPa``, the same cavity pressure)."""
+    return numbers["P_cavity_MPa"] if "P_cavity_MPa" in numbers else numbers["P_MPa"]
+
+
 def bend_case(params: dict, design: HandDesign, outdir: Path) -> dict:
     """Kind ``finger_bend``: the free-bending FEM of one design on the default mesh.
 
     params: ``pressures_mpa`` (list), ``theta_target_deg``, ``p_max_mpa``, ``p_step_mpa``;
     ``mesh_size_mm`` (optional): a uniform gmsh mesh of that size instead of the default mesh;
     ``axial_size_mm`` (optional): the default (layered) mesh with slices of at most that length.
-    Returns P_MPa, theta_deg, dQ_mm3 (whole finger) per converged pressure.
+    Returns P_cavity_MPa, theta_deg, dQ_mm3 (whole finger) per converged pressure.
     """
     from softhand.fem.hand.finger import FingerModel, solve_pressures
 
@@ -142,7 +148,7 @@ def bend_case(params: dict, design: HandDesign, outdir: Path) -> dict:
         states = states + extra[1:]
         its, facs, wall = its + s2.newton_iterations, facs + s2.factorizations, wall + s2.wall_seconds
         linear.append(s2.solver)
-    return {"P_MPa": [s.P for s in states], "theta_deg": [math.degrees(s.theta) for s in states],
+    return {"P_cavity_MPa": [s.P for s in states], "theta_deg": [math.degrees(s.theta) for s in states],
             "dQ_mm3": [s.dQ for s in states],
             "mesh": {"mesher": model.options.mesher, "dofs": model.ndofs,
                      "elements": model.mesh.nelements},

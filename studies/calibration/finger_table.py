@@ -16,7 +16,7 @@ from scipy.interpolate import PchipInterpolator
 from softhand.reduced.equations import finger, hand
 from softhand.reduced.vocabulary.design import HandDesign
 from softhand.reduced.calibrated.finger_fem import COLUMNS, GROUPS, groups_of
-from softhand.studies.calibration.finger import MIN_GAP_SLICES
+from softhand.studies.calibration.finger import MIN_GAP_SLICES, cavity_pressures
 from softhand.studies.calibration.space import DesignSpace, VARIABLES, finger_design
 from softhand.studies.calibration.tables import table_text, written_by
 from softhand.studies.io.files import write_atomic
@@ -39,7 +39,7 @@ def table_rows(results: list[tuple[HandDesign, dict]]) -> list[dict]:
     rows = []
     for i, (design, numbers) in enumerate(results):
         groups = groups_of(design)
-        for P, theta, dQ in zip(numbers["P_MPa"], numbers["theta_deg"], numbers["dQ_mm3"]):
+        for P, theta, dQ in zip(cavity_pressures(numbers), numbers["theta_deg"], numbers["dQ_mm3"]):
             if P > 0:
                 rows.append({"design": i, **groups, "theta": math.radians(theta),
                              "p_tilde": P / design.mu_sf, "q_tilde": dQ / design.a**3})
@@ -109,8 +109,8 @@ def provenance_lines(command: str, results: list[tuple[HandDesign, dict]], recor
 def mesh_correction(coarse: dict, fine: dict) -> tuple[float, float]:
     """(ln P_fine/P_coarse, dQ_fine/dQ_coarse) at equal bend, averaged over the pair's points:
     the same design on the space's mesh (``coarse`` numbers) and on the default mesh."""
-    th_c, P_c, dQ_c = (np.array(coarse[k], float) for k in ("theta_deg", "P_MPa", "dQ_mm3"))
-    th_f, P_f, dQ_f = (np.array(fine[k], float) for k in ("theta_deg", "P_MPa", "dQ_mm3"))
+    th_c, P_c, dQ_c = (np.array(v, float) for v in (coarse["theta_deg"], cavity_pressures(coarse), coarse["dQ_mm3"]))
+    th_f, P_f, dQ_f = (np.array(v, float) for v in (fine["theta_deg"], cavity_pressures(fine), fine["dQ_mm3"]))
     inside = th_c <= th_f.max()
     at = th_c[inside]
     P_fine = PchipInterpolator(np.r_[0.0, th_f], np.r_[0.0, P_f])(at)
@@ -164,27 +164,27 @@ def heldout_rows(results: list[tuple[HandDesign, dict]], table: str | None = Non
     for design, record in results:
         model = design.replace(finger_model="fem", finger_table=str(table or ""))
         n = record["numbers"]
-        P, th, dQ = (np.array(n[k], float) for k in ("P_MPa", "theta_deg", "dQ_mm3"))
+        P, th, dQ = (np.array(v, float) for v in (cavity_pressures(n), n["theta_deg"], n["dQ_mm3"]))
         keep = P > 0
         P, th, dQ = P[keep], th[keep], dQ[keep]
         at60 = th.max() >= 60.0
         if at60:
             P60, dQ60 = (float(PchipInterpolator(np.r_[0.0, th], np.r_[0.0, v])(60.0)) for v in (P, dQ))
         # one sheet FEM per design: the FEM points and the 60 deg point together
-        hand_err = _whole_hand_errors(design, {"P_MPa": [*P, P60] if at60 else P,
+        hand_err = _whole_hand_errors(design, {"P_cavity_MPa": [*P, P60] if at60 else P,
                                                "theta_deg": [*th, 60.0] if at60 else th,
                                                "dQ_mm3": [*dQ, dQ60] if at60 else dQ}, table)
         th_m = np.degrees(hand.bend_angle(P, model, reservoir=False))
         dQ_m = finger.oil_taken(np.radians(th), model)
         point = " ".join(f"{design.to_dict()[k]:g}" for k in VARIABLES)
         for k in range(P.size):
-            rows.append({"design": point, "P_MPa": P[k], "theta_fem_deg": th[k], "theta_model_deg": th_m[k],
+            rows.append({"design": point, "P_cavity_MPa": P[k], "theta_fem_deg": th[k], "theta_model_deg": th_m[k],
                          "theta_err_pct": 100 * (th_m[k] / th[k] - 1), "dQ_fem_mm3": dQ[k],
                          "dQ_model_mm3": dQ_m[k], "dQ_err_pct": 100 * (dQ_m[k] / dQ[k] - 1),
                          "P_hand_err_MPa": hand_err[k]})
         if at60:
             t60 = float(np.degrees(hand.bend_angle(P60, model, reservoir=False)))
-            rows.append({"design": point, "P_MPa": P60, "theta_fem_deg": 60.0, "theta_model_deg": t60,
+            rows.append({"design": point, "P_cavity_MPa": P60, "theta_fem_deg": 60.0, "theta_model_deg": t60,
                          "theta_err_pct": 100 * (t60 / 60.0 - 1), "dQ_fem_mm3": math.nan,
                          "dQ_model_mm3": math.nan, "dQ_err_pct": math.nan, "P_hand_err_MPa": hand_err[-1]})
     worst = {k: float(np.nanmax([abs(r[k]) for r in rows]))
@@ -199,8 +199,8 @@ def _whole_hand_errors(design: HandDesign, numbers: dict, table) -> np.ndarray:
     from softhand.reduced.vocabulary.errors import InputError
     from softhand.studies.compare import whole_hand
 
-    fem = [{"P_MPa": P, "theta_deg": t, "dQ_mm3": q}
-           for P, t, q in zip(numbers["P_MPa"], numbers["theta_deg"], numbers["dQ_mm3"]) if P > 0]
+    fem = [{"P_cavity_MPa": P, "theta_deg": t, "dQ_mm3": q}
+           for P, t, q in zip(cavity_pressures(numbers), numbers["theta_deg"], numbers["dQ_mm3"]) if P > 0]
     with warnings.catch_warnings():  # a dry reservoir is a nan here, reported in the table
         warnings.simplefilter("ignore")
         rows = whole_hand(fem, design).rows
@@ -209,7 +209,7 @@ def _whole_hand_errors(design: HandDesign, numbers: dict, table) -> np.ndarray:
     for k, r in enumerate(rows):
         if r["V_mm3"] > 0:
             try:
-                out[k] = float(hand.pressure(math.radians(r["theta_deg"]), model, reservoir=True)) - r["P_hand_fem_MPa"]
+                out[k] = float(hand.pressure(math.radians(r["theta_deg"]), model, reservoir=True)) - r["P_pump_fem_MPa"]
             except InputError:  # the model's fingers take more oil than V0 there
                 pass
     return out
@@ -247,7 +247,7 @@ def leave_one_out(path: str | Path | None = None) -> list[dict]:
             dQ_m = finger.oil_taken(theta, model)
             for k in range(theta.size):
                 out.append({"design": int(i), **{key: round(v, 4) for key, v in g.items()},
-                            "P_MPa": float(P[k]), "theta_fem_deg": math.degrees(theta[k]),
+                            "P_cavity_MPa": float(P[k]), "theta_fem_deg": math.degrees(theta[k]),
                             "theta_err_pct": 100 * (th_m[k] / theta[k] - 1),
                             "dQ_err_pct": 100 * (dQ_m[k] / (r["q_tilde"][at][k] * a**3) - 1)})
     return out

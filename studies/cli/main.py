@@ -21,7 +21,7 @@ import signal
 import sys
 import warnings
 
-from softhand.reduced.vocabulary.errors import InputError, short
+from softhand.reduced.vocabulary.errors import InputError, Note, short
 from softhand.reduced.vocabulary.inputfiles import plain_float
 from softhand.reduced.vocabulary.versions import package_version
 
@@ -118,7 +118,8 @@ def main(argv: list[str] | None = None) -> int:
     previous = _sigterm_as_interrupt()
     float_errors = _quiet_float_warnings()
     form = warnings.formatwarning  # every warning shown is one line (which are shown: the filters)
-    warnings.formatwarning = lambda message, *rest, **kw: f"softhand {verb}: warning: {message}\n"
+    warnings.formatwarning = lambda message, category, *rest, **kw: (
+        f"softhand {verb}: {'note' if issubclass(category, Note) else 'warning'}: {message}\n")
     try:
         _check(verb, args, parser)
         code = int(module.run(args) or 0)

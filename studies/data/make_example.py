@@ -48,7 +48,7 @@ def bending(design, rng) -> str:
     theta = np.degrees(bend_angle(P, design)) + SIGMA_THETA_DEG * rng.standard_normal(P.size)
     lines = [f"{p:.2f},{t:.2f},{f}" for p, t, f in zip(P, theta, finger)]
     what = f"free bending, theta noise sigma = {SIGMA_THETA_DEG} deg"
-    return _header(what) + "P_MPa,theta_deg,finger\n" + "\n".join(lines) + "\n"
+    return _header(what) + "P_pump_MPa,theta_deg,finger\n" + "\n".join(lines) + "\n"
 
 
 def grasp(design, rng) -> str:
@@ -61,7 +61,7 @@ def grasp(design, rng) -> str:
             rows.append((P, round(theta, 2), F_v + SIGMA_F_V_N * rng.standard_normal()))
     lines = [f"{P:.2f},{t:.2f},{mass:g},{F:.3f},{diameter:g}" for P, t, F in rows]
     what = f"2 kg, 180 mm object, F_v noise sigma = {SIGMA_F_V_N} N"
-    return _header(what) + "P_MPa,theta_deg,mass_kg,F_v_N,diameter_mm\n" + "\n".join(lines) + "\n"
+    return _header(what) + "P_pump_MPa,theta_deg,mass_kg,F_v_N,diameter_mm\n" + "\n".join(lines) + "\n"
 
 
 def main() -> None:

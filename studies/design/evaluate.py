@@ -44,7 +44,8 @@ import numpy as np
 from softhand.reduced.equations import contact, finger, grasp, hand, reservoir
 from softhand.reduced.calibrated import grasp_hold
 from softhand.reduced.vocabulary.design import HandDesign
-from softhand.reduced.vocabulary.design_files import design_from_dict, hinges_for
+from softhand.reduced.vocabulary.design import hinges_for
+from softhand.reduced.vocabulary.design_files import design_from_dict
 from softhand.reduced.vocabulary.errors import InputError
 from softhand.studies.design.task import Task
 

@@ -66,8 +66,9 @@ def sheet_pressure(sheet):
     return lambda V: np.interp(V, sheet.path_volume, sheet.path_pressure)
 
 
-def free_bend(finger, theta_g: float, options: ProofOptions) -> dict:
-    """The free finger FEM up to theta_g [rad]: cavity pressure, dQ, stretch at theta_g."""
+def free_bend(finger, theta_g: float, options: ProofOptions, tick=None) -> dict:
+    """The free finger FEM up to theta_g [rad]: cavity pressure, dQ, stretch at theta_g;
+    ``tick(text)`` is told each converged state's bend."""
     from softhand.fem.hand.finger import solve_pressures
     from softhand.fem.newton import NotConverged
 
@@ -77,6 +78,8 @@ def free_bend(finger, theta_g: float, options: ProofOptions) -> dict:
 
     def keep(state):
         states.append(state)
+        if tick is not None:
+            tick(f"free bend {math.degrees(state.theta):.1f} of {math.degrees(theta_g):.1f} deg")
         if state.theta > theta_g:
             raise _Past
 
@@ -204,7 +207,7 @@ def margin(model, sheet, best, ev: Evaluation, task: Task, options: ProofOptions
         return float(reservoir.pump_pressure(state.P, oil_left(state), design, sheet_pressure(sheet)))
 
     def row(state):
-        return {"pump_pressure_MPa": pump(state), "cavity_pressure_MPa": state.P, "F_v_N": state.F_v,
+        return {"P_pump_MPa": pump(state), "P_cavity_MPa": state.P, "F_v_N": state.F_v,
                 "oil_left_mm3": oil_left(state),
                 "theta_deg": math.degrees(state.theta),
                 "links_in_contact": [int(k) for k in np.flatnonzero(state.N > 0)],
@@ -320,8 +323,9 @@ def corrected_task(task: Task, ev: Evaluation, fem: dict) -> Task | None:
 
 
 def prove(ev: Evaluation, task: Task, options: ProofOptions = ProofOptions(), *, out=None,
-          progress=None) -> dict:
-    """Run the three FEM models for the evaluated design; the FEM's numbers (see module doc)."""
+          progress=None, tick=None) -> dict:
+    """Run the three FEM models for the evaluated design; the FEM's numbers (see module doc).
+    ``progress(text)`` is told each phase, ``tick(text)`` each converged free-bend state."""
     from softhand.fem.hand.finger import FingerModel
     from softhand.fem.hand.grasp import GraspModel
     from softhand.fem.hand.reservoir import SheetModel, inflate
@@ -333,7 +337,7 @@ def prove(ev: Evaluation, task: Task, options: ProofOptions = ProofOptions(), *,
     finger = FingerModel(design, replace(finger_options(options.mesh_size_mm), edge_ratio=options.edge_ratio))
     say(f"free bend FEM to the grasp angle {math.degrees(ev.theta_grasp):.2f} deg "
         f"({finger.ndofs} unknowns)")
-    bend = free_bend(finger, ev.theta_grasp, options)
+    bend = free_bend(finger, ev.theta_grasp, options, tick)
     touch = _touch(bend, ev, task)
     say("reservoir sheet FEM at the oil left at contact")
     V_contact = float(reservoir.oil_left(bend["dQ_mm3"], design))
@@ -375,13 +379,13 @@ def prove(ev: Evaluation, task: Task, options: ProofOptions = ProofOptions(), *,
         "max_principal_stretch": fs.max_principal_stretch,
         "max_principal_stretch_at_contact": bend["max_principal_stretch"],
         "contact_force_N": best.N.tolist(),
-        "cavity_pressure_MPa": best.P,
+        "P_cavity_MPa": best.P,
         "reservoir_pressure_MPa": p_grasp,
         "reservoir_offset_MPa": sheet.states[1].pressure,
         "reservoir_pressure_maximum": sheet.pressure_max,
         "depth_mm": model.depth,
         "free_bend": bend,
-        "grasp_states": [{"P_MPa": s.P, "theta_deg": math.degrees(s.theta), "F_v_N": s.F_v}
+        "grasp_states": [{"P_cavity_MPa": s.P, "theta_deg": math.degrees(s.theta), "F_v_N": s.F_v}
                          for s in g["states"]],
         "finger_ndofs": finger.ndofs, "sheet_ndofs": sheet.ndofs,
         "mesh_size_mm": options.mesh_size_mm,

@@ -23,8 +23,8 @@ def margin_lines(fem: dict, task) -> list[str]:
     m = fem["margin"]
     if "error" in m:
         return [f"# FEM margin: not computed ({m['error']}); predicted F_v {m['predicted_F_v_N']:.4g} N"]
-    lines = [f"# FEM margin: F_v {m['F_v_N']:.4g} N at the pump pressure {m['pump_pressure_MPa']:.4g} MPa "
-             f"(cavity {m['cavity_pressure_MPa']:.4g} MPa, {on(m)}), predicted {m['predicted_F_v_N']:.4g} N"]
+    lines = [f"# FEM margin: F_v {m['F_v_N']:.4g} N at the pump pressure {m['P_pump_MPa']:.4g} MPa "
+             f"(cavity {m['P_cavity_MPa']:.4g} MPa, {on(m)}), predicted {m['predicted_F_v_N']:.4g} N"]
     limit = fem.get("at_pump_limit")
     if limit and "error" in limit:
         lines.append(f"# FEM at the pump limit {task.max_pressure:g} MPa: not reached ({limit['error']})")

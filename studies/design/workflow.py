@@ -31,7 +31,7 @@ class DesignRun:
     fem: bool = True                  #: prove the optimum with the FEM
     correct: bool = True              #: re-optimise with the FEM's stretch factor if the limit breaks
     mesh_size_mm: float | None = None  #: finger mesh of the proof (None: the task's)
-    show_progress: bool = True        #: the optimiser's bar on stderr
+    show_progress: bool = True        #: the optimiser's and the FEM proof's bars on stderr
 
 
 def run_task(task, out, run: DesignRun = DesignRun(), say=print):
@@ -87,7 +87,7 @@ def prove_and_correct(result: dict, task, opt, base, run: DesignRun, out, say, o
     re-optimisation with eq. (8)'s strain scaled to the FEM's and the proof of that design
     (the first optimum is kept under ``rejected``)."""
     ev = opt.evaluation
-    result["fem"] = prove_on_meshes(ev, task, run.mesh_size_mm, out, say)
+    result["fem"] = prove_on_meshes(ev, task, run.mesh_size_mm, out, say, show_progress=run.show_progress)
     report = proof.fem_report(result["fem"], ev)
     if not report:
         return result
@@ -105,7 +105,8 @@ def prove_and_correct(result: dict, task, opt, base, run: DesignRun, out, say, o
     if not opt.evaluation.feasible:
         new["report"] = design_opt.infeasible_report(corrected, opt)
         return new
-    new["fem"] = prove_on_meshes(opt.evaluation, corrected, run.mesh_size_mm, out, say)
+    new["fem"] = prove_on_meshes(opt.evaluation, corrected, run.mesh_size_mm, out, say,
+                                 show_progress=run.show_progress)
     report = proof.fem_report(new["fem"], opt.evaluation)
     if report:
         new["fem_report"] = report
@@ -124,26 +125,47 @@ def prove_knee(pareto: dict, task, run: DesignRun, out, say) -> dict | None:
     say(f"FEM proof of the Pareto knee (stretch {row['max_principal_stretch']:.4g})")
     return {"design_file": str(write_atomic(out / "knee" / "design.toml", ev.design.to_toml())),
             "stretch_limit": row["stretch_limit"], "predicted": ev.predicted(),
-            "fem": prove_on_meshes(ev, sub, run.mesh_size_mm, out / "knee", say)}
+            "fem": prove_on_meshes(ev, sub, run.mesh_size_mm, out / "knee", say,
+                                   show_progress=run.show_progress)}
 
 
-def prove_on_meshes(ev, task, mesh_size_mm: float | None, out, say) -> dict:
+def prove_on_meshes(ev, task, mesh_size_mm: float | None, out, say, *, show_progress: bool = False) -> dict:
     """The FEM proof of the evaluated design on the finger mesh ``mesh_size_mm`` (None: the
-    task's), a mesh that fails retried on the next finer one (:func:`~softhand.studies.design.proof.proof_meshes`); the
+    task's), a mesh that fails retried on the next finer one
+    (:func:`~softhand.studies.design.proof.proof_meshes`), which is said as information; with
+    ``show_progress`` a bar of its phases (free bend, sheet, grasp states) on stderr. The
     proof's record, or its error and the meshes that failed."""
+    import sys
+
+    from tqdm import tqdm
+
     from softhand.fem.newton import NotConverged
 
     failed = []
-    for size in proof.proof_meshes(ev.design, mesh_size_mm if mesh_size_mm is not None else task.mesh_size):
-        try:  # a finger mesh that fails is retried on the next finer one
-            options = proof.ProofOptions(mesh_size_mm=size, dP_mpa=task.dP, edge_ratio=task.edge_ratio)
-            fem = proof.prove(ev, task, options, out=out, progress=say)
-            return {**fem, "failed_meshes": failed} if failed else fem
-        except (NotConverged, RuntimeError, MeshRejected) as exc:
-            say(f"the FEM proof on the {size:g} mm finger mesh failed: {str(exc)[:300]}")  # e.g. folded
-            failed.append({"mesh_size_mm": size, "error": str(exc)[:300]})
-            if isinstance(exc, MeshTooLarge):  # a finer mesh would be larger still
-                return {"error": failed[-1]["error"], "failed_meshes": failed, "too_large": True}
+    sizes = proof.proof_meshes(ev.design, mesh_size_mm if mesh_size_mm is not None else task.mesh_size)
+    with tqdm(desc="FEM proof", unit="phase", file=sys.stderr, leave=False, disable=not show_progress) as bar:
+        def phase(text):  # each line the proof says starts a phase
+            with bar.external_write_mode(file=sys.stderr):
+                say(text)
+            bar.set_postfix_str("", refresh=False)
+            bar.update()
+
+        for k, size in enumerate(sizes):
+            try:
+                options = proof.ProofOptions(mesh_size_mm=size, dP_mpa=task.dP, edge_ratio=task.edge_ratio)
+                fem = proof.prove(ev, task, options, out=out, progress=phase,
+                                  tick=lambda text: bar.set_postfix_str(text))
+                return {**fem, "failed_meshes": failed} if failed else fem
+            except (NotConverged, RuntimeError, MeshRejected) as exc:
+                failed.append({"mesh_size_mm": size, "error": str(exc)[:300]})  # e.g. folded elements
+                if isinstance(exc, MeshTooLarge):  # a finer mesh would be larger still
+                    phase(f"the FEM proof on the {size:g} mm finger mesh failed: {str(exc)[:300]}")
+                    return {"error": failed[-1]["error"], "failed_meshes": failed, "too_large": True}
+                if k + 1 < len(sizes):
+                    phase(f"note: the {size:g} mm finger mesh did not serve ({str(exc)[:200]}); "
+                          f"proving on the {sizes[k + 1]:g} mm mesh instead")
+                else:
+                    phase(f"the FEM proof on the {size:g} mm finger mesh failed: {str(exc)[:300]}")
     return {"error": failed[-1]["error"], "failed_meshes": failed}
 
 

@@ -18,12 +18,12 @@ def plot_bending(path, rows: list[dict], design, hand_rows: list[dict] | None = 
     fig, (ax,) = figure()
     ax.plot(hand.pressure(theta, design, reservoir=False), theta_deg, "k:",
             label="eq. (28), no reservoir")
-    ax.plot([r["P_MPa"] for r in rows], [r["theta_deg"] for r in rows], "o",
+    ax.plot([r["P_cavity_MPa"] for r in rows], [r["theta_deg"] for r in rows], "o",
             label="finger FEM (no reservoir)")
     if hand_rows:
         ax.plot(hand.pressure(theta, design, reservoir=True), theta_deg, "k-",
                 label="eq. (27), with reservoir")
-        ax.plot([r["P_hand_fem_MPa"] for r in hand_rows],
+        ax.plot([r["P_pump_fem_MPa"] for r in hand_rows],
                 [r["theta_deg"] for r in hand_rows], "s", mfc="none",
                 label="finger FEM + reservoir FEM")
     ax.set(xlabel="pump pressure P [MPa]", ylabel="bend angle θ [deg]", title=title)

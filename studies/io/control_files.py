@@ -77,7 +77,7 @@ def _row(path: Path, number: int, cells: list[str]) -> tuple[float, float]:
 def series_rows(sim, every: int) -> list[dict]:
     """The time series at the sensor rate (every ``every``-th integration step)."""
     theta = np.degrees(sim.theta[::every])
-    columns = {"t_s": sim.t[::every], "P_MPa": sim.P[::every], "P_ref_MPa": sim.P_ref[::every],
+    columns = {"t_s": sim.t[::every], "P_pump_MPa": sim.P[::every], "P_pump_ref_MPa": sim.P_ref[::every],
                "theta_mean_deg": theta.mean(axis=1),
                **{f"theta_{j + 1}_deg": theta[:, j] for j in range(theta.shape[1])},
                "V_mm3": sim.V[::every], "push_N": sim.force[::every], "flow_limit": sim.flow_limit[::every]}

@@ -186,12 +186,15 @@ def _stamps(folder: Path, depth: int = 3) -> dict:
 @contextmanager
 def kept_if_unwritable(what, verb: str):
     """Write ``what`` inside this block; if the disk refuses (full, gone, read-only) after the
-    computation, a warning instead of losing the results, which the verb still prints."""
+    computation, a warning instead of losing the results, which the verb still prints; once
+    written, one line on stderr says where (``softhand VERB: wrote FILE``)."""
     try:
         yield
     except OSError as exc:
         print(f"softhand {verb}: warning: {what} not written ({exc.strerror or exc}); "
               f"the results are printed on stdout", file=sys.stderr)
+    else:
+        print(f"softhand {verb}: wrote {what}", file=sys.stderr)
 
 
 def write_outputs(result, verb: str, out=None, plot=None) -> None:

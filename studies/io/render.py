@@ -27,7 +27,7 @@ from softhand.meshes.atomic import atomic_path
 from softhand.reduced.vocabulary.errors import InputError
 from softhand.studies.io.scene_read import field_names, field_values, load_scene
 from softhand.studies.io.render_style import (VIEWS, body_name, camera, clim_of, colour_label, default_field,
-                                   default_png, has_display, title_of)
+                                   default_png, finger_turns, has_display, title_of)
 
 ANIMATIONS = (".gif", ".mp4")
 
@@ -175,15 +175,16 @@ def _draw(plotter, scene, field, *, title, view, clim=None, keep_camera=False, h
         elif name == "contact_forces":
             _draw_forces(plotter, block)
     n = int(np.asarray(body.field_data["n_fingers"]).ravel()[0]) if "n_fingers" in body.field_data and hand else 1
-    actors = [plotter.add_mesh(mesh.rotate_y(360.0 * k / n, point=(0.0, 0.0, 0.0), inplace=False)
-                               if k else mesh, show_scalar_bar=False, **style)
-              for k in range(n) for mesh, style in parts]
+    turns = finger_turns(n, view if body_key == "tube" else "iso")
+    actors = [plotter.add_mesh(mesh.rotate_y(turn, point=(0.0, 0.0, 0.0), inplace=False)
+                               if turn else mesh, show_scalar_bar=False, **style)
+              for turn in turns for mesh, style in parts]
     plotter.add_scalar_bar(colour_label(field), mapper=actors[0].mapper, vertical=True, position_x=0.8, position_y=0.12,
                            width=0.05, height=0.7, color="black", fmt="%.3g", title_font_size=14,
                            label_font_size=13)
     plotter.add_text(title, font_size=10, color="black")
     if not keep_camera:
-        camera(plotter, view, sheet=body_key != "tube", zoom=1.0 if body_key == "tube" and n == 1 else 1.3)
+        camera(plotter, view, sheet=body_key != "tube", zoom=1.0 if body_key == "tube" and len(turns) == 1 else 1.3)
 
 
 def _draw_forces(plotter, forces) -> None:

@@ -52,13 +52,20 @@ def colour_label(field: str) -> str:
     return words if unit is None else f"{words} [{unit}]"
 
 
+#: field-data pressure -> its name in a picture's title (``pressure_MPa``: files written before
+#: the pressures were named, a finger's cavity pressure or the reservoir sheet's)
+PRESSURES = {"P_pump_MPa": "P_pump", "P_cavity_MPa": "P_cavity", "p_reservoir_MPa": "p_reservoir",
+             "pressure_MPa": "P"}
+
+
 def title_of(path, scene, index: int, n_steps: int) -> str:
     """File, step and the state's numbers (pressure, bend angle, volume) from field data."""
     fd = next((b.field_data for b in scene if len(b.field_data)), {})
     value = lambda k: float(np.asarray(fd[k]).ravel()[0])  # noqa: E731
     parts = [Path(path).name, f"step {index}/{n_steps - 1}"]
-    if "pressure_MPa" in fd:
-        parts.append(f"P = {value('pressure_MPa'):.3g} MPa")
+    for key, name in PRESSURES.items():  # each pressure by its name: pump, cavity, reservoir
+        if key in fd:
+            parts.append(f"{name} = {value(key):.4g} MPa")
     if "theta_deg" in fd:
         parts.append(f"theta = {value('theta_deg'):.1f} deg")
     if "volume_mm3" in fd:
@@ -66,6 +73,15 @@ def title_of(path, scene, index: int, n_steps: int) -> str:
     if "F_v_N" in fd:
         parts.append(f"F_v = {value('F_v_N'):.3g} N")
     return "   ".join(parts)
+
+
+def finger_turns(n: int, view: str | None) -> list[float]:
+    """The turns about the hand's axis [deg] of the fingers drawn of an n-finger hand: all of
+    them, except in the side view, which looks along the bending plane's normal: there only
+    the fingers in that plane (the modelled one, and the one opposite it when n is even) --
+    any other would be seen edge-on across the object, drawn through it."""
+    turns = [360.0 * k / n for k in range(n)]
+    return [a for a in turns if a in (0.0, 180.0)] if view in (None, "side") else turns
 
 
 def camera(plotter, view: str | None, *, sheet: bool, zoom: float = 1.0) -> None:

@@ -60,7 +60,7 @@ def write_sheet_states(solid, states, outdir: Path) -> list[str]:
     series = SceneSeries(Path(outdir) / "sheet.pvd")
     for state in sorted({s.volume: s for s in states}.values(), key=lambda s: s.volume):
         series.write(state.volume, [sheet_block(solid, state)],
-                     {"volume_mm3": state.volume, "pressure_MPa": state.pressure})
+                     {"volume_mm3": state.volume, "p_reservoir_MPa": state.pressure})
         name = f"sheet_V{state.volume:.0f}_rz.vtu"
         points, cells, data = sheet_vtk(solid, state)
         write_vtu(Path(outdir) / name, points, cells, point_data=data)

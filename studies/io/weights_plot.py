@@ -51,7 +51,7 @@ def draw_fig8(ax, result) -> None:
     """The Fig. 8 analogue of a :class:`softhand.studies.fig8.Fig8Result` on the axes ``ax``: per
     pressure the FEM points and eq. (25) with that pressure's mean FEM w."""
     for k, (P, theta_deg, F_v_kgf) in enumerate(result.model_lines()):
-        pts = [r for r in result.rows if r["P_MPa"] == P]
+        pts = [r for r in result.rows if r["P_cavity_MPa"] == P]
         color = f"C{k}"
         ax.plot([r["theta_deg"] for r in pts], [r["F_v_fem_N"] / KGF for r in pts], "o",
                 color=color, label=f"FEM {P:g} MPa")

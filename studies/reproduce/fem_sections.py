@@ -73,8 +73,8 @@ def fig7_fem(ctx: Context, outdir: Path):
                "max_radial_stretch": float(max(r["radial_stretch_max"] for r in rows)),
                "dofs": result.ndofs, "newton_iterations": result.stats.newton_iterations,
                "fem_wall_time_s": result.stats.wall_seconds}
-    columns = ["P_MPa", "theta_deg", "theta_reduced_deg", "dQ_mm3", "dQ_reduced_mm3",
-               "radial_stretch_max", "p_reservoir_fem_MPa", "P_hand_fem_MPa", "P_hand_eq27_MPa"]
+    columns = ["P_cavity_MPa", "theta_deg", "theta_reduced_deg", "dQ_mm3", "dQ_reduced_mm3",
+               "radial_stretch_max", "p_reservoir_fem_MPa", "P_pump_fem_MPa", "P_pump_eq27_MPa"]
     text = f"""The finger FEM (half model, rigid links on hinges, {result.ndofs} unknowns,
 {'CI mesh 6 mm' if ctx.quick else 'default mesh'}) at {len(rows)} pressures, against eq. (28)
 at the same pressure; the whole hand P = p_finger − p_r(V0 − n ΔQ_FEM) with the
@@ -153,7 +153,7 @@ def weights_fem(ctx: Context, outdir: Path):
         r = run_case(WeightsCase(design=ctx.design, diameter_mm=D, mass_kg=mass, pressure_mpa=P),
                      out=outdir / f"D{D:.0f}").summary()
         w_paper = np.asarray(paper.WEIGHTS[D])
-        rows.append({"diameter_mm": D, "mass_kg": mass, "P_MPa": r["P_MPa"],
+        rows.append({"diameter_mm": D, "mass_kg": mass, "P_cavity_MPa": r["P_cavity_MPa"],
                      "theta_deg": r["theta_deg"], "w_fem": r["w"],
                      "w_paper_normalised": (w_paper / w_paper.sum()).tolist(),
                      "F_v_fem_N": r["F_v_fem_N"], "F_v_reduced_N": r["F_v_reduced_N"],
@@ -167,7 +167,7 @@ normalised to Σw = 1, for the paper's two objects at a pressure inside the pape
 [D180/grasp.pvd](D180/grasp.pvd), [D240/grasp.pvd](D240/grasp.pvd)). The paper's vectors
 are shown normalised (its 180 mm vector sums to 1.40 as printed).
 
-{md_table(rows, ["diameter_mm", "mass_kg", "P_MPa", "theta_deg", "w_fem", "w_paper_normalised",
+{md_table(rows, ["diameter_mm", "mass_kg", "P_cavity_MPa", "theta_deg", "w_fem", "w_paper_normalised",
                  "F_v_fem_N", "F_v_reduced_N", "ndofs"], digits=3)}
 """
     return text, numbers

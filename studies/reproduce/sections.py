@@ -23,21 +23,22 @@ from softhand.studies.reproduce.section import Context, Section, md_table
 # ---------------------------------------------------------------------- Fig. 7, reduced
 def fig7_reduced(ctx: Context, outdir: Path):
     """Eq. (27) with and (28) without reservoir over 0-90 deg; the reservoir's offset."""
-    from softhand.studies.curve import at_angles, at_pressures, plot_curve
+    from softhand.studies.curve import at_angles, at_pressures, plot_curves
 
     d = ctx.design
     theta_deg = np.arange(0.0, 90.0 + 1e-9, 1.0)
     rows = at_angles(theta_deg, d)
-    P, P0 = (np.array([r[k] for r in rows]) for k in ("P_MPa", "P_no_reservoir_MPa"))
+    P, P0 = (np.array([r[k] for r in rows]) for k in ("P_pump_MPa", "P_cavity_MPa"))
     offset = P0 - P
-    write_csv(outdir / "fig7_reduced.csv", rows, ["theta_deg", "P_MPa", "P_no_reservoir_MPa"])
+    write_csv(outdir / "fig7_reduced.csv", rows, ["theta_deg", "P_pump_MPa", "P_cavity_MPa"])
     pressures = np.round(np.arange(0.0, 0.8 + 1e-9, 0.1), 10)
     by_p = at_pressures(pressures, d, strict=False)
     write_csv(outdir / "fig7_reduced_by_pressure.csv", by_p)
     P_fem, why = _pressure_fem_reservoir(np.radians(theta_deg), d)
-    plot_curve(outdir / "fig7_reduced.png", d, rows, title="Fig. 7 analogue: reduced model", markers=False,
-               extra=[] if P_fem is None else [("eq. (27), FEM-calibrated reservoir", P_fem, theta_deg)],
-               xlim=(-0.15, None))
+    plot_curves(outdir / "fig7_reduced.png", [("the paper's design", d, rows)],
+                title="Fig. 7 analogue: reduced model", markers=False,
+                extra=[] if P_fem is None else [("eq. (27), FEM-calibrated reservoir", P_fem, theta_deg)],
+                xlim=(-0.15, None))
     numbers = {"offset_mean_MPa": float(offset.mean()), "offset_min_MPa": float(offset.min()),
                "offset_max_MPa": float(offset.max()), "P_at_0deg_MPa": float(P[0]),
                "P_at_90deg_MPa": float(P[-1])}
@@ -93,7 +94,7 @@ def table2_reduced(ctx: Context, outdir: Path):
             warnings.simplefilter("ignore", WeightSumWarning)  # stated in the text below
             F = grasp_forces(P, math.radians(theta_deg), 2.0, w_paper, d).F_v / KGF
         F_unit = grasp_forces(P, math.radians(theta_deg), 2.0, w_unit, d).F_v / KGF
-        rows.append({"state": state, "P_MPa": P, "theta_deg": theta_deg, "F_v_paper_kgf": F_paper,
+        rows.append({"state": state, "P_pump_MPa": P, "theta_deg": theta_deg, "F_v_paper_kgf": F_paper,
                      "F_v_kgf": float(F), "F_v_w_normalised_kgf": float(F_unit)})
     write_csv(outdir / "table2_reduced.csv", rows)
     numbers = {f"F_v_{r['state']}_kgf": r["F_v_kgf"] for r in rows}
@@ -140,7 +141,7 @@ def fig8_reduced(ctx: Context, outdir: Path):
                 F_v = grasp_forces(P, np.radians(theta_deg), mass, w, d).F_v / KGF
                 theta_free = float(np.degrees(angle_at(P, mass, w, d)))
             ax.plot(theta_deg, F_v, label=f"{P} MPa")
-            rows += [{"diameter_mm": D, "mass_kg": mass, "P_MPa": P, "theta_deg": t, "F_v_kgf": f}
+            rows += [{"diameter_mm": D, "mass_kg": mass, "P_pump_MPa": P, "theta_deg": t, "F_v_kgf": f}
                      for t, f in zip(theta_deg, F_v)]
             numbers[f"theta_F0_{D:.0f}mm_{P}MPa_deg"] = theta_free
         ax.axhline(0.0, color="k", lw=0.6)
@@ -150,7 +151,7 @@ def fig8_reduced(ctx: Context, outdir: Path):
         ax.legend(fontsize=8)
     save_figure(fig, outdir / "fig8_reduced.png")
     write_csv(outdir / "fig8_reduced.csv", rows)
-    free = [{"diameter_mm": D, "mass_kg": m, "P_MPa": P,
+    free = [{"diameter_mm": D, "mass_kg": m, "P_pump_MPa": P,
              "theta_at_F_v_0_deg": numbers[f"theta_F0_{D:.0f}mm_{P}MPa_deg"]}
             for D, m, ps, *_ in paper.FIG8 for P in ps]
     text = f"""Eq. (25) solved for F_x, with F_y = mg/n (24) and F_v by (29), against θ at the
@@ -181,12 +182,13 @@ def table2_control(ctx: Context, outdir: Path):
     """Table II by simulation: the three states of the flexibility experiment."""
     result = _flexibility(ctx)
     study = result.study
-    columns = ["state", "P_MPa", "theta_deg", "F_v_estimated_kgf", "F_v_actual_mean_N",
-               "paper_P_MPa", "paper_theta_deg", "paper_F_v_kgf"]
+    columns = ["state", "P_pump_MPa", "theta_deg", "F_v_estimated_kgf", "F_v_actual_mean_N",
+               "paper_P_pump_MPa", "paper_theta_deg", "paper_F_v_kgf"]
+    columns = [c for c in columns if c in result.rows[0]]  # the paper's columns: its own hand only
     write_csv(outdir / "table2_control.csv", result.rows)
     F = {r["state"]: r["F_v_estimated_kgf"] for r in result.rows}
     numbers = {f"F_v_{k}_kgf": v for k, v in F.items()}
-    numbers["P_a_MPa"] = result.rows[0]["P_MPa"]
+    numbers["P_a_MPa"] = result.rows[0]["P_pump_MPa"]
     verdict = "holds" if F["c_push_angle_control"] < F["b_push_pressure_control"] else "does not hold"
     text = f"""The simulated hand (reduced-model statics, pump and finger lags; the paper's
 design and 180 mm w) holds a 2 kg object under angle control at θ_ref = 50° (eqs. (30),

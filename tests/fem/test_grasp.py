@@ -114,7 +114,7 @@ def test_weights_cli_caches_by_input(tmp_path, monkeypatch, capsys):
 
     calls = []
 
-    def fake_compute(case):
+    def fake_compute(case, out=None, progress=None):
         calls.append(case)
         return {"diameter_mm": case.diameter_mm, "w": [0.2] * 5, "w_sum": 1.0, "theta_deg": 40.0,
                 "F_v_fem_N": 3.0, "mesh_size_mm": case.mesh_size_mm, "ndofs": 10}
@@ -162,7 +162,7 @@ def test_vtk_series_of_the_contact_states(grasp180, tmp_path):
     mesh = meshio.read(tmp_path / "grasp" / "grasp_0001" / "tube.vtu")
     u = mesh.point_data["displacement_mm"]
     assert u.shape[1] == 3 and np.isfinite(u).all() and np.abs(u).max() > 1.0  # mm: the finger moved
-    assert mesh.field_data["pressure_MPa"][0] == b.P
+    assert mesh.field_data["P_cavity_MPa"][0] == b.P
 
 
 def test_scene_of_a_contact_state_holds_the_object_and_the_pad_forces(grasp180, tmp_path):
@@ -204,6 +204,14 @@ def test_grasp_cli_takes_w_from_the_fem_or_the_paper_by_name(tmp_path, monkeypat
     assert main(base + ["--weights", "paper240"]) == 0
     out = json.loads(capsys.readouterr().out)
     assert out["w"] == pytest.approx([-0.2, 0.0, 0.1, 0.3, 0.8]) and out["w_source"].startswith("paper")
+    # where the grasp FEM's own F_v says eq. (25) with its w is off, the F_v printed comes with why
+    far = {"w": w_fem, "diameter_mm": 210.0, "P_cavity_MPa": 0.8, "theta_deg": 30.0, "F_v_fem_N": 4.0,
+           "F_v_reduced_N": 93.4, "contact_force_N": [0.0, 0.0, 3.9, 0.0, 0.0, 0.0]}
+    monkeypatch.setattr(sw, "compute", lambda case: far)
+    assert main(base + ["--diameter-mm", "210"]) == 0
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and err.startswith("softhand grasp: warning: at the grasp FEM's own state")
+    assert "touches link 2 of 5" in err and "23.4 x the FEM's" in err and "--model fem" in err
 
 
 @pytest.mark.parametrize("forces, warned", [([0.0] * 6, True), ([0.0, 0.0, 0.0, 0.0, 0.0, 1.5], False)])
@@ -214,7 +222,7 @@ def test_w_of_a_finger_that_does_not_touch_the_object_is_said_to_be_no_grasps(fo
     paper's finger, eqs. (28) and the pad geometry): the warning says both."""
     import softhand.studies.weights as sw
 
-    def fake_compute(case):
+    def fake_compute(case, out=None, progress=None):
         return {"diameter_mm": case.diameter_mm, "depth_mm": 40.0, "w": [0.2] * 5, "w_sum": 1.0,
                 "theta_deg": 20.54, "F_v_fem_N": 0.0, "contact_force_N": forces,
                 "mesh_size_mm": case.mesh_size_mm, "ndofs": 10}

@@ -47,7 +47,7 @@ def test_blocks_have_the_right_names_counts_and_units(finger, series):
     assert tube.n_points == 2 * nodes and tube.n_cells == 2 * finger.mesh.nelements
     assert np.bincount(tube.cell_data["mirrored"]).tolist() == [finger.mesh.nelements] * 2
     assert {"displacement_mm", "von_mises_MPa", "cauchy_stress_MPa", "principal_stretches"} <= set(tube.point_data)
-    assert float(tube.field_data["pressure_MPa"][0]) == 0.8
+    assert float(tube.field_data["P_cavity_MPa"][0]) == 0.8
     assert all(scene[f"link_{k}"].n_points == 8 for k in range(n_s + 1))
 
 
@@ -127,7 +127,7 @@ def test_animation_has_one_frame_per_step(series, tmp_path):
 def test_fields_lists_blocks_and_cli_errors(series, capsys):
     rows = describe(series.parent / "finger" / "finger_0001.vtm")  # one step's scene
     assert {"block": "tube", "field": "von_mises_MPa", "location": "point", "components": 1} in rows
-    assert {"block": "link_3", "field": "pressure_MPa", "location": "field", "components": 1} in rows
+    assert {"block": "link_3", "field": "P_cavity_MPa", "location": "field", "components": 1} in rows
     assert main(["inspect", str(series), "--fields"]) == 0
     assert "displacement_mm" in capsys.readouterr().out
     bad = [(["--view", "up"], "--view"), (["--animate", "x.png"], "--animate")]

@@ -211,7 +211,7 @@ def test_flexibility_under_a_push(tables):
                          rows["c_push_angle_control"]["F_v_estimated_N"])
         # angle control restores the mean angle; pressure control holds P_a
         assert rows["c_push_angle_control"]["theta_deg"] == pytest.approx(50.0, abs=0.1)
-        assert rows["b_push_pressure_control"]["P_MPa"] == pytest.approx(rows["a_no_push"]["P_MPa"],
+        assert rows["b_push_pressure_control"]["P_pump_MPa"] == pytest.approx(rows["a_no_push"]["P_pump_MPa"],
                                                                          abs=0.01)
     for name in ("horizontal", "down"):
         b, c = results[name]
@@ -252,7 +252,7 @@ def test_cli_json_reports_table_ii(capsys, tmp_path):
     assert s["P_error_MPa"] is None  # not applicable to angle control: null, not NaN
     assert report["other_mode"]["P_during_MPa"] == pytest.approx(s["P_before_MPa"], abs=0.01)
     rows = (tmp_path / "run" / "control_angle.csv").read_text().splitlines()
-    assert rows[0].startswith("t_s,P_MPa,P_ref_MPa,theta_mean_deg,theta_1_deg")
+    assert rows[0].startswith("t_s,P_pump_MPa,P_pump_ref_MPa,theta_mean_deg,theta_1_deg")
     assert len(rows) == 1 + 600  # 6 s at the 100 Hz sensor rate
     assert (tmp_path / "run" / "summary.json").exists()
 

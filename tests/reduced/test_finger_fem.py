@@ -305,7 +305,7 @@ def test_the_held_out_whole_hand_error_is_the_fingers_for_the_models_own_reservo
     theta = np.radians([5.0, 12.0, 20.0])
     P = hand.pressure(theta, model, reservoir=False)
     dQ = finger.oil_taken(theta, model)
-    numbers = {"P_MPa": [*(1.01 * P), 3.0], "theta_deg": [*np.degrees(theta), 150.0],
+    numbers = {"P_cavity_MPa": [*(1.01 * P), 3.0], "theta_deg": [*np.degrees(theta), 150.0],
                "dQ_mm3": [*dQ, d.V0 / d.n * 1.1]}
     err = _whole_hand_errors(d, numbers, None)
     assert err[:3] == pytest.approx(-0.01 * P, abs=1e-6) and np.isnan(err[3])
@@ -320,13 +320,13 @@ def test_heldout_60_deg_row_is_the_fem_point_there_when_one_lies_at_60_deg():
     design = HandDesign()
     model = design.replace(finger_model="fem")
     theta = np.radians([20.0, 40.0, 60.0, 70.0])
-    numbers = {"P_MPa": hand.pressure(theta, model, reservoir=False).tolist(),
+    numbers = {"P_cavity_MPa": hand.pressure(theta, model, reservoir=False).tolist(),
                "theta_deg": np.degrees(theta).tolist(), "dQ_mm3": finger.oil_taken(theta, model).tolist()}
     rows, _ = heldout_rows([(design, {"numbers": numbers})])
     at60 = [r for r in rows if r["theta_fem_deg"] == pytest.approx(60.0, abs=1e-9)]
     assert len(at60) == 2  # the FEM point and the interpolated row
     fem, interpolated = at60
-    assert interpolated["P_MPa"] == pytest.approx(fem["P_MPa"], rel=1e-12)
+    assert interpolated["P_cavity_MPa"] == pytest.approx(fem["P_cavity_MPa"], rel=1e-12)
     assert interpolated["P_hand_err_MPa"] == pytest.approx(fem["P_hand_err_MPa"], abs=1e-9)
     assert abs(fem["theta_err_pct"]) < 1e-6  # the model against its own curve
     assert abs(fem["P_hand_err_MPa"]) < 0.01  # the reservoir model "fem" against the sheet FEM

@@ -85,13 +85,13 @@ def test_too_few_points():
 # ---------------------------------------------------------------- CSV
 def test_csv_round_trip(tmp_path):
     f = tmp_path / "d.csv"
-    f.write_text("# synthetic\nP_MPa,theta_deg,finger\n0.1,10.5,1\n0.2, 20,2\n\n")
+    f.write_text("# synthetic\nP_pump_MPa,theta_deg,finger\n0.1,10.5,1\n0.2, 20,2\n\n")
     m = read_measurements(f)
     assert m.kind == "bending" and len(m) == 2
     np.testing.assert_allclose(m.observed, [10.5, 20.0])
     np.testing.assert_array_equal(m.finger, [1, 2])
     g = tmp_path / "g.csv"
-    g.write_text("P_MPa,theta_deg,mass_kg,F_v_N,diameter_mm\n0.8,50,2,6.0,180\n")
+    g.write_text("P_pump_MPa,theta_deg,mass_kg,F_v_N,diameter_mm\n0.8,50,2,6.0,180\n")
     m = read_measurements(g)
     assert m.kind == "grasp" and m.quantity == "F_v_N" and m.diameter[0] == 180
 

@@ -131,19 +131,20 @@ def test_an_angle_the_object_cannot_hold_is_refused():
 def test_agrees_with_the_grasp_fem(state):
     """Same object, placement, cavity pressure and mass as a stored grasp FEM state (the command
     that made it is stored with it): F_v within 10 % or 0.05 kgf, the larger."""
-    F_v = grasp_fem.vertical_force(DESIGN, state["diameter_mm"], state["P_MPa"], mass_kg=state["mass_kg"],
+    F_v = grasp_fem.vertical_force(DESIGN, state["diameter_mm"], state["P_cavity_MPa"], mass_kg=state["mass_kg"],
                                    depth_mm=state["depth_mm"])
     assert abs(F_v - state["F_v_fem_N"]) <= max(0.1 * state["F_v_fem_N"], 0.05 * grasp.KGF)
 
 
-def test_cli_model_fem_table_without_a_contact(capsys):
-    """Below the free finger's pressure at that angle the finger does not reach the object:
-    no contact point, printed as 'none' (the table had crashed on it half-way)."""
+def test_cli_model_fem_without_a_contact_is_one_error_line(capsys):
+    """Below the free finger's pressure at that angle the finger does not reach the object: no
+    placement lets it press there, said in one line naming the bend it reaches free (not a
+    table of zeros with the object far below the palm)."""
     argv = ["grasp", "--pressure-mpa", "0.8", "--theta-deg", "40", "--mass-kg", "1", "--diameter-mm", "180",
             "--model", "fem"]
-    assert main(argv) == 0
-    rows = dict(line.split(None, 1) for line in capsys.readouterr().out.splitlines())
-    assert rows["contact_link"] == "-1" and rows["contact_point_mm"] == "none" and rows["F_v_N"] == "0"
+    assert main(argv) == 2
+    out, err = capsys.readouterr()
+    assert out == "" and err.count("\n") == 1 and "--theta-deg" in err and "bends only to" in err
 
 
 def test_cli_model_fem_and_its_bad_inputs(capsys):
@@ -160,7 +161,7 @@ def test_cli_model_fem_and_its_bad_inputs(capsys):
     assert json.loads(capsys.readouterr().out)["model"] == "paper"
     for extra, field in ((["--diameter-mm", "180", "--model", "fe"], "--model"),
                          (["--weights", "paper180", "--model", "fem"], "--model"),
-                         (["--diameter-mm", "100", "--model", "fem"], "theta_deg")):
+                         (["--diameter-mm", "100", "--model", "fem"], "--theta-deg")):
         assert main([*argv, *extra]) == 2
         err = capsys.readouterr().err
         assert err.count("\n") == 1 and field in err
@@ -179,9 +180,9 @@ def test_the_one_pad_grasp_ends_where_the_grasp_fem_touches_with_a_second_pad(da
 
     design = grasp_fem.fem_finger(design_from_dict(data["design"], DESIGN, source="stored")) \
         if data["design"] else DESIGN
-    rows = sorted(data["states"], key=lambda r: r["P_MPa"])
-    one = [r["P_MPa"] for r in rows if np.count_nonzero(r["contact_force_N"]) == 1]
-    two = [r["P_MPa"] for r in rows if np.count_nonzero(r["contact_force_N"]) == 2]
+    rows = sorted(data["states"], key=lambda r: r["P_cavity_MPa"])
+    one = [r["P_cavity_MPa"] for r in rows if np.count_nonzero(r["contact_force_N"]) == 1]
+    two = [r["P_cavity_MPa"] for r in rows if np.count_nonzero(r["contact_force_N"]) == 2]
     assert one and two and max(one) < min(two)
     holding = {int(np.argmax(r["contact_force_N"])) for r in rows}
     second = {i for r in rows for i in np.flatnonzero(r["contact_force_N"]) if i not in holding}
@@ -191,5 +192,5 @@ def test_the_one_pad_grasp_ends_where_the_grasp_fem_touches_with_a_second_pad(da
     gaps = contact.pad_gaps(s.q, (0.0, s.depth), 0.5 * data["diameter_mm"], design)
     gaps[end.link] = np.inf
     assert {int(np.argmin(np.abs(gaps)))} == second and np.min(np.abs(gaps)) < 1e-8
-    F_fem = np.interp(end.P_cavity, [r["P_MPa"] for r in rows], [r["F_v_fem_N"] for r in rows])
+    F_fem = np.interp(end.P_cavity, [r["P_cavity_MPa"] for r in rows], [r["F_v_fem_N"] for r in rows])
     assert end.F_v == pytest.approx(F_fem, rel=0.1)

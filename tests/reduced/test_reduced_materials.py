@@ -127,9 +127,9 @@ def test_curve_honours_the_materials(tmp_path, capsys):
     V = d.V0 - d.n * d.a**2 * math.pi * d.d * theta
     lam = float(reservoir.stretch(V, d))
     p_r = 4 * (lam - lam**-5) * (0.5 + 0.075 * lam**2) * float(reservoir.dstretch_dV(V, d)) * math.pi * 24.0**2
-    assert row["P_no_reservoir_MPa"] == pytest.approx(free, rel=1e-9)
-    assert row["P_MPa"] == pytest.approx(free - p_r, rel=1e-9)
+    assert row["P_cavity_MPa"] == pytest.approx(free, rel=1e-9)
+    assert row["P_pump_MPa"] == pytest.approx(free - p_r, rel=1e-9)
     assert row["p_reservoir_MPa"] == pytest.approx(p_r, rel=1e-12)
-    assert main(["curve", "--pressure-mpa", str(row["P_MPa"]), "--design", str(path), "--json"]) == 0
+    assert main(["curve", "--pressure-mpa", str(row["P_pump_MPa"]), "--design", str(path), "--json"]) == 0
     back = json.loads(capsys.readouterr().out)["rows"][0]
     assert back["theta_deg"] == pytest.approx(60.0, abs=1e-8)

@@ -10,7 +10,7 @@ from softhand.studies.cli.main import main
 
 
 def _fake_compute(calls):
-    def compute(case):
+    def compute(case, out=None, progress=None):
         calls.append(case.diameter_mm)
         return {"diameter_mm": case.diameter_mm, "w": [0.2] * 5, "w_sum": 1.0, "theta_deg": 40.0,
                 "F_v_fem_N": 3.0, "mesh_size_mm": case.mesh_size_mm, "ndofs": 10}

@@ -1,14 +1,17 @@
 """softhand curve / grasp: columns, JSON shapes, the plot, bad input -> one line, exit 2."""
 import json
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
 
-from softhand.reduced.equations import grasp, hand
+from softhand.reduced.equations import grasp, hand, reservoir
 from softhand.reduced.vocabulary.design import HandDesign
 from softhand.reduced.vocabulary.errors import InputError
 from softhand.studies.cli.main import main
+
+ROOT = Path(__file__).resolve().parents[2]
 
 D = HandDesign()
 
@@ -22,13 +25,13 @@ def test_curve_by_angle(capsys):
     out = run_json(capsys, "curve", "--theta-deg", "0:90:10")
     rows = out["rows"]
     assert [r["theta_deg"] for r in rows] == pytest.approx(np.arange(0, 91, 10))  # stop included
-    assert set(rows[0]) == {"theta_deg", "P_MPa", "P_no_reservoir_MPa", "V_mm3", "p_reservoir_MPa", "h_mm",
+    assert set(rows[0]) == {"theta_deg", "P_pump_MPa", "P_cavity_MPa", "V_mm3", "p_reservoir_MPa", "h_mm",
                             "lambda_r"}
     for r in rows:  # eq. (27): P = p_finger - p_r, and p_finger is eq. (28)'s pressure
-        assert r["P_MPa"] == pytest.approx(r["P_no_reservoir_MPa"] - r["p_reservoir_MPa"], abs=1e-12)
-    assert rows[0]["P_no_reservoir_MPa"] == 0.0 and rows[0]["P_MPa"] < 0
+        assert r["P_pump_MPa"] == pytest.approx(r["P_cavity_MPa"] - r["p_reservoir_MPa"], abs=1e-12)
+    assert rows[0]["P_cavity_MPa"] == 0.0 and rows[0]["P_pump_MPa"] < 0
     assert rows[0]["V_mm3"] == D.V0
-    assert rows[5]["P_MPa"] == pytest.approx(float(hand.pressure(math.radians(50), D)), rel=1e-12)
+    assert rows[5]["P_pump_MPa"] == pytest.approx(float(hand.pressure(math.radians(50), D)), rel=1e-12)
     assert out["design"]["V0_mm3"] == D.V0
 
 
@@ -36,19 +39,24 @@ def test_curve_with_the_fem_reservoir_model_has_no_ellipse_columns(capsys, tmp_p
     design = tmp_path / "softhand.fem.toml"
     design.write_text('reservoir_model = "fem"\n')
     rows = run_json(capsys, "curve", "--theta-deg", "0,30", "--design", str(design))["rows"]
-    assert set(rows[0]) == {"theta_deg", "P_MPa", "P_no_reservoir_MPa", "V_mm3", "p_reservoir_MPa"}
-    assert rows[0]["p_reservoir_MPa"] == pytest.approx(-rows[0]["P_MPa"], abs=1e-12)  # theta = 0: no finger
+    assert set(rows[0]) == {"theta_deg", "P_pump_MPa", "P_cavity_MPa", "V_mm3", "p_reservoir_MPa"}
+    assert rows[0]["p_reservoir_MPa"] == pytest.approx(-rows[0]["P_pump_MPa"], abs=1e-12)  # theta = 0: no finger
 
 
 def test_curve_by_pressure_and_table(capsys):
     rows = run_json(capsys, "curve", "--pressure-mpa", "0,0.4,0.8")["rows"]
-    assert set(rows[0]) == {"P_MPa", "theta_deg", "theta_no_reservoir_deg"}
+    assert set(rows[0]) == {"P_pump_MPa", "theta_deg", "P_cavity_MPa", "theta_no_reservoir_deg"}
     for r in rows:  # the angles (rounded to 1e-10 deg, dP/dtheta < 3 MPa/rad) reproduce the pressures
-        assert hand.pressure(math.radians(r["theta_deg"]), D) == pytest.approx(r["P_MPa"], abs=1e-10)
+        theta = math.radians(r["theta_deg"])
+        assert hand.pressure(theta, D) == pytest.approx(r["P_pump_MPa"], abs=1e-10)
+        # the cavity holds the pump's pressure plus the reservoir's at that bend (eq. (27))
+        V = reservoir.oil_volume(theta, D)
+        p_r = float(reservoir.state(np.array([V]), D)["p_reservoir_MPa"][0])
+        assert r["P_cavity_MPa"] == pytest.approx(r["P_pump_MPa"] + p_r, abs=1e-9)
         assert r["theta_deg"] > r["theta_no_reservoir_deg"]  # the reservoir helps
     assert main(["curve", "--theta-deg", "0:90:15"]) == 0
     lines = capsys.readouterr().out.splitlines()
-    assert lines[0].split()[:3] == ["theta_deg", "P_MPa", "P_no_reservoir_MPa"] and len(lines) == 8
+    assert lines[0].split()[:3] == ["theta_deg", "P_pump_MPa", "P_cavity_MPa"] and len(lines) == 8
 
 
 def test_curve_plot(tmp_path, capsys):
@@ -64,7 +72,7 @@ def test_curve_plot_in_postscript_says_nothing_on_stderr(tmp_path, capfd, caplog
     path = tmp_path / f"fig7{suffix}"
     assert main(["curve", "--pressure-mpa", "0:0.8:0.1", "--plot", str(path)]) == 0
     assert path.read_bytes().startswith(magic)
-    assert capfd.readouterr().err == "" and not caplog.records
+    assert capfd.readouterr().err == f"softhand curve: wrote {path}\n" and not caplog.records
 
 
 def test_grasp_json(capsys):
@@ -181,3 +189,80 @@ def test_the_pressures_of_a_curve_are_those_both_models_reach():
     for outside in (lo - 1e-3, hi + 1e-3):
         with pytest.raises(InputError, match=f"must be in \\[{lo:.4g}, {hi:.4g}\\] MPa"):
             hand.bend_angles(outside, d)
+
+
+#: a 3-finger gripper of a user's own (not the paper's): the finger of the "fem" model bends
+#: 28.9 deg free at a pump pressure of 1 MPa
+GRIPPER = "l0_mm = 150.0\na_mm = 3.5\nb_mm = 4.0\nd_mm = 13.0\nn = 3\n"
+
+
+def test_grasp_fem_past_the_free_bend_is_an_error_naming_the_bend(tmp_path, capsys):
+    """At a bend the free finger does not reach at that pressure no placement of the object is
+    touched: one line naming the free bend (below which it would press) and the pump pressure
+    from which it presses at the bend asked, exit 2 -- not F_v = 0 with the object 480 mm deep."""
+    from softhand.reduced.calibrated import grasp_fem
+
+    design = tmp_path / "gripper.toml"
+    design.write_text(GRIPPER)
+    argv = ["grasp", "--model", "fem", "--diameter-mm", "120", "--mass-kg", "0.8", "--pressure-mpa", "1.0",
+            "--theta-deg", "60", "--design", str(design)]
+    assert main(argv) == 2
+    out, err = capsys.readouterr()
+    assert out == "" and err.count("\n") == 1 and err.startswith("softhand grasp: error: --theta-deg")
+    from softhand.reduced.vocabulary.design_files import load_design
+
+    fem = grasp_fem.fem_finger(load_design(design))
+    P_cavity = 1.0 + float(hand.pressure(math.radians(60), fem, reservoir=False) - hand.pressure(math.radians(60), fem))
+    free = math.degrees(float(hand.bend_angle(P_cavity, fem, reservoir=False)))
+    assert f"bends only to {free:.4g} deg" in err and f"bends below {free:.4g} deg" in err
+    P_from = float(hand.pressure(math.radians(60), fem))
+    assert f"from P_pump = {P_from:.4g} MPa on" in err
+    # and from that pump pressure on the finger does press at 60 deg (eq. (29): F_v > 0)
+    assert main([*argv[:-4], "--pressure-mpa", f"{P_from + 0.2:.3f}", "--theta-deg", "60",
+                 "--design", str(design), "--json"]) == 0
+    result = json.loads(capsys.readouterr().out)
+    assert result["contact_link"] >= 1 and result["F_v_N"] > 0
+
+
+def _figures(monkeypatch) -> list:
+    """The matplotlib figures the verbs save (``save_figure`` still writes them)."""
+    from softhand.studies.io import files
+
+    saved, save = [], files.save_figure
+    monkeypatch.setattr(files, "save_figure", lambda fig, path, **kw: (saved.append(fig), save(fig, path, **kw))[1])
+    return saved
+
+
+def test_curve_plot_is_titled_with_its_design_and_finger_model(tmp_path, capsys, monkeypatch):
+    saved = _figures(monkeypatch)
+    design = tmp_path / "gripper.toml"
+    design.write_text(GRIPPER)
+    path = tmp_path / "one.png"
+    assert main(["curve", "--pressure-mpa", "0:1:0.5", "--design", str(design), "--model", "fem",
+                 "--plot", str(path)]) == 0
+    assert path.read_bytes()[:4] == b"\x89PNG"
+    assert saved[-1].axes[0].get_title() == "Free bending, reduced model: gripper, finger model fem"
+    assert capsys.readouterr().err.splitlines()[-1] == f"softhand curve: wrote {path}"
+    assert main(["curve", "--pressure-mpa", "0:1:0.5", "--plot", str(path)]) == 0
+    assert saved[-1].axes[0].get_title() == "Free bending, reduced model: the paper's design, finger model paper"
+    assert "pump pressure P_pump" in saved[-1].axes[0].get_xlabel()
+
+
+def test_curve_compare_overlays_designs_and_models_on_one_plot(tmp_path, capsys, monkeypatch):
+    """Two designs on both finger models: four curves on one plot, each named in its legend, and
+    each curve's rows the ones the design alone prints."""
+    saved = _figures(monkeypatch)
+    (tmp_path / "gripper.toml").write_text(GRIPPER)
+    (tmp_path / "paper.toml").write_text((ROOT / "studies" / "designs" / "paper.toml").read_text())
+    path = tmp_path / "compare.png"
+    argv = ["curve", "--theta-deg", "0:60:30", "--compare", str(tmp_path / "paper.toml"),
+            str(tmp_path / "gripper.toml"), "--model", "paper,fem", "--plot", str(path), "--json"]
+    assert main(argv) == 0
+    out = json.loads(capsys.readouterr().out)["curves"]
+    labels = [f"{name}, finger model {model}" for name in ("paper", "gripper") for model in ("paper", "fem")]
+    assert [c["label"] for c in out] == labels
+    legend = [t.get_text() for t in saved[-1].axes[0].get_legend().get_texts()]
+    assert legend == labels and path.read_bytes()[:4] == b"\x89PNG"
+    assert main(["curve", "--theta-deg", "0:60:30", "--design", str(tmp_path / "gripper.toml"),
+                 "--model", "fem", "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["rows"] == out[3]["rows"]

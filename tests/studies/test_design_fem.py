@@ -65,9 +65,9 @@ def test_the_margin_is_proven_by_the_grasp_fem_at_the_pump_limit():
     assert ev.margin_edge == "" and ev.P_margin == task.max_pressure
     fem = prove(ev, task, CI)
     m = fem["margin"]
-    assert m["pump_pressure_MPa"] == pytest.approx(task.max_pressure, abs=CI.pump_tol_mpa)
+    assert m["P_pump_MPa"] == pytest.approx(task.max_pressure, abs=CI.pump_tol_mpa)
     p_r = inflate(SheetModel.from_design(design, **CI.sheet), [m["oil_left_mm3"]]).states[0].pressure
-    assert m["cavity_pressure_MPa"] - p_r == pytest.approx(task.max_pressure, abs=2 * CI.pump_tol_mpa)
+    assert m["P_cavity_MPa"] - p_r == pytest.approx(task.max_pressure, abs=2 * CI.pump_tol_mpa)
     assert fem["F_v_at_pump_limit_N"] == m["F_v_N"]
     assert fem["margin_N"] == pytest.approx(m["F_v_N"] - task.required_F_v(), rel=1e-12)
     # the pump limit lies above the verified grasp: the finger presses harder there, on the same pad
@@ -90,17 +90,17 @@ def test_a_margin_below_the_pump_limit_is_proven_there_and_the_fem_goes_on_to_th
     assert ev.margin_edge and ev.P_margin < task.max_pressure
     fem = prove(ev, task, CI, out=tmp_path)
     m, limit = fem["margin"], fem["at_pump_limit"]
-    assert m["pump_pressure_MPa"] == pytest.approx(ev.P_margin, abs=CI.pump_tol_mpa)
+    assert m["P_pump_MPa"] == pytest.approx(ev.P_margin, abs=CI.pump_tol_mpa)
     # the pad the reduced model holds with there (the hold has rolled on from the first pad, ev.link)
     end = grasp_hold.at_pump(task.base, task.diameter, task.mass, task.max_pressure)
     assert (end.P_pump, end.F_v) == (ev.P_margin, ev.F_v_at_limit)
     assert m["links_in_contact"] == [end.link]
     assert m["F_v_N"] == pytest.approx(ev.F_v_at_limit, rel=0.1)
     assert fem["margin_N"] == pytest.approx(m["F_v_N"] - task.required_F_v(), rel=1e-12)
-    assert limit["pump_pressure_MPa"] == pytest.approx(task.max_pressure, abs=CI.pump_tol_mpa)
+    assert limit["P_pump_MPa"] == pytest.approx(task.max_pressure, abs=CI.pump_tol_mpa)
     assert limit["links_in_contact"] == [end.link, ev.design.n_s]  # and the tip pad
     assert fem["F_v_at_pump_limit_N"] == limit["F_v_N"] > m["F_v_N"]
     # the VTK series: the verified grasp, the margin's state and the pump limit's, by cavity pressure
     steps = _pvd_times(tmp_path / "grasp.pvd")
-    assert steps == pytest.approx([fem["cavity_pressure_MPa"], m["cavity_pressure_MPa"],
-                                   limit["cavity_pressure_MPa"]], rel=1e-6)
+    assert steps == pytest.approx([fem["P_cavity_MPa"], m["P_cavity_MPa"],
+                                   limit["P_cavity_MPa"]], rel=1e-6)

@@ -45,7 +45,7 @@ def test_a_failed_proof_mesh_is_retried_on_the_next_finer_one(monkeypatch):
 
     tried, works = [], 6.0
 
-    def prove(ev, task, options, out=None, progress=None):
+    def prove(ev, task, options, out=None, progress=None, tick=None):
         tried.append(options.mesh_size_mm)
         if options.mesh_size_mm == 10.0:  # the FEM refuses the mesh: the proof's choice, not the user's
             raise MeshRejected("gmsh 10 mm", "has 39 curved elements that fold over themselves")
@@ -92,7 +92,7 @@ def test_a_proof_mesh_too_large_for_the_optimum_is_not_retried_finer(monkeypatch
 
     tried = []
 
-    def prove(ev, task, options, out=None, progress=None):
+    def prove(ev, task, options, out=None, progress=None, tick=None):
         tried.append(options.mesh_size_mm)
         raise MeshTooLarge("gmsh mesh_size=10", "has at least 900,000 unknowns; choose a coarser mesh")
 
@@ -136,7 +136,7 @@ def test_a_fem_stretch_above_the_limit_reoptimises_with_the_fems_factor(tmp_path
 
     seen = []
 
-    def prove(ev, task, options, out=None, progress=None):
+    def prove(ev, task, options, out=None, progress=None, tick=None):
         seen.append((ev, task))
         stretch = first if len(seen) == 1 else 1 + 0.999 * (ev.stretch - 1)  # the second: as the factor says
         fem = {"max_principal_stretch": stretch, "P_grasp_MPa": ev.P_grasp, "F_v_N": ev.F_v}
@@ -180,7 +180,7 @@ def test_the_pareto_knee_goes_through_the_fem_too(tmp_path, monkeypatch, capsys)
 
     seen = []
 
-    def prove(ev, task, options, out=None, progress=None):
+    def prove(ev, task, options, out=None, progress=None, tick=None):
         seen.append((ev, out))
         fem = {"max_principal_stretch": ev.stretch, "P_grasp_MPa": ev.P_grasp, "F_v_N": ev.F_v}
         return {**fem, "constraints": fem_constraints(fem, task)}
@@ -206,7 +206,7 @@ def test_a_proof_that_fails_on_every_mesh_is_not_a_proven_design(tmp_path, monke
     from softhand.studies.cli.main import main
     from softhand.studies.design import proof
 
-    def prove(ev, task, options, out=None, progress=None):
+    def prove(ev, task, options, out=None, progress=None, tick=None):
         raise RuntimeError("free-bend FEM: Newton failed at 0.2 MPa")
 
     monkeypatch.setattr(proof, "prove", prove)
@@ -227,7 +227,7 @@ def test_the_fem_margin_is_printed_with_the_pads_on_the_object(capsys):
     def print_margin(fem, task):  # what softhand design prints
         print(*margin_lines(fem, task), sep="\n")
 
-    at = {"F_v_N": 40.19, "pump_pressure_MPa": 2.8143, "cavity_pressure_MPa": 2.861,
+    at = {"F_v_N": 40.19, "P_pump_MPa": 2.8143, "P_cavity_MPa": 2.861,
           "links_in_contact": [3], "predicted_F_v_N": 38.13}
     limit = {"F_v_N": 43.16, "margin_N": 28.45, "links_in_contact": [3, 5]}
     print_margin({"margin": at, "at_pump_limit": limit}, SimpleNamespace(max_pressure=3.2))
@@ -281,19 +281,19 @@ def test_the_margin_state_is_the_pump_pressure_asked():
     task = SimpleNamespace(required_F_v=lambda: 10.0, max_pressure=1.5)
     best = model.solve(0.5)
     out, states = margin(model, sheet, best, ev, task, options)
-    assert [s.P for s in states] == [out["margin"]["cavity_pressure_MPa"]]
+    assert [s.P for s in states] == [out["margin"]["P_cavity_MPa"]]
     P = (1.5 + 0.2) / 1.08
-    assert out["margin"]["cavity_pressure_MPa"] == pytest.approx(P, abs=1e-9)
-    assert out["margin"]["pump_pressure_MPa"] == pytest.approx(1.5, abs=1e-9)
+    assert out["margin"]["P_cavity_MPa"] == pytest.approx(P, abs=1e-9)
+    assert out["margin"]["P_pump_MPa"] == pytest.approx(1.5, abs=1e-9)
     assert out["margin_N"] == pytest.approx(30.0 * P - 10.0, abs=1e-7) and out["F_v_at_pump_limit_N"] == out["margin"]["F_v_N"]
     assert max(np.diff(model.solves[1:6])) <= options.max_step_mpa + 1e-12  # continued in steps
     # below the pump limit (a second pad touches in the reduced model) the FEM goes on to the limit
     model = _LinearGrasp()
     out, states = margin(model, sheet, model.solve(0.5), SimpleNamespace(P_margin=1.2, margin_edge="a second pad",
                          F_v_at_limit=40.0), task, options)
-    assert len(states) == 2 and states[1].P == out["at_pump_limit"]["cavity_pressure_MPa"]
-    assert out["margin"]["pump_pressure_MPa"] == pytest.approx(1.2, abs=1e-9)
-    assert out["at_pump_limit"]["cavity_pressure_MPa"] == pytest.approx(P, abs=1e-9)
+    assert len(states) == 2 and states[1].P == out["at_pump_limit"]["P_cavity_MPa"]
+    assert out["margin"]["P_pump_MPa"] == pytest.approx(1.2, abs=1e-9)
+    assert out["at_pump_limit"]["P_cavity_MPa"] == pytest.approx(P, abs=1e-9)
     assert out["F_v_at_pump_limit_N"] == pytest.approx(30.0 * P, abs=1e-7)
 
 
@@ -323,7 +323,7 @@ def test_a_margin_the_grasp_fem_does_not_reach_is_reported_not_raised(capsys):
     model = _LinearGrasp(fails_above=1.45)
     out, states = margin(model, sheet, model.solve(0.5), SimpleNamespace(P_margin=1.2, margin_edge="a second pad",
                          F_v_at_limit=40.0), task, ProofOptions())
-    assert len(states) == 1 and out["margin"]["pump_pressure_MPa"] == pytest.approx(1.2, abs=1e-3)
+    assert len(states) == 1 and out["margin"]["P_pump_MPa"] == pytest.approx(1.2, abs=1e-3)
     assert out["F_v_at_pump_limit_N"] is None and "error" in out["at_pump_limit"]
 
 

@@ -100,8 +100,8 @@ def test_mesh_correction_scales_only_the_designs_on_longer_slices(tmp_path):
 
     space = load_space(_gap_space(tmp_path, "[mesh_pair]\na_mm = 4.0\nb_mm = 5.0\nd_mm = 15.0\n"
                                               "l0_mm = 180.0\ntie_width_mm = 10.0\npressures_mpa = [0.4, 0.8]\n"))
-    numbers = {"P_MPa": [0.4, 0.8], "theta_deg": [10.0, 20.0], "dQ_mm3": [100.0, 200.0]}
-    fine = {"P_MPa": [0.4, 0.8], "theta_deg": [11.0, 22.0], "dQ_mm3": [110.0, 220.0]}
+    numbers = {"P_cavity_MPa": [0.4, 0.8], "theta_deg": [10.0, 20.0], "dQ_mm3": [100.0, 200.0]}
+    fine = {"P_cavity_MPa": [0.4, 0.8], "theta_deg": [11.0, 22.0], "dQ_mm3": [110.0, 220.0]}
     cases = as_study(space).cases()
     records = [{"numbers": n, "provenance": {"inputs": params, "mesh": {"mesher": "layered", "dofs": 1},
                                              "solver": {"wall_time_s": 1.0}}}

@@ -63,3 +63,29 @@ def test_bad_file_is_one_line_exit_2(tmp_path, capsys, content):
         assert main(["inspect", str(path)]) == 2
         err = capsys.readouterr().err
         assert err.count("\n") == 1 and str(path.name) in err
+
+
+@pytest.mark.parametrize("n, view, turns", [
+    (4, None, [0.0, 180.0]), (4, "side", [0.0, 180.0]), (3, "side", [0.0]), (5, None, [0.0]),
+    (3, "iso", [0.0, 120.0, 240.0]), (4, "top", [0.0, 90.0, 180.0, 270.0]), (1, "side", [0.0])])
+def test_the_side_view_draws_only_the_fingers_in_the_bending_plane(n, view, turns):
+    """Seen along the bending plane's normal, a finger turned out of that plane lies across the
+    object: the side view draws the modelled finger and the one opposite it (n even) only."""
+    from softhand.studies.io.render_style import finger_turns
+
+    assert finger_turns(n, view) == pytest.approx(turns)
+
+
+@pytest.mark.parametrize("key, shown", [("P_cavity_MPa", "P_cavity = 1.014 MPa"),
+                                        ("p_reservoir_MPa", "p_reservoir = 0.05127 MPa"),
+                                        ("pressure_MPa", "P = 0.8 MPa")])
+def test_a_pictures_title_names_its_pressure(key, shown):
+    """A finger's or grasp's scene carries its cavity pressure, the sheet's its own: the title
+    says which (a file written before the names, ``pressure_MPa``, is shown as P)."""
+    import pyvista as pv
+
+    from softhand.studies.io.render_style import title_of
+
+    block = pv.PolyData(np.zeros((1, 3)))
+    block.field_data[key] = [{"P_cavity_MPa": 1.014, "p_reservoir_MPa": 0.05127, "pressure_MPa": 0.8}[key]]
+    assert shown in title_of("grasp.pvd", [block], 0, 1)

@@ -16,6 +16,8 @@ from softhand.reduced.vocabulary import paper
 from softhand.reduced.vocabulary.design import HandDesign
 from softhand.reduced.vocabulary.versions import package_version
 
+from conftest import CI_FINGER
+
 ROOT = Path(__file__).resolve().parents[2]
 SOURCES = [p for layer in ("fem", "reduced", "meshes", "studies") for p in (ROOT / layer).rglob("*.py")]
 
@@ -64,13 +66,13 @@ def test_the_whole_hand_is_both_fems_against_eq27(bent):
     for r, row in zip(result.rows, h["rows"]):
         assert row["theta_deg"] == r["theta_deg"]
         assert math.isclose(row["V_mm3"], d.V0 - d.n * r["dQ_mm3"])
-        assert math.isclose(row["P_hand_fem_MPa"], r["P_MPa"] - row["p_reservoir_fem_MPa"])
+        assert math.isclose(row["P_pump_fem_MPa"], r["P_cavity_MPa"] - row["p_reservoir_fem_MPa"])
     # the straight finger: the pump pulls by the sheet's pressure at V0. The sheet FEM run
     # here against the FEM-calibrated reduced reservoir (a shipped table, interpolated):
     assert result.rows[0]["dQ_mm3"] == 0.0
     calibrated = float(reservoir.pressure(d.V0, d.replace(reservoir_model="fem")))
     assert math.isclose(h["offset_fem_MPa"], calibrated, rel_tol=2e-3)
-    assert math.isclose(-h["rows"][0]["P_hand_fem_MPa"], calibrated, rel_tol=2e-3)
+    assert math.isclose(-h["rows"][0]["P_pump_fem_MPa"], calibrated, rel_tol=2e-3)
 
 
 def test_the_result_writes_what_it_computed(bent):
@@ -97,9 +99,9 @@ def test_the_whole_hand_stops_where_the_reservoir_runs_dry():
 
     d = HandDesign()
     dry = d.V0 / d.n * 1.01
-    rows = [{"P_MPa": 0.2, "theta_deg": 8.0, "dQ_mm3": 500.0}, {"P_MPa": 0.9, "theta_deg": 90.0, "dQ_mm3": dry}]
+    rows = [{"P_cavity_MPa": 0.2, "theta_deg": 8.0, "dQ_mm3": 500.0}, {"P_cavity_MPa": 0.9, "theta_deg": 90.0, "dQ_mm3": dry}]
     with pytest.warns(UserWarning, match=r"take more oil than V0 = 17800 mm\^3 from 90 deg on"):
         h = whole_hand(rows, d)
-    assert math.isnan(h.rows[1]["P_hand_fem_MPa"]) and math.isnan(h.rows[1]["P_hand_eq27_MPa"])
+    assert math.isnan(h.rows[1]["P_pump_fem_MPa"]) and math.isnan(h.rows[1]["P_pump_eq27_MPa"])
     alone = whole_hand(rows[:1], d)
     assert h.rows[0] == alone.rows[0] and h.max_abs_difference_MPa() == alone.max_abs_difference_MPa()

@@ -28,7 +28,7 @@ def test_tiny_run_writes_a_report_with_every_section(tmp_path):
 
     # the headline number is the one in the section's own data, computed in this run
     rows = list(csv.DictReader(open(out / "fig7_reduced" / "fig7_reduced.csv")))
-    offset = [float(r["P_no_reservoir_MPa"]) - float(r["P_MPa"]) for r in rows]
+    offset = [float(r["P_cavity_MPa"]) - float(r["P_pump_MPa"]) for r in rows]
     summary = {r["name"]: r["value"] for r in csv.DictReader(open(out / "summary.csv"))}
     assert np.isclose(float(summary["offset_max_MPa"]), max(offset), rtol=1e-12)  # CSV rounding
 

@@ -61,7 +61,7 @@ def test_dask_local_cluster_gives_the_same_results_as_the_process_pool(tmp_path)
     assert a == b  # bit-identical: the same function on the same inputs
     # and the curve is the curve: without reservoir P(0) = 0 (eq. (28)), P rises with theta
     rows = sorted((c.point["mu_sf_MPa"], c.point["theta_deg"], a[c.key]) for c in plan(study))
-    assert all(r[2]["P_no_reservoir_MPa"] == 0.0 for r in rows if r[1] == 0.0)
+    assert all(r[2]["P_cavity_MPa"] == 0.0 for r in rows if r[1] == 0.0)
 
 
 def _default_sigint():

@@ -54,7 +54,7 @@ def test_control_result_is_what_the_verb_prints_and_writes(tmp_path):
     a = result.rows[0]
     sim = result.flex.angle
     window = (sim.t >= 1.0 - 1e-9) & (sim.t < 2.0 - 1e-9)
-    assert a["state"] == "a_no_push" and a["P_MPa"] == pytest.approx(sim.P[window].mean(), rel=1e-3)
+    assert a["state"] == "a_no_push" and a["P_pump_MPa"] == pytest.approx(sim.P[window].mean(), rel=1e-3)
 
 
 def test_control_kind_keeps_the_studys_numbers(tmp_path):
@@ -97,7 +97,7 @@ def _linear_w(D: float) -> list[float]:
 def fake_grasp_fem(tmp_path, monkeypatch):
     import softhand.studies.weights as sw
 
-    def compute(case, out=None):
+    def compute(case, out=None, progress=None):
         if out is not None:
             Path(out).mkdir(parents=True, exist_ok=True)
             (Path(out) / "grasp.pvd").write_text("<VTKFile/>")
@@ -155,7 +155,7 @@ def _fig8_result():
     for P, theta_deg, F_fem in ((0.6, 35.0, 20.0), (0.6, 45.0, 15.0), (0.9, 40.0, 30.0), (0.9, 50.0, 25.0)):
         w = [0.05, 0.15, 0.2, 0.3, 0.3]
         F_red = reduced_F_v(P, math.radians(theta_deg), case.mass_kg, w, case.design)
-        rows.append({"P_MPa": P, "theta_deg": theta_deg, "w": w, "F_v_fem_N": F_fem, "F_v_reduced_N": F_red,
+        rows.append({"P_cavity_MPa": P, "theta_deg": theta_deg, "w": w, "F_v_fem_N": F_fem, "F_v_reduced_N": F_red,
                      "F_v_reduced_paper_w_N": paper_w_F_v(P, math.radians(theta_deg), case)})
     return Fig8Result(case, rows)
 
@@ -177,7 +177,7 @@ def test_fig8_lines_pass_through_the_rows_reduced_values():
     is the rows' F_v_reduced (linear interpolation on the 50-point line: ~1e-3 relative)."""
     result = _fig8_result()
     for P, theta, F_kgf in result.model_lines():
-        for r in (r for r in result.rows if r["P_MPa"] == P):
+        for r in (r for r in result.rows if r["P_cavity_MPa"] == P):
             assert np.interp(r["theta_deg"], theta, F_kgf) == pytest.approx(r["F_v_reduced_N"] / grasp.KGF, rel=2e-3)
 
 

@@ -1,6 +1,6 @@
 """``softhand bend``: free bending of the finger FEM under pressure, against eqs. (28) and (2).
 
-Per pressure: P_MPa, theta_deg, hinge_deg, dQ_mm3, radial_stretch_max,
+Per cavity pressure: P_cavity_MPa, theta_deg, hinge_deg, dQ_mm3, radial_stretch_max,
 max_principal_stretch, theta_reduced_deg (eq. (28) at the same P), dQ_reduced_mm3 (eq. (2)
 at the FEM's theta), max_von_mises_MPa, newton_iterations. Then, unless ``--peak-mpa 0``,
 the path goes on to 2.0 MPa and the peak stretch and stress there are reported.
@@ -20,7 +20,7 @@ HELP = "finger FEM: free bending under pressure vs the reduced model (eqs. 28, 2
 
 def configure(parser) -> None:
     parser.add_argument("--pressure-mpa", metavar="RANGE", default="0:0.8:0.1",
-                        help="pressures [MPa]: start:stop:step (stop included) or a,b,c "
+                        help="cavity pressures [MPa] (one finger, no reservoir): start:stop:step (stop included) or a,b,c "
                              "(default 0:0.8:0.1)")
     parser.add_argument("--mesher", choices=("layered", "gmsh"), default=None,
                         help="layered: structured mesh, thin layers at the cavity (default); "
@@ -45,7 +45,7 @@ def configure(parser) -> None:
                         help="width of each ring for --tie ring [mm]; overrides the design's "
                              "tie_width_mm (default 10)")
     parser.add_argument("--peak-mpa", type=float, default=None,
-                        help=f"go on to this pressure and report peak stretch and stress "
+                        help=f"go on to this cavity pressure [MPa] and report peak stretch and stress "
                              f"(default {PEAK_MPA:g} when above the last pressure; 0: skip)")
     parser.add_argument("--hand", action="store_true",
                         help="also the whole hand: P = p_finger - p_reservoir(V0 - n dQ) with the "
@@ -195,9 +195,9 @@ def run(args) -> int:
         if result.peak:
             p = result.peak
             if p["failure"]:
-                print(f"# Newton gave up on the way to {p['target_MPa']} MPa ({p['failure']}); "
+                print(f"# Newton gave up on the way to {p['target_P_cavity_MPa']} MPa ({p['failure']}); "
                       f"last converged state:")
-            print(f"# at {p['P_MPa']:.2f} MPa: theta {p['theta_deg']:.1f} deg, max principal "
+            print(f"# at {p['P_cavity_MPa']:.2f} MPa: theta {p['theta_deg']:.1f} deg, max principal "
                   f"stretch {p['max_principal_stretch']:.3f}, max von Mises "
                   f"{p['max_von_mises_MPa']:.2f} MPa, hoop stretch {p['radial_stretch_max']:.4f}")
         print(f"# files in {out}")
@@ -224,8 +224,8 @@ def _failed(exc, converged, study, write_vtk, out: Path) -> int:
         write_vtk(model, last_y, reached)
         rows.append(row(state, study.design))
     message = str(exc).split(";")[0]
-    last = rows[-1]["P_MPa"] if rows else 0.0
+    last = rows[-1]["P_cavity_MPa"] if rows else 0.0
     return save_last_converged(
-        out, "bend", "finger FEM", message, f"P = {last:.4g} MPa",
-        {"last_converged_MPa": last, "rows": rows, "design": study.design.to_dict()},
+        out, "bend", "finger FEM", message, f"P_cavity = {last:.4g} MPa",
+        {"last_converged_P_cavity_MPa": last, "rows": rows, "design": study.design.to_dict()},
         write_files=(lambda: write_csv(out / "table.csv", rows)) if rows else None, files="finger.pvd")

@@ -182,8 +182,8 @@ def _print_text(report: dict) -> None:
     print_table(rows)
     if report["table2"]:
         print("\nTable II: F_v estimated as the paper does, eqs. (25), (29) from the mean P and theta")
-        print_table([{"state": r["state"], "P_MPa": r["P_MPa"], "theta_deg": r["theta_deg"],
+        paper = ("paper_P_pump_MPa", "paper_theta_deg", "paper_F_v_kgf")  # the paper's hand only
+        print_table([{"state": r["state"], "P_pump_MPa": r["P_pump_MPa"], "theta_deg": r["theta_deg"],
                       "F_v_kgf": r["F_v_estimated_kgf"], "F_v_actual_N": r["F_v_actual_mean_N"],
-                      "paper_P_MPa": r["paper_P_MPa"], "paper_theta_deg": r["paper_theta_deg"],
-                      "paper_F_v_kgf": r["paper_F_v_kgf"]} for r in report["table2"]])
+                      **{k: r[k] for k in paper if k in r}} for r in report["table2"]])
     sys.stdout.flush()

@@ -21,8 +21,8 @@ HELP = "calibrate design parameters (V0, mu, ...) to measured bend angles or gra
 
 def configure(parser) -> None:
     parser.add_argument("--data", required=True, metavar="FILE.csv",
-                        help="measurements: columns P_MPa,theta_deg[,finger] (free bending) or "
-                             "P_MPa,theta_deg,mass_kg,F_v_N[,diameter_mm] (grasp); '#' comments")
+                        help="measurements: columns P_pump_MPa,theta_deg[,finger] (free bending) or "
+                             "P_pump_MPa,theta_deg,mass_kg,F_v_N[,diameter_mm] (grasp); '#' comments")
     parser.add_argument("--params", required=True, metavar="KEYS",
                         help="design keys to fit, comma-separated, e.g. V0_mm3,mu_sf_MPa")
     parser.add_argument("--model", default="reduced", help="model to fit (default: reduced)")

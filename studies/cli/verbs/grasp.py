@@ -69,32 +69,39 @@ def _scalar(text: str, field: str) -> float:
     return float(values[0])
 
 
-def _fem_weights(diameter: float, mass: float, design) -> tuple[np.ndarray, str]:
-    """w from the grasp FEM (studies.weights, cached) at its default pressure and mesh."""
-    from softhand.studies.weights import WeightsCase, weights
+def _fem_weights(diameter: float, mass: float, design) -> tuple[np.ndarray, str, list[str]]:
+    """w from the grasp FEM (studies.weights, cached) at its default pressure and mesh, where it
+    came from, and the caveat on eq. (25) with it where the FEM's own F_v says it is off."""
+    from softhand.studies.weights import WeightsCase, reduced_note, weights
 
     if not diameter > 0:
         raise InputError("diameter_mm", diameter, "must be a positive number")
     case = WeightsCase(design=design, diameter_mm=diameter, mass_kg=mass)
     result = weights(case)
-    return np.array(result["w"]), (f"FEM: D = {diameter:g} mm, m = {mass:g} kg, P = "
+    note = reduced_note(result.get("F_v_reduced_N"), result["F_v_fem_N"], result["contact_force_N"], design) \
+        if "F_v_fem_N" in result else None
+    caveat = [f"at the grasp FEM's own state (P_cavity {result['P_cavity_MPa']:g} MPa, theta "
+              f"{result['theta_deg']:.4g} deg) {note}; --model fem puts the force where the finger "
+              "touches"] if note else []
+    return np.array(result["w"]), (f"FEM: D = {diameter:g} mm, m = {mass:g} kg, P_cavity = "
                                    f"{case.pressure_mpa:g} + {case.dP_mpa:g} MPa, mesh "
-                                   f"{case.mesh_size_mm:g} mm{' (cached)' if result['cached'] else ''}")
+                                   f"{case.mesh_size_mm:g} mm{' (cached)' if result['cached'] else ''}"), caveat
 
 
 def _weights(args, design, mass: float) -> tuple[np.ndarray, str, list[str]]:
     """The w asked for (checked, maybe normalised), where it came from, the warnings about it."""
+    caveat = []
     if args.weights is not None and args.weights.strip() in PAPER_NAMES:
         D = PAPER_NAMES[args.weights.strip()]
         w, source = grasp.weights_for_diameter(D, design), f"paper, {D:g} mm (section III-C)"
     elif args.weights is not None:
         w, source = parse_values(args.weights, "--weights", forms=_WEIGHT_FORMS), "given"
     else:
-        w, source = _fem_weights(_scalar(args.diameter_mm, "--diameter-mm"), mass, design)
+        w, source, caveat = _fem_weights(_scalar(args.diameter_mm, "--diameter-mm"), mass, design)
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", grasp.WeightSumWarning)
         w = grasp.check_weights(w, design, normalise=args.normalise)
-    return w, source, [str(warning.message) for warning in caught]
+    return w, source, [str(warning.message) for warning in caught] + caveat
 
 
 def _model(args) -> str:
@@ -114,7 +121,10 @@ def run(args) -> int:
     mass = _scalar(args.mass_kg, "--mass-kg")
     if _model(args) == "fem":
         diameter = _scalar(args.diameter_mm, "--diameter-mm")
-        result = state_fem(P, theta_deg, mass, diameter, design)
+        try:
+            result = state_fem(P, theta_deg, mass, diameter, design)
+        except InputError as exc:  # named as the option the user typed
+            raise (exc.renamed("--theta-deg") if exc.field == "theta_deg" else exc) from None
         _require_finite(result, args)
         return _print(args, result)
     if args.weights is not None and args.weights.strip() not in PAPER_NAMES:
@@ -139,7 +149,7 @@ def run(args) -> int:
 
 
 def _require_finite(result: dict, args) -> None:
-    require_finite(result, args, f"at P = {result['P_MPa']:g} MPa, theta = {result['theta_deg']:g} deg")
+    require_finite(result, args, f"at P_pump = {result['P_pump_MPa']:g} MPa, theta = {result['theta_deg']:g} deg")
 
 
 def _print(args, result: dict) -> int:

@@ -11,8 +11,11 @@ def configure(parser) -> None:
                         help="output folder (default: results/reproduce)")
     parser.add_argument("--quick", action="store_true",
                         help="CI-sized meshes and fewer points (one to two minutes on 2 cores)")
+    from softhand.studies.reproduce.core import sections
+
     parser.add_argument("--only", default=None, metavar="KEY,KEY",
-                        help="build only these sections (keys as in the report's folders)")
+                        help="build only these sections (the report's folders): "
+                             + ", ".join(s.key for s in sections()))
     parser.add_argument("--fresh", action="store_true",
                         help="recompute every section, even those a previous run finished")
     add_progress_option(parser)

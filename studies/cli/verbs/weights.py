@@ -113,7 +113,7 @@ def _failed(exc, out: Path) -> int:
 
     record = failed_record(exc.case, exc.states)
     return save_last_converged(
-        out, "weights", "grasp FEM", str(exc).split(";")[0], f"P = {record['last_converged_MPa']:.4g} MPa",
+        out, "weights", "grasp FEM", str(exc).split(";")[0], f"P_cavity = {record['last_converged_P_cavity_MPa']:.4g} MPa",
         record, write_files=lambda: write_vtk(out, exc.model, exc.states), files="grasp.pvd")
 
 
@@ -166,10 +166,15 @@ def _run(args) -> int:
 
 
 def _one(case, args) -> dict:
+    """One diameter's grasp FEM, with a bar of its two contact states (P, P + dP) on stderr."""
+    from tqdm import tqdm
+
     from softhand.studies.weights import run_case
 
-    with replaced_outputs(args.out, OUTPUT_PATTERNS):  # the series is written as the states converge
-        result = run_case(case, cache=not args.no_cache, out=args.out)
+    with replaced_outputs(args.out, OUTPUT_PATTERNS), \
+            tqdm(total=2, desc="grasp FEM", unit="state", file=sys.stderr, leave=False,
+                 disable=args.no_progress) as bar:  # the series is written as the states converge
+        result = run_case(case, cache=not args.no_cache, out=args.out, progress=lambda state: bar.update())
         if args.out:
             with kept_if_unwritable(Path(args.out) / "result.json", "weights"):
                 result.write(args.out)
@@ -181,6 +186,7 @@ OUTPUT_PATTERNS = ("result.json", "grasp.pvd", "grasp")
 
 
 def _print_one(result: dict) -> None:
+    note = result.pop("F_v_reduced_note", None)
     width = max(map(len, result))
     for key, value in result.items():
         if isinstance(value, list):
@@ -190,6 +196,8 @@ def _print_one(result: dict) -> None:
         else:
             text = str(value)
         print(f"{key:<{width}}  {text}")
+    if note:
+        print(f"# F_v_reduced_N: {note}")
 
 
 def _sweep(args, case, diameters) -> int:
@@ -225,7 +233,7 @@ def _fig8(args, case, pressures) -> int:
     if args.json:
         print_json(summary)
     else:
-        print_table(result.rows, ["depth_mm", "P_MPa", "theta_deg", "F_v_fem_N", "F_v_reduced_N",
+        print_table(result.rows, ["depth_mm", "P_cavity_MPa", "theta_deg", "F_v_fem_N", "F_v_reduced_N",
                            "F_v_error_kgf", "w"], digits=3)
         for prefix, what in (("", "the FEM's w"), ("paper_w_", "the paper's w, normalised")):
             if summary[f"{prefix}rms_error_kgf"] is not None:
