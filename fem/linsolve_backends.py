@@ -86,6 +86,11 @@ class LinearSolver:
         """Order of the matrix of the current factor (None: nothing factorised yet)."""
         return None if self._K is None else self._K.shape[0]
 
+    def forget(self) -> None:
+        """Drop the current factor (the analysis is kept): a caller that knows it belongs to a
+        state of no further use (a failed solve's last iterate) keeps it from being applied."""
+        self._K = None
+
     def factorize(self, K: sp.spmatrix) -> None:
         """Factorise K (square sparse) for :meth:`apply`; the analysis is reused for the same pattern."""
         t0 = time.perf_counter()

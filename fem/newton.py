@@ -309,6 +309,8 @@ def solve_path(fun_t, x0, options: PathOptions = PathOptions(), *, solver=None, 
             except NotConverged as err:
                 res.cutbacks += 1
                 dt, streak = 0.5 * dt, 0
+                if reuse and hasattr(solver, "forget"):  # the failed solve's last factor is of an
+                    solver.forget()  # iterate far off the path: the retry's predictor must not use it
                 if dt < options.min_dt:
                     failed = NotConverged(f"load step cut back below {options.min_dt} at t = {t:.4g}",
                                           err.history, err.x, (res.t[-1], res.x[-1]))

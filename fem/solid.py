@@ -52,6 +52,8 @@ from skfem import Basis, ElementTetP2
 from softhand.fem import kinematics as kin
 from softhand.fem import threads
 from softhand.fem.assembly import ElementScatter, Restriction
+from softhand.fem.lowrank import neo_hookean_terms, write_matrices
+from softhand.fem.materials import NeoHookeanIsochoric
 from softhand.fem.mixed import MixedNewton, PressureAnchor
 
 __all__ = ["FORMULATIONS", "Solid", "MixedNewton", "PressureAnchor", "element_matrices"]
@@ -198,12 +200,17 @@ class Solid:
         """(residual, CSR data array) for callers that add terms in the same pattern."""
         return self._assemble(u, tangent=True, anchor=anchor)
 
-    def residual_element_matrices(self, u: np.ndarray, anchor: "PressureAnchor | None" = None):
+    def residual_element_matrices(self, u: np.ndarray, anchor: "PressureAnchor | None" = None, extra=None):
         """(residual, element matrices in the block layout of :func:`element_matrices`, not yet
         scattered) for callers that add element terms of their own before the one scatter
         (:meth:`softhand.fem.assembly.ElementScatter.block_matrix_data`); the buffer is reused by the
-        next call."""
-        return self._assemble(u, tangent=True, anchor=anchor, scatter=False)
+        next call.
+
+        extra(c) -> (re, L, R, S): terms of another energy on the same elements (e.g. the
+        finger's windings), per chunk c of elements: element residuals re (ne, 3 nloc) and the
+        element matrices sum_k L[e, (n a), k] R[e, k, (b m)] + delta_ab S[e, n, m]
+        (:func:`softhand.fem.lowrank.write_matrices`), computed in the same pass and the same product."""
+        return self._assemble(u, tangent=True, anchor=anchor, scatter=False, extra=extra)
 
     def anchor(self, u: np.ndarray) -> "PressureAnchor | None":
         """The element pressures linearised at u (None for the displacement formulation)."""
@@ -219,14 +226,15 @@ class Solid:
             b.append(np.einsum("akeq,eqnk->ena", kin.cofactor(F), GW, optimize=True).reshape(len(W), -1))
         return PressureAnchor(u.copy(), np.concatenate(p0), np.concatenate(c0), np.concatenate(b))
 
-    def _assemble(self, u, tangent, anchor=None, scatter=True):
+    def _assemble(self, u, tangent, anchor=None, scatter=True, extra=None):
         """(R, CSR data of the tangent or None); scatter=False: (R, the element matrix buffer)."""
         R = np.zeros(self.ndofs)
         Ke = self._element_matrix_buffer() if tangent else None
 
         def kernels(c):  # in a thread: writes only its own chunk of Ke
             p_geo = None if anchor is None else anchor.pressure(u, c, self.scatter.vector_dofs(c))
-            return self._element_kernels(u, c, None if Ke is None else Ke[c], p_geo)
+            return self._element_kernels(u, c, None if Ke is None else Ke[c], p_geo,
+                                         None if extra is None else extra(c))
 
         self.scatter.add_chunk_vectors(R, threads.map_chunks(kernels, self._chunks))
         if not tangent or not scatter:
@@ -240,9 +248,59 @@ class Solid:
             self._ke = np.empty((nel, nloc, 3, 3, nloc))
         return self._ke
 
-    def _element_kernels(self, u, c, Ke=None, p_geo=None):
+    def _element_kernels(self, u, c, Ke=None, p_geo=None, extra=None):
         """Element residuals (ne, 3nloc) of chunk c; with Ke (its slice of the element matrix
-        buffer), the element matrices are written into it."""
+        buffer), the element matrices are written into it; extra: (re, L, R, S) of another
+        energy's terms on these elements (:meth:`residual_element_matrices`), added.
+
+        The Neo-Hookean isochoric law takes the low-rank kernel of :mod:`softhand.fem.lowrank` (no
+        fourth-order tangent per point); any other law the general :func:`element_matrices`."""
+        if Ke is not None and type(self._dev) is NeoHookeanIsochoric:
+            return self._neo_hookean_kernels(u, c, Ke, p_geo, extra)
+        re = self._general_kernels(u, c, Ke, p_geo)
+        if extra is not None:
+            re = re + extra[0]
+            if Ke is not None:
+                write_matrices(Ke, extra[1], extra[2], extra[3], add=True)
+        return re
+
+    def _stress_and_volume(self, F, c):
+        """(P of the formulation, cof F, Ve, Jbar, p_e) of chunk c; the last four None
+        without a volumetric part."""
+        P = self._dev.take(c).stress(F)
+        if self._vol is None:
+            return P, None, None, None, None
+        W = self.W[c]
+        cof = kin.cofactor(F)
+        Ve = W.sum(axis=1)
+        Jbar = (W * kin.det(F)).sum(axis=1) / Ve
+        p = self._vol.dU(Jbar)
+        return P + p[:, None] * cof, cof, Ve, Jbar, p
+
+    def _neo_hookean_kernels(self, u, c, Ke, p_geo, extra):
+        """Residuals and element matrices of chunk c by the low-rank kernel (:mod:`softhand.fem.lowrank`)."""
+        F = self.F(u, c)
+        G, W = self.G[c], self.W[c]
+        P, cof, Ve, Jbar, p = self._stress_and_volume(F, c)
+        GW = G * W[:, :, None, None]
+        re = np.einsum("akeq,eqnk->ena", P, GW, optimize=True).reshape(len(W), -1)
+        p_geo = p if p_geo is None else p_geo
+        L, R, S, X = neo_hookean_terms(F, G, W, self._dev.mu, p_geo)
+        Ls, Rs = [L], [R]
+        if self._vol is not None:  # + U''/V_e b_e b_e^T, b[e, (n a)]
+            b = np.einsum("akeq,eqnk->ena", cof, GW, optimize=True)
+            Ls.append(b.reshape(len(W), -1, 1))
+            Rs.append(((self._vol.ddU(Jbar) / Ve)[:, None, None] * b.transpose(0, 2, 1)).reshape(len(W), 1, -1))
+        if extra is not None:
+            re = re + extra[0]
+            Ls.append(extra[1])
+            Rs.append(extra[2])
+            S = S + extra[3]
+        write_matrices(Ke, np.concatenate(Ls, axis=2), np.concatenate(Rs, axis=1), S, X)
+        return re
+
+    def _general_kernels(self, u, c, Ke=None, p_geo=None):
+        """Element residuals of chunk c and (with Ke) its element matrices, for any law."""
         F = self.F(u, c)
         dev = self._dev.take(c)
         G, W = self.G[c], self.W[c]

@@ -158,8 +158,8 @@ class FingerModel:
         [N mm] and their derivative (e.g. from :meth:`~softhand.fem.constraints.PlanarChain.point_load`).
         """
         u = self.constraint.expand(y)
-        R, Ke = self.solid.residual_element_matrices(u)
-        self.windings.add_residual_tangent(u, R, Ke)  # rubber + windings: one scatter
+        # rubber + windings: one kernel pass, one product, one scatter
+        R, Ke = self.solid.residual_element_matrices(u, extra=lambda c: self.windings.terms(u, c))
         R = R - P * self.cavity.gradient(u)
         data = self.solid.scatter.block_matrix_data(Ke)
         self.cavity.add_hessian_data(data, u, -P)

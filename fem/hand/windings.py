@@ -14,6 +14,7 @@ from skfem import Basis, ElementTetP2
 
 from softhand.fem import kinematics as kin
 from softhand.fem import threads
+from softhand.fem.lowrank import write_matrices
 from softhand.fem.materials import Fibers
 
 
@@ -88,10 +89,10 @@ class Windings:
 
     With f = F a0 = a0 + sum_n u_n g_n (g_n = grad N_n . a0) and c1 = k (G''/lam^2 -
     G'/lam^3), c2 = k G'/lam: r_na = sum_q w k G'/lam f_a g_n and
-    K_(na)(mb) = sum_q w (c1 f_a g_n f_b g_m + c2 delta_ab g_n g_m): two batched products,
-    far cheaper than the general anisotropic tangent of :mod:`softhand.fem.solid`, written in the
-    block layout K[e, n, a, b, m] of :func:`softhand.fem.solid.element_matrices` and added to the
-    rubber's element matrices, so the two are scattered together, once
+    K_(na)(mb) = sum_q w (c1 f_a g_n f_b g_m + c2 delta_ab g_n g_m): a rank-one term per point
+    and a delta term, far cheaper than the general anisotropic tangent of :mod:`softhand.fem.solid`;
+    :meth:`terms` hands them to the rubber's low-rank kernel (:mod:`softhand.fem.lowrank`), which adds
+    them in its own batched product, so the two are computed and scattered together, once
     (:meth:`softhand.fem.assembly.ElementScatter.block_matrix_data`).
     """
 
@@ -102,6 +103,7 @@ class Windings:
         grads = np.stack([basis.basis[i][0].grad for i in range(basis.Nbfun)])  # (nloc, 3, nel, nq)
         self.g = np.einsum("nkeq,keq->eqn", grads, a0)                      # (nel, nq, nloc)
         self.W = np.asarray(basis.dx)                                       # (nel, nq)
+        self._a0q = np.ascontiguousarray(a0.transpose(1, 2, 0))             # (nel, nq, 3)
         self.scatter = scatter
         nel = self.W.shape[0]
         self.chunks = [slice(i, min(i + chunk, nel)) for i in range(0, nel, chunk)]
@@ -117,37 +119,46 @@ class Windings:
         lam = self.stretch(u)[1]
         return float(np.sum(self.W * self.law.k * self.law._g(lam - 1.0)[0]))
 
-    def _chunk(self, u, c):
-        """(f (3, ne, nq), lam, G', G'', v (ne, nq, (n a)) = f_a g_n) of chunk c."""
-        f, lam = self.stretch(u, c)
+    def _points(self, u, c):
+        """(f = F a0 (ne, nq, 3), c1, c2 (ne, nq), the weighted coefficients of the class docstring)
+        of chunk c."""
+        g, W, k = self.g[c], self.W[c], self.law.k
+        ne, nq, nloc = g.shape
+        f = self._a0q[c] + np.matmul(g, u[self.scatter.vector_dofs(c)].reshape(ne, nloc, 3))
+        lam = np.sqrt(np.einsum("eqa,eqa->eq", f, f))
         _, G1, G2 = self.law._g(lam - 1.0)
-        v = np.einsum("aeq,eqn->eqna", f, self.g[c]).reshape(*lam.shape, -1)
-        return f, lam, G1, G2, v
+        return f, W * k * (G2 / lam ** 2 - G1 / lam ** 3), W * k * G1 / lam
 
     def add_residual(self, u: np.ndarray, R: np.ndarray) -> None:
-        """R += the windings' internal force."""
+        """R += the windings' internal force, r_(n a) = sum_q c2 f_a g_n."""
         def forces(c):
-            _, lam, G1, _, v = self._chunk(u, c)
-            return np.einsum("eq,eqi->ei", self.W[c] * self.law.k * G1 / lam, v)
+            f, _, c2 = self._points(u, c)
+            return np.matmul(self.g[c].transpose(0, 2, 1), c2[:, :, None] * f).reshape(len(f), -1)
 
         self.scatter.add_chunk_vectors(R, threads.map_chunks(forces, self.chunks))
 
     def add_residual_tangent(self, u: np.ndarray, R: np.ndarray, Ke_all: np.ndarray) -> None:
         """R += the windings' internal force; Ke_all (element matrices of the whole mesh in the
-        block layout of :func:`softhand.fem.solid.element_matrices`, e.g. the rubber's) += their tangent."""
-        k = self.law.k
-        nloc = self.g.shape[2]
-
+        block layout of :func:`softhand.fem.solid.element_matrices`) += their tangent. (The finger passes
+        :meth:`terms` to the rubber's kernel instead, which adds them in its own product.)"""
         def kernels(c):  # in a thread: adds only to its own chunk of Ke_all
-            f, lam, G1, G2, v = self._chunk(u, c)
-            g, W = self.g[c], self.W[c]
-            c1, c2 = W * k * (G2 / lam ** 2 - G1 / lam ** 3), W * k * G1 / lam
-            vt = np.einsum("aeq,eqn->eqan", f, g).reshape(*W.shape, -1)     # (ne, nq, (b m))
-            Ke = np.matmul(v.transpose(0, 2, 1) * c1[:, None, :], vt).reshape(len(W), nloc, 3, 3, nloc)
-            S = np.matmul(g.transpose(0, 2, 1) * c2[:, None, :], g)         # (ne, nloc, nloc)
-            for a in range(3):  # + delta_ab S_nm
-                Ke[:, :, a, a, :] += S
-            Ke_all[c] += Ke
-            return np.einsum("eq,eqi->ei", c2, v)
+            re, L, Rw, S = self.terms(u, c)
+            write_matrices(Ke_all[c], L, Rw, S, add=True)
+            return re
 
         self.scatter.add_chunk_vectors(R, threads.map_chunks(kernels, self.chunks))
+
+    def terms(self, u: np.ndarray, c: slice):
+        """The windings' (re, L, R, S) on the elements c, as :meth:`softhand.fem.solid.Solid.residual_element_matrices`
+        takes them (``extra=``): element forces re (ne, 3 nloc) and the tangent
+        sum_q c1 (f_a g_n)(f_b g_m) + delta_ab S_nm, S_nm = sum_q c2 g_n g_m (class docstring),
+        L = v (ne, (n a), q), R = c1 v (ne, q, (b m))."""
+        f, c1, c2 = self._points(u, c)
+        g = self.g[c]
+        ne, nq, nloc = g.shape
+        v = (g[:, :, :, None] * f[:, :, None, :]).reshape(ne, nq, -1)     # v[e, q, (n a)] = f_a g_n
+        re = np.matmul(g.transpose(0, 2, 1), c2[:, :, None] * f).reshape(ne, -1)
+        L = v.transpose(0, 2, 1)                                            # (ne, (n a), q)
+        R = ((c1[:, :, None] * f)[:, :, :, None] * g[:, :, None, :]).reshape(ne, nq, -1)  # (ne, q, (b m))
+        S = np.matmul(g.transpose(0, 2, 1) * c2[:, None, :], g)            # (ne, nloc, nloc)
+        return re, L, R, S

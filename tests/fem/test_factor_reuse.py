@@ -144,3 +144,20 @@ def test_the_mkl_runtime_found_without_a_search_is_the_one_pypardiso_finds(monke
     found = _wheel_mkl_rt()
     searched = pypardiso.PyPardisoSolver().libmkl._name
     assert found is None or os.path.samefile(found, searched)
+
+
+def test_a_failed_step_leaves_no_factor_for_the_retry():
+    """After a load step fails, the factor is of the failed solve's last iterate, off the path:
+    the retry's predictor factorises the tangent at the last converged state instead of
+    solving with it (a compliant finger's retry had predicted a 17 rad hinge turn from it)."""
+    fun_t, n = inflated_block()
+    solver, calls = make_solver(), []
+    for name in ("apply", "solve", "forget"):
+        method = getattr(solver, name)
+        setattr(solver, name, lambda *a, _m=method, _n=name, **k: calls.append(_n) or _m(*a, **k))
+    opts = PathOptions(steps=1, newton=NewtonOptions(rtol=1e-10, refactor="adaptive", contraction=0.5, max_iter=8))
+    res = solve_path(fun_t, np.zeros(n), opts, solver=solver, residual_t=lambda x, t: fun_t(x, t)[0])
+    assert res.t[-1] == 1.0 and res.cutbacks >= 1
+    assert calls.count("forget") == res.cutbacks
+    after = [calls[i + 1] for i, c in enumerate(calls) if c == "forget"]
+    assert after == ["solve"] * res.cutbacks  # a fresh factorisation, not the stored factor

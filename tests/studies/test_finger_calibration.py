@@ -140,3 +140,39 @@ def test_latin_hypercube_designs_keep_the_design_rules(tmp_path):
                                                       {**box, "d_mm": (6.0, 6.5)}.items()))
     with pytest.raises(InputError, match=f"lhs = 20: too many: {MAX_DRAWS} Latin hypercubes"):
         load_space(space)
+
+
+def _table_rows(path):
+    """The numeric rows of a calibration table (its comment lines hold the command, which differs)."""
+    import csv
+
+    lines = [line for line in path.read_text().splitlines() if line and not line.startswith("#")]
+    return list(csv.DictReader(lines))
+
+
+@pytest.mark.slow
+def test_table_on_a_local_dask_cluster_is_the_process_pools(tmp_path):
+    """The table of a CI-sized space (two designs, CI mesh) from a Dask LocalCluster with two
+    workers (``--scheduler local``, what ``--scheduler tcp://...`` does on a remote cluster)
+    equals the one from the process pool: the same cases in other processes. Tolerance 1e-7
+    relative: the FEM's Newton tolerance (1e-9 on the residual) and PARDISO's threads (a worker's
+    share of the cores differs between the runs) move theta by ~1e-9 of itself."""
+    pytest.importorskip("dask.distributed")
+    tables = []
+    for name, how in (("pool", ["--workers", "1"]), ("dask", ["--workers", "2", "--scheduler", "local"])):
+        space = _space(tmp_path / f"{name}.toml", "ties", (6.0, 14.0))
+        table = tmp_path / f"{name}.csv"
+        assert main(["calibrate", "finger", "--space", str(space), "--out", str(table),
+                     "--results", str(tmp_path / name), "--no-progress", *how]) == 0
+        tables.append(_table_rows(table))
+    pool, dask = tables
+    assert len(pool) == len(dask) == 2 * 2  # two designs, two pressures each
+    for a, b in zip(pool, dask):
+        assert a.keys() == b.keys()
+        for key in a:
+            try:
+                x, y = float(a[key]), float(b[key])
+            except ValueError:
+                assert a[key] == b[key]
+                continue
+            assert y == pytest.approx(x, rel=1e-7, abs=1e-12), key
