@@ -460,14 +460,17 @@ def test_a_free_sheet_stays_a_thin_sheet_that_the_pump_pushes():
 
 def test_a_design_run_stopped_mid_proof_leaves_none_of_its_files(tmp_path, monkeypatch):
     """Ctrl-C during the FEM proof had left design.toml without result.json, next to an
-    earlier run's result.json that no longer matched it. The earlier record goes when a run
-    starts, the stopped run's files (design, VTK) when it stops; other files stay."""
+    earlier run's result.json that no longer matched it. The run writes into a staging folder:
+    stopped, the earlier run's record stays whole and none of the stopped run's files (design,
+    VTK) shows; other files stay."""
     from softhand.studies.cli import main as cli
     from softhand.studies.cli.verbs import design as design_verb
+    from softhand.studies.io.files import MANIFEST
 
     task, out = _write(tmp_path, CI_TASK_TOML), tmp_path / "out"
     out.mkdir()
     (out / "result.json").write_text('{"design_file": "design.toml"}\n')  # an earlier run's record
+    (out / MANIFEST).write_text('{"run": "earlier", "outputs": ["result.json"]}\n')
     (out / "notes.txt").write_text("mine\n")
 
     def stopped_proof(ev, task, args, out, say):
@@ -477,7 +480,8 @@ def test_a_design_run_stopped_mid_proof_leaves_none_of_its_files(tmp_path, monke
 
     monkeypatch.setattr(design_verb, "_prove", stopped_proof)
     assert cli.main(["design", "--task", str(task), "--out", str(out), "--seed", "3"]) == 130
-    assert sorted(p.name for p in out.iterdir()) == ["notes.txt"]
+    assert sorted(p.name for p in out.iterdir()) == [MANIFEST, "notes.txt", "result.json"]
+    assert (out / "result.json").read_text() == '{"design_file": "design.toml"}\n'
     fresh = tmp_path / "fresh" / "out"  # a folder the stopped run made goes too
     assert cli.main(["design", "--task", str(task), "--out", str(fresh), "--seed", "3"]) == 130
     assert not fresh.exists()

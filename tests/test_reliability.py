@@ -12,6 +12,7 @@ import pytest
 from softhand.studies.cli.main import main
 from softhand.studies.batch.runner import RESULT, plan, study_dir
 from softhand.studies.batch.studyfile import load_study
+from softhand.studies.io.files import MANIFEST
 from test_runner import _default_sigint, install_kind
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -238,10 +239,12 @@ def test_bend_failure_is_one_line_with_the_pressure_and_out_never_mixes_runs(tmp
 
     out = tmp_path / "bend"
     out.mkdir()
-    for name in ("result.json", "table.csv", "hand.csv", "finger.pvd", "finger_0007.vtu", "notes.txt"):
+    for name in ("result.json", "table.csv", "hand.csv", "finger.pvd", "notes.txt"):
         (out / name).write_text("an earlier run")
     (out / "finger").mkdir()
     (out / "finger" / "finger_0003.vtm").write_text("an earlier run")
+    earlier = ["result.json", "table.csv", "hand.csv", "finger.pvd", "finger"]  # not notes.txt: the user's
+    (out / MANIFEST).write_text(json.dumps({"run": "earlier", "outputs": earlier}))
 
     def failing(study, on_state=None, model=None):
         error = NotConverged("Newton did not converge above P = 0.03 MPa on the way to 0.1 MPa",
@@ -255,7 +258,7 @@ def test_bend_failure_is_one_line_with_the_pressure_and_out_never_mixes_runs(tmp
     assert len(err) == 1 and "P = 0.03 MPa" in err[0] and "Traceback" not in err[0]
     result = json.loads((out / "result.json").read_text())
     assert result["failed"] and "0.03 MPa" in result["error"] and result["rows"] == []
-    assert sorted(p.name for p in out.iterdir()) == ["notes.txt", "result.json"]  # the user's file stays
+    assert sorted(p.name for p in out.iterdir()) == [MANIFEST, "notes.txt", "result.json"]  # the user's file stays
 
 
 def test_an_output_that_fails_after_the_computation_loses_nothing(tmp_path, monkeypatch, capsys):
@@ -266,7 +269,7 @@ def test_an_output_that_fails_after_the_computation_loses_nothing(tmp_path, monk
         raise OSError(28, "No space left on device")
 
     monkeypatch.setattr(files, "write_atomic", full_disk)
-    assert main(["curve", "--theta-deg", "0:90:30", "--plot", str(tmp_path / "c.png"), "--json"]) == 0
+    assert main(["curve", "--theta-deg", "0:90:30", "--plot", str(tmp_path / "c.png"), "--json"]) == 3
     out, err = capsys.readouterr()
     assert len(json.loads(out)["rows"]) == 4
     assert "warning" in err and "No space left on device" in err and not (tmp_path / "c.png").exists()

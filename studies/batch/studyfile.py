@@ -61,6 +61,12 @@ _TOP_KEYS = ("kind", "name", "description", "design", "mesh_size_mm", "sweep", "
 _NAME_RE = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_.-]*$")
 
 
+def is_folder_name(name) -> bool:
+    """``name`` can name a results folder: letters, digits, '_', '-', '.', starting with a letter
+    or digit, at most 100 characters (never '.', '..' nor a path)."""
+    return isinstance(name, str) and bool(_NAME_RE.match(name)) and len(name) <= 100
+
+
 @dataclass(frozen=True)
 class Study:
     """A validated study: the product of its sweep axes over a base design."""
@@ -104,7 +110,7 @@ def study_from_dict(doc: dict, *, path: Path | None = None, max_cases: int = MAX
             raise InputError(f"{src}: {key}", doc[key], f"unknown key; allowed: {', '.join(_TOP_KEYS)}")
     kind = _kind(doc.get("kind"), src)
     name = doc.get("name", path.stem if path else None)
-    if not isinstance(name, str) or not _NAME_RE.match(name) or len(name) > 100:
+    if not is_folder_name(name):
         given = "" if "name" in doc else (" (the study's results folder is named after its file "
                                           "unless the file sets name = \"...\")")
         raise InputError(f"{src}: name", name, "must be a string of at most 100 letters, digits, '_', "

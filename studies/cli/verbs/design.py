@@ -22,7 +22,7 @@ from softhand.reduced.errors import InputError, MeshRejected, MeshTooLarge
 from softhand.studies.cli.args import add_json_option, add_progress_option, print_json, print_table
 
 HELP = "size finger and reservoir for an object (reduced model, optimiser) and prove it with the FEM"
-#: what a design run writes into --out (an earlier run's are removed before it writes)
+#: what a design run writes into --out (its manifest: an earlier run's are replaced whole)
 OUTPUT_FILES = ("result.json", "design.toml", "rejected_design.toml", "pareto.png", "grasp.pvd")
 OUTPUT_FOLDERS = ("knee", "grasp")
 
@@ -50,7 +50,8 @@ def run(args) -> int:
     from softhand.studies.design.task import load_task
     from softhand.studies.design.task import LOWER, UPPER
     from softhand.studies.cli.checks import check_writable
-    from softhand.studies.io.files import check_output_tree, replaced_outputs, write_atomic, write_json
+    from softhand.studies.io.files import check_output_tree, check_owned, kept_if_unwritable, replaced_outputs, \
+        write_atomic, write_json
 
     lo, hi = LOWER["mesh_size_mm"], UPPER["mesh_size_mm"]
     if args.mesh_size_mm is not None and not lo <= args.mesh_size_mm <= hi:
@@ -64,9 +65,10 @@ def run(args) -> int:
             if value is not None:
                 raise InputError(option, value, "sets the FEM proof, which --no-fem skips")
     task = load_task(args.task)
-    out = Path(args.out) if args.out else Path("results") / "design" / task.name
+    out = Path(args.out) if args.out else _default_out(task, args.task)
     check_writable(out, "dir", "--out")  # also the default folder, which argparse's checks do not see
-    check_output_tree(out, "--out", files=OUTPUT_FILES, folders=OUTPUT_FOLDERS)
+    check_output_tree(out, "--out")
+    check_owned(out, OUTPUT_FILES + OUTPUT_FOLDERS, "--out")
     if not args.no_fem:
         _check_proof_size(task, args)
     say = (lambda text: print(f"softhand design: {text}", file=sys.stderr)) if args.json else print
@@ -78,25 +80,29 @@ def run(args) -> int:
         result = {**_result(task, opt, base, None, args.seed), "report": design_opt.infeasible_report(task, opt)}
         print_json(result) if args.json else _print(result, task, opt)
         return 1
-    # an earlier run's outputs go first (the folder never mixes two runs), and a run stopped
-    # mid-proof leaves none of its own
-    with replaced_outputs(out, OUTPUT_FILES + OUTPUT_FOLDERS):
-        out.mkdir(parents=True, exist_ok=True)
-        design_file = write_atomic(out / "design.toml", ev.design.to_toml())
-        result = _result(task, opt, base, design_file, args.seed)
+    # written into a private staging folder, renamed into place when the run is complete: the
+    # earlier run's result stays whole until then, a run stopped mid-proof leaves nothing
+    with replaced_outputs(out, OUTPUT_FILES + OUTPUT_FOLDERS, verb="design") as stage:
+        dirs = (stage, out)
+        with kept_if_unwritable(out / "design.toml", "design"):
+            write_atomic(stage / "design.toml", ev.design.to_toml())
+        result = _result(task, opt, base, out / "design.toml", args.seed)
         if args.pareto:
             from softhand.studies.design import pareto as design_pareto
 
             rows = design_pareto.front(task, opt, options)
-            plot = design_pareto.plot(rows, args.plot or out / "pareto.png", task=task, base=base)
+            plot = Path(args.plot) if args.plot else out / "pareto.png"
+            with kept_if_unwritable(plot, "design"):
+                design_pareto.plot(rows, args.plot or stage / "pareto.png", task=task, base=base)
             result["pareto"] = {"rows": rows, "knee": design_pareto.knee(rows), "plot": str(plot)}
         if not args.no_fem:
-            result = _prove_and_correct(result, task, opt, base, args, out, say, options)
+            result = _prove_and_correct(result, task, opt, base, args, dirs, say, options)
             if args.pareto:
-                result["pareto"]["knee_proof"] = _prove_knee(result["pareto"], task, args, out, say)
+                result["pareto"]["knee_proof"] = _prove_knee(result["pareto"], task, args, dirs, say)
         ok = result["feasible"] and "fem_report" not in result and "report" not in result
         result["proven"] = None if args.no_fem else ok  # by the FEM; None: not asked (--no-fem)
-        write_json(out / "result.json", result)
+        with kept_if_unwritable(out / "result.json", "design"):
+            write_json(stage / "result.json", result)
     if args.json:
         print_json(result)
     else:
@@ -121,16 +127,18 @@ def _optimise(task, options, args):
                                    say=lambda text: bar.write(f"softhand design: {text}", file=sys.stderr))
 
 
-def _prove_and_correct(result, task, opt, base, args, out, say, options) -> dict:
+def _prove_and_correct(result, task, opt, base, args, dirs, say, options) -> dict:
     """The FEM proof of the optimum; if the FEM's peak stretch breaks the task's limit, one
     re-optimisation with eq. (8)'s strain scaled to the FEM's and the proof of that design
-    (the first optimum is kept under ``rejected``)."""
+    (the first optimum is kept under ``rejected``). ``dirs``: (staging folder written, output
+    folder named)."""
     from softhand.studies.design import optimise as design_opt
     from softhand.studies.design.proof import corrected_task, fem_report
-    from softhand.studies.io.files import write_atomic
+    from softhand.studies.io.files import kept_if_unwritable, write_atomic
 
     ev = opt.evaluation
-    result["fem"] = _prove(ev, task, args, out, say)
+    stage, out = dirs
+    result["fem"] = _prove(ev, task, args, stage, say)
     report = fem_report(result["fem"], ev)
     if not report:
         return result
@@ -140,37 +148,54 @@ def _prove_and_correct(result, task, opt, base, args, out, say, options) -> dict
         return result
     say(f"the FEM's peak stretch is {corrected.stretch_factor:.3g} x eq. (8)'s strain: optimising again with it")
     rejected = {k: result[k] for k in ("design", "predicted", "fem", "constraints", "fem_report")}
-    rejected["design_file"] = str(write_atomic(out / "rejected_design.toml", ev.design.to_toml()))
+    rejected["design_file"] = str(out / "rejected_design.toml")
+    with kept_if_unwritable(out / "rejected_design.toml", "design"):
+        write_atomic(stage / "rejected_design.toml", ev.design.to_toml())
     opt = _optimise(corrected, options, args)
-    design_file = write_atomic(out / "design.toml", opt.evaluation.design.to_toml())
-    new = {**_result(corrected, opt, base, design_file, args.seed), "stretch_factor": corrected.stretch_factor,
+    with kept_if_unwritable(out / "design.toml", "design"):
+        write_atomic(stage / "design.toml", opt.evaluation.design.to_toml())
+    new = {**_result(corrected, opt, base, out / "design.toml", args.seed), "stretch_factor": corrected.stretch_factor,
            "rejected": rejected, **{k: result[k] for k in ("pareto",) if k in result}}
     if not opt.evaluation.feasible:
         new["report"] = design_opt.infeasible_report(corrected, opt)
         return new
-    new["fem"] = _prove(opt.evaluation, corrected, args, out, say)
+    new["fem"] = _prove(opt.evaluation, corrected, args, stage, say)
     report = fem_report(new["fem"], opt.evaluation)
     if report:
         new["fem_report"] = report
     return new
 
 
-def _prove_knee(pareto: dict, task, args, out, say) -> dict | None:
+def _prove_knee(pareto: dict, task, args, dirs, say) -> dict | None:
     """The FEM proof of the Pareto front's knee (None if the knee is the optimum): its design
     (knee/design.toml), prediction and FEM, the VTK in knee/."""
     from softhand.studies.design import optimise as design_opt
-    from softhand.studies.io.files import write_atomic
+    from softhand.studies.io.files import kept_if_unwritable, write_atomic
 
     row = pareto["rows"][pareto["knee"]]
     if pareto["knee"] == 0:
         return None
     sub = replace(task, max_stretch=row["stretch_limit"])
     ev = design_opt.Problem(sub).evaluation(np.array([row["free"][k] for k, _, _ in task.free]))
-    (out / "knee").mkdir(exist_ok=True)
+    stage, out = dirs
     say(f"FEM proof of the Pareto knee (stretch {row['max_principal_stretch']:.4g})")
-    return {"design_file": str(write_atomic(out / "knee" / "design.toml", ev.design.to_toml())),
+    with kept_if_unwritable(out / "knee" / "design.toml", "design"):
+        write_atomic(stage / "knee" / "design.toml", ev.design.to_toml())
+    return {"design_file": str(out / "knee" / "design.toml"),
             "stretch_limit": row["stretch_limit"], "predicted": ev.predicted(),
-            "fem": _prove(ev, sub, args, out / "knee", say)}
+            "fem": _prove(ev, sub, args, stage / "knee", say)}
+
+
+def _default_out(task, path) -> Path:
+    """results/design/<task's name>, the name checked: one that is no plain folder name (a task
+    file named '...toml' gives '..') would write elsewhere, e.g. into results/ itself."""
+    from softhand.studies.batch.studyfile import is_folder_name
+
+    if not is_folder_name(task.name):
+        raise InputError("--task", str(path), f"its name {task.name!r} cannot name the output folder "
+                         "results/design/NAME (letters, digits, '_', '-', '.', starting with a letter "
+                         "or digit); rename the file or give --out DIR")
+    return Path("results") / "design" / task.name
 
 
 def _check_proof_size(task, args) -> None:
