@@ -192,7 +192,7 @@ def test_a_kernel_table_whose_features_do_not_tell_its_designs_apart_is_named(tm
 
 
 def test_a_design_file_names_its_own_table_relative_to_itself(tmp_path):
-    """write_design_with_table: FILE.toml next to FILE.csv, finger_model "fem", the table found
+    """write_design_with_table: FILE_fem.toml next to FILE.csv, finger_model "fem", the table found
     relative to the design file; the CLI's error for a design outside it is one line, exit 2."""
     from softhand.studies.cli.main import main
     from softhand.studies.calibration.finger_table import write_design_with_table

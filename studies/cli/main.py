@@ -135,18 +135,18 @@ def main(argv: list[str] | None = None) -> int:
     except InputError as exc:
         print(f"softhand {verb}: error: {exc}", file=sys.stderr)
         return 2
-    except OSError as exc:  # a write no verb expected to fail: one line, not a traceback
-        if exc.errno not in WRITE_ERRNOS:
-            raise
-        print(f"softhand {verb}: error: {exc.filename or 'an output'} could not be written "
-              f"({exc.strerror or exc}); finished results are kept", file=sys.stderr)
-        return EXIT_UNWRITTEN
     except KeyboardInterrupt:
         print(f"softhand {verb}: interrupted; finished results are kept", file=sys.stderr)
         return 130
     except BrokenPipeError:  # e.g. 'softhand study status FILE | head': the reader left
         _silence_stdout()
         return 141
+    except OSError as exc:  # a write no verb expected to fail: one line, not a traceback
+        if exc.errno not in WRITE_ERRNOS:
+            raise
+        print(f"softhand {verb}: error: {exc.filename or 'an output'} could not be written "
+              f"({exc.strerror or exc}); finished results are kept", file=sys.stderr)
+        return EXIT_UNWRITTEN
     finally:
         warnings.formatwarning = form
         _restore_float_warnings(float_errors)

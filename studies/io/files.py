@@ -114,7 +114,8 @@ def check_output_tree(folder: str | Path, field: str, *, files=(), folders=()) -
     """Before any work: the output ``folder`` and the named ``files`` and ``folders`` in it
     that a run writes are each of their kind or not there yet (a file where a folder goes
     fails its first write after the computation, a folder where a file goes its last); the
-    folder's ancestors are folders. InputError naming ``field`` and the path otherwise."""
+    folder's ancestors are folders; a named folder is no symbolic link (a run would write through
+    it out of ``folder``). InputError naming ``field`` and the path otherwise."""
     from softhand.reduced.errors import InputError
 
     folder = Path(folder)
@@ -130,6 +131,10 @@ def check_output_tree(folder: str | Path, field: str, *, files=(), folders=()) -
         if (path.exists() or path.is_symlink()) and not path.is_dir():
             raise InputError(field, str(path), "is not a folder, and the run writes a folder there; "
                                                "move it away or give another folder")
+        if path.is_symlink():
+            raise InputError(field, str(path), "is a symbolic link, and the run writes a folder there; "
+                                               "it does not follow it out of the folder: replace it by "
+                                               "a folder")
     for name in files:
         if (folder / name).is_dir():
             raise InputError(field, str(folder / name), "is a folder, and the run writes a file "

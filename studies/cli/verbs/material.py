@@ -56,12 +56,14 @@ def run(args) -> int:
         u = drucker["first_unstable"]
         notes.append(f"the fit is not Drucker-stable in {u['mode']} at stretch {u['stretch']:.4g} "
                      f"(checked {stretch_range[0]:.4g}..{stretch_range[1]:.4g}); do not use it there")
-    if args.out:
-        from softhand.studies.io.files import write_atomic
+    from softhand.studies.io.files import kept_if_unwritable, write_atomic
 
-        write_atomic(args.out, material_toml(result, args.data))
+    if args.out:
+        with kept_if_unwritable(args.out, "material fit"):
+            write_atomic(args.out, material_toml(result, args.data))
     if args.plot:
-        plot_material_fit(args.plot, result)
+        with kept_if_unwritable(args.plot, "material fit"):
+            plot_material_fit(args.plot, result)
     for note in notes:
         print(f"softhand material fit: warning: {note}", file=sys.stderr)
     if args.json:
