@@ -106,6 +106,19 @@ def valid_entry(path: Path) -> bool:
         return False
 
 
+def _named_checksum(path: Path) -> bool:
+    """Whether the checksum file of ``path`` is of this format (checksum and name), not the
+    earlier one (the checksum alone)."""
+    checksum = Path(f"{path}.sha256")
+    try:
+        if not checksum.is_file():  # none, a FIFO, a folder: the warning says the entry is not used
+            return True
+        with open(checksum, "rb") as f:
+            return len(f.read(1024).split()) == 2
+    except OSError:
+        return True
+
+
 def cached_msh(geometry: Geometry, params, *, size: float, order: int = 2, refine: int = 0,
                folder: str | Path | None = None) -> Path:
     """The ``.msh`` file of this geometry; generated with gmsh only if not cached (and valid)."""
@@ -113,7 +126,7 @@ def cached_msh(geometry: Geometry, params, *, size: float, order: int = 2, refin
     path = (Path(folder) if folder is not None else cache_dir()) / name
     if valid_entry(path):
         return path
-    if path.exists():
+    if path.exists() and _named_checksum(path):  # an entry of an earlier format: quietly replaced
         print(f"softhand: warning: cached mesh {name} does not match its checksum; "
               f"generating it again", file=sys.stderr)
     try:

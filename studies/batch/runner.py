@@ -80,6 +80,7 @@ def run_study(study: Study, *, results_root: str | Path = "results", workers: in
     if summary.corrupt:
         print(f"softhand study: {summary.corrupt} case files do not parse; recomputing them",
               file=sys.stderr)
+    check_meshes(study.kind, [(c.key, c.params, c.design) for c in todo], study.name)  # folded: one line now
     workers = max(1, workers or os.cpu_count() or 1)
     dask = None
     if scheduler and todo:
@@ -132,6 +133,36 @@ def _committed(sdir: Path, study: Study, case: Case, output: dict) -> bool:
     with kept_if_unwritable(sdir / case.key, "study"):
         commit_case(sdir, study, case, output)
     return len(UNWRITTEN) == before
+
+
+def _finger_options(kind: str, params: dict, design):
+    """The finger FEM's options of a case of ``kind``, or None if the kind builds no finger."""
+    if kind == "finger_bend":
+        from softhand.studies.calibration.finger import case_options
+
+        return case_options(params)
+    if kind == "weights":
+        from softhand.studies.weights import WeightsCase, finger_options
+
+        return finger_options(WeightsCase(design=design, **{k: float(v) for k, v in params.items()}).mesh_size_mm)
+    return None
+
+
+def check_meshes(kind: str, cases, src: str) -> None:
+    """Each case's finger mesh one the FEM takes (not folded), before any case runs: one line
+    naming the case, as ``bend`` and ``design`` refuse such a mesh up front, not a failed case
+    after the others ran. ``cases``: (key, params, design)."""
+    from softhand.fem.hand.finger import check_finger_mesh
+    from softhand.reduced.errors import InputError, MeshRejected
+
+    for key, params, design in cases:
+        options = _finger_options(kind, params, design)
+        if options is None:
+            return
+        try:
+            check_finger_mesh(design, options)
+        except MeshRejected as exc:
+            raise InputError(f"{src}: case {key}", exc.value, exc.allowed) from None
 
 
 def _claimed(sdir: Path, todo: list[Case], claims: Claims, fresh: bool, deferred: list,

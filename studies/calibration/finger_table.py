@@ -34,6 +34,11 @@ def space_ranges(box: dict) -> dict:
     return {g: (min(v[g] for v in values), max(v[g] for v in values)) for g in GROUPS}
 
 
+def designs_ranges(rows: list[dict]) -> dict:
+    """group -> (min, max) over the table rows' designs."""
+    return {g: (min(r[g] for r in rows), max(r[g] for r in rows)) for g in GROUPS}
+
+
 def table_rows(results: list[tuple[HandDesign, dict]]) -> list[dict]:
     """Nondimensional table rows from (design, numbers of its finger_bend case), P > 0 only."""
     rows = []
@@ -139,7 +144,9 @@ def write_table(path, space: DesignSpace, results: list[tuple[HandDesign, dict]]
                      f"equal bend): P x {math.exp(dy):.5f}, dQ x {rq:.5f}, applied to the {len(coarse)} "
                      f"designs on the longer slices; {n - len(coarse)} designs (untied gap shorter than "
                      f"{MIN_GAP_SLICES} slices) ran on the default mesh")
-    ranges = space_ranges(space.box)
+    # the range a table states is that of its own designs, never more of the box than they
+    # cover (a few designs of a wide box would otherwise answer far from any of them)
+    ranges = {g: (lo, hi) for g, (lo, hi) in designs_ranges(rows).items()}
     fit, fit_notes = choose_fit(rows, ranges, space.prior)
     text = table_csv(rows, ranges, notes + fit_notes, fit, prior=space.prior)
     return write_atomic(path, text)
