@@ -66,6 +66,10 @@ OUTPUT_NAMES = ("result.json", "rows.csv", "sheet.pvd", "sheet", "sheet_V*_rz.vt
 
 def run(args) -> int:
     study = _study(args)
+    if args.out:
+        from softhand.studies.io.files import check_owned
+
+        check_owned(args.out, OUTPUT_NAMES, "--out")  # a folder of the user's named sheet/: before the FEM
     if args.write_calibration:
         return _write_calibration(study, args.write_calibration)
     from tqdm import tqdm
