@@ -131,7 +131,7 @@ def main(argv: list[str] | None = None) -> int:
         _check(verb, args, parser)
         code = int(module.run(args) or 0)
         sys.stdout.flush()  # a closed pipe shows here, not in Python's exit
-        return EXIT_UNWRITTEN if code == 0 and UNWRITTEN else code  # computed, printed, not all written
+        return EXIT_UNWRITTEN if code in (0, 1) and UNWRITTEN else code  # computed, printed, not all written
     except InputError as exc:
         print(f"softhand {verb}: error: {exc}", file=sys.stderr)
         return 2

@@ -150,6 +150,8 @@ EXIT_UNWRITTEN = 3
 #: the outputs this process could not write since :func:`reset_unwritten` (the CLI's exit code)
 UNWRITTEN: list[str] = []
 _STAGE = ".softhand-stage-"
+#: the staging folders of the runs going on in this process (innermost last)
+_STAGED: list[Path] = []
 
 
 def reset_unwritten() -> None:
@@ -210,9 +212,11 @@ def replaced_outputs(folder: str | Path | None, names, *, verb: str = "softhand"
     stage = folder / f"{_STAGE}{os.getpid()}-{uuid.uuid4().hex[:8]}"
     stage.mkdir(parents=True)
     seen, unwritten = _manifest_run(folder), len(UNWRITTEN)
+    _STAGED.append(stage)  # the warnings of writes refused in it: one line when it ends
     try:
         yield stage
     except BaseException:
+        _STAGED.pop()
         shutil.rmtree(stage, ignore_errors=True)
         if made:
             _rmdir_quietly(folder)
@@ -220,6 +224,7 @@ def replaced_outputs(folder: str | Path | None, names, *, verb: str = "softhand"
     record = {"run": uuid.uuid4().hex, "verb": verb, "pid": os.getpid(),
               "finished_utc": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime()),
               "outputs": sorted(p.name for p in stage.iterdir() if any(fnmatch.fnmatchcase(p.name, n) for n in names))}
+    _STAGED.pop()
     with _folder_lock(folder):
         if len(UNWRITTEN) > unwritten:
             _keep_incomplete(folder, stage, record, UNWRITTEN[unwritten:], verb)
@@ -264,8 +269,9 @@ def _keep_incomplete(folder: Path, stage: Path, record: dict, missing, verb: str
             write_json(folder / MANIFEST, {**_manifest(folder), "outputs": sorted(owned)})
         except OSError:
             pass
-    print(f"softhand {verb}: warning: the outputs written are in {target if not stage.exists() else stage} "
-          f"(the earlier result in {folder} is kept); exit code {EXIT_UNWRITTEN}", file=sys.stderr)
+    print(f"softhand {verb}: warning: {'; '.join(missing)} not written; the results are printed on "
+          f"stdout, the outputs written are in {target if not stage.exists() else stage} (the earlier "
+          f"result in {folder} is kept); exit code {EXIT_UNWRITTEN}", file=sys.stderr)
 
 
 def _manifest(folder: Path) -> dict:
@@ -342,9 +348,10 @@ def kept_if_unwritable(what, verb: str):
     try:
         yield
     except OSError as exc:
-        UNWRITTEN.append(str(what))
-        print(f"softhand {verb}: warning: {what} not written ({exc.strerror or exc}); "
-              f"the results are printed on stdout", file=sys.stderr)
+        UNWRITTEN.append(f"{what} ({exc.strerror or exc})")
+        if not _STAGED:  # in a staged run, one line says it all when the run ends
+            print(f"softhand {verb}: warning: {UNWRITTEN[-1]} not written; the results are printed "
+                  f"on stdout", file=sys.stderr)
 
 
 def unwritable_tolerant(write, what, verb: str):
