@@ -160,6 +160,18 @@ def _scratch_folder() -> Path:
     return folder
 
 
+def discard(path: Path, folders=()) -> None:
+    """Remove the cache entry ``path`` (a mesh this process made and the FEM refuses) and the
+    ``folders`` it made for it, if empty (innermost first)."""
+    for name in (f"{path}.sha256", str(path)):
+        Path(name).unlink(missing_ok=True)
+    for folder in folders:
+        try:
+            Path(folder).rmdir()
+        except OSError:
+            break
+
+
 def load_mesh(geometry: Geometry, params, *, size: float, order: int = 2, refine: int = 0,
               folder: str | Path | None = None) -> skfem.Mesh:
     """A scikit-fem mesh (named boundaries/subdomains) of this geometry, through the cache."""

@@ -1,6 +1,7 @@
 """Concurrent runs of one study, corrupt case files and cache entries, signals, pipes."""
 import json
 import os
+import shutil
 import signal
 import subprocess
 import sys
@@ -345,3 +346,102 @@ def test_a_grasp_fem_that_stops_saves_the_states_it_reached(tmp_path, monkeypatc
     assert sum(first["contact_force_N"]) > 0 and first["theta_deg"] > 0
     datasets = re.findall(r"<DataSet[^>]*file=\"([^\"]+)\"", (out / "grasp.pvd").read_text())
     assert len(datasets) == 2 and all((out / f).is_file() for f in datasets)
+
+
+def test_damaged_case_state_is_recomputed_never_followed_nor_waited_on(quick_study, tmp_path, capsys):
+    """A finished case's folder replaced by a symbolic link (to a valid result elsewhere), its
+    result.json by a FIFO (status and run hung on it), by a 600 MB file (read whole) or by
+    JSON nested 200 000 deep: each case is 'corrupt' and recomputed; the link's target and
+    the other files are never touched."""
+    root = tmp_path / "res"
+    argv = ["study", "run", str(quick_study), "--workers", "1", "--results", str(root), "--no-progress"]
+    assert main(argv) == 0
+    study = load_study(quick_study)
+    sdir = study_dir(study, root)
+    link, fifo, huge, deep = plan(study)[:4]
+    elsewhere = tmp_path / "elsewhere"
+    shutil.move(sdir / link.key, elsewhere)
+    (sdir / link.key).symlink_to(elsewhere, target_is_directory=True)
+    kept = {p.name: p.read_bytes() for p in elsewhere.iterdir()}
+    (sdir / fifo.key / RESULT).unlink()
+    os.mkfifo(sdir / fifo.key / RESULT)
+    with open(sdir / huge.key / RESULT, "r+b") as f:
+        f.truncate(600 * 2**20)  # sparse: no 600 MB on the disk
+    (sdir / deep.key / RESULT).write_text("[" * 200_000 + "]" * 200_000)
+    capsys.readouterr()
+    start = time.monotonic()
+    assert main(["study", "status", str(quick_study), "--results", str(root)]) == 0
+    assert "4 corrupt" in capsys.readouterr().out and time.monotonic() - start < 30
+    (tmp_path / "log").unlink()
+    assert main(argv) == 0
+    assert len((tmp_path / "log").read_text().splitlines()) == 4
+    assert not (sdir / link.key).is_symlink() and {p.name: p.read_bytes() for p in elsewhere.iterdir()} == kept
+    _check_results(study, root)
+
+
+def test_damaged_claims_and_report_folders_are_one_line(quick_study, tmp_path, capsys):
+    """A folder where a case's claim lock goes, symbolic links for .claims/ or report/ (followed
+    out of --results before): one error line, exit 2, nothing written through the link."""
+    root = tmp_path / "res"
+    study = load_study(quick_study)
+    sdir = study_dir(study, root)
+    (sdir / ".claims" / f"{plan(study)[0].key}.lock").mkdir(parents=True)
+    argv = ["study", "run", str(quick_study), "--workers", "1", "--results", str(root), "--no-progress"]
+    assert main(argv) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "claim lock" in err[0]
+    shutil.rmtree(sdir / ".claims")
+    outside = tmp_path / "outside"
+    outside.mkdir()
+    for name, action in ((".claims", "run"), ("report", "report")):
+        (sdir / name).symlink_to(outside, target_is_directory=True)
+        assert main(["study", action, str(quick_study), "--results", str(root)]) == 2
+        err = capsys.readouterr().err.strip().splitlines()
+        assert len(err) == 1 and "symbolic link" in err[0]
+        (sdir / name).unlink()
+    assert list(outside.iterdir()) == []
+
+
+def test_a_read_only_finished_study_is_one_warning(quick_study, tmp_path, monkeypatch, capsys):
+    """run and report of a finished study whose folder refuses writes (tests run as root, for
+    whom chmod refuses nothing: the refusal is simulated): tracebacks before; now the summary,
+    one warning line, exit 3."""
+    from softhand.studies.batch import index, report
+
+    root = tmp_path / "res"
+    argv = ["study", "run", str(quick_study), "--workers", "1", "--results", str(root), "--no-progress"]
+    assert main(argv) == 0
+    capsys.readouterr()
+
+    def refused(path, *args, **kwargs):
+        raise PermissionError(13, "Permission denied", str(path))
+
+    monkeypatch.setattr(index, "write_csv", refused)
+    monkeypatch.setattr(report, "write_atomic", refused)
+    assert main(argv) == 3
+    out, err = capsys.readouterr()
+    assert "31 done" in out and len(err.strip().splitlines()) == 1 and "Permission denied" in err
+    assert main(["study", "report", str(quick_study), "--results", str(root)]) == 3
+    assert len(capsys.readouterr().err.strip().splitlines()) == 1
+
+
+def test_a_weights_cache_entry_that_is_a_fifo_or_nested_deep_is_recomputed(tmp_path, capsys):
+    from softhand.studies.weights import read_entry
+
+    fifo, deep = tmp_path / "fifo.json", tmp_path / "deep.json"
+    os.mkfifo(fifo)
+    deep.write_text("[" * 200_000 + "]" * 200_000)
+    assert read_entry(fifo, "k") is None and read_entry(deep, "k") is None
+    assert capsys.readouterr().err.count("invalid cache entry") == 2
+
+
+def test_a_folded_mesh_in_a_weights_study_is_refused_before_any_case(tmp_path, capsys):
+    """gmsh 10 mm graded at the ring edges folds (tests/test_meshes.py): the weights study's
+    cases failed one by one after the others ran; now one line when the run starts."""
+    study = tmp_path / "w.toml"
+    study.write_text('kind = "weights"\nmesh_size_mm = 10.0\n[sweep]\ndiameter_mm = [180.0, 200.0]\n')
+    assert main(["study", "run", str(study), "--workers", "1", "--results", str(tmp_path / "r"),
+                 "--no-progress"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "fold over themselves" in err[0]
+    assert not (tmp_path / "r" / "w").exists() or not any((tmp_path / "r" / "w").iterdir())

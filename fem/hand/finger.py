@@ -101,10 +101,25 @@ def refuse_folds(mesh, options: FingerOptions) -> None:
 
 def check_finger_mesh(design: HandDesign, options: FingerOptions) -> None:
     """The finger mesh of ``design`` is one the FEM takes (size, folds), without the FEM: a
-    study checks each case's mesh before any case runs (gmsh meshes go through the cache)."""
+    study checks each case's mesh before any case runs. A gmsh mesh goes through the cache,
+    which keeps it only if it is taken (a refused run leaves nothing behind)."""
     tube = finger_tube(design, options)
     check_size(tube, options)
-    refuse_folds(build_mesh(tube, options), options)
+    if options.mesher == "layered":
+        refuse_folds(build_mesh(tube, options), options)
+        return
+    from softhand.meshes.cache import cache_dir, discard, mesh_key, valid_entry
+    from softhand.meshes.finger import finger_geometry
+
+    key = mesh_key(finger_geometry, tube, size=options.mesh_size, order=2, refine=options.mesh_refine)
+    path = cache_dir() / f"{finger_geometry.__name__}-{key}.msh"
+    cached, made = valid_entry(path), [d for d in (path.parent, path.parent.parent) if not d.exists()]
+    try:
+        refuse_folds(build_mesh(tube, options), options)
+    except MeshRejected:
+        if not cached:
+            discard(path, made)
+        raise
 
 
 class FingerModel:
