@@ -304,3 +304,13 @@ def test_meshes_of_an_unwritable_cache_are_removed_at_exit(tmp_path):
     folder = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True,
                             env={**os.environ, "PYTHONPATH": str(ROOT)}).stdout.strip()
     assert folder and not Path(folder).exists()
+
+
+def test_an_edited_manifest_cannot_point_a_run_outside_its_folder(tmp_path):
+    out = tmp_path / "out"
+    out.mkdir()
+    (tmp_path / "precious.txt").write_text("outside the folder")
+    (out / MANIFEST).write_text(json.dumps({"run": "x", "outputs": ["../precious.txt", "/etc", ".", "a.txt"]}))
+    _run_into(out, ("a.txt",), lambda stage: (stage / "a.txt").write_text("new"))
+    assert (tmp_path / "precious.txt").read_text() == "outside the folder"
+    assert json.loads((out / MANIFEST).read_text())["outputs"] == ["a.txt"]

@@ -165,7 +165,9 @@ def owned_outputs(folder: str | Path) -> set[str]:
         names = record.get("outputs") if isinstance(record, dict) else None
     except (OSError, ValueError, RecursionError):
         return set()
-    return {n for n in names if isinstance(n, str)} if isinstance(names, list) else set()
+    # plain names only: a damaged or edited manifest cannot point a run outside the folder
+    return {n for n in names if isinstance(n, str) and n not in ("", ".", "..", MANIFEST) and "/" not in n
+            and "\0" not in n} if isinstance(names, list) else set()
 
 
 def check_owned(folder: str | Path, names, field: str) -> None:
