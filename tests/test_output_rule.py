@@ -314,3 +314,21 @@ def test_an_edited_manifest_cannot_point_a_run_outside_its_folder(tmp_path):
     _run_into(out, ("a.txt",), lambda stage: (stage / "a.txt").write_text("new"))
     assert (tmp_path / "precious.txt").read_text() == "outside the folder"
     assert json.loads((out / MANIFEST).read_text())["outputs"] == ["a.txt"]
+
+
+def test_a_manifest_that_is_no_plain_file_is_one_line(tmp_path):
+    out = tmp_path / "out"
+    (out / MANIFEST).mkdir(parents=True)
+    with pytest.raises(InputError, match="no plain file"):
+        _run_into(out, ("a.txt",), lambda stage: None)
+
+
+@pytest.mark.slow  # two Pareto fronts: minutes
+def test_design_pareto_plot_named_inside_its_folder_is_staged_with_it(tmp_path, capsys):
+    out = tmp_path / "d"
+    argv = ["design", "--task", str(TASK), "--no-fem", "--no-progress", "--json", "--pareto", "--out", str(out),
+            "--plot", str(out / "pareto.png")]
+    assert main(argv) == 0
+    assert main(argv) == 0  # the earlier run's plot is replaced by this run's, not removed after it
+    assert (out / "pareto.png").stat().st_size > 0
+    assert "pareto.png" in json.loads((out / MANIFEST).read_text())["outputs"]

@@ -179,6 +179,10 @@ def check_owned(folder: str | Path, names, field: str) -> None:
     folder = Path(folder)
     if not folder.is_dir():
         return
+    record = folder / MANIFEST
+    if record.is_symlink() or record.exists() and not record.is_file():
+        raise InputError(field, str(record), "is where a run records its outputs, and is no plain file; "
+                                             "remove it or give another folder")
     owned = owned_outputs(folder)
     for name in (*names, INCOMPLETE):
         for path in folder.glob(name) if glob.has_magic(name) else [folder / name]:

@@ -92,8 +92,9 @@ def run(args) -> int:
 
             rows = design_pareto.front(task, opt, options)
             plot = Path(args.plot) if args.plot else out / "pareto.png"
+            inside = plot.resolve() == (out / "pareto.png").resolve()  # the run's own: staged with it
             with kept_if_unwritable(plot, "design"):
-                design_pareto.plot(rows, args.plot or stage / "pareto.png", task=task, base=base)
+                design_pareto.plot(rows, stage / "pareto.png" if inside else plot, task=task, base=base)
             result["pareto"] = {"rows": rows, "knee": design_pareto.knee(rows), "plot": str(plot)}
         if not args.no_fem:
             result = _prove_and_correct(result, task, opt, base, args, dirs, say, options)
