@@ -458,7 +458,7 @@ def test_a_free_sheet_stays_a_thin_sheet_that_the_pump_pushes():
     assert 0.0 <= ev.P_contact <= ev.P_grasp <= task.max_pressure
 
 
-def test_a_design_run_stopped_mid_proof_leaves_none_of_its_files(tmp_path, monkeypatch):
+def test_a_design_run_stopped_mid_proof_leaves_none_of_its_files_and_the_earlier_whole(tmp_path, monkeypatch):
     """Ctrl-C during the FEM proof had left design.toml without result.json, next to an
     earlier run's result.json that no longer matched it. The run writes into a staging folder:
     stopped, the earlier run's record stays whole and none of the stopped run's files (design,

@@ -61,7 +61,7 @@ def test_csv_lists_become_semicolon_cells(tmp_path):
     assert path.read_text().splitlines() == ["P,w", "0.1,0.2;0.8"]
 
 
-def test_a_reservoir_run_replaces_the_last_runs_outputs_and_leaves_none_when_stopped(tmp_path, monkeypatch):
+def test_a_reservoir_run_replaces_the_last_runs_outputs_and_keeps_them_whole_when_stopped(tmp_path, monkeypatch):
     from softhand.studies.cli.main import main
     from softhand.studies.io import reservoir_files
 
@@ -109,7 +109,7 @@ def test_a_stopped_bend_leaves_no_half_written_series(tmp_path, monkeypatch):
     assert sorted(p.name for p in out.iterdir()) == ["notes.txt"]
 
 
-def test_a_design_run_replaces_the_last_runs_outputs_and_leaves_none_when_stopped(tmp_path, monkeypatch, capsys):
+def test_a_design_run_replaces_the_last_runs_outputs_and_keeps_them_whole_when_stopped(tmp_path, monkeypatch, capsys):
     from softhand.studies.cli.main import main
     from softhand.studies.io import files
 
