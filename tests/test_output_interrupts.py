@@ -16,6 +16,8 @@ import pytest
 from softhand.studies.io.files import EXIT_UNWRITTEN, INCOMPLETE, MANIFEST
 
 ROOT = Path(__file__).resolve().parent.parent
+#: real bend FEM runs in subprocesses: 2 to 8 minutes in all (part of the CI suite)
+pytestmark = pytest.mark.slow
 #: the bend verb, its VTK writer marking each state written (``MARK``) and then sleeping
 #: ``SLEEP`` seconds: time to signal a run while its series is half-written
 BEND = '''
