@@ -29,7 +29,7 @@ import numpy as np
 from softhand.reduced.equations import grasp
 from softhand.reduced.vocabulary.design import HandDesign
 from softhand.reduced.vocabulary.errors import InputError
-from softhand.studies.io.files import json_text, jsonable, write_json
+from softhand.studies.io.files import json_text, jsonable, read_bounded, write_json
 
 #: bump when the FEM or the result's fields change, to invalidate cached results
 CACHE_FORMAT = 6  # 6: the pressure named P_cavity_MPa, eq. (25)'s F_v_reduced_note; 5: entries {format, key, sha256, result}; 4: factorisations counted; 3: the finger's windings on their own degree-5 rule, mesh graded at the ring edges
@@ -251,18 +251,22 @@ def _checksum(result: dict) -> str:
     return hashlib.sha256(json.dumps(result, sort_keys=True, default=jsonable).encode()).hexdigest()
 
 
+#: the largest cache entry read (one grasp's numbers: a few kB)
+MAX_ENTRY_BYTES = 1 << 20
+
+
 def read_entry(path: Path, key: str) -> dict | None:
     """The cached result at ``path`` if it is there and valid (format, key, schema, checksum)."""
-    if not path.exists():
+    if not (path.exists() or path.is_symlink()):
         return None
     try:
-        entry = json.loads(path.read_text())
+        entry = json.loads(read_bounded(path, MAX_ENTRY_BYTES))  # a FIFO: refused, not waited on
         result = entry["result"]
         valid = (entry["format"] == CACHE_FORMAT and entry["key"] == key
                  and entry["sha256"] == _checksum(result)
                  and all(isinstance(result.get(k), t if t is not float else (int, float))
                          for k, t in _SCHEMA.items()))
-    except (OSError, ValueError, KeyError, TypeError):
+    except (OSError, ValueError, KeyError, TypeError, RecursionError):  # RecursionError: nested deep
         valid = False
     if valid:
         return result

@@ -238,7 +238,57 @@ EXTRA_FILES.update({
     "sp_press_tiny.toml": "pressures_mpa = [1e-300]\n" + SPACE,
 })
 
+
+
+def _few_designs_table() -> str:
+    """The package's finger table cut to its first 4 designs, still declaring the whole box
+    (as a table of a few designs of a wide space did), fitted in terms 4 designs can carry."""
+    from softhand.reduced.calibrated.finger_fem_table import TABLE_FILE
+
+    lines = TABLE_FILE.read_text().splitlines()
+    keep = [line for line in lines if line.startswith(("#", "design")) or line.split(",")[0] in "0123"]
+    return "\n".join("# fit: prior=rings, p_terms=lb th, q_terms=lb" if line.startswith("# fit:") else line
+                     for line in keep) + "\n"
+
+
+#: outputs and inputs the outputs rule protects (docs/outputs.md): a folder of the user's
+#: where a run writes one, an input or a user's file where calibrate writes its design
+EXTRA_FILES.update({
+    "own/grasp/thesis.tex": "the user's", "own/knee/thesis.tex": "the user's",
+    "own/finger/thesis.tex": "the user's", "own/sheet/thesis.tex": "the user's",
+    "own/result.json": "the user's, not a run's",
+    "cal.toml": "# my finger\na_mm = 4.0\n", "cal_dir_fem.toml/keep": "a folder where the design goes",
+    "users_fem.toml": "my own file\n", "x_fem.toml": "a_mm = 4.0\n",
+    "...toml": TASK,
+    "fit_repeated.csv": "P_MPa,theta_deg\n" + "0.3,40\n" * 4,
+    "fit_zeros.csv": "P_MPa,theta_deg\n" + "0,0\n" * 3,
+    "few_designs.csv": _few_designs_table(),
+    "d_few_designs.toml": 'finger_model = "fem"\nfinger_table = "few_designs.csv"\nb_mm = 3.0\n',
+    "st_weights_folded.toml": 'kind = "weights"\nmesh_size_mm = 10.0\n[sweep]\ndiameter_mm = [180.0, 200.0]\n',
+    "tables/st_table_here.toml": 'kind = "curve"\n[design]\nfinger_model = "fem"\nfinger_table = "few_designs.csv"\n'
+                                 'b_mm = 3.0\n[sweep]\ntheta_deg = [10]\n',
+    "tables/few_designs.csv": _few_designs_table(),
+})
+
 GOOD_TASK, GOOD_SPACE = "good_task.toml", "good_space.toml"
+
+
+def outputs_cases() -> list[tuple[str, list[str]]]:
+    """The outputs rule's refusals: before any work, one line, nothing written."""
+    no_fem = ["--no-fem", "--no-progress"]
+    cases = [["design", "--task", GOOD_TASK, *no_fem, "--out", "own"], ["design", "--task", "...toml", *no_fem],
+             ["bend", "--pressure-mpa", "0.1", "--out", "own"], ["weights", "--diameter-mm", "180", "--out", "own"],
+             ["reservoir", "--volume-mm3", "16000", "--out", "own"],
+             ["calibrate", "finger", "--design", "cal.toml", "--out", "cal_dir.csv"],
+             ["calibrate", "finger", "--design", "cal.toml", "--out", "users.csv"],
+             ["calibrate", "finger", "--design", "x_fem.toml", "--out", "x.csv"],
+             ["grasp", "--pressure-mpa", "0.5", "--theta-deg", "40", "--mass-kg", "1", "--weights", "0:1:0.25"],
+             ["fit", "--data", "fit_repeated.csv", "--params", "mu_sf_MPa"],
+             ["fit", "--data", "fit_zeros.csv", "--params", "mu_sf_MPa"],
+             ["curve", "--theta-deg", "10", "--design", "d_few_designs.toml"],
+             ["study", "run", "tables/st_table_here.toml", "--workers", "1"],
+             ["study", "run", "st_weights_folded.toml", "--workers", "1"]]
+    return [("outputs", c) for c in cases]
 
 
 def replay_cases() -> list[tuple[str, list[str]]]:
@@ -421,4 +471,5 @@ def replay_cases() -> list[tuple[str, list[str]]]:
               ["study", "run", "st_grasp_bad_table.toml", "--workers", "1"],
               ["weights", "--diameter-mm", "180", "--plot", "w.png"]]
     cases += [("files", f) for f in files]
+    cases += outputs_cases()
     return [(f"{name}-{k}-{' '.join(argv[1:])[:40]}", argv) for k, (name, argv) in enumerate(cases)]

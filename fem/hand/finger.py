@@ -88,6 +88,40 @@ def finger_tube(design: HandDesign, options: FingerOptions) -> FingerTube:
                       options.edge_ratio, options.edge_reach)
 
 
+def refuse_folds(mesh, options: FingerOptions) -> None:
+    """MeshRejected if curved elements of ``mesh`` fold over themselves (positive at the
+    quadrature points, folded between them: the FEM stops or balloons the tube)."""
+    folded = folded_elements(mesh)
+    if folded.size:
+        raise MeshRejected(describe_mesh(options),
+                           f"has {folded.size} curved elements that fold over themselves (its FEM "
+                           f"stops or balloons the tube); try a finer mesh size, edge_ratio 1 "
+                           f"(uniform) or the layered mesher")
+
+
+def check_finger_mesh(design: HandDesign, options: FingerOptions) -> None:
+    """The finger mesh of ``design`` is one the FEM takes (size, folds), without the FEM: a
+    study checks each case's mesh before any case runs. A gmsh mesh goes through the cache,
+    which keeps it only if it is taken (a refused run leaves nothing behind)."""
+    tube = finger_tube(design, options)
+    check_size(tube, options)
+    if options.mesher == "layered":
+        refuse_folds(build_mesh(tube, options), options)
+        return
+    from softhand.meshes.cache import cache_dir, discard, mesh_key, valid_entry
+    from softhand.meshes.finger import finger_geometry
+
+    key = mesh_key(finger_geometry, tube, size=options.mesh_size, order=2, refine=options.mesh_refine)
+    path = cache_dir() / f"{finger_geometry.__name__}-{key}.msh"
+    cached, made = valid_entry(path), [d for d in (path.parent, path.parent.parent) if not d.exists()]
+    try:
+        refuse_folds(build_mesh(tube, options), options)
+    except MeshRejected:
+        if not cached:
+            discard(path, made)
+        raise
+
+
 class FingerModel:
     """The built finger FEM: mesh, solid, shell constraint and pressure load."""
 
@@ -103,12 +137,7 @@ class FingerModel:
             raise MeshRejected(describe_mesh(options),
                                "has curved elements turned inside out (negative Jacobian); "
                                "try another mesh size, edge_ratio 1 (uniform) or the layered mesher")
-        folded = folded_elements(self.mesh)
-        if folded.size:  # positive at the quadrature points, folded between them
-            raise MeshRejected(describe_mesh(options),
-                               f"has {folded.size} curved elements that fold over themselves (its FEM "
-                               f"stops or balloons the tube); try a finer mesh size, edge_ratio 1 "
-                               f"(uniform) or the layered mesher")
+        refuse_folds(self.mesh, options)
         self.windings = Windings(self.mesh, options.fiber_ratio * mu, options.fiber_toe,
                                  options.fiber_intorder, self.solid.scatter)
         X_q = self.solid.sbasis.global_coordinates().value

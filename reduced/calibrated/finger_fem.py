@@ -35,9 +35,10 @@ per piece) and W_f as its exact integral (3-point Gauss per piece, W_f(0) = 0), 
 P dQ/dtheta = dW_f/dtheta holds to rounding and (27), (28), (25) follow from the
 virtual-work balance unchanged.
 
-Its space. Designs whose groups leave the table's range, or that do not have 5 equal hinges,
-raise one InputError naming the group and its range; ``softhand calibrate finger --design``
-makes a table for such a design. Units: mm, MPa, N mm, rad.
+Its space: the table's ``# range:`` narrowed to its own designs (a table answers only where
+it was measured). Designs whose groups leave it, or that do not have 5 equal hinges, raise
+one InputError naming the group and its range; ``softhand calibrate finger --design`` makes
+a table for such a design. Units: mm, MPa, N mm, rad.
 """
 from __future__ import annotations
 

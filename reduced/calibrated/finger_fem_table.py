@@ -81,6 +81,7 @@ def read_table(path: str | Path = TABLE_FILE) -> Table:
         lo, hi = ranges[g]
         if np.any(rows[g] < lo * (1 - 1e-9)) or np.any(rows[g] > hi * (1 + 1e-9)):
             raise table_error(path, f"has {LABELS[g]} outside its '# range:' [{lo:g}, {hi:g}]")
+    declared, ranges = ranges, _measured(ranges, rows)
     if "kernel" in spec:
         if spec["kernel"] not in KERNELS:
             raise table_error(path, f"has kernel={spec['kernel']}; allowed: {', '.join(KERNELS)}")
@@ -94,8 +95,14 @@ def read_table(path: str | Path = TABLE_FILE) -> Table:
                              f"among {', '.join(KERNEL_FEATURES)}")
         return Table(path.name, rows, ranges, (), (), prior=prior, header=comments,
                      kernel=spec["kernel"], features=features)
-    terms = _terms(spec, ranges, path)
-    return Table(path.name, rows, ranges, *terms, prior=prior, header=comments)
+    terms = _terms(spec, declared, path)
+    return Table(path.name, rows, ranges, *terms, prior=prior, header=tuple(comments))
+
+
+def _measured(ranges: dict, rows) -> dict:
+    """The declared ranges narrowed to the table's own designs: a table answers only where it
+    was measured (one that declares a whole box over a few designs is held to those)."""
+    return {g: (max(lo, float(rows[g].min())), min(hi, float(rows[g].max()))) for g, (lo, hi) in ranges.items()}
 
 
 def _check_designs(rows: dict, path) -> None:

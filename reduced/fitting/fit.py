@@ -121,6 +121,7 @@ def fit(data: Measurements, params, predictor: Callable[[HandDesign], np.ndarray
     """
     design = design if design is not None else HandDesign()
     keys = check_params(params, len(data))
+    _check_distinct(data, len(keys))
     p0 = np.array([design.to_dict()[k] for k in keys], dtype=float)
     lo, hi = _bounds(keys, p0, design, data, bounds, options)
     scale = np.where(p0 != 0.0, np.abs(p0), 1.0)
@@ -232,6 +233,17 @@ def check_params(params, n_points: int) -> tuple[str, ...]:
         raise InputError("--data", f"{n_points} points",
                          f"need more points than the {len(keys)} parameters fitted")
     return keys
+
+
+def _check_distinct(data: Measurements, k: int) -> None:
+    """More distinct rows than parameters: copies of one row (or rows all zero) add no
+    information, and a fit through them would report errors of 0 that the data never measured."""
+    columns = [c for c in (data.P, data.theta, data.finger, data.mass, data.F_v, data.diameter) if c is not None]
+    rows = {tuple(str(c[i]) for c in columns) for i in range(len(data))}
+    if len(rows) <= k:
+        raise InputError("--data", f"{len(data)} points, {len(rows)} distinct",
+                         f"the data cannot identify the {k} parameter{'s' if k > 1 else ''} fitted "
+                         f"nor their errors: give more distinct points than parameters")
 
 
 def default_bounds(key: str, p0: float, design: HandDesign, data: Measurements,

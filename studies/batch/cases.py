@@ -27,7 +27,7 @@ import numpy as np
 from softhand.reduced.vocabulary.design import HandDesign
 from softhand.reduced.vocabulary.versions import package_version
 from softhand.studies.batch.studyfile import Study, resolve_kind
-from softhand.studies.io.files import finite_or_none, write_json
+from softhand.studies.io.files import finite_or_none, read_bounded, write_json
 
 RESULT, FAILED = "result.json", "failed.json"
 _PACKAGES = ("fem", "meshes", "reduced", "studies")
@@ -86,6 +86,8 @@ def study_dir(study: Study, results_root: str | Path = "results") -> Path:
 
 #: the file in a study's folder that says which kind of study it holds
 OWNER = "study.json"
+#: the largest case file read (a case's numbers and provenance: kB; a kind's curves: MB)
+MAX_RECORD_BYTES = 64 << 20
 
 
 def own_study_dir(study: Study, results_root: str | Path = "results", *, write: bool) -> Path:
@@ -98,7 +100,7 @@ def own_study_dir(study: Study, results_root: str | Path = "results", *, write: 
     sdir = study_dir(study, results_root)
     check_output_tree(sdir, "--results", files=(OWNER, "index.csv", "report.md"), folders=(".claims", "report"))
     try:
-        held = json.loads((sdir / OWNER).read_text()).get("kind")
+        held = json.loads(read_bounded(sdir / OWNER, MAX_RECORD_BYTES)).get("kind")
     except (OSError, ValueError, AttributeError, RecursionError):
         held = None  # none yet (or a folder from before this record): this study takes it
     if held is not None and held != study.kind:
@@ -111,8 +113,11 @@ def own_study_dir(study: Study, results_root: str | Path = "results", *, write: 
 
 
 def case_state(sdir: Path, case: Case) -> str:
-    """'done', 'failed', 'pending' or 'corrupt' (a case file that does not parse)."""
+    """'done', 'failed', 'pending' or 'corrupt' (a case file that does not parse, a case folder
+    that is a symbolic link or no folder: recomputed by a run)."""
     folder = sdir / case.key
+    if folder.is_symlink() or folder.exists() and not folder.is_dir():
+        return "corrupt"
     for name, state in ((RESULT, "done"), (FAILED, "failed")):
         if (folder / name).exists():
             return state if _record(folder / name) is not None else "corrupt"
@@ -121,9 +126,11 @@ def case_state(sdir: Path, case: Case) -> str:
 
 def read_case(sdir: Path, case: Case) -> dict | None:
     """The stored result.json or failed.json of a case; None if pending or corrupt."""
+    if (sdir / case.key).is_symlink():
+        return None
     for name in (RESULT, FAILED):
         path = sdir / case.key / name
-        if path.exists():
+        if path.exists() or path.is_symlink():
             return _record(path)
     return None
 
@@ -131,8 +138,8 @@ def read_case(sdir: Path, case: Case) -> dict | None:
 def _record(path: Path) -> dict | None:
     """A case file's record if it parses and has the record's shape (its numbers finite numbers,
     null or lists of them, as :func:`execute_case` writes them), else None."""
-    try:
-        record = json.loads(path.read_text())
+    try:  # bounded, and never waiting on a FIFO; a file nested too deep does not parse
+        record = json.loads(read_bounded(path, MAX_RECORD_BYTES))
     except (OSError, ValueError, RecursionError):
         return None
     ok = (isinstance(record, dict) and record.get("status") == ("done" if path.name == RESULT else "failed")
@@ -243,7 +250,9 @@ def commit(final: Path, record: dict, files: dict) -> Path:
             (tmp / rel).parent.mkdir(parents=True, exist_ok=True)
             (tmp / rel).write_bytes(data)
         write_json(tmp / (RESULT if record["status"] == "done" else FAILED), record)
-        if final.exists():
+        if final.is_symlink() or final.exists() and not final.is_dir():
+            final.unlink()  # a damaged case: the link itself goes, never what it points to
+        elif final.exists():
             shutil.rmtree(final)  # an earlier failure, a corrupt file, or a result of other inputs
         os.rename(tmp, final)
     except BaseException:  # Ctrl-C, SIGTERM, a full disk: no half-written folder stays behind

@@ -9,6 +9,7 @@ two runs can wait on each other.
 """
 from __future__ import annotations
 
+import errno
 import fcntl
 import os
 from pathlib import Path
@@ -25,8 +26,17 @@ class Claims:
         """Claim case ``key`` if no other process holds it; True if this process now does."""
         if key in self.held:
             return True
-        self.folder.mkdir(parents=True, exist_ok=True)
-        fd = os.open(self.folder / f"{key}.lock", os.O_RDWR | os.O_CREAT, 0o666)
+        path = self.folder / f"{key}.lock"
+        try:
+            self.folder.mkdir(parents=True, exist_ok=True)
+            if self.folder.is_symlink():
+                raise OSError(errno.ELOOP, "a symbolic link, not followed out of the study's folder")
+            fd = os.open(path, os.O_RDWR | os.O_CREAT | os.O_NOFOLLOW, 0o666)
+        except OSError as exc:  # damaged or read-only state: one line, not a traceback
+            from softhand.reduced.vocabulary.errors import InputError
+
+            raise InputError("--results", str(path), f"cannot hold the case's claim lock ({exc.strerror or exc}); "
+                             "remove what stands there or make the study's folder writable") from None
         try:
             fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
         except BlockingIOError:

@@ -41,7 +41,7 @@ from softhand.studies.batch.cases import (FAILED, RESULT, Case, case_key, case_s
 from softhand.studies.batch.claims import Claims
 from softhand.studies.batch.index import index_rows, other_sources, status, write_index  # noqa: F401
 from softhand.studies.batch.studyfile import Study
-from softhand.studies.io.files import check_output_tree
+from softhand.studies.io.files import check_output_tree, kept_if_unwritable
 
 
 @dataclass
@@ -71,7 +71,8 @@ def run_study(study: Study, *, results_root: str | Path = "results", workers: in
     """
     sdir = own_study_dir(study, results_root, write=False)
     cases = plan(study)
-    check_output_tree(sdir, "--results", folders=[c.key for c in cases])
+    # a case folder that is a symbolic link is a damaged case: recomputed, the link replaced
+    check_output_tree(sdir, "--results", folders=[c.key for c in cases if not (sdir / c.key).is_symlink()])
     states = {c.key: case_state(sdir, c) for c in cases}
     todo = [c for c in cases if fresh or states[c.key] != "done"]
     summary = RunSummary(total=len(cases), reused=len(cases) - len(todo), not_run=len(todo),
@@ -79,6 +80,7 @@ def run_study(study: Study, *, results_root: str | Path = "results", workers: in
     if summary.corrupt:
         print(f"softhand study: {summary.corrupt} case files do not parse; recomputing them",
               file=sys.stderr)
+    check_meshes(study.kind, [(c.key, c.params, c.design) for c in todo], study.name)  # folded: one line now
     workers = max(1, workers or os.cpu_count() or 1)
     dask = None
     if scheduler and todo:
@@ -94,7 +96,9 @@ def run_study(study: Study, *, results_root: str | Path = "results", workers: in
             mine = _claimed(sdir, todo, claims, fresh, deferred, summary, bar)
             with closing(_outcomes(study, mine, workers, dask)) as outcomes:
                 for case, output in outcomes:
-                    commit_case(sdir, study, case, output)
+                    if not _committed(sdir, study, case, output):
+                        todo = []
+                        break  # the disk refuses: the cases finished stay, the others are not run
                     claims.release(case.key)
                     summary.not_run -= 1
                     if output["status"] == "done":
@@ -103,6 +107,8 @@ def run_study(study: Study, *, results_root: str | Path = "results", workers: in
                         summary.failed[case.key] = output["error"]
                     bar.update(1)
                     bar.set_postfix(running=min(workers, summary.not_run), failed=len(summary.failed))
+            if not todo:
+                break
             if deferred and len(deferred) == len(todo):
                 time.sleep(0.2)  # every case left is another run's: wait for it
             todo, fresh = deferred, False
@@ -113,8 +119,50 @@ def run_study(study: Study, *, results_root: str | Path = "results", workers: in
             from softhand.studies.batch.cluster import close_cluster
 
             close_cluster(*dask)
-        write_index(study, results_root)
+        with kept_if_unwritable(study_dir(study, results_root) / "index.csv", "study", say_written=False):
+            write_index(study, results_root)
     return summary
+
+
+def _committed(sdir: Path, study: Study, case: Case, output: dict) -> bool:
+    """Store a case's outcome (:func:`commit_case`); False, after one warning, if the disk
+    refuses it (full, a file-size limit, read-only): the run then stops, exit code 3."""
+    from softhand.studies.io.files import UNWRITTEN
+
+    before = len(UNWRITTEN)
+    with kept_if_unwritable(sdir / case.key, "study", say_written=False):
+        commit_case(sdir, study, case, output)
+    return len(UNWRITTEN) == before
+
+
+def _finger_options(kind: str, params: dict, design):
+    """The finger FEM's options of a case of ``kind``, or None if the kind builds no finger."""
+    if kind == "finger_bend":
+        from softhand.studies.calibration.finger import case_options
+
+        return case_options(params)
+    if kind == "weights":
+        from softhand.studies.weights import WeightsCase, finger_options
+
+        return finger_options(WeightsCase(design=design, **{k: float(v) for k, v in params.items()}).mesh_size_mm)
+    return None
+
+
+def check_meshes(kind: str, cases, src: str) -> None:
+    """Each case's finger mesh one the FEM takes (not folded), before any case runs: one line
+    naming the case, as ``bend`` and ``design`` refuse such a mesh up front, not a failed case
+    after the others ran. ``cases``: (key, params, design)."""
+    from softhand.fem.hand.finger import check_finger_mesh
+    from softhand.reduced.vocabulary.errors import InputError, MeshRejected
+
+    for key, params, design in cases:
+        options = _finger_options(kind, params, design)
+        if options is None:
+            return
+        try:
+            check_finger_mesh(design, options)
+        except MeshRejected as exc:
+            raise InputError(f"{src}: case {key}", exc.value, exc.allowed) from None
 
 
 def _claimed(sdir: Path, todo: list[Case], claims: Claims, fresh: bool, deferred: list,

@@ -42,6 +42,7 @@ from __future__ import annotations
 
 import itertools
 import math
+import os
 import re
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -62,6 +63,12 @@ __all__ = ["KINDS", "MAX_CASES", "Kind", "Num", "NumList", "Study", "all_kinds",
 _TOP_KEYS = ("kind", "name", "description", "design", "mesh_size_mm", "sweep", "params")
 #: what a study's (and a design space's) name may be: it names a results folder
 NAME_RE = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_.-]*$")
+
+
+def is_folder_name(name) -> bool:
+    """``name`` can name a results folder: letters, digits, '_', '-', '.', starting with a letter
+    or digit, at most 100 characters (never '.', '..' nor a path)."""
+    return isinstance(name, str) and bool(NAME_RE.match(name)) and len(name) <= 100
 
 
 @dataclass(frozen=True)
@@ -107,7 +114,7 @@ def study_from_dict(doc: dict, *, path: Path | None = None, max_cases: int = MAX
             raise InputError(f"{src}: {key}", doc[key], f"unknown key; allowed: {', '.join(_TOP_KEYS)}")
     kind = _kind(doc.get("kind"), src)
     name = doc.get("name", path.stem if path else None)
-    if not isinstance(name, str) or not NAME_RE.match(name) or len(name) > 100:
+    if not is_folder_name(name):
         given = "" if "name" in doc else (" (the study's results folder is named after its file "
                                           "unless the file sets name = \"...\")")
         raise InputError(f"{src}: name", name, "must be a string of at most 100 letters, digits, '_', "
@@ -191,6 +198,9 @@ def _design(spec, base: Path, src: str) -> HandDesign:
         start = load_design(base / file) if file else HandDesign()
     except InputError as exc:
         raise (exc.renamed(f"{src}: design.file") if exc.field == "--design" else exc) from None
+    table = overrides.get("finger_table")
+    if isinstance(table, str) and table and "\0" not in table:  # next to the study file, as a design file's
+        overrides["finger_table"] = os.path.abspath(base / table)
     return design_from_dict(overrides, start, source=f"{src}: design")
 
 

@@ -34,6 +34,11 @@ def space_ranges(box: dict) -> dict:
     return {g: (min(v[g] for v in values), max(v[g] for v in values)) for g in GROUPS}
 
 
+def designs_ranges(rows: list[dict]) -> dict:
+    """group -> (min, max) over the table rows' designs."""
+    return {g: (min(r[g] for r in rows), max(r[g] for r in rows)) for g in GROUPS}
+
+
 def table_rows(results: list[tuple[HandDesign, dict]]) -> list[dict]:
     """Nondimensional table rows from (design, numbers of its finger_bend case), P > 0 only."""
     rows = []
@@ -138,17 +143,58 @@ def write_table(path, space: DesignSpace, results: list[tuple[HandDesign, dict]]
                      f"equal bend): P x {math.exp(dy):.5f}, dQ x {rq:.5f}, applied to the {len(coarse)} "
                      f"designs on the longer slices; {n - len(coarse)} designs (untied gap shorter than "
                      f"{MIN_GAP_SLICES} slices) ran on the default mesh")
-    ranges = space_ranges(space.box)
+    # the range a table states is that of its own designs, never more of the box than they
+    # cover (a few designs of a wide box would otherwise answer far from any of them)
+    ranges = {g: (lo, hi) for g, (lo, hi) in designs_ranges(rows).items()}
     fit, fit_notes = choose_fit(rows, ranges, space.prior)
     text = table_csv(rows, ranges, notes + fit_notes, fit, prior=space.prior)
     return write_atomic(path, text)
 
 
-def write_design_with_table(design: HandDesign, table: Path) -> Path:
-    """FILE.toml next to FILE.csv: the design with finger_model = "fem" and this table."""
+#: the first line of the design file :func:`write_design_with_table` writes (a file without it
+#: is the user's, never written over)
+DESIGN_MARK = "# softhand calibrate finger: this design on the finger table "
+
+
+def design_file_for(table) -> Path:
+    """Where the design using the table FILE.csv goes: FILE_fem.toml next to it (never FILE.toml,
+    which is often the design the table was made from)."""
     table = Path(table)
-    path = table.with_suffix(".toml")
-    text = design.replace(finger_model="fem", finger_table=table.name).to_toml()
+    return table.with_name(f"{table.stem}_fem.toml")
+
+
+def check_design_file(table, inputs, field: str = "--out") -> None:
+    """Before any FEM: the design file of ``table`` can be written: not a folder, not one of the
+    ``inputs`` (by any path), not a file of the user's (one this verb wrote begins with
+    :data:`DESIGN_MARK`); InputError naming ``field`` otherwise."""
+    from softhand.reduced.vocabulary.errors import InputError
+
+    path = design_file_for(table)
+    if path.is_dir() or path.is_symlink() and not path.exists():
+        raise InputError(field, str(path), "is where the design using the table goes, and is a folder "
+                                           "or a broken link; move it away or give another --out")
+    for given in inputs:
+        if given is not None and path.exists() and Path(given).exists() and path.samefile(given):
+            raise InputError(field, str(path), "is where the design using the table goes, and is an "
+                                               "input of this run; give another --out")
+    if path.is_file():
+        try:
+            with open(path, "rb") as f:
+                first = f.read(len(DESIGN_MARK.encode()))
+        except OSError:
+            first = b""
+        if first != DESIGN_MARK.encode():
+            raise InputError(field, str(path), "is where the design using the table goes, and holds a "
+                                               "file softhand did not write; move it away or give "
+                                               "another --out")
+
+
+def write_design_with_table(design: HandDesign, table: Path) -> Path:
+    """FILE_fem.toml next to FILE.csv (:func:`design_file_for`): the design with finger_model =
+    "fem" and this table."""
+    table = Path(table)
+    path = design_file_for(table)
+    text = DESIGN_MARK + table.name + "\n" + design.replace(finger_model="fem", finger_table=table.name).to_toml()
     return write_atomic(path, text)
 
 

@@ -14,6 +14,7 @@ stderr and exit code 2.
 from __future__ import annotations
 
 import argparse
+import errno
 import importlib
 import os
 import re
@@ -31,6 +32,10 @@ VERBS = (
     "verify", "reservoir", "bend", "weights",
     "design", "study", "calibrate", "inspect", "reproduce", "material",
 )
+
+
+#: errors of a write the disk refuses: full, a file-size limit, a quota, read-only
+WRITE_ERRNOS = (errno.ENOSPC, errno.EFBIG, errno.EDQUOT, errno.EROFS)
 
 
 class ArgumentParser(argparse.ArgumentParser):
@@ -120,11 +125,14 @@ def main(argv: list[str] | None = None) -> int:
     form = warnings.formatwarning  # every warning shown is one line (which are shown: the filters)
     warnings.formatwarning = lambda message, category, *rest, **kw: (
         f"softhand {verb}: {'note' if issubclass(category, Note) else 'warning'}: {message}\n")
+    from softhand.studies.io.files import EXIT_UNWRITTEN, UNWRITTEN, reset_unwritten
+
+    reset_unwritten()
     try:
         _check(verb, args, parser)
         code = int(module.run(args) or 0)
         sys.stdout.flush()  # a closed pipe shows here, not in Python's exit
-        return code
+        return EXIT_UNWRITTEN if code in (0, 1) and UNWRITTEN else code  # computed, printed, not all written
     except InputError as exc:
         print(f"softhand {verb}: error: {exc}", file=sys.stderr)
         return 2
@@ -134,6 +142,12 @@ def main(argv: list[str] | None = None) -> int:
     except BrokenPipeError:  # e.g. 'softhand study status FILE | head': the reader left
         _silence_stdout()
         return 141
+    except OSError as exc:  # a write no verb expected to fail: one line, not a traceback
+        if exc.errno not in WRITE_ERRNOS:
+            raise
+        print(f"softhand {verb}: error: {exc.filename or 'an output'} could not be written "
+              f"({exc.strerror or exc}); finished results are kept", file=sys.stderr)
+        return EXIT_UNWRITTEN
     finally:
         warnings.formatwarning = form
         _restore_float_warnings(float_errors)

@@ -32,6 +32,7 @@ from __future__ import annotations
 
 import math
 import time
+from pathlib import Path
 from dataclasses import dataclass, field, replace
 
 import numpy as np
@@ -399,6 +400,9 @@ def prove(ev: Evaluation, task: Task, options: ProofOptions = ProofOptions(), *,
         states += more
         fem["wall_seconds"] = time.perf_counter() - t0
     if out is not None:  # the verified grasp, then the margin's states (by cavity pressure)
-        write_vtk(out, model, sorted(states, key=lambda s: s.P))
+        from softhand.studies.io.files import kept_if_unwritable
+
+        with kept_if_unwritable(Path(out) / "grasp.pvd", "design"):
+            write_vtk(out, model, sorted(states, key=lambda s: s.P))
     fem["constraints"] = fem_constraints(fem, task)
     return fem

@@ -14,9 +14,9 @@ import numpy as np
 from softhand.reduced.vocabulary.errors import MeshRejected, MeshTooLarge
 from softhand.studies.design import optimise as design_opt
 from softhand.studies.design import proof
-from softhand.studies.io.files import replaced_outputs, write_atomic, write_json
+from softhand.studies.io.files import kept_if_unwritable, replaced_outputs, write_atomic, write_json
 
-#: what a design run writes into its folder (an earlier run's are removed before it writes)
+#: what a design run writes into its folder (its manifest: an earlier run's are replaced whole)
 OUTPUT_FILES = ("result.json", "design.toml", "rejected_design.toml", "pareto.png", "grasp.pvd")
 OUTPUT_FOLDERS = ("knee", "grasp")
 
@@ -36,9 +36,10 @@ class DesignRun:
 
 def run_task(task, out, run: DesignRun = DesignRun(), say=print):
     """(record, optimum, ok) of the task: nothing written if it cannot be met (the record has
-    the ``report``), else the design, result.json and the proof's files in ``out`` (an earlier
-    run's outputs replaced; a run stopped mid-proof leaves none of its own). ``ok``: met, and
-    proven by the FEM unless ``run.fem`` is False."""
+    the ``report``), else the design, result.json and the proof's files in ``out``, written into
+    a private staging folder renamed into place when the run is complete (the earlier run's
+    result stays whole until then; a run stopped mid-proof leaves none of its own). The record
+    names the final paths. ``ok``: met, and proven by the FEM unless ``run.fem`` is False."""
     out = Path(out)
     options = design_opt.OptimiserOptions(seed=run.seed)
     opt = optimise_task(task, options, show_progress=run.show_progress)
@@ -47,23 +48,28 @@ def run_task(task, out, run: DesignRun = DesignRun(), say=print):
     if not ev.feasible:  # the documented outcome, before anything is written
         return {**result_record(task, opt, base, None, run.seed),
                 "report": design_opt.infeasible_report(task, opt)}, opt, False
-    with replaced_outputs(out, OUTPUT_FILES + OUTPUT_FOLDERS):
-        out.mkdir(parents=True, exist_ok=True)
-        design_file = write_atomic(out / "design.toml", ev.design.to_toml())
-        result = result_record(task, opt, base, design_file, run.seed)
+    with replaced_outputs(out, OUTPUT_FILES + OUTPUT_FOLDERS, verb="design") as stage:
+        dirs = (stage, out)
+        with kept_if_unwritable(out / "design.toml", "design"):
+            write_atomic(stage / "design.toml", ev.design.to_toml())
+        result = result_record(task, opt, base, out / "design.toml", run.seed)
         if run.pareto:
             from softhand.studies.design import pareto as design_pareto
 
             rows = design_pareto.front(task, opt, options)
-            plot = design_pareto.plot(rows, run.plot or out / "pareto.png", task=task, base=base)
+            plot = Path(run.plot) if run.plot else out / "pareto.png"
+            inside = plot.resolve() == (out / "pareto.png").resolve()  # the run's own: staged with it
+            with kept_if_unwritable(plot, "design"):
+                design_pareto.plot(rows, stage / "pareto.png" if inside else plot, task=task, base=base)
             result["pareto"] = {"rows": rows, "knee": design_pareto.knee(rows), "plot": str(plot)}
         if run.fem:
-            result = prove_and_correct(result, task, opt, base, run, out, say, options)
+            result = prove_and_correct(result, task, opt, base, run, dirs, say, options)
             if run.pareto:
-                result["pareto"]["knee_proof"] = prove_knee(result["pareto"], task, run, out, say)
+                result["pareto"]["knee_proof"] = prove_knee(result["pareto"], task, run, dirs, say)
         ok = result["feasible"] and "fem_report" not in result and "report" not in result
         result["proven"] = ok if run.fem else None  # by the FEM; None: not asked
-        write_json(out / "result.json", result)
+        with kept_if_unwritable(out / "result.json", "design"):
+            write_json(stage / "result.json", result)
     return result, opt, ok
 
 
@@ -82,12 +88,14 @@ def optimise_task(task, options, *, show_progress: bool = True):
                                    say=lambda text: bar.write(f"softhand design: {text}", file=sys.stderr))
 
 
-def prove_and_correct(result: dict, task, opt, base, run: DesignRun, out, say, options) -> dict:
+def prove_and_correct(result: dict, task, opt, base, run: DesignRun, dirs, say, options) -> dict:
     """The FEM proof of the optimum; if the FEM's peak stretch breaks the task's limit, one
     re-optimisation with eq. (8)'s strain scaled to the FEM's and the proof of that design
-    (the first optimum is kept under ``rejected``)."""
+    (the first optimum is kept under ``rejected``). ``dirs``: (staging folder written, output
+    folder named)."""
     ev = opt.evaluation
-    result["fem"] = prove_on_meshes(ev, task, run.mesh_size_mm, out, say, show_progress=run.show_progress)
+    stage, out = dirs
+    result["fem"] = prove_on_meshes(ev, task, run.mesh_size_mm, stage, say, show_progress=run.show_progress)
     report = proof.fem_report(result["fem"], ev)
     if not report:
         return result
@@ -97,15 +105,18 @@ def prove_and_correct(result: dict, task, opt, base, run: DesignRun, out, say, o
         return result
     say(f"the FEM's peak stretch is {corrected.stretch_factor:.3g} x eq. (8)'s strain: optimising again with it")
     rejected = {k: result[k] for k in ("design", "predicted", "fem", "constraints", "fem_report")}
-    rejected["design_file"] = str(write_atomic(out / "rejected_design.toml", ev.design.to_toml()))
+    rejected["design_file"] = str(out / "rejected_design.toml")
+    with kept_if_unwritable(out / "rejected_design.toml", "design"):
+        write_atomic(stage / "rejected_design.toml", ev.design.to_toml())
     opt = optimise_task(corrected, options, show_progress=run.show_progress)
-    design_file = write_atomic(out / "design.toml", opt.evaluation.design.to_toml())
-    new = {**result_record(corrected, opt, base, design_file, run.seed), "stretch_factor": corrected.stretch_factor,
+    with kept_if_unwritable(out / "design.toml", "design"):
+        write_atomic(stage / "design.toml", opt.evaluation.design.to_toml())
+    new = {**result_record(corrected, opt, base, out / "design.toml", run.seed), "stretch_factor": corrected.stretch_factor,
            "rejected": rejected, **{k: result[k] for k in ("pareto",) if k in result}}
     if not opt.evaluation.feasible:
         new["report"] = design_opt.infeasible_report(corrected, opt)
         return new
-    new["fem"] = prove_on_meshes(opt.evaluation, corrected, run.mesh_size_mm, out, say,
+    new["fem"] = prove_on_meshes(opt.evaluation, corrected, run.mesh_size_mm, stage, say,
                                  show_progress=run.show_progress)
     report = proof.fem_report(new["fem"], opt.evaluation)
     if report:
@@ -113,7 +124,7 @@ def prove_and_correct(result: dict, task, opt, base, run: DesignRun, out, say, o
     return new
 
 
-def prove_knee(pareto: dict, task, run: DesignRun, out, say) -> dict | None:
+def prove_knee(pareto: dict, task, run: DesignRun, dirs, say) -> dict | None:
     """The FEM proof of the Pareto front's knee (None if the knee is the optimum): its design
     (knee/design.toml), prediction and FEM, the VTK in knee/."""
     row = pareto["rows"][pareto["knee"]]
@@ -121,11 +132,14 @@ def prove_knee(pareto: dict, task, run: DesignRun, out, say) -> dict | None:
         return None
     sub = replace(task, max_stretch=row["stretch_limit"])
     ev = design_opt.Problem(sub).evaluation(np.array([row["free"][k] for k, _, _ in task.free]))
-    (out / "knee").mkdir(exist_ok=True)
+    stage, out = dirs
+    (stage / "knee").mkdir(exist_ok=True)
     say(f"FEM proof of the Pareto knee (stretch {row['max_principal_stretch']:.4g})")
-    return {"design_file": str(write_atomic(out / "knee" / "design.toml", ev.design.to_toml())),
+    with kept_if_unwritable(out / "knee" / "design.toml", "design"):
+        write_atomic(stage / "knee" / "design.toml", ev.design.to_toml())
+    return {"design_file": str(out / "knee" / "design.toml"),
             "stretch_limit": row["stretch_limit"], "predicted": ev.predicted(),
-            "fem": prove_on_meshes(ev, sub, run.mesh_size_mm, out / "knee", say,
+            "fem": prove_on_meshes(ev, sub, run.mesh_size_mm, stage / "knee", say,
                                    show_progress=run.show_progress)}
 
 

@@ -25,6 +25,7 @@ import pyvista as pv
 
 from softhand.meshes.atomic import atomic_path
 from softhand.reduced.vocabulary.errors import InputError
+from softhand.studies.io.files import kept_if_unwritable
 from softhand.studies.io.scene_read import field_names, field_values, load_scene
 from softhand.studies.io.render_style import (VIEWS, body_name, camera, clim_of, colour_label, default_field,
                                    default_png, finger_turns, has_display, title_of)
@@ -75,14 +76,17 @@ def inspect(path: str | Path, *, field: str | None = None, step: int | None = No
     png = None if interactive and out is None else Path(out or default_png(path, index, field))
     plotter = _plotter(interactive=interactive)
     _draw(plotter, scene, field, title=title_of(path, scene, index, n_steps), view=view, hand=hand)
+    written = None
     if png is not None:
-        with atomic_path(png) as tmp:
-            plotter.screenshot(str(tmp))
+        with kept_if_unwritable(png, "inspect"):  # a full disk: the field's range is still printed
+            with atomic_path(png) as tmp:
+                plotter.screenshot(str(tmp))
+            written = str(png)
     if interactive:
         plotter.show()
     plotter.close()
     return FieldSummary(str(path), index, n_steps, field, location, float(np.nanmin(values)),
-                        float(np.nanmax(values)), tuple(peak.tolist()), None if png is None else str(png))
+                        float(np.nanmax(values)), tuple(peak.tolist()), written)
 
 
 #: most steps an animation draws (the FEM verbs write at most 200 pressures or volumes)
@@ -121,13 +125,16 @@ def animate(path: str | Path, out: str | Path, *, field: str | None = None,
         frames.append(plotter.screenshot(return_img=True))
     plotter.close()
     frames = frames[::-1]
-    with atomic_path(out) as tmp:
-        if out.suffix == ".gif":
-            imageio.mimsave(tmp, frames, format="GIF", duration=1000.0 / fps, loop=0)
-        else:
-            imageio.mimsave(tmp, frames, fps=fps)
+    written = None
+    with kept_if_unwritable(out, "inspect"):
+        with atomic_path(out) as tmp:
+            if out.suffix == ".gif":
+                imageio.mimsave(tmp, frames, format="GIF", duration=1000.0 / fps, loop=0)
+            else:
+                imageio.mimsave(tmp, frames, fps=fps)
+        written = str(out)
     return FieldSummary(str(path), len(scenes) - 1, len(scenes), field, "point", clim[0], clim[1],
-                        (np.nan,) * 3, str(out))
+                        (np.nan,) * 3, written)
 
 
 def _check_view(view) -> None:

@@ -169,9 +169,12 @@ def _finished(section: Section, ctx: Context, out: Path, fresh: bool) -> Outcome
 
 
 def _read(path: Path) -> dict | None:
+    """A section's record; None if missing or damaged (too large, a FIFO, nested too deep)."""
+    from softhand.studies.io.files import read_bounded
+
     try:
-        return json.loads(path.read_text())
-    except (OSError, ValueError):
+        return json.loads(read_bounded(path, 64 << 20))
+    except (OSError, ValueError, RecursionError):
         return None
 
 

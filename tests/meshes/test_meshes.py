@@ -309,6 +309,10 @@ def test_a_mesh_too_large_for_the_memory_is_refused_before_meshing(monkeypatch):
         FingerModel(design, large)
 
 
+#: the manifest of an earlier bend run that wrote result.json (docs/outputs.md)
+EARLIER = '{"run": "earlier", "outputs": ["result.json"]}'
+
+
 @pytest.mark.parametrize("files, argv, field", [
     ({"t.toml": "[object]\ndiameter_mm = 180.0\nmass_kg = 2.0\n[pump]\nmax_pressure_MPa = 2.0\n"
                 "[free]\na_mm = [3.5, 4.5]\n[fem]\nmesh_size_mm = 0.6\n"},
@@ -319,9 +323,9 @@ def test_a_mesh_too_large_for_the_memory_is_refused_before_meshing(monkeypatch):
     ({"s.toml": "lhs = 2\nmesh_size_mm = 0.5\n[space]\na_mm = [3.0, 6.0]\nb_mm = [3.0, 7.0]\n"
                 "d_mm = [10.0, 20.0]\nl0_mm = [120.0, 200.0]\ntie_width_mm = [5.0, 15.0]\n"},
      ["calibrate", "finger", "--space", "s.toml", "--out", "t.csv", "--no-progress"], "s.toml: mesh_size_mm = 0.5"),
-    ({"o/result.json": "{}"},  # the last run's result, kept
+    ({"o/result.json": "{}", "o/.softhand-outputs.json": EARLIER},  # the last run's result, kept
      ["bend", "--mesh-size-mm", "0.6", "--out", "o"], "mesh = 'gmsh mesh_size=0.6"),
-    ({"o/result.json": "{}"},  # a mesh refused for folded elements keeps it too
+    ({"o/result.json": "{}", "o/.softhand-outputs.json": EARLIER},  # a mesh refused for folded elements keeps it too
      ["bend", "--mesh-size-mm", "12", "--edge-ratio", "0.5", "--out", "o"], "fold over themselves"),
 ])
 def test_a_refused_mesh_is_one_line_before_any_work_and_touches_no_output(files, argv, field, tmp_path,

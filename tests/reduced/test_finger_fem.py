@@ -12,48 +12,10 @@ from softhand.reduced.vocabulary.errors import InputError
 from softhand.studies.calibration.space import finger_design
 from softhand.studies.calibration.finger_table import table_csv
 
+from synthetic_tables import synthetic_table as _synthetic_table, truth as _truth
+
 BOX = {"a_mm": (3.0, 6.0), "b_mm": (3.0, 7.0), "d_mm": (10.0, 20.0), "l0_mm": (120.0, 200.0),
        "tie_width_mm": (5.0, 15.0)}
-#: a known residual the fit's model class holds exactly: y = ln(P / P_28) and ln kappa, where
-#: dQ = a^2 pi d theta + a^3 kappa P / mu_sf
-Y = (0.25, 0.05, 0.1)   # y = Y0 + Y1 x_shape + Y2 theta, x_shape: (b / (L - w))^2 scaled
-K = (1.2, -0.3, 0.08)   # ln kappa = K0 + K1 x_tie + K2 theta, x_tie: -ln(1 - w / L) scaled
-
-
-def _scaled(v, lo, hi):
-    return 2 * (v - lo) / (hi - lo) - 1
-
-
-def _truth(d, theta, ties):
-    """(P, dQ) of the model class at design d from Y, K (the scalings over the ties' range)."""
-    L = d.l0 / 6
-    shape = lambda w: (d.b / (L - w))**2  # noqa: E731
-    tie = lambda w: -math.log1p(-w / L)  # noqa: E731
-    xs = _scaled(shape(d.tie_width), shape(ties[0]), shape(ties[-1]))
-    xt = _scaled(tie(d.tie_width), tie(ties[0]), tie(ties[-1]))
-    P = hand.finger_pressure(theta, d.replace(finger_model="paper")) * np.exp(Y[0] + Y[1] * xs + Y[2] * theta)
-    kappa = np.exp(K[0] + K[1] * xt + K[2] * theta)
-    return P, d.a**2 * math.pi * d.d * theta + d.a**3 * kappa * P / d.mu_sf
-
-
-def _synthetic_table(tmp_path, ties=(5.0, 10.0, 15.0)):
-    """A table whose 'FEM' points follow Y, K exactly, over the tie width only."""
-    designs = [finger_design({"a_mm": 4.0, "b_mm": 5.0, "d_mm": 15.0, "l0_mm": 180.0,
-                              "tie_width_mm": t}) for t in ties]
-    groups = [finger_fem.groups_of(d) for d in designs]
-    rows = []
-    for i, (d, g) in enumerate(zip(designs, groups)):
-        for theta in (0.2, 0.6, 1.0):
-            P, dQ = _truth(d, theta, ties)
-            rows.append({"design": i, **g, "theta": theta, "p_tilde": float(P) / d.mu_sf,
-                         "q_tilde": float(dQ) / d.a**3})
-    ranges = {k: (v, v) for k, v in groups[0].items()}
-    ranges["tie_link"] = (groups[0]["tie_link"], groups[-1]["tie_link"])
-    path = tmp_path / "synthetic.csv"
-    path.write_text(table_csv(rows, ranges, ["synthetic test table"], "p_terms=s2 th, q_terms=lt th"))
-    return path, designs, ties
-
-
 def test_fit_recovers_a_residual_of_its_model_class(tmp_path):
     """P = P_28 e^y and dQ = a^2 pi d theta + a^3 kappa P / mu between and beyond the rows: rtol
     1e-6 bounds the cubic splines' interpolation error (0.5 deg knots); theta is capped at the
@@ -193,7 +155,7 @@ def test_a_kernel_table_whose_features_do_not_tell_its_designs_apart_is_named(tm
 
 
 def test_a_design_file_names_its_own_table_relative_to_itself(tmp_path):
-    """write_design_with_table: FILE.toml next to FILE.csv, finger_model "fem", the table found
+    """write_design_with_table: FILE_fem.toml next to FILE.csv, finger_model "fem", the table found
     relative to the design file; the CLI's error for a design outside it is one line, exit 2."""
     from softhand.studies.cli.main import main
     from softhand.studies.calibration.finger_table import write_design_with_table

@@ -459,26 +459,30 @@ def test_a_free_sheet_stays_a_thin_sheet_that_the_pump_pushes():
     assert 0.0 <= ev.P_contact <= ev.P_grasp <= task.max_pressure
 
 
-def test_a_design_run_stopped_mid_proof_leaves_none_of_its_files(tmp_path, monkeypatch):
+def test_a_design_run_stopped_mid_proof_leaves_none_of_its_files_and_the_earlier_whole(tmp_path, monkeypatch):
     """Ctrl-C during the FEM proof had left design.toml without result.json, next to an
-    earlier run's result.json that no longer matched it. The earlier record goes when a run
-    starts, the stopped run's files (design, VTK) when it stops; other files stay."""
+    earlier run's result.json that no longer matched it. The run writes into a staging folder:
+    stopped, the earlier run's record stays whole and none of the stopped run's files (design,
+    VTK) shows; other files stay."""
     from softhand.studies.cli import main as cli
     from softhand.studies.design import workflow
+    from softhand.studies.io.files import MANIFEST
 
     task, out = _write(tmp_path, CI_TASK_TOML), tmp_path / "out"
     out.mkdir()
     (out / "result.json").write_text('{"design_file": "design.toml"}\n')  # an earlier run's record
+    (out / MANIFEST).write_text('{"run": "earlier", "outputs": ["result.json"]}\n')
     (out / "notes.txt").write_text("mine\n")
 
-    def stopped_proof(ev, task, mesh_size_mm, out, say):
+    def stopped_proof(ev, task, mesh_size_mm, out, say, **options):
         (out / "grasp").mkdir()
         (out / "grasp" / "step_0.vtu").write_text("half a VTK")
         raise KeyboardInterrupt
 
     monkeypatch.setattr(workflow, "prove_on_meshes", stopped_proof)
     assert cli.main(["design", "--task", str(task), "--out", str(out), "--seed", "3"]) == 130
-    assert sorted(p.name for p in out.iterdir()) == ["notes.txt"]
+    assert sorted(p.name for p in out.iterdir()) == [MANIFEST, "notes.txt", "result.json"]
+    assert (out / "result.json").read_text() == '{"design_file": "design.toml"}\n'
     fresh = tmp_path / "fresh" / "out"  # a folder the stopped run made goes too
     assert cli.main(["design", "--task", str(task), "--out", str(fresh), "--seed", "3"]) == 130
     assert not fresh.exists()

@@ -62,7 +62,7 @@ def test_csv_lists_become_semicolon_cells(tmp_path):
     assert path.read_text().splitlines() == ["P,w", "0.1,0.2;0.8"]
 
 
-def test_a_reservoir_run_replaces_the_last_runs_outputs_and_leaves_none_when_stopped(tmp_path, monkeypatch):
+def test_a_reservoir_run_replaces_the_last_runs_outputs_and_keeps_them_whole_when_stopped(tmp_path, monkeypatch):
     from softhand.studies.cli.main import main
     from softhand.studies.io import reservoir_files
 
@@ -80,9 +80,12 @@ def test_a_reservoir_run_replaces_the_last_runs_outputs_and_leaves_none_when_sto
         write(result, folder)
         raise KeyboardInterrupt
 
+    before = {p.name: p.read_bytes() for p in out.iterdir() if p.is_file()}
     monkeypatch.setattr(reservoir_files, "write_sheet_vtk", stopped)
     assert main(["reservoir", "--volume-mm3", "16000", "--out", str(out), "--no-progress"]) == 130
-    assert sorted(p.name for p in out.iterdir()) == ["notes.txt"]  # no half of two runs
+    # the earlier complete result stays whole, nothing of the stopped run shows
+    assert {p.name: p.read_bytes() for p in out.iterdir() if p.is_file()} == before
+    assert sorted(p.name for p in out.iterdir() if p.is_dir()) == ["sheet"]
 
 
 def test_a_stopped_bend_leaves_no_half_written_series(tmp_path, monkeypatch):
@@ -107,23 +110,27 @@ def test_a_stopped_bend_leaves_no_half_written_series(tmp_path, monkeypatch):
     assert sorted(p.name for p in out.iterdir()) == ["notes.txt"]
 
 
-def test_a_design_run_replaces_the_last_runs_outputs_and_leaves_none_when_stopped(tmp_path, monkeypatch, capsys):
+def test_a_design_run_replaces_the_last_runs_outputs_and_keeps_them_whole_when_stopped(tmp_path, monkeypatch, capsys):
     from softhand.studies.cli.main import main
     from softhand.studies.io import files
 
     task = str(Path(__file__).resolve().parents[2] / "studies" / "designs" / "tasks" / "paper_task.toml")
     out = tmp_path / "d"
     (out / "knee").mkdir(parents=True)
-    (out / "knee" / "design.toml").write_text("an earlier run's")
-    (out / "grasp.pvd").write_text("an earlier run's")
+    (out / "knee" / "design.toml").write_text("the user's, not a run's")
     (out / "notes.txt").write_text("the user's")
     argv = ["design", "--task", task, "--no-fem", "--no-progress", "--json", "--out", str(out)]
+    assert main(argv) == 2  # a folder of the user's where the run writes one: refused, kept
+    assert "knee" in capsys.readouterr().err and (out / "knee" / "design.toml").read_text() == "the user's, not a run's"
+    (out / "knee" / "design.toml").unlink()
+    (out / "knee").rmdir()
     assert main(argv) == 0
-    assert sorted(p.name for p in out.iterdir()) == ["design.toml", "notes.txt", "result.json"]
+    assert sorted(p.name for p in out.iterdir()) == [files.MANIFEST, "design.toml", "notes.txt", "result.json"]
+    before = {p.name: p.read_bytes() for p in out.iterdir()}
 
     def stopped(path, data):
         raise KeyboardInterrupt
 
     monkeypatch.setattr(files, "write_atomic", stopped)
     assert main(argv) == 130
-    assert sorted(p.name for p in out.iterdir()) == ["notes.txt"]  # no half of a run, no orphan
+    assert {p.name: p.read_bytes() for p in out.iterdir()} == before  # the earlier result whole, no orphan

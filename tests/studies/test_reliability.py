@@ -1,6 +1,7 @@
 """Concurrent runs of one study, corrupt case files and cache entries, signals, pipes."""
 import json
 import os
+import shutil
 import signal
 import subprocess
 import sys
@@ -12,6 +13,8 @@ import pytest
 from softhand.studies.cli.main import main
 from softhand.studies.batch.runner import RESULT, plan, study_dir
 from softhand.studies.batch.studyfile import load_study
+from softhand.studies.io.files import MANIFEST
+
 from conftest import CI_MESH_ARGS
 from test_runner import _default_sigint, install_kind
 
@@ -239,10 +242,12 @@ def test_bend_failure_is_one_line_with_the_pressure_and_out_never_mixes_runs(tmp
 
     out = tmp_path / "bend"
     out.mkdir()
-    for name in ("result.json", "table.csv", "hand.csv", "finger.pvd", "finger_0007.vtu", "notes.txt"):
+    for name in ("result.json", "table.csv", "hand.csv", "finger.pvd", "notes.txt"):
         (out / name).write_text("an earlier run")
     (out / "finger").mkdir()
     (out / "finger" / "finger_0003.vtm").write_text("an earlier run")
+    earlier = ["result.json", "table.csv", "hand.csv", "finger.pvd", "finger"]  # not notes.txt: the user's
+    (out / MANIFEST).write_text(json.dumps({"run": "earlier", "outputs": earlier}))
 
     def failing(study, on_state=None, model=None):
         error = NotConverged("Newton did not converge above P = 0.03 MPa on the way to 0.1 MPa",
@@ -256,7 +261,7 @@ def test_bend_failure_is_one_line_with_the_pressure_and_out_never_mixes_runs(tmp
     assert len(err) == 1 and "P = 0.03 MPa" in err[0] and "Traceback" not in err[0]
     result = json.loads((out / "result.json").read_text())
     assert result["failed"] and "0.03 MPa" in result["error"] and result["rows"] == []
-    assert sorted(p.name for p in out.iterdir()) == ["notes.txt", "result.json"]  # the user's file stays
+    assert sorted(p.name for p in out.iterdir()) == [MANIFEST, "notes.txt", "result.json"]  # the user's file stays
 
 
 def test_an_output_that_fails_after_the_computation_loses_nothing(tmp_path, monkeypatch, capsys):
@@ -267,7 +272,7 @@ def test_an_output_that_fails_after_the_computation_loses_nothing(tmp_path, monk
         raise OSError(28, "No space left on device")
 
     monkeypatch.setattr(files, "write_atomic", full_disk)
-    assert main(["curve", "--theta-deg", "0:90:30", "--plot", str(tmp_path / "c.png"), "--json"]) == 0
+    assert main(["curve", "--theta-deg", "0:90:30", "--plot", str(tmp_path / "c.png"), "--json"]) == 3
     out, err = capsys.readouterr()
     assert len(json.loads(out)["rows"]) == 4
     assert "warning" in err and "No space left on device" in err and not (tmp_path / "c.png").exists()
@@ -343,3 +348,102 @@ def test_a_grasp_fem_that_stops_saves_the_states_it_reached(tmp_path, monkeypatc
     assert sum(first["contact_force_N"]) > 0 and first["theta_deg"] > 0
     datasets = re.findall(r"<DataSet[^>]*file=\"([^\"]+)\"", (out / "grasp.pvd").read_text())
     assert len(datasets) == 2 and all((out / f).is_file() for f in datasets)
+
+
+def test_damaged_case_state_is_recomputed_never_followed_nor_waited_on(quick_study, tmp_path, capsys):
+    """A finished case's folder replaced by a symbolic link (to a valid result elsewhere), its
+    result.json by a FIFO (status and run hung on it), by a 600 MB file (read whole) or by
+    JSON nested 200 000 deep: each case is 'corrupt' and recomputed; the link's target and
+    the other files are never touched."""
+    root = tmp_path / "res"
+    argv = ["study", "run", str(quick_study), "--workers", "1", "--results", str(root), "--no-progress"]
+    assert main(argv) == 0
+    study = load_study(quick_study)
+    sdir = study_dir(study, root)
+    link, fifo, huge, deep = plan(study)[:4]
+    elsewhere = tmp_path / "elsewhere"
+    shutil.move(sdir / link.key, elsewhere)
+    (sdir / link.key).symlink_to(elsewhere, target_is_directory=True)
+    kept = {p.name: p.read_bytes() for p in elsewhere.iterdir()}
+    (sdir / fifo.key / RESULT).unlink()
+    os.mkfifo(sdir / fifo.key / RESULT)
+    with open(sdir / huge.key / RESULT, "r+b") as f:
+        f.truncate(600 * 2**20)  # sparse: no 600 MB on the disk
+    (sdir / deep.key / RESULT).write_text("[" * 200_000 + "]" * 200_000)
+    capsys.readouterr()
+    start = time.monotonic()
+    assert main(["study", "status", str(quick_study), "--results", str(root)]) == 0
+    assert "4 corrupt" in capsys.readouterr().out and time.monotonic() - start < 30
+    (tmp_path / "log").unlink()
+    assert main(argv) == 0
+    assert len((tmp_path / "log").read_text().splitlines()) == 4
+    assert not (sdir / link.key).is_symlink() and {p.name: p.read_bytes() for p in elsewhere.iterdir()} == kept
+    _check_results(study, root)
+
+
+def test_damaged_claims_and_report_folders_are_one_line(quick_study, tmp_path, capsys):
+    """A folder where a case's claim lock goes, symbolic links for .claims/ or report/ (followed
+    out of --results before): one error line, exit 2, nothing written through the link."""
+    root = tmp_path / "res"
+    study = load_study(quick_study)
+    sdir = study_dir(study, root)
+    (sdir / ".claims" / f"{plan(study)[0].key}.lock").mkdir(parents=True)
+    argv = ["study", "run", str(quick_study), "--workers", "1", "--results", str(root), "--no-progress"]
+    assert main(argv) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "claim lock" in err[0]
+    shutil.rmtree(sdir / ".claims")
+    outside = tmp_path / "outside"
+    outside.mkdir()
+    for name, action in ((".claims", "run"), ("report", "report")):
+        (sdir / name).symlink_to(outside, target_is_directory=True)
+        assert main(["study", action, str(quick_study), "--results", str(root)]) == 2
+        err = capsys.readouterr().err.strip().splitlines()
+        assert len(err) == 1 and "symbolic link" in err[0]
+        (sdir / name).unlink()
+    assert list(outside.iterdir()) == []
+
+
+def test_a_read_only_finished_study_is_one_warning(quick_study, tmp_path, monkeypatch, capsys):
+    """run and report of a finished study whose folder refuses writes (tests run as root, for
+    whom chmod refuses nothing: the refusal is simulated): tracebacks before; now the summary,
+    one warning line, exit 3."""
+    from softhand.studies.batch import index, report
+
+    root = tmp_path / "res"
+    argv = ["study", "run", str(quick_study), "--workers", "1", "--results", str(root), "--no-progress"]
+    assert main(argv) == 0
+    capsys.readouterr()
+
+    def refused(path, *args, **kwargs):
+        raise PermissionError(13, "Permission denied", str(path))
+
+    monkeypatch.setattr(index, "write_csv", refused)
+    monkeypatch.setattr(report, "write_atomic", refused)
+    assert main(argv) == 3
+    out, err = capsys.readouterr()
+    assert "31 done" in out and len(err.strip().splitlines()) == 1 and "Permission denied" in err
+    assert main(["study", "report", str(quick_study), "--results", str(root)]) == 3
+    assert len(capsys.readouterr().err.strip().splitlines()) == 1
+
+
+def test_a_weights_cache_entry_that_is_a_fifo_or_nested_deep_is_recomputed(tmp_path, capsys):
+    from softhand.studies.weights import read_entry
+
+    fifo, deep = tmp_path / "fifo.json", tmp_path / "deep.json"
+    os.mkfifo(fifo)
+    deep.write_text("[" * 200_000 + "]" * 200_000)
+    assert read_entry(fifo, "k") is None and read_entry(deep, "k") is None
+    assert capsys.readouterr().err.count("invalid cache entry") == 2
+
+
+def test_a_folded_mesh_in_a_weights_study_is_refused_before_any_case(tmp_path, capsys):
+    """gmsh 10 mm graded at the ring edges folds (tests/test_meshes.py): the weights study's
+    cases failed one by one after the others ran; now one line when the run starts."""
+    study = tmp_path / "w.toml"
+    study.write_text('kind = "weights"\nmesh_size_mm = 10.0\n[sweep]\ndiameter_mm = [180.0, 200.0]\n')
+    assert main(["study", "run", str(study), "--workers", "1", "--results", str(tmp_path / "r"),
+                 "--no-progress"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "fold over themselves" in err[0]
+    assert not (tmp_path / "r" / "w").exists() or not any((tmp_path / "r" / "w").iterdir())

@@ -26,8 +26,11 @@ def verb_json(argv: list[str]) -> dict:
 
 
 def same_files(a: Path, b: Path) -> list[str]:
-    names = sorted(p.name for p in a.iterdir())
-    assert names == sorted(p.name for p in b.iterdir())
+    """The same outputs, byte for byte (a verb's folder also holds its run's manifest)."""
+    from softhand.studies.io.files import MANIFEST
+
+    names = sorted(p.name for p in a.iterdir() if p.name != MANIFEST)
+    assert names == sorted(p.name for p in b.iterdir() if p.name != MANIFEST)
     for name in names:
         assert (a / name).read_bytes() == (b / name).read_bytes(), name
     return names

@@ -136,9 +136,11 @@ def run(args) -> int:
 
     from softhand.fem.newton import NotConverged
     from softhand.studies.bending import BendingStudy, run as run_study, vtk_writer
-    from softhand.studies.io.files import kept_if_unwritable, replaced_outputs
+    from softhand.studies.io.files import check_owned, kept_if_unwritable, replaced_outputs, unwritable_tolerant
 
     pressures = _check(args)
+    out = Path(args.out)
+    check_owned(out, OUTPUT_NAMES, "--out")
     design = design_from_args(args)
     if args.tie_width_mm is not None and args.tie_width_mm >= min(design.link_lengths):
         from softhand.reduced.vocabulary.errors import InputError
@@ -154,7 +156,6 @@ def run(args) -> int:
     t0 = time.perf_counter()
     model = FingerModel(study.design, study.options)
     build = time.perf_counter() - t0
-    out = Path(args.out)
     n_steps = len(pressures) + (1 if study.peak_mpa else 0)
     bar = tqdm(total=n_steps, desc="bend", unit="pressure", file=sys.stderr, leave=False,
                disable=args.no_progress)
@@ -165,18 +166,24 @@ def run(args) -> int:
         bar.set_postfix(P=f"{state.P:.2f}", theta=f"{state.theta * 57.29578:.1f}deg")
         bar.update(0 if state.P > pressures[-1] and state.P < study.peak_mpa else 1)
 
-    # the last run's outputs go now; stopped (Ctrl-C, SIGTERM), no half-written series stays
-    with replaced_outputs(out, OUTPUT_PATTERNS):
-        on_state = vtk_writer(out / "finger.pvd", then=progress)
+    # written into a private staging folder, renamed into place when complete: stopped (Ctrl-C,
+    # SIGTERM, SIGKILL), the earlier run's result stays whole and no half-written series shows
+    with replaced_outputs(out, OUTPUT_NAMES, verb="bend") as stage:
+        write = unwritable_tolerant(vtk_writer(stage / "finger.pvd").write, out / "finger.pvd", "bend")
+
+        def on_state(model, state):
+            write(model, state.y, state.P)
+            progress(model, state)
+
         try:
             result = replace(run_study(study, on_state=on_state, model=model), build_seconds=build)
         except NotConverged as exc:  # Newton gave up: its last converged state is kept, with a record
-            return _failed(exc, converged, study, on_state.write, out)
+            return _failed(exc, converged, study, write, stage, out)
         finally:
             bar.close()
         summary = result.summary()
         with kept_if_unwritable(f"{out}/result.json, table.csv", "bend"):
-            result.write(out)
+            result.write(stage)
     if args.plot:
         with kept_if_unwritable(args.plot, "bend"):
             result.plot(args.plot)
@@ -204,13 +211,14 @@ def run(args) -> int:
     return 0
 
 
-#: the files and folders a bend run writes into --out; removed before a run so runs never mix
-OUTPUT_PATTERNS = ("result.json", "table.csv", "hand.csv", "finger.pvd", "finger", "finger_*.vtu")
+#: the files and folders a bend run writes into --out (its manifest: an earlier run's are replaced whole)
+OUTPUT_NAMES = ("result.json", "table.csv", "hand.csv", "finger.pvd", "finger")
 
 
-def _failed(exc, converged, study, write_vtk, out: Path) -> int:
-    """Newton gave up: the last converged state (VTK + result.json) and one error line naming
-    the pressure reached; exit code 1. ``write_vtk(model, y, P)`` adds a state to the VTK series."""
+def _failed(exc, converged, study, write_vtk, stage: Path, out: Path) -> int:
+    """Newton gave up: the last converged state (VTK + result.json, into the run's ``stage``)
+    and one error line naming the pressure reached; exit code 1. ``write_vtk(model, y, P)``
+    adds a state to the VTK series."""
     from softhand.studies.bending import row
     from softhand.studies.io.failure import save_last_converged
     from softhand.studies.io.files import write_csv
@@ -226,6 +234,7 @@ def _failed(exc, converged, study, write_vtk, out: Path) -> int:
     message = str(exc).split(";")[0]
     last = rows[-1]["P_cavity_MPa"] if rows else 0.0
     return save_last_converged(
-        out, "bend", "finger FEM", message, f"P_cavity = {last:.4g} MPa",
+        stage, "bend", "finger FEM", message, f"P_cavity = {last:.4g} MPa",
         {"last_converged_P_cavity_MPa": last, "rows": rows, "design": study.design.to_dict()},
-        write_files=(lambda: write_csv(out / "table.csv", rows)) if rows else None, files="finger.pvd")
+        write_files=(lambda folder: write_csv(folder / "table.csv", rows)) if rows else None, files="finger.pvd",
+        shown=out)

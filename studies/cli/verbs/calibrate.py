@@ -5,7 +5,7 @@
   (results/<name>/, resumable, ``--workers N``, ``--scheduler local|tcp://...``), then the
   nondimensional table with its provenance (the package's is reduced/calibrated/data/finger_fem.csv);
 * ``--design FILE.toml --out FILE.csv``: the same for one design (any geometry with 5 equal
-  hinges), and a design file FILE.toml next to the table that uses it
+  hinges), and a design file FILE_fem.toml next to the table that uses it
   (``finger_model = "fem"``, ``finger_table = "FILE.csv"``);
 * ``--check FILE.toml [--table FILE.csv]``: the designs of FILE.toml by FEM against the
   calibrated model (the package's table or ``--table``): theta at every FEM pressure, dQ,
@@ -71,6 +71,10 @@ def run(args) -> int:
                                             "FEM and writes none")
     if args.check is not None:
         return _check(_load_space(args.check), args)
+    if args.design:
+        from softhand.studies.calibration.finger_table import check_design_file
+
+        check_design_file(args.out, (args.design,))
     space = _load_space(args.space) if args.space else fc.single_design_space(args.design)
     results = _run(space, args)
     if results is None:
@@ -80,11 +84,17 @@ def run(args) -> int:
         ("--workers", args.workers if args.workers != 1 else None), ("--scheduler", args.scheduler)
     command = "softhand calibrate finger " + " ".join(f"{k} {shlex.quote(str(v))}" for k, v in given
                                                       if v is not None)
-    path = write_table(args.out, space, results, command)
-    print(f"table: {path} ({len(space.points)} designs)")
-    if args.design:
-        toml = write_design_with_table(space.designs()[0], path)
-        print(f"design using it: {toml}")
+    from softhand.studies.batch.runner import study_dir
+    from softhand.studies.calibration.finger import as_study
+    from softhand.studies.io.files import kept_if_unwritable
+
+    with kept_if_unwritable(f"{args.out} (the FEM cases are kept in {study_dir(as_study(space), args.results)}: "
+                            f"rerun with --finished)", "calibrate"):
+        path = write_table(args.out, space, results, command)
+        print(f"table: {path} ({len(space.points)} designs)")
+        if args.design:
+            toml = write_design_with_table(space.designs()[0], path)
+            print(f"design using it: {toml}")
     return 0
 
 

@@ -142,15 +142,17 @@ def study_from_args(args):
 
 def run(args) -> int:
     from softhand.studies.control import FILES, run as run_study
-    from softhand.studies.io.files import check_output_tree
+    from softhand.studies.io.files import check_output_tree, check_owned, replaced_outputs
 
     study = study_from_args(args)
     if args.out:
         check_output_tree(args.out, "--out", files=FILES)
+        check_owned(args.out, FILES, "--out")
     result = run_study(study)
-    if args.out:
-        with kept_if_unwritable(Path(args.out), "control"):
-            result.write(args.out, args.mode)
+    with replaced_outputs(args.out, FILES, verb="control") as stage:  # renamed into place when whole
+        if stage is not None:
+            with kept_if_unwritable(Path(args.out), "control"):
+                result.write(stage, args.mode)
     if args.plot:
         with kept_if_unwritable(args.plot, "control"):
             result.plot(args.plot, args.mode)

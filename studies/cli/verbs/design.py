@@ -43,7 +43,7 @@ def run(args) -> int:
     from softhand.studies.cli.checks import check_writable
     from softhand.studies.design.task import LOWER, UPPER, load_task
     from softhand.studies.design.workflow import OUTPUT_FILES, OUTPUT_FOLDERS, DesignRun, run_task
-    from softhand.studies.io.files import check_output_tree
+    from softhand.studies.io.files import check_output_tree, check_owned
 
     lo, hi = LOWER["mesh_size_mm"], UPPER["mesh_size_mm"]
     if args.mesh_size_mm is not None and not lo <= args.mesh_size_mm <= hi:
@@ -57,9 +57,10 @@ def run(args) -> int:
             if value is not None:
                 raise InputError(option, value, "sets the FEM proof, which --no-fem skips")
     task = load_task(args.task)
-    out = Path(args.out) if args.out else Path("results") / "design" / task.name
+    out = Path(args.out) if args.out else _default_out(task, args.task)
     check_writable(out, "dir", "--out")  # also the default folder, which argparse's checks do not see
-    check_output_tree(out, "--out", files=OUTPUT_FILES, folders=OUTPUT_FOLDERS)
+    check_output_tree(out, "--out")
+    check_owned(out, OUTPUT_FILES + OUTPUT_FOLDERS, "--out")
     if not args.no_fem:
         _check_proof_size(task, args)
     say = (lambda text: print(f"softhand design: {text}", file=sys.stderr)) if args.json else print
@@ -71,6 +72,18 @@ def run(args) -> int:
     else:
         _print(result, task, opt)
     return 0 if ok else 1
+
+
+def _default_out(task, path) -> Path:
+    """results/design/<task's name>, the name checked: one that is no plain folder name (a task
+    file named '...toml' gives '..') would write elsewhere, e.g. into results/ itself."""
+    from softhand.studies.batch.studyfile import is_folder_name
+
+    if not is_folder_name(task.name):
+        raise InputError("--task", str(path), f"its name {task.name!r} cannot name the output folder "
+                         "results/design/NAME (letters, digits, '_', '-', '.', starting with a letter "
+                         "or digit); rename the file or give --out DIR")
+    return Path("results") / "design" / task.name
 
 
 def _check_proof_size(task, args) -> None:

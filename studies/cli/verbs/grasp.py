@@ -95,6 +95,9 @@ def _weights(args, design, mass: float) -> tuple[np.ndarray, str, list[str]]:
         D = PAPER_NAMES[args.weights.strip()]
         w, source = grasp.weights_for_diameter(D, design), f"paper, {D:g} mm (section III-C)"
     elif args.weights is not None:
+        if ":" in args.weights:  # a range start:stop:step is no vector of hinge weights
+            raise InputError("--weights", args.weights, f"must be {_WEIGHT_FORMS}: one weight per hinge, "
+                                                        "not a range")
         w, source = parse_values(args.weights, "--weights", forms=_WEIGHT_FORMS), "given"
     else:
         w, source, caveat = _fem_weights(_scalar(args.diameter_mm, "--diameter-mm"), mass, design)

@@ -59,12 +59,16 @@ def _study(args):
                           n_thick=args.n_thick)
 
 
-#: what a reservoir run writes into --out (an earlier run's are removed when this one writes)
-OUTPUT_PATTERNS = ("result.json", "rows.csv", "sheet.pvd", "sheet", "sheet_V*_rz.vtu")
+#: what a reservoir run writes into --out (its manifest: an earlier run's are replaced whole)
+OUTPUT_NAMES = ("result.json", "rows.csv", "sheet.pvd", "sheet", "sheet_V*_rz.vtu")
 
 
 def run(args) -> int:
     study = _study(args)
+    if args.out:
+        from softhand.studies.io.files import check_owned
+
+        check_owned(args.out, OUTPUT_NAMES, "--out")  # a folder of the user's named sheet/: before the FEM
     if args.write_calibration:
         from softhand.studies.reservoir import write_calibration
 
@@ -83,8 +87,8 @@ def run(args) -> int:
     except NotConverged as exc:
         return _failed(exc, study, Path(args.out or FAILED_OUT))
     summary = result.summary()
-    with replaced_outputs(args.out, OUTPUT_PATTERNS):  # the earlier run's stay until this one has finished
-        write_outputs(result, "reservoir", args.out, args.plot)
+    with replaced_outputs(args.out, OUTPUT_NAMES, verb="reservoir") as stage:  # renamed into place when whole
+        write_outputs(result, "reservoir", stage, args.plot, shown=args.out)
     if args.json:
         print_json({"rows": result.rows, **summary})
     else:
@@ -124,5 +128,6 @@ def _failed(exc, study, out: Path) -> int:
     return save_last_converged(
         out, "reservoir", "reservoir FEM", f"{str(exc).split(';')[0]} (Newton failed at the "
         "smallest volume step)", reached, record,
-        write_files=(lambda: write_sheet_states(solid, [state], out)) if state else None,
-        files="sheet.pvd" if state else "")
+        write_files=(lambda folder: write_sheet_states(solid, [state], folder)) if state else None,
+        files="sheet.pvd" if state else "", names=OUTPUT_NAMES)
+

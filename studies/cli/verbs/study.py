@@ -95,6 +95,10 @@ def _status(study, args) -> int:
 def _report(study, args) -> int:
     from softhand.studies.batch.report import write_report
 
-    path = write_report(study, args.results)
-    print(f"report: {path}", file=sys.stdout)
+    from softhand.studies.batch.runner import study_dir
+    from softhand.studies.io.files import kept_if_unwritable
+
+    with kept_if_unwritable(study_dir(study, args.results) / "report.md", "study"):  # e.g. a read-only study
+        path = write_report(study, args.results)
+        print(f"report: {path}", file=sys.stdout)
     return 0

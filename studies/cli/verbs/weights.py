@@ -114,7 +114,8 @@ def _failed(exc, out: Path) -> int:
     record = failed_record(exc.case, exc.states)
     return save_last_converged(
         out, "weights", "grasp FEM", str(exc).split(";")[0], f"P_cavity = {record['last_converged_P_cavity_MPa']:.4g} MPa",
-        record, write_files=lambda: write_vtk(out, exc.model, exc.states), files="grasp.pvd")
+        record, write_files=lambda folder: write_vtk(folder, exc.model, exc.states), files="grasp.pvd",
+        names=OUTPUT_NAMES)
 
 
 def _distinct(values, text: str, option: str) -> None:
@@ -171,18 +172,19 @@ def _one(case, args) -> dict:
 
     from softhand.studies.weights import run_case
 
-    with replaced_outputs(args.out, OUTPUT_PATTERNS), \
+    # staged, renamed into place when complete: the earlier run's result stays whole until then
+    with replaced_outputs(args.out, OUTPUT_NAMES, verb="weights") as stage, \
             tqdm(total=2, desc="grasp FEM", unit="state", file=sys.stderr, leave=False,
                  disable=args.no_progress) as bar:  # the series is written as the states converge
-        result = run_case(case, cache=not args.no_cache, out=args.out, progress=lambda state: bar.update())
+        result = run_case(case, cache=not args.no_cache, out=stage, progress=lambda state: bar.update())
         if args.out:
             with kept_if_unwritable(Path(args.out) / "result.json", "weights"):
-                result.write(args.out)
+                result.write(stage)
     return result.summary()
 
 
-#: what one grasp writes into --out (an earlier run's are removed before it writes)
-OUTPUT_PATTERNS = ("result.json", "grasp.pvd", "grasp")
+#: what one grasp writes into --out (its manifest: an earlier run's are replaced whole)
+OUTPUT_NAMES = ("result.json", "grasp.pvd", "grasp")
 
 
 def _print_one(result: dict) -> None:
