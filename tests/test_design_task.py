@@ -18,7 +18,7 @@ CI_TASK = {
     "object": {"diameter_mm": 180.0, "mass_kg": 2.0},
     "grasp": {"force_factor": 2.0},
     "pump": {"max_pressure_MPa": 2.0},
-    "limits": {"max_principal_stretch": 1.4},
+    "limits": {"rubber_stretch": 1.4},
     "free": {"d_mm": [10.0, 20.0], "V0_mm3": [12000.0, 30000.0]},
 }
 FAST = design_opt.OptimiserOptions(seed=3)
@@ -46,7 +46,8 @@ def test_task_file_reads_the_paper_task():
     ({"grasp": {"force_factor": 2.0, "margin_N": 1.0}}, "grasp.margin_N"),
     ({"grasp": {"objective": "cheapest"}}, "grasp.objective"),
     ({"pump": {"max_pressure_MPa": "high"}}, "pump.max_pressure_MPa"),
-    ({"limits": {"max_principal_stretch": 0.9}}, "limits.max_principal_stretch"),
+    ({"limits": {"rubber_stretch": 0.9}}, "limits.rubber_stretch"),
+    ({"limits": {"max_principal_stretch": 1.5}}, "limits.max_principal_stretch"),  # renamed: refused
     ({"colour": "red"}, "colour"),
     ({"base_design": "nowhere.toml"}, "base_design"),
     ({"design": {"b_mm": -5.0}}, "b_mm"),
@@ -251,7 +252,7 @@ force_factor = 2.0
 [pump]
 max_pressure_MPa = 2.0
 [limits]
-max_principal_stretch = 1.4
+rubber_stretch = 1.4
 [free]
 d_mm = [10.0, 20.0]
 V0_mm3 = [12000.0, 30000.0]
@@ -266,7 +267,7 @@ def test_cli_json_no_fem_writes_a_design_every_verb_reads(tmp_path):
     result = json.loads(proc.stdout)
     for key in ("design", "predicted", "fem", "constraints", "design_file"):
         assert key in result
-    assert set(result["predicted"]) >= {"P_grasp_MPa", "theta_grasp_deg", "F_v_N", "max_principal_stretch"}
+    assert set(result["predicted"]) >= {"P_grasp_MPa", "theta_grasp_deg", "F_v_N", "rubber_stretch"}
     assert all({"name", "value", "limit", "satisfied"} <= set(c) for c in result["constraints"])
     assert result["fem"] is None
     design = load_design(result["design_file"])
@@ -284,7 +285,7 @@ def test_cli_pareto_plot(tmp_path):
     assert proc.returncode == 0, proc.stderr
     rows = json.loads(proc.stdout)["pareto"]["rows"]
     assert plot.stat().st_size > 1000
-    lam = [r["max_principal_stretch"] for r in rows]
+    lam = [r["rubber_stretch"] for r in rows]
     P = [r["P_grasp_MPa"] for r in rows]
     assert np.all(np.diff(lam) < 0) and np.all(np.diff(P) >= -1e-9)  # less stretch costs pressure
 

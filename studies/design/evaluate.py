@@ -91,7 +91,7 @@ class Evaluation:
     P_contact: float           #: free hand's pump pressure at theta_g (27) [MPa]
     F_v: float                 #: required normal force per finger [N]
     F_v_at_limit: float        #: F_v at the pump limit, or at P_margin below it (see margin_edge) [N]
-    stretch: float             #: the tube's peak principal stretch, eq. (8) x stretch_factor, at theta_hold
+    stretch: float             #: the tube's rubber stretch, eq. (8) x stretch_factor, at theta_hold
     sheet_stretch: float       #: the reservoir sheet's stretch at V0, eq. (16)
     constraints: tuple[Constraint, ...]
     theta_hold: float = math.nan  #: the finger's bend when it presses with the required F_v [rad]
@@ -118,7 +118,7 @@ class Evaluation:
                    if self.margin_edge else {}),
                 **({"no_P_grasp": self.no_grasp} if self.no_grasp else {}),
                 "w": self.w.tolist(), "touching_link": self.link, "depth_mm": self.depth,
-                "max_principal_stretch": self.stretch, "sheet_stretch": self.sheet_stretch,
+                "rubber_stretch": self.stretch, "sheet_stretch": self.sheet_stretch,
                 **self.contact_parts()}
 
     def contact_parts(self) -> dict:
@@ -211,7 +211,7 @@ def _constraints(design: HandDesign, task: Task, oil, stretch, sheet, P_grasp, P
         Constraint("sheet_thickness t [mm]", design.t, 0.0, ">=", 1.0),
         Constraint("reservoir_oil the fingers take at the grasp [mm^3]", oil, design.V0, "<="),
         Constraint("reservoir_below_limit_point V0 [mm^3]", design.V0, limit_point_volume(design), "<="),
-        Constraint("max_principal_stretch", stretch, task.max_stretch, "<="),
+        Constraint("rubber_stretch of the tube", stretch, task.max_stretch, "<="),
         Constraint("sheet_stretch at V0, eq. (16)", sheet, task.max_stretch, "<="),
         Constraint("pump_pressure at the grasp [MPa]", P_grasp, task.max_pressure, "<=", shortfall=grasp_shortfall),
         Constraint("contact: P(theta_g), the free hand's pump pressure where a pad touches the object "

@@ -167,7 +167,7 @@ def _prove_knee(pareto: dict, task, args, out, say) -> dict | None:
     sub = replace(task, max_stretch=row["stretch_limit"])
     ev = design_opt.Problem(sub).evaluation(np.array([row["free"][k] for k, _, _ in task.free]))
     (out / "knee").mkdir(exist_ok=True)
-    say(f"FEM proof of the Pareto knee (stretch {row['max_principal_stretch']:.4g})")
+    say(f"FEM proof of the Pareto knee (stretch {row['rubber_stretch']:.4g})")
     return {"design_file": str(write_atomic(out / "knee" / "design.toml", ev.design.to_toml())),
             "stretch_limit": row["stretch_limit"], "predicted": ev.predicted(),
             "fem": _prove(ev, sub, args, out / "knee", say)}
@@ -245,7 +245,7 @@ def _print(result: dict, task, opt) -> None:
     rows = [{"constraint": c["name"], "value": c["value"], "sense": c["sense"], "limit": c["limit"],
              "satisfied": c["satisfied"]} for c in result["constraints"]]
     print_table(rows)
-    keys = ("P_grasp_MPa", "P_contact_MPa", "theta_grasp_deg", "F_v_N", "max_principal_stretch", "w") + \
+    keys = ("P_grasp_MPa", "P_contact_MPa", "theta_grasp_deg", "F_v_N", "rubber_stretch", "w") + \
         (("F_v_at_pump_limit_N", "margin_N") if task.objective == "margin" else ())
     fem = result.get("fem") or {}
     base = result["base_design"]["predicted"]
@@ -268,7 +268,7 @@ def _print(result: dict, task, opt) -> None:
     if "pareto" in result:
         k = result["pareto"]["knee"]
         print(f"Pareto front: {len(result['pareto']['rows'])} points, knee at stretch "
-              f"{result['pareto']['rows'][k]['max_principal_stretch']:.4g}; plot {result['pareto']['plot']}")
+              f"{result['pareto']['rows'][k]['rubber_stretch']:.4g}; plot {result['pareto']['plot']}")
         knee = result["pareto"].get("knee_proof")
         if knee and "P_grasp_MPa" in knee["fem"]:
             print(_knee_line(knee))
