@@ -149,14 +149,16 @@ def main() -> None:
     parser.add_argument("--levels", type=int, nargs="+", default=[0, 1, 2])
     parser.add_argument("--designs", nargs="+", default=list(DESIGNS), choices=list(DESIGNS))
     parser.add_argument("--solve-only", action="store_true")
+    parser.add_argument("--order", nargs="+", metavar="DESIGN:LEVEL", help="solve these cases first, in this order")
     parser.add_argument("--no-sheet", action="store_true", help="leave out the reservoir sheet")
     parser.add_argument("--out", type=Path, default=Path("results/rubber_convergence"))
     args = parser.parse_args()
-    for n in sorted(args.levels):  # the coarse levels of every design first
-        for name in args.designs:
-            t0 = time.perf_counter()
-            solve_case(args.out, name, n)
-            print(f"solved {name} level {n} in {time.perf_counter() - t0:.0f} s", flush=True)
+    order = args.order or [f"{name}:{n}" for n in sorted(args.levels) for name in args.designs]
+    for case in order:  # default: the coarse levels of every design first
+        name, n = case.split(":")
+        t0 = time.perf_counter()
+        solve_case(args.out, name, int(n))
+        print(f"solved {name} level {n} in {time.perf_counter() - t0:.0f} s", flush=True)
     if args.solve_only:
         return
     groups = {}

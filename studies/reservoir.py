@@ -29,7 +29,7 @@ __all__ = ["ReservoirStudy", "ReservoirStudyResult", "run", "stroke_volume", "CO
 
 #: table columns of the CLI, in order
 COLUMNS = ["V_mm3", "p_MPa", "h_mm", "W_Nmm", "p_ellipse_MPa", "h_ellipse_mm", "W_ellipse_Nmm",
-           "lambda_r", "lambda_fem", "max_gap_mm"]
+           "lambda_r", "lambda_fem", "rubber_stretch", "max_gap_mm"]
 
 
 @dataclass(frozen=True)
@@ -120,6 +120,7 @@ def _row(state, design: HandDesign) -> dict:
         "h_ellipse_mm": float(ellipse.height(V, design)),
         "W_ellipse_Nmm": float(ellipse.strain_energy(V, design)),
         "lambda_r": float(ellipse.stretch(V, design)), "lambda_fem": state.mean_stretch,
+        "rubber_stretch": state.rubber_stretch, "max_principal_stretch": state.max_principal_stretch,
         "max_gap_mm": _ellipse_gap(state, design),
     }
 
