@@ -25,6 +25,8 @@ TABLE_FILE = Path(__file__).resolve().parent / "data" / "finger_fem.csv"
 GROUPS = ("b_a", "d_a", "link_a", "tie_link")
 LABELS = {"b_a": "b/a", "d_a": "d/a", "link_a": "link/a", "tie_link": "tie/link"}
 COLUMNS = ("design", *GROUPS, "theta", "p_tilde", "q_tilde")
+#: the optional last column: the FEM's converged rubber stretch less 1 (fem.rubber_stretch)
+STRETCH = "s_tilde"
 #: the physics a table's residual is taken against (see :func:`prior_pressure`)
 PRIORS = ("paper", "rings")
 #: the radial basis functions a kernel fit may use (scipy.interpolate.RBFInterpolator's)
@@ -58,7 +60,8 @@ def _bad(path, allowed: str):
 
 #: column -> (lowest, highest) of a row: theta [rad] of a bend up to a full turn; the
 #: pressure and oil per mu_sf and a^3 of any finger the FEM can solve
-ROW_LIMITS = {"theta": (1e-6, 2 * math.pi), "p_tilde": (1e-9, 1e6), "q_tilde": (1e-9, 1e6)}
+ROW_LIMITS = {"theta": (1e-6, 2 * math.pi), "p_tilde": (1e-9, 1e6), "q_tilde": (1e-9, 1e6),
+              STRETCH: (1e-9, 100.0)}
 
 
 def read_table(path: str | Path = TABLE_FILE) -> Table:
@@ -71,18 +74,21 @@ def read_table(path: str | Path = TABLE_FILE) -> Table:
         raise _bad(path, "is not a text (CSV) file") from None
     comments = [line for line in text.splitlines() if line.startswith("#")]
     lines = [line for line in text.splitlines() if line.strip() and not line.startswith("#")]
-    if not lines or tuple(c.strip() for c in lines[0].split(",")) != COLUMNS:
-        raise _bad(path, f"needs the header {','.join(COLUMNS)}")
+    header = tuple(c.strip() for c in lines[0].split(",")) if lines else ()
+    if header not in (COLUMNS, (*COLUMNS, STRETCH)):
+        raise _bad(path, f"needs the header {','.join(COLUMNS)}[,{STRETCH}]")
     try:
         values = np.array([[plain_float(x) for x in line.split(",")] for line in lines[1:]], ndmin=2)
     except ValueError:
         raise _bad(path, "has a cell that is not a number") from None
-    if values.shape[0] == 0 or values.shape[1] != len(COLUMNS) or not np.all(np.isfinite(values)):
-        raise _bad(path, f"needs rows of {len(COLUMNS)} finite numbers")
-    rows = {c: values[:, i] for i, c in enumerate(COLUMNS)}
+    if values.shape[0] == 0 or values.shape[1] != len(header) or not np.all(np.isfinite(values)):
+        raise _bad(path, f"needs rows of {len(header)} finite numbers")
+    rows = {c: values[:, i] for i, c in enumerate(header)}
     if np.any(rows["theta"] <= 0) or np.any(rows["p_tilde"] <= 0) or np.any(rows["q_tilde"] <= 0):
         raise _bad(path, "theta, p_tilde and q_tilde must be positive (the P = 0 state is implied)")
     for column, (lo, hi) in ROW_LIMITS.items():
+        if column not in rows:
+            continue
         bad = np.flatnonzero((rows[column] < lo) | (rows[column] > hi))
         if bad.size:
             raise _bad(path, f"has {column} = {rows[column][bad[0]]:g} in data row {bad[0] + 1}; a "

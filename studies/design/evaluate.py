@@ -15,10 +15,11 @@ that keeps that pad on the object (:func:`reduced.contact.rolling_weights`). The
 for ``finger_model = "fem"`` by the FEM-informed grasp (:mod:`reduced.grasp_hold`: the
 calibrated finger in equilibrium hinge by hinge against the object, the reservoir's pressure
 at the oil taken), for the paper's finger model by eqs. (25), (29) at theta_g with the
-rolling w. The tube's peak principal stretch is eq. (8), 1 + (d + a + b) theta / l0 (the outer
-fibre on the far side of the hinge plate), at the bend that holds the object, with its strain
-lambda - 1 scaled by the task's ``stretch_factor`` once an FEM proof has measured how far the
-FEM's peak (at the tied rings and the end cap) lies above it.
+rolling w. The tube's rubber stretch at the bend that holds the object is the calibrated finger
+table's prediction of the FEM's converged stretch (:func:`tube_stretch`) where the table holds
+it; else eq. (8), 1 + (d + a + b) theta / l0 (the outer fibre on the far side of the hinge
+plate), with its strain lambda - 1 scaled by the task's ``stretch_factor`` once an FEM proof
+has measured how far the FEM's stretch (at the tied rings and the end cap) lies above it.
 
 Constraints (each ``(name, value, limit, sense)``, normalised slack >= 0 when met): the tube
 fits its links (a + b < d), walls (b >= min wall, t > 0), the reservoir keeps oil at the grasp
@@ -41,7 +42,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from softhand.reduced import contact, finger, grasp, grasp_hold, hand, reservoir
+from softhand.reduced import contact, finger, finger_fem, grasp, grasp_hold, hand, reservoir
 from softhand.reduced.design import HandDesign, design_from_dict, hinges_for
 from softhand.reduced.errors import InputError
 from softhand.studies.design.task import Task
@@ -166,6 +167,20 @@ def peak_stretch(theta, design: HandDesign) -> float:
     return 1.0 + (design.d + design.a + design.b) * theta / design.l0
 
 
+def tube_stretch(theta, design: HandDesign, task: Task) -> float:
+    """The tube's rubber stretch at bend theta [rad]: the calibrated finger table's (finger_model
+    "fem" with a table that holds the FEM's converged stretch, reduced.finger_fem.rubber_stretch),
+    else eq. (8) with its strain x the task's stretch_factor."""
+    if design.finger_model == "fem":
+        try:
+            calibrated = finger_fem.rubber_stretch(theta, design)
+        except InputError:  # outside the calibrated range: eq. (8), the range constraint says so
+            calibrated = None
+        if calibrated is not None:
+            return float(calibrated)
+    return 1.0 + task.stretch_factor * (peak_stretch(theta, design) - 1.0)
+
+
 @lru_cache(maxsize=4096)
 def limit_point_volume(design: HandDesign) -> float:
     """Oil volume [mm^3] of the first pressure maximum of p_r(V) up to 4 V0 (inf: none)."""
@@ -192,7 +207,7 @@ def evaluate(design: HandDesign, task: Task, *, exact: bool = True) -> Evaluatio
         oil = design.n * float(finger.oil_taken(theta_hold, design))
     except InputError:
         oil = math.inf
-    stretch = 1.0 + task.stretch_factor * (peak_stretch(theta_hold, design) - 1.0)
+    stretch = tube_stretch(theta_hold, design, task)
     sheet = float(reservoir.stretch(design.V0, design))
     # no P_grasp: how far short of F_req the finger comes (for the optimiser)
     shortfall = min(1.0, 1.0 - max(F_reached, 0.0) / F_req) if no_grasp and F_reached < F_req else None
