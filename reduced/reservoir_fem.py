@@ -10,6 +10,7 @@ Neo-Hookean sheet of radius R, thickness t and modulus μ has
 and the dependence on τ = t/R is the bending share (mostly the clamp's boundary layer;
 measured close to linear in τ: p̃ at V0 is 1.435, 1.463, 1.512 for τ = 1/48, 1/24, 1/12).
 The file ``reduced/data/reservoir_fem.csv`` holds :math:`\tilde W, \tilde p, \tilde h = h/R`
+(and the converged rubber stretch less 1, ``s_tilde``)
 on the same v grid at τ = 1/24 (Table I) and τ = 1/12, with its provenance in the header;
 this model rescales them to the design's R, t, μ_sr and interpolates linearly in τ
 (extrapolates outside [1/24, 1/12]; at τ = 1/48 that is within 0.5 %, see
@@ -31,10 +32,12 @@ from .design import HandDesign
 from .errors import InputError
 from .reservoir import register_model
 
-__all__ = ["TABLE_FILE", "table", "pressure", "strain_energy", "height"]
+__all__ = ["TABLE_FILE", "table", "pressure", "strain_energy", "height", "rubber_stretch"]
 
 TABLE_FILE = Path(__file__).resolve().parent / "data" / "reservoir_fem.csv"
 COLUMNS = ("v", "p_tilde", "W_tilde", "h_tilde")
+#: the optional column: the FEM's converged rubber stretch less 1 (fem.rubber_stretch)
+STRETCH = "s_tilde"
 
 
 @lru_cache(maxsize=1)
@@ -45,7 +48,8 @@ def table() -> dict:
     header = lines[0].split(",")
     values = np.array([[float(x) for x in line.split(",")] for line in lines[1:]])
     tau = values[:, header.index("tau")]
-    return {float(t): {name: values[tau == t, header.index(name)] for name in COLUMNS}
+    return {float(t): {name: values[tau == t, header.index(name)] for name in (*COLUMNS, STRETCH)
+                       if name in header}
             for t in np.unique(tau)}
 
 
@@ -102,6 +106,16 @@ def height(V, design: HandDesign):
     """FEM apex height h(V) [mm] of the wet surface (h̃ linear in v and in τ)."""
     v = np.asarray(V, float) / design.R**3
     return design.R * sum(w * np.interp(v, tab["v"], tab["h_tilde"]) for tab, w in _weights(design))
+
+
+def rubber_stretch(V, design: HandDesign):
+    """The sheet's converged rubber stretch (the FEM's ``rubber_stretch``) at oil volume V
+    [mm^3]: s_tilde linear in v and in tau, held at its last value beyond the table; None if
+    the table has no stretch column. A Neo-Hookean sheet's stretch depends on v and tau only."""
+    if any(STRETCH not in tab for tab in table().values()):
+        return None
+    v = np.asarray(V, float) / design.R**3
+    return 1.0 + sum(w * np.interp(v, tab["v"], tab[STRETCH]) for tab, w in _weights(design))
 
 
 register_model("fem", pressure)

@@ -172,9 +172,10 @@ def calibration_rows(model: SheetModel, *, v_max: float = 1.75, n: int = 71, pro
     R, t, mu = model.R, model.t, model.mu
     v = np.linspace(0.0, v_max, n)[1:]
     fem = inflate(model, v * R**3, progress=progress)
-    rows = [{"tau": t / R, "v": 0.0, "p_tilde": 0.0, "W_tilde": 0.0, "h_tilde": 0.0}]
+    rows = [{"tau": t / R, "v": 0.0, "p_tilde": 0.0, "W_tilde": 0.0, "h_tilde": 0.0, "s_tilde": 0.0}]
     rows += [{"tau": t / R, "v": s.volume / R**3, "p_tilde": s.pressure * R / (mu * t),
-              "W_tilde": s.energy / (mu * t * R**2), "h_tilde": s.apex / R} for s in fem.states]
+              "W_tilde": s.energy / (mu * t * R**2), "h_tilde": s.apex / R,
+              "s_tilde": s.rubber_stretch - 1.0} for s in fem.states]
     return rows
 
 
@@ -186,8 +187,9 @@ def calibration_csv(models: list, rows: list, provenance: str) -> str:
         head.append(f"# model: R={m.R} mm, t={m.t} mm (tau=t/R={m.t / m.R:.6g}), mu={m.mu} MPa, "
                     f"kappa/mu={m.kappa_ratio}, Q2/P1disc, {m.n_radial} x {m.n_thick} elements "
                     f"(clamp ratio {m.clamp_ratio})")
-    head.append("# tau = t/R, v = V/R^3, p_tilde = p R/(mu t), W_tilde = W/(mu t R^2), h_tilde = h/R")
-    lines = ["tau,v,p_tilde,W_tilde,h_tilde"]
+    head.append("# tau = t/R, v = V/R^3, p_tilde = p R/(mu t), W_tilde = W/(mu t R^2), h_tilde = h/R, "
+                "s_tilde = rubber_stretch - 1 (the converged stretch, fem.rubber_stretch)")
+    lines = ["tau,v,p_tilde,W_tilde,h_tilde,s_tilde"]
     lines += [f"{r['tau']:.10g},{r['v']:.6g},{r['p_tilde']:.10g},{r['W_tilde']:.10g},"
-              f"{r['h_tilde']:.10g}" for r in rows]
+              f"{r['h_tilde']:.10g},{r['s_tilde']:.10g}" for r in rows]
     return "\n".join(head + lines) + "\n"

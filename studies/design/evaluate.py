@@ -42,7 +42,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from softhand.reduced import contact, finger, finger_fem, grasp, grasp_hold, hand, reservoir
+from softhand.reduced import contact, finger, finger_fem, grasp, grasp_hold, hand, reservoir, reservoir_fem
 from softhand.reduced.design import HandDesign, design_from_dict, hinges_for
 from softhand.reduced.errors import InputError
 from softhand.studies.design.task import Task
@@ -93,7 +93,7 @@ class Evaluation:
     F_v: float                 #: required normal force per finger [N]
     F_v_at_limit: float        #: F_v at the pump limit, or at P_margin below it (see margin_edge) [N]
     stretch: float             #: the tube's rubber stretch, eq. (8) x stretch_factor, at theta_hold
-    sheet_stretch: float       #: the reservoir sheet's stretch at V0, eq. (16)
+    sheet_stretch: float       #: the reservoir sheet's rubber stretch at V0 (:func:`sheet_stretch`)
     constraints: tuple[Constraint, ...]
     theta_hold: float = math.nan  #: the finger's bend when it presses with the required F_v [rad]
     P_margin: float = math.nan    #: the pump pressure F_v_at_limit is at: the limit, or lower (margin_edge) [MPa]
@@ -181,6 +181,17 @@ def tube_stretch(theta, design: HandDesign, task: Task) -> float:
     return 1.0 + task.stretch_factor * (peak_stretch(theta, design) - 1.0)
 
 
+def sheet_stretch(design: HandDesign) -> float:
+    """The reservoir sheet's rubber stretch at V0: the calibrated sheet table's prediction of the
+    FEM's converged stretch (reservoir_model "fem" with a table that holds it: at the clamp,
+    where the sheet stretches most), else eq. (16)'s mean stretch."""
+    if design.reservoir_model == "fem":
+        calibrated = reservoir_fem.rubber_stretch(design.V0, design)
+        if calibrated is not None:
+            return float(calibrated)
+    return float(reservoir.stretch(design.V0, design))
+
+
 @lru_cache(maxsize=4096)
 def limit_point_volume(design: HandDesign) -> float:
     """Oil volume [mm^3] of the first pressure maximum of p_r(V) up to 4 V0 (inf: none)."""
@@ -208,7 +219,7 @@ def evaluate(design: HandDesign, task: Task, *, exact: bool = True) -> Evaluatio
     except InputError:
         oil = math.inf
     stretch = tube_stretch(theta_hold, design, task)
-    sheet = float(reservoir.stretch(design.V0, design))
+    sheet = sheet_stretch(design)
     # no P_grasp: how far short of F_req the finger comes (for the optimiser)
     shortfall = min(1.0, 1.0 - max(F_reached, 0.0) / F_req) if no_grasp and F_reached < F_req else None
     cons = _constraints(design, task, oil, stretch, sheet, P_grasp, P_contact, F_lim, P_open, shortfall)
@@ -227,7 +238,9 @@ def _constraints(design: HandDesign, task: Task, oil, stretch, sheet, P_grasp, P
         Constraint("reservoir_oil the fingers take at the grasp [mm^3]", oil, design.V0, "<="),
         Constraint("reservoir_below_limit_point V0 [mm^3]", design.V0, limit_point_volume(design), "<="),
         Constraint("rubber_stretch of the tube", stretch, task.max_stretch, "<="),
-        Constraint("sheet_stretch at V0, eq. (16)", sheet, task.max_stretch, "<="),
+        Constraint("sheet_stretch at V0" + (" (FEM-calibrated rubber_stretch)" if design.reservoir_model == "fem"
+                                            and reservoir_fem.rubber_stretch(design.V0, design) is not None
+                                            else ", eq. (16)"), sheet, task.max_stretch, "<="),
         Constraint("pump_pressure at the grasp [MPa]", P_grasp, task.max_pressure, "<=", shortfall=grasp_shortfall),
         Constraint("contact: P(theta_g), the free hand's pump pressure where a pad touches the object "
                    "[MPa] (the hand at rest must not reach into the object's place)", P_contact, 0.0, ">=",

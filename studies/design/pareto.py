@@ -1,7 +1,8 @@
-"""Pump pressure against peak stretch: the Pareto front of a design task, its knee and plot.
+"""Pump pressure against rubber stretch: the Pareto front of a design task, its knee and plot.
 
-The stretch is the rubber's: the larger of the tube's (eq. (8)) and the reservoir sheet's
-(eq. (16)). A fuller sheet or a longer lever arm needs less pump pressure but stretches the
+The stretch is the rubber's: the larger of the tube's and the reservoir sheet's (their
+calibrated converged stretches where the models' tables hold them, else eqs. (8) and (16);
+:mod:`studies.design.evaluate`). A fuller sheet or a longer lever arm needs less pump pressure but stretches the
 rubber more.
 The front is traced by the epsilon-constraint method: the least stretch any feasible design
 reaches (differential evolution on the stretch, polished by SLSQP), then the task's objective with the stretch
@@ -95,7 +96,7 @@ def plot(rows: list[dict], path, *, task: Task, base: design_opt.Evaluation | No
     ax.plot(lam[k], obj[k], "D", ms=9, mfc="none", label="knee")
     if base is not None and math.isfinite(design_opt.objective(base, task)):
         ax.plot(base.rubber_stretch, design_opt.objective(base, task), "x", ms=9, label="base design")
-    ax.set_xlabel("rubber stretch: tube eq. (8), sheet eq. (16)")
+    ax.set_xlabel("rubber stretch of the tube and the sheet (the larger)")
     ax.set_ylabel(label)
     ax.set_title(f"{task.name}: {task.diameter:g} mm, {task.mass:g} kg")
     ax.grid(alpha=0.3)
