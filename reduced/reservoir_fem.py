@@ -110,12 +110,19 @@ def height(V, design: HandDesign):
 
 def rubber_stretch(V, design: HandDesign):
     """The sheet's converged rubber stretch (the FEM's ``rubber_stretch``) at oil volume V
-    [mm^3]: s_tilde linear in v and in tau, held at its last value beyond the table; None if
-    the table has no stretch column. A Neo-Hookean sheet's stretch depends on v and tau only."""
+    [mm^3]: s_tilde linear in v and in tau, continued linearly beyond the table's last volume;
+    None if the table has no stretch column. A Neo-Hookean sheet's stretch depends on v and
+    tau only."""
     if any(STRETCH not in tab for tab in table().values()):
         return None
     v = np.asarray(V, float) / design.R**3
-    return 1.0 + sum(w * np.interp(v, tab["v"], tab[STRETCH]) for tab, w in _weights(design))
+    return 1.0 + sum(w * _linear(v, tab["v"], tab[STRETCH]) for tab, w in _weights(design))
+
+
+def _linear(v, x, y):
+    """y(v) piecewise linear in the table, continued by its last segment beyond it."""
+    slope = (y[-1] - y[-2]) / (x[-1] - x[-2])
+    return np.where(v > x[-1], y[-1] + slope * (v - x[-1]), np.interp(v, x, y))
 
 
 register_model("fem", pressure)

@@ -101,3 +101,12 @@ def test_the_sheets_rubber_stretch_converges_where_its_corner_peak_does_not():
     assert abs(peak[2] - peak[1]) > abs(peak[1] - peak[0])
     assert abs(avg[2] - avg[1]) < abs(avg[1] - avg[0]) / 2 and abs(avg[2] / avg[1] - 1) < 0.01, avg
     assert np.all(avg < peak) and np.all(avg > np.array([s.mean_stretch for s in states]))
+
+
+def test_inspect_colours_by_the_converged_stretch_by_default():
+    """A file with rubber_stretch is coloured by it; older files keep von Mises."""
+    from softhand.studies.io.render_style import colour_label, default_field
+
+    assert default_field(["displacement_mm", "von_mises_MPa", "rubber_stretch"]) == "rubber_stretch"
+    assert default_field(["displacement_mm", "von_mises_MPa"]) == "von_mises_MPa"
+    assert colour_label("rubber_stretch") == "rubber stretch (ball average) [-]"
