@@ -181,6 +181,20 @@ def tube_stretch(theta, design: HandDesign, task: Task) -> float:
     return 1.0 + task.stretch_factor * (peak_stretch(theta, design) - 1.0)
 
 
+def models(design: HandDesign, task: Task) -> dict:
+    """The reduced models a design is judged on: the finger's, the reservoir's and where the
+    tube's and the sheet's rubber stretch come from."""
+    try:
+        tube = design.finger_model == "fem" and finger_fem.rubber_stretch(0.1, design) is not None
+    except InputError:
+        tube = False
+    sheet = design.reservoir_model == "fem" and reservoir_fem.rubber_stretch(design.V0, design) is not None
+    return {"finger_model": design.finger_model, "reservoir_model": design.reservoir_model,
+            "tube_stretch": "FEM-calibrated rubber_stretch" if tube else
+            f"eq. (8), strain x {task.stretch_factor:.4g}",
+            "sheet_stretch": "FEM-calibrated rubber_stretch" if sheet else "eq. (16)"}
+
+
 def sheet_stretch(design: HandDesign) -> float:
     """The reservoir sheet's rubber stretch at V0: the calibrated sheet table's prediction of the
     FEM's converged stretch (reservoir_model "fem" with a table that holds it: at the clamp,

@@ -204,9 +204,12 @@ def _prove(ev, task, args, out, say) -> dict:
 
 
 def _result(task, opt, base, design_file, seed: int) -> dict:
+    from softhand.studies.design import evaluate
+
     ev = opt.evaluation
     return {
         "task": task.name, "feasible": ev.feasible, "objective": task.objective,
+        "models": evaluate.models(ev.design, task),
         "design": ev.design.to_dict(),
         "free": {k: float(v) for (k, _, _), v in zip(task.free, opt.x)},
         "free_bounds": {k: [lo, hi] for k, lo, hi in task.free},
@@ -228,6 +231,9 @@ def _print(result: dict, task, opt) -> None:
     free = ", ".join(f"{k} = {v:.5g}" for k, v in result["free"].items())
     print(f"task {task.name}: {task.diameter:g} mm, {task.mass:g} kg, F_v >= {task.required_F_v():.4g} N "
           f"per finger, pump <= {task.max_pressure:g} MPa; objective: {task.objective}")
+    m = result["models"]
+    print(f"models: finger {m['finger_model']!r}, reservoir {m['reservoir_model']!r}; rubber stretch of the "
+          f"tube: {m['tube_stretch']}, of the sheet: {m['sheet_stretch']}")
     print(f"optimum: {free}  ({opt.evaluations} model evaluations, {opt.seconds:.1f} s wall, "
           f"{opt.cpu_seconds:.1f} s CPU)")
     if not opt.evaluation.feasible:  # why the search ended where it did
