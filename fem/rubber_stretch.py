@@ -31,8 +31,9 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 #: the averaging radius rho [mm]: the scale below which the rubber's stretch is not judged
-#: pointwise; the smallest radius whose measure converged to 2 % on the finger's layered
-#: meshes with 2.5 mm slices (docs/finger.md, converged rubber stretch)
+#: pointwise; of 1, 1.5, 2 and 3 mm the smallest whose value moved by less than 2 % between
+#: the layered meshes with 5 and 2.5 mm slices (the paper's and a thin finger at 2.0 MPa;
+#: docs/finger.md, "The rubber's stretch")
 RADIUS_MM = 2.0
 #: the share of points (largest lambda first) whose averages give the first bound L
 SEED_SHARE = 0.01
