@@ -6,7 +6,8 @@ Fields written (3D displacement bases ``ElementVector`` of P1/P2 tetrahedra):
   roots of the eigenvalues of :math:`C = F^T F`), ``cauchy_stress_MPa`` (the 9 components,
   row-major), ``von_mises_MPa`` (:math:`\sqrt{3/2\, s:s}`, s = dev σ), ``J`` and, when the
   law has a fiber family, ``fiber_stretch`` :math:`|F a_0|` (the name carries the unit;
-  stretches and J have none);
+  stretches and J have none); a model may add its own (the finger: ``rubber_stretch``, the
+  principal stretch averaged over a ball, :mod:`fem.rubber_stretch`);
 * cell data: the same stress-like quantities averaged over each element's quadrature points.
 
 Quadratic meshes are written as **quadratic cells** (``tetra10``), so ParaView and pyvista
@@ -42,13 +43,14 @@ CELL_TYPES = {
 }
 
 
-def state_fields(basis: Basis, u: np.ndarray, law=None, *, J_bar=None) -> tuple[dict, dict]:
-    """(point_data, cell_data) of displacement ``u`` on the vector ``basis`` (see module doc)."""
+def state_fields(basis: Basis, u: np.ndarray, law=None, *, J_bar=None, extra=None) -> tuple[dict, dict]:
+    """(point_data, cell_data) of displacement ``u`` on the vector ``basis`` (see module doc);
+    ``extra``: more fields by name, given at the basis' quadrature points (nel, nqp)."""
     scalar = basis.split(u)[0][1]
     point_data = {"displacement_mm": _nodal_vector(basis, u)}
     if law is None:
         return point_data, {}
-    qp_values = _measures(basis, u, _per_element(law, basis.mesh.nelements), J_bar)
+    qp_values = {**_measures(basis, u, _per_element(law, basis.mesh.nelements), J_bar), **(extra or {})}
     vertex_basis = basis.with_element(ElementTetP1())
     for name, value in qp_values.items():
         point_data[name] = _extend_to_nodes(_lumped_projection(value, vertex_basis), scalar)

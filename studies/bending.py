@@ -105,6 +105,8 @@ def row(state: FingerState, design: HandDesign) -> dict:
         "dQ_mm3": state.dQ,
         "radial_stretch_max": state.radial_stretch_max,
         "radial_stretch_q99": state.radial_stretch_q99,
+        "radial_stretch": state.radial_stretch,
+        "rubber_stretch": state.rubber_stretch,
         "max_principal_stretch": state.max_principal_stretch,
         "theta_reduced_deg": math.degrees(theta_red),
         "dQ_reduced_mm3": dQ_red,
@@ -172,7 +174,8 @@ def _peak(model: FingerModel, study: BendingStudy, start: FingerState, on_state)
         failure = str(exc).split(";")[0]
     s = reached[-1]
     return {"P_cavity_MPa": s.P, "theta_deg": math.degrees(s.theta),
-            "max_principal_stretch": s.max_principal_stretch,
-            "max_von_mises_MPa": s.max_von_mises, "radial_stretch_max": s.radial_stretch_max,
+            "rubber_stretch": s.rubber_stretch, "max_principal_stretch": s.max_principal_stretch,
+            "max_von_mises_MPa": s.max_von_mises, "radial_stretch": s.radial_stretch,
+            "radial_stretch_max": s.radial_stretch_max,
             "max_fiber_stress_MPa": s.max_fiber_stress, "target_P_cavity_MPa": study.peak_mpa,
             "failure": failure}

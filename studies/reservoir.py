@@ -32,7 +32,7 @@ __all__ = ["ReservoirStudy", "ReservoirStudyResult", "run", "stroke_volume", "CO
 
 #: table columns of the CLI, in order
 COLUMNS = ["V_mm3", "p_MPa", "h_mm", "W_Nmm", "p_ellipse_MPa", "h_ellipse_mm", "W_ellipse_Nmm",
-           "lambda_r", "lambda_fem", "max_gap_mm"]
+           "lambda_r", "lambda_fem", "rubber_stretch", "max_gap_mm"]
 
 
 @dataclass(frozen=True)
@@ -123,6 +123,7 @@ def _row(state, design: HandDesign) -> dict:
         "h_ellipse_mm": float(ellipse.height(V, design)),
         "W_ellipse_Nmm": float(ellipse.strain_energy(V, design)),
         "lambda_r": float(ellipse.stretch(V, design)), "lambda_fem": state.mean_stretch,
+        "rubber_stretch": state.rubber_stretch, "max_principal_stretch": state.max_principal_stretch,
         "max_gap_mm": _ellipse_gap(state, design),
     }
 
@@ -174,9 +175,10 @@ def calibration_rows(model: SheetModel, *, v_max: float = 1.75, n: int = 71, pro
     R, t, mu = model.R, model.t, model.mu
     v = np.linspace(0.0, v_max, n)[1:]
     fem = inflate(model, v * R**3, progress=progress)
-    rows = [{"tau": t / R, "v": 0.0, "p_tilde": 0.0, "W_tilde": 0.0, "h_tilde": 0.0}]
+    rows = [{"tau": t / R, "v": 0.0, "p_tilde": 0.0, "W_tilde": 0.0, "h_tilde": 0.0, "s_tilde": 0.0}]
     rows += [{"tau": t / R, "v": s.volume / R**3, "p_tilde": s.pressure * R / (mu * t),
-              "W_tilde": s.energy / (mu * t * R**2), "h_tilde": s.apex / R} for s in fem.states]
+              "W_tilde": s.energy / (mu * t * R**2), "h_tilde": s.apex / R,
+              "s_tilde": s.rubber_stretch - 1.0} for s in fem.states]
     return rows
 
 
@@ -187,12 +189,13 @@ def calibration_provenance(models: list, command: str) -> list[str]:
         head.append(f"model: R={m.R} mm, t={m.t} mm (tau=t/R={m.t / m.R:.6g}), mu={m.mu} MPa, "
                     f"kappa/mu={m.kappa_ratio}, Q2/P1disc, {m.n_radial} x {m.n_thick} elements "
                     f"(clamp ratio {m.clamp_ratio})")
-    head.append("tau = t/R, v = V/R^3, p_tilde = p R/(mu t), W_tilde = W/(mu t R^2), h_tilde = h/R")
+    head.append("tau = t/R, v = V/R^3, p_tilde = p R/(mu t), W_tilde = W/(mu t R^2), h_tilde = h/R, "
+                "s_tilde = rubber_stretch - 1 (the converged stretch, softhand.fem.rubber_stretch)")
     return head
 
 
 #: the reservoir table's columns (:mod:`softhand.reduced.calibrated.reservoir_fem`)
-CALIBRATION_COLUMNS = ("tau", "v", "p_tilde", "W_tilde", "h_tilde")
+CALIBRATION_COLUMNS = ("tau", "v", "p_tilde", "W_tilde", "h_tilde", "s_tilde")
 
 
 def write_calibration(study: ReservoirStudy, path) -> int:

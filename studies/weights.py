@@ -148,8 +148,15 @@ def compute(case: WeightsCase, out=None, progress=None) -> dict:
         write_vtk(out, model, (r.state, r.state_dP))
     return {"diameter_mm": case.diameter_mm, "mass_kg": case.mass_kg, "depth_mm": model.depth,
             "dP_MPa": case.dP_mpa, "w": r.w.tolist(), "w_sum": float(r.w.sum()),
-            **state_row(r.state, r.w, case.mass_kg, case.design),
+            **state_row(r.state, r.w, case.mass_kg, case.design), **rubber_stretches(finger, r.state),
             "mesh_size_mm": case.mesh_size_mm, "ndofs": r.ndofs, "wall_seconds": r.wall_seconds}
+
+
+def rubber_stretches(finger, state) -> dict:
+    """The tube's converged ``rubber_stretch`` and its corner peak ``max_principal_stretch``
+    (mesh-dependent) at a grasp state (:mod:`fem.rubber_stretch`)."""
+    fs = finger.state(state.y, state.P)
+    return {"rubber_stretch": fs.rubber_stretch, "max_principal_stretch": fs.max_principal_stretch}
 
 
 def write_vtk(out, model, states) -> None:

@@ -102,7 +102,7 @@ EXTRA_FILES = {
     "t_objective.toml": _task("[grasp]\nobjective = \"speed\"\n"),
     "t_factor_neg.toml": _task("[grasp]\nforce_factor = -2.0\n"),
     "t_both_force.toml": _task("[grasp]\nforce_factor = 2.0\nmargin_N = 1.0\n"),
-    "t_stretch.toml": _task("[limits]\nmax_principal_stretch = 0.5\n"),
+    "t_stretch.toml": _task("[limits]\nrubber_stretch = 0.5\n"),
     "t_wall_text.toml": _task("[limits]\nmin_wall_mm = \"one\"\n"),
     "t_material.toml": _task("[material]\nmu_sf_MPa = -1.0\n"),
     "t_design_key.toml": _task("[design]\ncolour = 1\n"),

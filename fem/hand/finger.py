@@ -37,6 +37,7 @@ Generalised forces on the links (contact with an object, its weight) are passed 
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from functools import cached_property
 
 import numpy as np
 from skfem import Basis, ElementTetP2, ElementVector
@@ -50,6 +51,7 @@ from softhand.fem.hand.windings import Windings, WindingFibers, hoop_directions
 from softhand.fem.hyperelastic import rubber_law
 from softhand.fem.loads import CavityVolume
 from softhand.fem.mapping import folded_elements
+from softhand.fem.rubber_stretch import Averager
 from softhand.fem.solid import Solid
 from softhand.meshes.finger import FingerTube
 from softhand.reduced.vocabulary.design import HandDesign
@@ -68,7 +70,14 @@ class FingerState:
     dQ: float                      #: cavity volume change of the whole finger [mm^3]
     radial_stretch_max: float      #: max hoop (fiber) stretch in the wall, cap excluded; the paper's lambda_2
     radial_stretch_q99: float      #: hoop stretch exceeded in 1 % of the wall's volume
-    max_principal_stretch: float   #: max principal stretch over the quadrature points
+    #: the windings' hoop stretch averaged over the wall as rubber_stretch (fem.rubber_stretch)
+    radial_stretch: float
+    #: max principal stretch over the quadrature points: the bonded rings' corner peak,
+    #: mesh-dependent (it grows without limit as the mesh is refined)
+    max_principal_stretch: float
+    #: the converged rubber stretch: the principal stretch averaged over a ball of radius
+    #: fem.rubber_stretch.RADIUS_MM, at its worst place (fem.rubber_stretch)
+    rubber_stretch: float
     max_von_mises: float           #: max Cauchy von Mises stress [MPa]
     max_fiber_stress: float        #: max fiber stress k (lambda_f - 1) [MPa]
     iterations: int                #: Newton iterations of this pressure step
@@ -145,6 +154,7 @@ class FingerModel:
         self.fibers = WindingFibers(options.fiber_ratio * mu, hoop_directions(np.asarray(X_q)),
                                     options.fiber_toe)
         self.law = rubber + self.fibers
+        self._X_q = np.asarray(X_q)
         self.cavity = _cavity(self.solid, self.mesh, options)
         #: elements of the tube wall (not the end cap): where the windings are
         self.wall = self.mesh.p[0, self.mesh.t[:4]].mean(axis=0) < design.l0 - self.tube.cap
@@ -232,7 +242,9 @@ class FingerModel:
             dQ=self._dQ(u),
             radial_stretch_max=float(lam_f.max()),
             radial_stretch_q99=float(lam_f.ravel()[order][np.searchsorted(share, 0.99 * share[-1])]),
+            radial_stretch=self.wall_averager.peak(self.fibers.take(self.wall).stretch(F[:, :, self.wall]))[0],
             max_principal_stretch=float(np.sqrt(eig.max())),
+            rubber_stretch=self.averager.peak(np.sqrt(eig[..., -1]))[0],
             max_von_mises=float(np.sqrt(1.5 * np.einsum("ab...,ab...->...", dev, dev)).max()),
             max_fiber_stress=float(self.fibers.k * np.clip(lam_f - 1.0, 0.0, None).max()),
             iterations=int(iterations), y=np.array(y))
@@ -240,6 +252,26 @@ class FingerModel:
     def link_poses(self, y) -> tuple[np.ndarray, np.ndarray]:
         """Link poses in the finger frame: origins c_k (n_s+1, 2) [mm], angles phi_k [rad]."""
         return self.chain.link_poses(self.constraint.q(y))
+
+    @cached_property
+    def averager(self) -> Averager:
+        """Ball averages over the rubber's quadrature points, both halves (fem.rubber_stretch)."""
+        return Averager(self._X_q.reshape(3, -1).T, self.solid.W, mirror=2)
+
+    @cached_property
+    def wall_averager(self) -> Averager:
+        """Ball averages over the rubber's quadrature points of the wall (the windings), both halves."""
+        return Averager(self._X_q[:, self.wall].reshape(3, -1).T, self.solid.W[self.wall], mirror=2)
+
+    def principal_stretch(self, y) -> np.ndarray:
+        """The largest principal stretch at the rubber's quadrature points (nel, nq) [-]."""
+        C = kin.right_cauchy_green(self.solid.F(self.constraint.expand(y)))
+        return np.sqrt(np.linalg.eigvalsh(np.moveaxis(C, (0, 1), (-2, -1)))[..., -1])
+
+    def rubber_stretch_field(self, y) -> np.ndarray:
+        """The ball-averaged principal stretch at every quadrature point (nel, nq) [-]."""
+        lam = self.principal_stretch(y)
+        return self.averager.at(lam.ravel()).reshape(lam.shape)
 
     def vector_basis(self) -> Basis:
         """The vector P2 basis of the displacement (for VTK output)."""

@@ -29,6 +29,7 @@ import numpy as np
 
 from softhand.fem.axisym import AxisymSolid, RevolvedVolume
 from softhand.fem.hyperelastic import rubber_law
+from softhand.fem.rubber_stretch import Averager
 from softhand.reduced.materials.rubber import NeoHookean, Rubber
 from softhand.fem.volume_path import PathOptions, follow_volume, volume_path_options
 from softhand.meshes.reservoir import sheet_mesh
@@ -87,6 +88,11 @@ class SheetState:
     lambda_meridian: np.ndarray = field(repr=False)  #: mid-surface meridional stretch [-]
     lambda_hoop: np.ndarray = field(repr=False)  #: mid-surface hoop stretch [-]
     u: np.ndarray = field(repr=False)  #: displacement vector [mm]
+    #: largest principal stretch at any quadrature point: at the clamp's corner, mesh-dependent
+    max_principal_stretch: float = float("nan")
+    #: the converged rubber stretch: the principal stretch averaged over a ring of radius
+    #: fem.rubber_stretch.RADIUS_MM around its worst place (fem.rubber_stretch)
+    rubber_stretch: float = float("nan")
 
     @property
     def lambda_thickness(self):
@@ -132,14 +138,29 @@ def surface_nodes(solid, u, z0):
     return r0, r0 + u[rdofs[on]], X[1, zdofs[on]] + u[zdofs[on]]
 
 
-def sheet_state(model: SheetModel, solid, s) -> SheetState:
+def sheet_state(model: SheetModel, solid, s, averager=None) -> SheetState:
     """The sheet at the path state ``s`` (volume, pressure, energy, u): its profile and stretches."""
     _, r, z = surface_nodes(solid, s.u, 0.0)
     r0m, rm, zm = surface_nodes(solid, s.u, model.t / 2)
     arc = np.hypot(np.gradient(rm, r0m), np.gradient(zm, r0m))
     hoop = np.where(r0m > 0, rm / np.where(r0m > 0, r0m, 1.0), arc)
     hoop[0] = arc[0]  # on the axis the hoop stretch equals the meridional one
-    return SheetState(s.volume, s.pressure, s.energy, float(z[0]), r, z, r0m, arc, hoop, s.u)
+    lam = principal_stretch(solid, s.u)
+    averager = sheet_averager(solid) if averager is None else averager
+    return SheetState(s.volume, s.pressure, s.energy, float(z[0]), r, z, r0m, arc, hoop, s.u,
+                      float(lam.max()), averager.peak(lam)[0])
+
+
+def principal_stretch(solid, u) -> np.ndarray:
+    """The largest principal stretch at the quadrature points (nel, nqp) [-]."""
+    return np.maximum(*solid.stretches(u)[::2])
+
+
+def sheet_averager(solid) -> Averager:
+    """Averages over the sheet's r-z quadrature points weighted by their ring volumes (a ball's
+    average of an axisymmetric field becomes one over a ring of the same radius), mirrored in the axis."""
+    points = np.asarray(solid.basis.mapping.F(solid.basis.X)).reshape(2, -1).T
+    return Averager(points, solid.wdV, mirror=0)
 
 
 def pressure_maximum(V, p):
@@ -165,7 +186,8 @@ def inflate(model: SheetModel, volumes, *, options: PathOptions | None = None,
     options = options or volume_path_options(max_step=0.5 * model.R**2 * model.t, atol=atol)
     hits, path = follow_volume(solid, volume, fixed, targets, options=options,
                                volume_scale=model.R**2 * model.t, progress=progress)
-    states = [sheet_state(model, solid, s) for s in hits]
+    averager = sheet_averager(solid)
+    states = [sheet_state(model, solid, s, averager) for s in hits]
     by_request = np.empty(volumes.size, dtype=object)
     by_request[order] = [states[i] for i in inverse]
     V = np.array([s.volume for s in path])

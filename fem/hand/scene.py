@@ -70,7 +70,8 @@ def finger_blocks(model, y, *, load=None) -> list[Block]:
 
     design, basis = model.design, _vector_basis(model)
     u = model.displacement(y)
-    point_data, cell_data = state_fields(basis, u, model.law, J_bar=model.element_dilatation(y))
+    point_data, cell_data = state_fields(basis, u, model.law, J_bar=model.element_dilatation(y),
+                                         extra={"rubber_stretch": model.rubber_stretch_field(y)})
     points = basis.split(u)[0][1].doflocs.T
     tube = _mirrored(Block("tube", points, {"tetra10": basis.split(u)[0][1].element_dofs.T},
                            point_data, cell_data), design)

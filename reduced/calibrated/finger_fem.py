@@ -53,10 +53,10 @@ from softhand.reduced.calibrated.finger_curves import Curves, energy_curves
 from softhand.reduced.vocabulary.design import HandDesign
 from softhand.reduced.vocabulary.errors import InputError
 from softhand.reduced.calibrated.finger_fem_terms import KernelFit, term_matrix
-from softhand.reduced.calibrated.finger_fem_table import COLUMNS, GROUPS, LABELS, PRIORS, TABLE_FILE, Table, table_error, read_table
+from softhand.reduced.calibrated.finger_fem_table import COLUMNS, GROUPS, LABELS, PRIORS, STRETCH, TABLE_FILE, Table, table_error, read_table
 
-__all__ = ["TABLE_FILE", "GROUPS", "COLUMNS", "PRIORS", "Table", "read_table", "check_table", "groups_of",
-           "curves", "FEM"]
+__all__ = ["TABLE_FILE", "GROUPS", "COLUMNS", "STRETCH", "PRIORS", "Table", "read_table", "check_table", "groups_of",
+           "curves", "rubber_stretch", "FEM"]
 
 N_LINKS = 6
 # ---------------------------------------------------------------------- groups and the fit
@@ -114,8 +114,15 @@ def prior_pressure(theta, groups: dict, prior: str):
     return P
 
 
-def fit_targets(rows: dict, prior: str, path="table") -> tuple[np.ndarray, np.ndarray]:
-    """The residuals a table's rows give the fit: y = ln(P / P_prior) and ln kappa."""
+def stretch_prior(theta, groups: dict):
+    """Eq. (8)'s strain at the tube's outer fibre, (d + a + b) theta / l0 [-]: the physics the
+    fit of the rubber's converged stretch corrects."""
+    return (groups["d_a"] + 1.0 + groups["b_a"]) * np.asarray(theta, float) / (N_LINKS * groups["link_a"])
+
+
+def fit_targets(rows: dict, prior: str, path="table") -> tuple[np.ndarray, ...]:
+    """The residuals a table's rows give the fit: y = ln(P / P_prior), ln kappa and, where the
+    table has the rubber's converged stretch, z = ln(s_tilde / eq. (8)'s strain)."""
     y = np.empty(rows["theta"].size)
     for i in np.unique(rows["design"]):  # the prior per design, all its angles at once
         at = rows["design"] == i
@@ -125,16 +132,19 @@ def fit_targets(rows: dict, prior: str, path="table") -> tuple[np.ndarray, np.nd
     if np.any(dilation <= 0):
         raise table_error(path, "has dQ/a^3 <= pi (d/a) theta in a row: below the tube's kinematic "
                          "oil volume of eq. (2)")
-    return y, np.log(dilation / rows["p_tilde"])
+    ln_kappa = np.log(dilation / rows["p_tilde"])
+    if STRETCH not in rows:
+        return y, ln_kappa
+    return y, ln_kappa, np.log(rows[STRETCH] / stretch_prior(rows["theta"], rows))
 
 
 class _TermsFit:
     """y and ln kappa by least squares in the table's terms."""
 
-    def __init__(self, table: Table, y, ln_kappa, path):
+    def __init__(self, table: Table, targets, path):
         r = table.rows
-        self.terms, self.betas = (table.p_terms, table.q_terms), []
-        for terms, target in zip(self.terms, (y, ln_kappa)):
+        self.terms, self.betas = (table.p_terms, table.q_terms, table.p_terms)[:len(targets)], []
+        for terms, target in zip(self.terms, targets):  # the stretch's z in P's terms
             try:
                 beta = lstsq_terms(r, r["theta"], target, terms)
             except (np.linalg.LinAlgError, ValueError) as error:  # e.g. SVD on columns that overflow
@@ -151,14 +161,14 @@ class _TermsFit:
 
 @lru_cache(maxsize=8)
 def _fit(path: str) -> tuple[Table, object, float]:
-    """(table, fit, theta_max): fit(groups, theta) -> (y, ln kappa)."""
+    """(table, fit, theta_max): fit(groups, theta) -> (y, ln kappa[, z of the stretch])."""
     table = read_table(path)
-    y, ln_kappa = fit_targets(table.rows, table.prior, path)
+    targets = fit_targets(table.rows, table.prior, path)
     if table.kernel is None:
-        fit = _TermsFit(table, y, ln_kappa, path)
+        fit = _TermsFit(table, targets, path)
     else:
         try:
-            fit = KernelFit(table.rows, y, ln_kappa, table.kernel, table.features)
+            fit = KernelFit(table.rows, targets, table.kernel, table.features)
         except np.linalg.LinAlgError as error:  # designs at one point of the features
             raise table_error(path, f"has designs that coincide in its '# fit:' features "
                              f"({' '.join(table.features)}), so the kernel interpolant cannot be built "
@@ -192,7 +202,21 @@ def residuals(theta, design: HandDesign) -> tuple[np.ndarray, np.ndarray]:
     P = P_prior e^y, Delta Q = a^2 pi d theta + a^3 kappa P / mu_sf."""
     table, fit, theta_max = _fit(_table_path(design))
     groups = check_space(design, table)
-    return fit(groups, np.clip(np.asarray(theta, float), -theta_max, theta_max))
+    return fit(groups, np.clip(np.asarray(theta, float), -theta_max, theta_max))[:2]
+
+
+def rubber_stretch(theta, design: HandDesign):
+    """The tube's converged rubber stretch (the FEM's ``rubber_stretch``) at bend theta [rad],
+    calibrated: 1 + eq. (8)'s strain x e^z, z fitted over the design space like y and ln kappa
+    (held at its end value beyond the table's angles); None if the design's table has no
+    stretch column (tables written before it)."""
+    table, fit, theta_max = _fit(_table_path(design))
+    if STRETCH not in table.rows:
+        return None
+    groups = check_space(design, table)
+    theta = np.asarray(theta, float)
+    z = fit(groups, np.clip(theta, 1e-9, theta_max))[2]
+    return 1.0 + stretch_prior(theta, groups) * np.exp(z)
 
 
 def _table_path(design: HandDesign) -> str:

@@ -25,6 +25,9 @@ TABLE_FILE = Path(__file__).resolve().parent / "data" / "finger_fem.csv"
 GROUPS = ("b_a", "d_a", "link_a", "tie_link")
 LABELS = {"b_a": "b/a", "d_a": "d/a", "link_a": "link/a", "tie_link": "tie/link"}
 COLUMNS = ("design", *GROUPS, "theta", "p_tilde", "q_tilde")
+#: the optional last column: the FEM's converged rubber stretch less 1
+#: (:mod:`softhand.fem.rubber_stretch`)
+STRETCH = "s_tilde"
 #: the physics a table's residual is taken against (see :func:`~softhand.reduced.calibrated.finger_fem.prior_pressure`)
 PRIORS = ("paper", "rings")
 #: the radial basis functions a kernel fit may use (scipy.interpolate.RBFInterpolator's)
@@ -59,18 +62,21 @@ def table_error(path, allowed: str) -> InputError:
 
 #: column -> (lowest, highest) of a row: theta [rad] of a bend up to a full turn; the
 #: pressure and oil per mu_sf and a^3 of any finger the FEM can solve
-ROW_LIMITS = {"theta": (1e-6, 2 * math.pi), "p_tilde": (1e-9, 1e6), "q_tilde": (1e-9, 1e6)}
+ROW_LIMITS = {"theta": (1e-6, 2 * math.pi), "p_tilde": (1e-9, 1e6), "q_tilde": (1e-9, 1e6),
+              STRETCH: (1e-9, 100.0)}
 
 
 def read_table(path: str | Path = TABLE_FILE) -> Table:
     """Read a finger calibration CSV; InputError naming the file on any problem."""
     path = Path(path)
-    comments, _, values = read_number_table(path, "finger_table", "a CSV written by softhand calibrate finger",
-                                            COLUMNS)
-    rows = {c: values[:, i] for i, c in enumerate(COLUMNS)}
+    comments, header, values = read_number_table(path, "finger_table", "a CSV written by softhand calibrate finger",
+                                                 COLUMNS, optional=(STRETCH,))
+    rows = {c: values[:, i] for i, c in enumerate(header)}
     if np.any(rows["theta"] <= 0) or np.any(rows["p_tilde"] <= 0) or np.any(rows["q_tilde"] <= 0):
         raise table_error(path, "theta, p_tilde and q_tilde must be positive (the P = 0 state is implied)")
     for column, (lo, hi) in ROW_LIMITS.items():
+        if column not in rows:
+            continue
         bad = np.flatnonzero((rows[column] < lo) | (rows[column] > hi))
         if bad.size:
             raise table_error(path, f"has {column} = {rows[column][bad[0]]:g} in data row {bad[0] + 1}; a "

@@ -97,12 +97,13 @@ KERNEL_FEATURES = ("lb", "ld", "lL", "lt", "s2")
 
 
 class KernelFit:
-    """y and ln kappa as a radial-basis interpolant over the designs: per design, each
-    residual's least-squares line in theta (a + b theta); a, b interpolated over the design
-    features (scaled to [0, 1] over the table's designs) by SciPy's RBFInterpolator with a
-    linear polynomial, exact at every design of the table."""
+    """Residuals (y and ln kappa; the rubber stretch's where the table has it) as a radial-basis
+    interpolant over the designs: per design, each residual's least-squares line in theta
+    (a + b theta); a, b interpolated over the design features (scaled to [0, 1] over the
+    table's designs) by SciPy's RBFInterpolator with a linear polynomial, exact at every
+    design of the table."""
 
-    def __init__(self, rows: dict, y: np.ndarray, ln_kappa: np.ndarray, kernel: str, features):
+    def __init__(self, rows: dict, targets, kernel: str, features):
         from scipy.interpolate import RBFInterpolator
 
         ids = np.unique(rows["design"])
@@ -110,8 +111,8 @@ class KernelFit:
         for i in ids:
             at = rows["design"] == i
             th = rows["theta"][at]
-            line = [np.polyfit(th, v[at], 1) if np.ptp(th) > 0 else (0.0, v[at].mean()) for v in (y, ln_kappa)]
-            coef.append([line[0][1], line[0][0], line[1][1], line[1][0]])
+            line = [np.polyfit(th, v[at], 1) if np.ptp(th) > 0 else (0.0, v[at].mean()) for v in targets]
+            coef.append([c for slope, intercept in line for c in (intercept, slope)])
             g = {k: rows[k][at][0] for k in ("b_a", "d_a", "link_a", "tie_link")}
             X.append([float(BASE[f](g, 0.0)) for f in features])
         X = np.array(X)
@@ -122,8 +123,8 @@ class KernelFit:
                              f"{len(features) + 2} designs over which every feature varies")
         self.rbf = RBFInterpolator((X - self.lo) / self.span, np.array(coef), kernel=kernel, degree=1)
 
-    def __call__(self, groups: dict, theta) -> tuple[np.ndarray, np.ndarray]:
+    def __call__(self, groups: dict, theta) -> tuple[np.ndarray, ...]:
         x = np.array([float(BASE[f](groups, 0.0)) for f in self.features])
-        a_y, b_y, a_k, b_k = self.rbf(((x - self.lo) / self.span)[None, :])[0]
+        c = self.rbf(((x - self.lo) / self.span)[None, :])[0]
         theta = np.asarray(theta, float)
-        return a_y + b_y * theta, a_k + b_k * theta
+        return tuple(c[k] + c[k + 1] * theta for k in range(0, c.size, 2))

@@ -10,6 +10,7 @@ Neo-Hookean sheet of radius R, thickness t and modulus μ has
 and the dependence on τ = t/R is the bending share (mostly the clamp's boundary layer;
 measured close to linear in τ: p̃ at V0 is 1.435, 1.463, 1.512 for τ = 1/48, 1/24, 1/12).
 The file ``reduced/calibrated/data/reservoir_fem.csv`` holds :math:`\tilde W, \tilde p, \tilde h = h/R`
+(and the converged rubber stretch less 1, ``s_tilde``)
 on the same v grid at τ = 1/24 (Table I) and τ = 1/12, with its provenance in the header;
 this model rescales them to the design's R, t, μ_sr and interpolates linearly in τ
 (extrapolates outside [1/24, 1/12]; at τ = 1/48 that is within 0.5 %, see
@@ -32,19 +33,23 @@ from softhand.reduced.vocabulary.errors import InputError
 from softhand.reduced.vocabulary.inputfiles import read_number_table
 from softhand.reduced.equations.reservoir import register_model
 
-__all__ = ["TABLE_FILE", "table", "pressure", "strain_energy", "height"]
+__all__ = ["TABLE_FILE", "table", "pressure", "strain_energy", "height", "rubber_stretch"]
 
 TABLE_FILE = Path(__file__).resolve().parent / "data" / "reservoir_fem.csv"
 COLUMNS = ("v", "p_tilde", "W_tilde", "h_tilde")
+#: the optional column: the FEM's converged rubber stretch less 1 (fem.rubber_stretch)
+STRETCH = "s_tilde"
 
 
 @lru_cache(maxsize=1)
 def table() -> dict:
     """The calibration tables: τ = t/R -> {v = V/R³, p̃ = pR/(μt), W̃ = W/(μtR²), h̃ = h/R}."""
     _, header, values = read_number_table(TABLE_FILE, "reservoir_table", "the reservoir calibration CSV "
-                                          "(softhand reservoir --write-calibration)", ("tau", *COLUMNS))
+                                          "(softhand reservoir --write-calibration)", ("tau", *COLUMNS),
+                                          optional=(STRETCH,))
     tau = values[:, 0]
-    return {float(t): {name: values[tau == t, header.index(name)] for name in COLUMNS}
+    return {float(t): {name: values[tau == t, header.index(name)] for name in (*COLUMNS, STRETCH)
+                       if name in header}
             for t in np.unique(tau)}
 
 
@@ -101,6 +106,23 @@ def height(V, design: HandDesign):
     """FEM apex height h(V) [mm] of the wet surface (h̃ linear in v and in τ)."""
     v = np.asarray(V, float) / design.R**3
     return design.R * sum(w * np.interp(v, tab["v"], tab["h_tilde"]) for tab, w in _weights(design))
+
+
+def rubber_stretch(V, design: HandDesign):
+    """The sheet's converged rubber stretch (the FEM's ``rubber_stretch``) at oil volume V
+    [mm^3]: s_tilde linear in v and in tau, continued linearly beyond the table's last volume;
+    None if the table has no stretch column. A Neo-Hookean sheet's stretch depends on v and
+    tau only."""
+    if any(STRETCH not in tab for tab in table().values()):
+        return None
+    v = np.asarray(V, float) / design.R**3
+    return 1.0 + sum(w * _linear(v, tab["v"], tab[STRETCH]) for tab, w in _weights(design))
+
+
+def _linear(v, x, y):
+    """y(v) piecewise linear in the table, continued by its last segment beyond it."""
+    slope = (y[-1] - y[-2]) / (x[-1] - x[-2])
+    return np.where(v > x[-1], y[-1] + slope * (v - x[-1]), np.interp(v, x, y))
 
 
 register_model("fem", pressure)

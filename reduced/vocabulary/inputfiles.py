@@ -88,10 +88,11 @@ class NumberTable(NamedTuple):
     values: np.ndarray         #: (rows, columns), every value finite
 
 
-def read_number_table(path: str | Path, field: str, what: str, columns=None) -> NumberTable:
+def read_number_table(path: str | Path, field: str, what: str, columns=None, optional=()) -> NumberTable:
     """The one reader of the calibration tables (CSV of numbers after ``#`` provenance lines).
 
-    ``columns``: the header it must have (or None: any). InputError naming ``field`` and the
+    ``columns``: the header it must have (or None: any), which may go on with the ``optional``
+    columns, in their order (a table written before they existed lacks them). InputError naming ``field`` and the
     file if it is unreadable, not UTF-8, lacks the header, or has a cell that is not a finite
     number or a row of the wrong length."""
     data = read_input_file(path, field, what)
@@ -102,8 +103,11 @@ def read_number_table(path: str | Path, field: str, what: str, columns=None) -> 
     comments = tuple(line for line in text.splitlines() if line.startswith("#"))
     lines = [line for line in text.splitlines() if line.strip() and not line.startswith("#")]
     header = tuple(c.strip() for c in lines[0].split(",")) if lines else ()
-    if not header or (columns is not None and header != tuple(columns)):
-        raise InputError(field, str(path), f"needs the header {','.join(columns or ('...',))}")
+    allowed = None if columns is None else \
+        [tuple(columns) + tuple(optional[:k]) for k in range(len(optional) + 1)]
+    if not header or (allowed is not None and header not in allowed):
+        shown = ",".join(columns or ("...",)) + "".join(f"[,{c}]" for c in optional)
+        raise InputError(field, str(path), f"needs the header {shown}")
     try:
         values = np.array([[plain_float(x) for x in line.split(",")] for line in lines[1:]], ndmin=2)
     except ValueError:

@@ -134,7 +134,8 @@ def bend_case(params: dict, design: HandDesign, outdir: Path) -> dict:
     params: ``pressures_mpa`` (list), ``theta_target_deg``, ``p_max_mpa``, ``p_step_mpa``;
     ``mesh_size_mm`` (optional): a uniform gmsh mesh of that size instead of the default mesh;
     ``axial_size_mm`` (optional): the default (layered) mesh with slices of at most that length.
-    Returns P_cavity_MPa, theta_deg, dQ_mm3 (whole finger) per converged pressure.
+    Returns P_cavity_MPa, theta_deg, dQ_mm3 (whole finger) and rubber_stretch
+    (:mod:`softhand.fem.rubber_stretch`) per converged pressure.
     """
     from softhand.fem.hand.finger import FingerModel, solve_pressures
 
@@ -150,6 +151,7 @@ def bend_case(params: dict, design: HandDesign, outdir: Path) -> dict:
         linear.append(s2.solver)
     return {"P_cavity_MPa": [s.P for s in states], "theta_deg": [math.degrees(s.theta) for s in states],
             "dQ_mm3": [s.dQ for s in states],
+            "rubber_stretch": [s.rubber_stretch for s in states],
             "mesh": {"mesher": model.options.mesher, "dofs": model.ndofs,
                      "elements": model.mesh.nelements},
             "solver": {"newton_iterations": its, "factorizations": facs, "wall_time_s": wall,

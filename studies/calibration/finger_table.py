@@ -15,7 +15,7 @@ from scipy.interpolate import PchipInterpolator
 
 from softhand.reduced.equations import finger, hand
 from softhand.reduced.vocabulary.design import HandDesign
-from softhand.reduced.calibrated.finger_fem import COLUMNS, GROUPS, groups_of
+from softhand.reduced.calibrated.finger_fem import COLUMNS, GROUPS, STRETCH, groups_of
 from softhand.studies.calibration.finger import MIN_GAP_SLICES, cavity_pressures
 from softhand.studies.calibration.space import DesignSpace, VARIABLES, finger_design
 from softhand.studies.calibration.tables import table_text, written_by
@@ -40,14 +40,18 @@ def designs_ranges(rows: list[dict]) -> dict:
 
 
 def table_rows(results: list[tuple[HandDesign, dict]]) -> list[dict]:
-    """Nondimensional table rows from (design, numbers of its finger_bend case), P > 0 only."""
+    """Nondimensional table rows from (design, numbers of its finger_bend case), P > 0 only;
+    with the converged rubber stretch (s_tilde = lambda - 1) where every case has it."""
     rows = []
+    stretch = all("rubber_stretch" in numbers for _, numbers in results)
     for i, (design, numbers) in enumerate(results):
         groups = groups_of(design)
-        for P, theta, dQ in zip(cavity_pressures(numbers), numbers["theta_deg"], numbers["dQ_mm3"]):
+        lam = numbers["rubber_stretch"] if stretch else [math.nan] * len(numbers["theta_deg"])
+        for P, theta, dQ, lam_k in zip(cavity_pressures(numbers), numbers["theta_deg"], numbers["dQ_mm3"], lam):
             if P > 0:
                 rows.append({"design": i, **groups, "theta": math.radians(theta),
-                             "p_tilde": P / design.mu_sf, "q_tilde": dQ / design.a**3})
+                             "p_tilde": P / design.mu_sf, "q_tilde": dQ / design.a**3,
+                             **({STRETCH: lam_k - 1.0} if stretch else {})})
     return rows
 
 
@@ -85,12 +89,15 @@ def table_csv(rows: list[dict], ranges: dict, provenance: list[str], fit: str,
     """The calibration CSV of :mod:`softhand.reduced.calibrated.finger_fem`: provenance, range and fit lines, rows."""
     lines = [f"# {line}" for line in provenance]
     lines.append("# groups: b_a = b/a, d_a = d/a, link_a = (l0/6)/a, tie_link = tie width/(l0/6); "
-                 "theta [rad]; p_tilde = P/mu_sf; q_tilde = dQ/a^3 (one finger)")
+                 "theta [rad]; p_tilde = P/mu_sf; q_tilde = dQ/a^3 (one finger)"
+                 + ("; s_tilde = rubber_stretch - 1 (the converged stretch, fem.rubber_stretch)"
+                    if rows and STRETCH in rows[0] else ""))
     lines.append("# range: " + ", ".join(f"{g}={ranges[g][0]:.10g}:{ranges[g][1]:.10g}" for g in GROUPS))
     lines.append(f"# fit: prior={prior}, {fit}")
-    lines.append(",".join(COLUMNS))
+    columns = (*COLUMNS, STRETCH) if rows and STRETCH in rows[0] else COLUMNS
+    lines.append(",".join(columns))
     for r in rows:
-        lines.append(",".join(str(int(r[c])) if c == "design" else f"{r[c]:.10g}" for c in COLUMNS))
+        lines.append(",".join(str(int(r[c])) if c == "design" else f"{r[c]:.10g}" for c in columns))
     return "\n".join(lines) + "\n"
 
 
@@ -268,7 +275,7 @@ def leave_one_out(path: str | Path | None = None) -> list[dict]:
     the groups do not see)."""
     import tempfile
 
-    from softhand.reduced.calibrated.finger_fem import TABLE_FILE, read_table
+    from softhand.reduced.calibrated.finger_fem import STRETCH, TABLE_FILE, read_table, rubber_stretch
 
     table = read_table(path or TABLE_FILE)
     r = table.rows
@@ -277,10 +284,11 @@ def leave_one_out(path: str | Path | None = None) -> list[dict]:
     with tempfile.TemporaryDirectory() as tmp:
         for i in np.unique(r["design"]):
             at = r["design"] == i
-            rest = [{c: r[c][k] for c in COLUMNS} for k in np.flatnonzero(~at)]
+            columns = [c for c in (*COLUMNS, STRETCH) if c in r]
+            rest = [{c: r[c][k] for c in columns} for k in np.flatnonzero(~at)]
             lines = [line.lstrip("#").strip() for line in header]
-            text = "\n".join(f"# {line}" for line in lines) + "\n" + ",".join(COLUMNS) + "\n"
-            text += "".join(",".join(f"{row[c]:.10g}" for c in COLUMNS) + "\n" for row in rest)
+            text = "\n".join(f"# {line}" for line in lines) + "\n" + ",".join(columns) + "\n"
+            text += "".join(",".join(f"{row[c]:.10g}" for c in columns) + "\n" for row in rest)
             held = Path(tmp) / f"without_{int(i)}.csv"
             held.write_text(text)
             g = {k: float(r[k][at][0]) for k in GROUPS}
@@ -291,9 +299,12 @@ def leave_one_out(path: str | Path | None = None) -> list[dict]:
             theta, P = r["theta"][at], r["p_tilde"][at] * design.mu_sf
             th_m = hand.bend_angle(P, model, reservoir=False)
             dQ_m = finger.oil_taken(theta, model)
+            lam_m = rubber_stretch(theta, model)
             for k in range(theta.size):
                 out.append({"design": int(i), **{key: round(v, 4) for key, v in g.items()},
                             "P_cavity_MPa": float(P[k]), "theta_fem_deg": math.degrees(theta[k]),
                             "theta_err_pct": 100 * (th_m[k] / theta[k] - 1),
-                            "dQ_err_pct": 100 * (dQ_m[k] / (r["q_tilde"][at][k] * a**3) - 1)})
+                            "dQ_err_pct": 100 * (dQ_m[k] / (r["q_tilde"][at][k] * a**3) - 1),
+                            **({} if lam_m is None else  # of the stretch itself, not of its strain
+                               {"rubber_stretch_err_pct": 100 * (lam_m[k] / (1 + r[STRETCH][at][k]) - 1)})})
     return out

@@ -15,10 +15,11 @@ that keeps that pad on the object (:func:`softhand.reduced.equations.contact.rol
 for ``finger_model = "fem"`` by the FEM-informed grasp (:mod:`softhand.reduced.calibrated.grasp_hold`: the
 calibrated finger in equilibrium hinge by hinge against the object, the reservoir's pressure
 at the oil taken), for the paper's finger model by eqs. (25), (29) at theta_g with the
-rolling w. The tube's peak principal stretch is eq. (8), 1 + (d + a + b) theta / l0 (the outer
-fibre on the far side of the hinge plate), at the bend that holds the object, with its strain
-lambda - 1 scaled by the task's ``stretch_factor`` once an FEM proof has measured how far the
-FEM's peak (at the tied rings and the end cap) lies above it.
+rolling w. The tube's rubber stretch at the bend that holds the object is the calibrated finger
+table's prediction of the FEM's converged stretch (:func:`tube_stretch`) where the table holds
+it; else eq. (8), 1 + (d + a + b) theta / l0 (the outer fibre on the far side of the hinge
+plate), with its strain lambda - 1 scaled by the task's ``stretch_factor`` once an FEM proof
+has measured how far the FEM's stretch (at the tied rings and the end cap) lies above it.
 
 Constraints (each ``(name, value, limit, sense)``, normalised slack >= 0 when met): the tube
 fits its links (a + b < d), walls (b >= min wall, t > 0), the reservoir keeps oil at the grasp
@@ -41,10 +42,9 @@ from typing import NamedTuple
 
 import numpy as np
 
+from softhand.reduced.calibrated import finger_fem, grasp_hold, reservoir_fem
 from softhand.reduced.equations import contact, finger, grasp, hand, reservoir
-from softhand.reduced.calibrated import grasp_hold
-from softhand.reduced.vocabulary.design import HandDesign
-from softhand.reduced.vocabulary.design import hinges_for
+from softhand.reduced.vocabulary.design import HandDesign, hinges_for
 from softhand.reduced.vocabulary.design_files import design_from_dict
 from softhand.reduced.vocabulary.errors import InputError
 from softhand.studies.design.task import Task
@@ -94,8 +94,8 @@ class Evaluation:
     P_contact: float           #: free hand's pump pressure at theta_g (27) [MPa]
     F_v: float                 #: required normal force per finger [N]
     F_v_at_limit: float        #: F_v at the pump limit, or at P_margin below it (see margin_edge) [N]
-    stretch: float             #: the tube's peak principal stretch, eq. (8) x stretch_factor, at theta_hold
-    sheet_stretch: float       #: the reservoir sheet's stretch at V0, eq. (16)
+    stretch: float             #: the tube's rubber stretch, eq. (8) x stretch_factor, at theta_hold
+    sheet_stretch: float       #: the reservoir sheet's rubber stretch at V0 (:func:`sheet_stretch`)
     constraints: tuple[Constraint, ...]
     theta_hold: float = math.nan  #: the finger's bend when it presses with the required F_v [rad]
     P_margin: float = math.nan    #: the pump pressure F_v_at_limit is at: the limit, or lower (margin_edge) [MPa]
@@ -121,7 +121,7 @@ class Evaluation:
                    if self.margin_edge else {}),
                 **({"no_P_grasp": self.no_grasp} if self.no_grasp else {}),
                 "w": self.w.tolist(), "touching_link": self.link, "depth_mm": self.depth,
-                "max_principal_stretch": self.stretch, "sheet_stretch": self.sheet_stretch,
+                "rubber_stretch": self.stretch, "sheet_stretch": self.sheet_stretch,
                 **self.contact_parts()}
 
     def contact_parts(self) -> dict:
@@ -169,6 +169,45 @@ def peak_stretch(theta, design: HandDesign) -> float:
     return 1.0 + (design.d + design.a + design.b) * theta / design.l0
 
 
+def tube_stretch(theta, design: HandDesign, task: Task) -> float:
+    """The tube's rubber stretch at bend theta [rad]: the calibrated finger table's (finger_model
+    "fem" with a table that holds the FEM's converged stretch, reduced.finger_fem.rubber_stretch),
+    else eq. (8) with its strain x the task's stretch_factor."""
+    if design.finger_model == "fem":
+        try:
+            calibrated = finger_fem.rubber_stretch(theta, design)
+        except InputError:  # outside the calibrated range: eq. (8), the range constraint says so
+            calibrated = None
+        if calibrated is not None:
+            return float(calibrated)
+    return 1.0 + task.stretch_factor * (peak_stretch(theta, design) - 1.0)
+
+
+def models(design: HandDesign, task: Task) -> dict:
+    """The reduced models a design is judged on: the finger's, the reservoir's and where the
+    tube's and the sheet's rubber stretch come from."""
+    try:
+        tube = design.finger_model == "fem" and finger_fem.rubber_stretch(0.1, design) is not None
+    except InputError:
+        tube = False
+    sheet = design.reservoir_model == "fem" and reservoir_fem.rubber_stretch(design.V0, design) is not None
+    return {"finger_model": design.finger_model, "reservoir_model": design.reservoir_model,
+            "tube_stretch": "FEM-calibrated rubber_stretch" if tube else
+            f"eq. (8), strain x {task.stretch_factor:.4g}",
+            "sheet_stretch": "FEM-calibrated rubber_stretch" if sheet else "eq. (16)"}
+
+
+def sheet_stretch(design: HandDesign) -> float:
+    """The reservoir sheet's rubber stretch at V0: the calibrated sheet table's prediction of the
+    FEM's converged stretch (reservoir_model "fem" with a table that holds it: at the clamp,
+    where the sheet stretches most), else eq. (16)'s mean stretch."""
+    if design.reservoir_model == "fem":
+        calibrated = reservoir_fem.rubber_stretch(design.V0, design)
+        if calibrated is not None:
+            return float(calibrated)
+    return float(reservoir.stretch(design.V0, design))
+
+
 @lru_cache(maxsize=4096)
 def limit_point_volume(design: HandDesign) -> float:
     """Oil volume [mm^3] of the first pressure maximum of p_r(V) up to 4 V0 (inf: none)."""
@@ -195,8 +234,8 @@ def evaluate(design: HandDesign, task: Task, *, exact: bool = True) -> Evaluatio
         oil = design.n * float(finger.oil_taken(theta_hold, design))
     except InputError:
         oil = math.inf
-    stretch = 1.0 + task.stretch_factor * (peak_stretch(theta_hold, design) - 1.0)
-    sheet = float(reservoir.stretch(design.V0, design))
+    stretch = tube_stretch(theta_hold, design, task)
+    sheet = sheet_stretch(design)
     # no P_grasp: how far short of F_req the finger comes (for the optimiser)
     shortfall = min(1.0, 1.0 - max(F_reached, 0.0) / F_req) if no_grasp and F_reached < F_req else None
     cons = _constraints(design, task, oil, stretch, sheet, P_grasp, P_contact, F_lim, P_open, shortfall)
@@ -214,8 +253,10 @@ def _constraints(design: HandDesign, task: Task, oil, stretch, sheet, P_grasp, P
         Constraint("sheet_thickness t [mm]", design.t, 0.0, ">=", 1.0),
         Constraint("reservoir_oil the fingers take at the grasp [mm^3]", oil, design.V0, "<="),
         Constraint("reservoir_below_limit_point V0 [mm^3]", design.V0, limit_point_volume(design), "<="),
-        Constraint("max_principal_stretch", stretch, task.max_stretch, "<="),
-        Constraint("sheet_stretch at V0, eq. (16)", sheet, task.max_stretch, "<="),
+        Constraint("rubber_stretch of the tube", stretch, task.max_stretch, "<="),
+        Constraint("sheet_stretch at V0" + (" (FEM-calibrated rubber_stretch)" if design.reservoir_model == "fem"
+                                            and reservoir_fem.rubber_stretch(design.V0, design) is not None
+                                            else ", eq. (16)"), sheet, task.max_stretch, "<="),
         Constraint("pump_pressure at the grasp [MPa]", P_grasp, task.max_pressure, "<=", shortfall=grasp_shortfall),
         Constraint("contact: P(theta_g), the free hand's pump pressure where a pad touches the object "
                    "[MPa] (the hand at rest must not reach into the object's place)", P_contact, 0.0, ">=",

@@ -1,7 +1,8 @@
-"""Pump pressure against peak stretch: the Pareto front of a design task, its knee and plot.
+"""Pump pressure against rubber stretch: the Pareto front of a design task, its knee and plot.
 
-The stretch is the rubber's: the larger of the tube's (eq. (8)) and the reservoir sheet's
-(eq. (16)). A fuller sheet or a longer lever arm needs less pump pressure but stretches the
+The stretch is the rubber's: the larger of the tube's and the reservoir sheet's (their
+calibrated converged stretches where the models' tables hold them, else eqs. (8) and (16);
+:mod:`studies.design.evaluate`). A fuller sheet or a longer lever arm needs less pump pressure but stretches the
 rubber more.
 The front is traced by the epsilon-constraint method: the least stretch any feasible design
 reaches (differential evolution on the stretch, polished by SLSQP), then the task's objective with the stretch
@@ -56,7 +57,7 @@ def front(task: Task, optimum: design_opt.Optimum, options: design_opt.Optimiser
 
 
 def _row(task: Task, x, ev: design_opt.Evaluation) -> dict:
-    return {"stretch_limit": task.max_stretch, "max_principal_stretch": ev.rubber_stretch,
+    return {"stretch_limit": task.max_stretch, "rubber_stretch": ev.rubber_stretch,
             "P_grasp_MPa": ev.P_grasp, "margin_N": ev.predicted()["margin_N"],
             "objective": design_opt.objective(ev, task),
             "free": {k: float(v) for (k, _, _), v in zip(task.free, x)}}
@@ -66,7 +67,7 @@ def knee(rows: list[dict]) -> int:
     """Index of the point farthest from the chord between the front's ends (scaled axes)."""
     if len(rows) < 3:
         return 0
-    xy = np.array([[r["max_principal_stretch"], r["objective"]] for r in rows])
+    xy = np.array([[r["rubber_stretch"], r["objective"]] for r in rows])
     span = np.ptp(xy, axis=0)
     xy = (xy - xy.min(axis=0)) / np.where(span > 0, span, 1.0)
     a, b = xy[0], xy[-1]
@@ -87,7 +88,7 @@ def plot(rows: list[dict], path, *, task: Task, base: design_opt.Evaluation | No
 
     label = "pump pressure at the grasp [MPa]" if task.objective == "pressure" else "- F_v margin [N]"
     fig, ax = plt.subplots(figsize=(5.5, 4))
-    lam = [r["max_principal_stretch"] for r in rows]
+    lam = [r["rubber_stretch"] for r in rows]
     obj = [r["objective"] for r in rows]
     ax.plot(lam, obj, "o-", label="Pareto front (reduced model)")
     ax.plot(lam[0], obj[0], "s", ms=9, mfc="none", label="optimum")
@@ -95,7 +96,7 @@ def plot(rows: list[dict], path, *, task: Task, base: design_opt.Evaluation | No
     ax.plot(lam[k], obj[k], "D", ms=9, mfc="none", label="knee")
     if base is not None and math.isfinite(design_opt.objective(base, task)):
         ax.plot(base.rubber_stretch, design_opt.objective(base, task), "x", ms=9, label="base design")
-    ax.set_xlabel("peak stretch of the rubber: tube eq. (8), sheet eq. (16)")
+    ax.set_xlabel("rubber stretch of the tube and the sheet (the larger)")
     ax.set_ylabel(label)
     ax.set_title(f"{task.name}: {task.diameter:g} mm, {task.mass:g} kg")
     ax.grid(alpha=0.3)

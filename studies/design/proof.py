@@ -5,8 +5,8 @@ Three FEM models check the reduced model's answer (:class:`softhand.studies.desi
 1. **Free bend** (finger FEM, :mod:`softhand.fem.hand.finger`): cavity pressures in steps of at most
    ``max_step_mpa`` up to eq. (28)'s pressure at the grasp angle theta_g, then 1.25, 1.5, ...
    times it, until the finger bends past theta_g; the
-   cavity pressure p_finger, the cavity volume change dQ and the peak principal stretch at
-   theta_g are interpolated (monotone cubic in theta).
+   cavity pressure p_finger, the cavity volume change dQ and the rubber's stretch (the converged
+   ``rubber_stretch`` and the corner peak ``max_principal_stretch``) at theta_g are interpolated (monotone cubic in theta).
 2. **Reservoir** (sheet FEM, :mod:`softhand.fem.hand.reservoir`, one path from flat to V0): p_r at the oil
    left, V = V0 - n dQ (at the grasp: interpolated on the path), so that the hand's pump
    pressure at contact is
@@ -15,7 +15,7 @@ Three FEM models check the reduced model's answer (:class:`softhand.studies.desi
    first at the cavity pressure that the *predicted* pump pressure gives with the FEM
    reservoir (F_v there is the FEM's answer to the prediction), then secant steps in the
    cavity pressure until the FEM's F_v is the required one within ``rtol``: that state is the
-   verified grasp (its pump pressure P_grasp, bend, w, peak stretch, VTK).
+   verified grasp (its pump pressure P_grasp, bend, w, rubber stretch, VTK).
 4. **Margin** (the "margin" objective only): the grasp FEM continued from the verified grasp
    to the pump pressure of the reduced model's margin (the pump limit, or where the reduced
    model's one-pad grasp ends below it), in cavity-pressure steps of at most ``max_step_mpa``,
@@ -106,6 +106,7 @@ def free_bend(finger, theta_g: float, options: ProofOptions, tick=None) -> dict:
     return {"P_finger_MPa": at([0.0, *(s.P for s in states)]),
             "hinge_share": [at([share[0, i], *share[:, i]]) for i in range(share.shape[1])],
             "dQ_mm3": at([0.0, *(s.dQ for s in states)]),
+            "rubber_stretch": at([1.0, *(s.rubber_stretch for s in states)]),
             "max_principal_stretch": at([1.0, *(s.max_principal_stretch for s in states)]),
             "pressures_MPa": [s.P for s in states], "theta_deg": np.degrees(theta[1:]).tolist(),
             "seconds": time.perf_counter() - t0}
@@ -285,10 +286,11 @@ def check_proof_size(task: Task, mesh_size_mm: float) -> None:
 
 
 def fem_constraints(fem: dict, task: Task) -> list[dict]:
-    """The task's limits on the FEM's verified grasp: its peak principal stretch (all quadrature
-    points, which eq. (8) of the reduced model does not see: the tied rings, the end cap) and
-    its pump pressure."""
-    rows = [("max_principal_stretch (FEM, verified grasp)", fem["max_principal_stretch"], task.max_stretch),
+    """The task's limits on the FEM's verified grasp: its converged rubber stretch (the tube's,
+    fem.rubber_stretch: where the tied rings and the end cap concentrate it, which eq. (8) of the
+    reduced model does not see; and the sheet's at V0) and its pump pressure."""
+    rows = [("rubber_stretch (FEM, verified grasp)", fem["rubber_stretch"], task.max_stretch),
+            ("sheet rubber_stretch at V0 (FEM)", fem["sheet_rubber_stretch"], task.max_stretch),
             ("pump_pressure at the grasp (FEM) [MPa]", fem["P_grasp_MPa"], task.max_pressure)]
     return [{"name": name, "value": value, "limit": limit, "sense": "<=", "satisfied": bool(value <= limit)}
             for name, value, limit in rows]
@@ -307,17 +309,18 @@ def fem_report(fem: dict, ev: Evaluation) -> str | None:
         return None
     names = "; ".join(f"{c['name']} = {c['value']:.4g} above the limit {c['limit']:.4g}" for c in broken)
     return (f"The FEM proof does not confirm the design: {names}. The reduced model's estimate of the "
-            f"peak stretch (eq. (8), the wall's bending strain) is {ev.stretch:.4g}; the FEM's peak sits "
+            f"rubber stretch (eq. (8), the wall's bending strain) is {ev.stretch:.4g}; the FEM's sits "
             f"at the tied rings and the end cap, which the reduced model does not see.")
 
 
 def corrected_task(task: Task, ev: Evaluation, fem: dict) -> Task | None:
-    """The task with eq. (8)'s strain scaled to the FEM's, if the FEM's peak stretch at the
+    """The task with eq. (8)'s strain scaled to the FEM's, if the FEM's rubber stretch at the
     verified grasp broke the task's limit (None otherwise): stretch_factor x (lambda_FEM - 1) /
-    (lambda_predicted - 1), so that the reduced model predicts this design's FEM peak and a new
-    optimum keeps its FEM stretch near the limit. The FEM's peak grows with the bend as eq. (8)
-    does (both are the wall's strain at the hinge), so one factor carries to nearby designs."""
-    stretch = fem.get("max_principal_stretch")
+    (lambda_predicted - 1), so that the reduced model predicts this design's FEM stretch and a
+    new optimum keeps its FEM stretch near the limit. The FEM's converged stretch grows with the
+    bend as eq. (8) does (both are the wall's strain at the hinge), so one factor carries to
+    nearby designs."""
+    stretch = fem.get("rubber_stretch")
     if stretch is None or stretch <= task.max_stretch or not ev.stretch > 1.0:
         return None
     return replace(task, stretch_factor=task.stretch_factor * (stretch - 1.0) / (ev.stretch - 1.0))
@@ -377,8 +380,12 @@ def prove(ev: Evaluation, task: Task, options: ProofOptions = ProofOptions(), *,
         "touches_at_predicted_pressure": P_start == P_cav,
         "F_v_at_P_grasp_N": best.F_v,
         "w": g["w"].tolist(),
+        "rubber_stretch": fs.rubber_stretch,
         "max_principal_stretch": fs.max_principal_stretch,
+        "rubber_stretch_at_contact": bend["rubber_stretch"],
         "max_principal_stretch_at_contact": bend["max_principal_stretch"],
+        "sheet_rubber_stretch": sheet.states[1].rubber_stretch,
+        "sheet_max_principal_stretch": sheet.states[1].max_principal_stretch,
         "contact_force_N": best.N.tolist(),
         "P_cavity_MPa": best.P,
         "reservoir_pressure_MPa": p_grasp,

@@ -13,7 +13,7 @@ A task is a TOML file (``studies/designs/tasks/paper_task.toml`` is the paper's)
     [pump]
     max_pressure_MPa = 1.0
     [limits]                  # optional
-    max_principal_stretch = 1.5
+    rubber_stretch = 1.5      # the converged rubber stretch of the tube and the sheet
     min_wall_mm = 1.0
     [material]                # optional: mu per part, over the base design
     mu_sf_MPa = 1.15
@@ -55,7 +55,7 @@ _SECTIONS = {
     "object": {"diameter_mm", "mass_kg"},
     "grasp": {"force_factor", "margin_N", "objective", "opening_mm"},
     "pump": {"max_pressure_MPa"},
-    "limits": {"max_principal_stretch", "min_wall_mm"},
+    "limits": {"rubber_stretch", "min_wall_mm"},
     "material": {"mu_sf_MPa", "mu_sr_MPa"},
     "fem": {"mesh_size_mm", "edge_ratio", "dP_MPa"},
 }
@@ -65,7 +65,7 @@ MODELS = {"finger_model": "fem", "reservoir_model": "fem"}
 CALIBRATED_SPACE = PAPER_DESIGN_FILE.parents[1] / "finger_space.toml"
 #: highest value of each number of a task (the lowest: > 0, or >= 0 where zero makes sense)
 UPPER = {"diameter_mm": 500.0, "mass_kg": 20.0, "max_pressure_MPa": 5.0, "force_factor": 100.0,
-         "margin_N": 1000.0, "opening_mm": 1000.0, "max_principal_stretch": 10.0, "min_wall_mm": 50.0,
+         "margin_N": 1000.0, "opening_mm": 1000.0, "rubber_stretch": 10.0, "min_wall_mm": 50.0,
          "mesh_size_mm": 12.0, "edge_ratio": 1.0, "dP_MPa": 0.5}
 #: lowest value of the FEM proof's mesh and step (a finer one is refused, not run for hours), of the
 #: force factor (below 1 the fingers would not carry the object's weight) and of the pump limit
@@ -92,7 +92,8 @@ class Task:
     margin: float | None = None            #: ... or F_v >= m g / n + margin [N]
     objective: str = "pressure"            #: one of OBJECTIVES
     opening: float | None = None           #: open tip span to pass [mm]; None: the diameter
-    max_stretch: float = 1.5               #: peak principal stretch of the tube
+    #: limit of the rubber's converged stretch (fem.rubber_stretch) in the tube and the sheet
+    max_stretch: float = 1.5
     #: the FEM's peak stretch over eq. (8)'s, in (lambda - 1): 1 until a proof has measured it
     stretch_factor: float = 1.0
     min_wall: float = 1.0                  #: least tube wall and sheet thickness [mm]
@@ -126,6 +127,10 @@ def task_from_dict(data: dict, *, folder: Path = Path("."), name: str = "task") 
         if key not in _TOP:
             raise InputError(key, data[key], f"unknown task key; allowed: {', '.join(sorted(_TOP))}")
     tables = {s: _table(data, s) for s in (*_SECTIONS, "design", "free")}
+    if "max_principal_stretch" in tables["limits"]:
+        raise InputError("limits.max_principal_stretch", tables["limits"]["max_principal_stretch"],
+                         "is now limits.rubber_stretch (the converged rubber stretch; the corner peak "
+                         "depends on the mesh)")
     for section, allowed in _SECTIONS.items():
         for key in tables[section]:
             if key not in allowed:
@@ -167,7 +172,7 @@ def task_from_dict(data: dict, *, folder: Path = Path("."), name: str = "task") 
         margin=_number(grasp, "grasp", "margin_N", default=None, positive=False),
         objective=objective,
         opening=opening,
-        max_stretch=_number(limits, "limits", "max_principal_stretch", default=1.5, above=1.0),
+        max_stretch=_number(limits, "limits", "rubber_stretch", default=1.5, above=1.0),
         min_wall=_number(limits, "limits", "min_wall_mm", default=1.0),
         mesh_size=_number(fem, "fem", "mesh_size_mm", default=6.0),
         edge_ratio=_number(fem, "fem", "edge_ratio", default=0.5),

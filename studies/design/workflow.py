@@ -13,7 +13,7 @@ import numpy as np
 
 from softhand.reduced.vocabulary.errors import MeshRejected, MeshTooLarge
 from softhand.studies.design import optimise as design_opt
-from softhand.studies.design import proof
+from softhand.studies.design import evaluate, proof
 from softhand.studies.io.files import kept_if_unwritable, replaced_outputs, write_atomic, write_json
 
 #: what a design run writes into its folder (its manifest: an earlier run's are replaced whole)
@@ -134,7 +134,7 @@ def prove_knee(pareto: dict, task, run: DesignRun, dirs, say) -> dict | None:
     ev = design_opt.Problem(sub).evaluation(np.array([row["free"][k] for k, _, _ in task.free]))
     stage, out = dirs
     (stage / "knee").mkdir(exist_ok=True)
-    say(f"FEM proof of the Pareto knee (stretch {row['max_principal_stretch']:.4g})")
+    say(f"FEM proof of the Pareto knee (stretch {row['rubber_stretch']:.4g})")
     with kept_if_unwritable(out / "knee" / "design.toml", "design"):
         write_atomic(stage / "knee" / "design.toml", ev.design.to_toml())
     return {"design_file": str(out / "knee" / "design.toml"),
@@ -188,6 +188,7 @@ def result_record(task, opt, base, design_file, seed: int) -> dict:
     ev = opt.evaluation
     return {
         "task": task.name, "feasible": ev.feasible, "objective": task.objective,
+        "models": evaluate.models(ev.design, task),
         "design": ev.design.to_dict(),
         "free": {k: float(v) for (k, _, _), v in zip(task.free, opt.x)},
         "free_bounds": {k: [lo, hi] for k, lo, hi in task.free},

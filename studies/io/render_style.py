@@ -17,11 +17,13 @@ from softhand.reduced.vocabulary.errors import InputError
 #: blocks that are the deformable body, in order of preference
 BODIES = ("tube", "sheet")
 #: the default field of a body: the first present (older files: names without units)
-DEFAULT_FIELDS = ("von_mises_MPa", "displacement_mm", "von_mises", "displacement", "height")
+#: (rubber_stretch: the converged measure the design limits judge; von Mises peaks at the
+#: bonded corners and paints one red spot)
+DEFAULT_FIELDS = ("rubber_stretch", "von_mises_MPa", "displacement_mm", "von_mises", "displacement", "height")
 #: --view: side = normal to the bending plane (finger) / to a meridian plane (sheet)
 VIEWS = ("side", "iso", "top", "front")
 UNITS = {"MPa": "MPa", "mm": "mm", "N": "N", "mm3": "mm^3", "deg": "deg"}  # VTK's font: ASCII
-DIMENSIONLESS = ("principal_stretches", "J", "fiber_stretch", "hoop_stretch")
+DIMENSIONLESS = ("principal_stretches", "J", "fiber_stretch", "hoop_stretch", "rubber_stretch")
 
 
 def body_name(names) -> str:
@@ -42,7 +44,8 @@ def colour_label(field: str) -> str:
     unit_match = re.fullmatch(r"(.+)_(MPa|mm3|mm|N|deg)", base)
     name, unit = (unit_match.group(1), UNITS[unit_match.group(2)]) if unit_match else \
         (base, "-" if base in DIMENSIONLESS else None)
-    words = {"von_mises": "von Mises stress", "cauchy_stress": "Cauchy stress"}.get(name, name.replace("_", " "))
+    words = {"von_mises": "von Mises stress", "cauchy_stress": "Cauchy stress",
+             "rubber_stretch": "rubber stretch (ball average)"}.get(name, name.replace("_", " "))
     if component is not None and name == "principal_stretches":
         words = f"principal stretch {int(component) + 1}" + (" (largest)" if component == "0" else "")
     elif component is not None:

@@ -46,7 +46,8 @@ def test_blocks_have_the_right_names_counts_and_units(finger, series):
     nodes = finger.vector_basis().N // 3
     assert tube.n_points == 2 * nodes and tube.n_cells == 2 * finger.mesh.nelements
     assert np.bincount(tube.cell_data["mirrored"]).tolist() == [finger.mesh.nelements] * 2
-    assert {"displacement_mm", "von_mises_MPa", "cauchy_stress_MPa", "principal_stretches"} <= set(tube.point_data)
+    assert {"displacement_mm", "von_mises_MPa", "cauchy_stress_MPa", "principal_stretches",
+            "rubber_stretch"} <= set(tube.point_data)
     assert float(tube.field_data["P_cavity_MPa"][0]) == 0.8
     assert all(scene[f"link_{k}"].n_points == 8 for k in range(n_s + 1))
 

@@ -88,7 +88,8 @@ TASKS = {
     "t_pump.toml": GOOD_TASK.replace("max_pressure_MPa = 2.0", 'max_pressure_MPa = "high"'),
     "t_objective.toml": GOOD_TASK + '[grasp]\nobjective = "cheap"\n',
     "t_both.toml": GOOD_TASK + "[grasp]\nforce_factor = 2.0\nmargin_N = 1.0\n",
-    "t_stretch.toml": GOOD_TASK + "[limits]\nmax_principal_stretch = 0.9\n",
+    "t_stretch.toml": GOOD_TASK + "[limits]\nrubber_stretch = 0.9\n",
+    "t_old_stretch.toml": GOOD_TASK + "[limits]\nmax_principal_stretch = 1.5\n",  # renamed: refused
     "t_model.toml": GOOD_TASK + '[design]\nfinger_model = "magic"\n',
     "t_base.toml": 'base_design = "nowhere.toml"\n' + GOOD_TASK,
     "t_unknown.toml": GOOD_TASK + 'colour = "red"\n',

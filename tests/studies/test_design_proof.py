@@ -16,16 +16,16 @@ def test_the_proof_flags_a_fem_stretch_above_the_limit():
     against the task's limit by the proof, and a break is one paragraph."""
     from softhand.studies.design.proof import fem_constraints, fem_report
 
-    task = task_from_dict(CI_TASK)  # stretch limit 1.4, pump 2 MPa
+    task = task_from_dict(CI_TASK)  # stretch limit 1.5, pump 2 MPa
     ev = design_opt.evaluate(task.base, task)
-    ok = {"max_principal_stretch": 1.39, "P_grasp_MPa": 0.7}
+    ok = {"rubber_stretch": 1.49, "sheet_rubber_stretch": 1.3, "P_grasp_MPa": 0.7}
     ok["constraints"] = fem_constraints(ok, task)
     assert all(c["satisfied"] for c in ok["constraints"]) and fem_report(ok, ev) is None
-    bad = {"max_principal_stretch": 1.44, "P_grasp_MPa": 0.7}
+    bad = {"rubber_stretch": 1.54, "sheet_rubber_stretch": 1.3, "P_grasp_MPa": 0.7}
     bad["constraints"] = fem_constraints(bad, task)
-    assert [c["satisfied"] for c in bad["constraints"]] == [False, True]
+    assert [c["satisfied"] for c in bad["constraints"]] == [False, True, True]
     text = fem_report(bad, ev)
-    assert "max_principal_stretch (FEM, verified grasp) = 1.44 above the limit 1.4" in text and "\n" not in text
+    assert "rubber_stretch (FEM, verified grasp) = 1.54 above the limit 1.5" in text and "\n" not in text
 
 
 def test_the_proof_mesh_follows_the_wall():
@@ -125,9 +125,9 @@ def test_the_proof_mesh_is_bounded_on_the_boxs_thinnest_shortest_tube(monkeypatc
 
 
 def test_a_fem_stretch_above_the_limit_reoptimises_with_the_fems_factor(tmp_path, monkeypatch, capsys):
-    """The proof's peak stretch 1.41 breaks the limit 1.4: the verb optimises again with eq. (8)'s
-    strain scaled by (1.41 - 1) / (lambda_pred - 1), proves that design (here: the FEM stand-in
-    gives its scaled prediction), keeps the first under "rejected" and exits 0. At 1.45 no design
+    """The proof's rubber stretch 1.51 breaks the limit 1.5: the verb optimises again with eq. (8)'s
+    strain scaled by (1.51 - 1) / (lambda_pred - 1), proves that design (here: the FEM stand-in
+    gives its scaled prediction), keeps the first under "rejected" and exits 0. At 1.55 no design
     meets the scaled limit if l0 is fixed: one paragraph naming it and the nearest design, exit 1."""
     from softhand.studies.cli.main import main
     from softhand.studies.design import proof
@@ -139,31 +139,31 @@ def test_a_fem_stretch_above_the_limit_reoptimises_with_the_fems_factor(tmp_path
     def prove(ev, task, options, out=None, progress=None, tick=None):
         seen.append((ev, task))
         stretch = first if len(seen) == 1 else 1 + 0.999 * (ev.stretch - 1)  # the second: as the factor says
-        fem = {"max_principal_stretch": stretch, "P_grasp_MPa": ev.P_grasp, "F_v_N": ev.F_v}
+        fem = {"rubber_stretch": stretch, "sheet_rubber_stretch": 1.0, "P_grasp_MPa": ev.P_grasp, "F_v_N": ev.F_v}
         return {**fem, "constraints": fem_constraints(fem, task)}
 
     monkeypatch.setattr(proof, "prove", prove)
     task = _write(tmp_path, CI_TASK_TOML + "l0_mm = [150.0, 200.0]\n")  # a longer finger stretches less
-    first = 1.41
+    first = 1.51
     assert main(["design", "--task", str(task), "--json", "--out", str(tmp_path / "out"), "--seed", "3"]) == 0
     result = json.loads(capsys.readouterr().out)
     (ev1, task1), (ev2, task2) = seen
-    factor = 0.41 / (ev1.stretch - 1.0)
+    factor = 0.51 / (ev1.stretch - 1.0)
     assert task1.stretch_factor == 1.0 and task2.stretch_factor == pytest.approx(factor, rel=1e-12)
     assert result["stretch_factor"] == pytest.approx(factor, rel=1e-12)
     # the new optimum's predicted stretch is eq. (8) x the factor, and within the limit
     eq8 = evaluate.peak_stretch(ev2.theta_hold, ev2.design)
-    assert ev2.stretch == pytest.approx(1 + factor * (eq8 - 1), rel=1e-12) and ev2.stretch <= 1.4 + 1e-9
-    assert ev2.design != ev1.design  # it moved: the first would be 1.41
-    assert result["rejected"]["fem"]["max_principal_stretch"] == 1.41 and "fem_report" not in result
+    assert ev2.stretch == pytest.approx(1 + factor * (eq8 - 1), rel=1e-12) and ev2.stretch <= 1.5 + 1e-9
+    assert ev2.design != ev1.design  # it moved: the first would be 1.51
+    assert result["rejected"]["fem"]["rubber_stretch"] == 1.51 and "fem_report" not in result
     assert load_design(result["design_file"]).to_dict() == result["design"] == ev2.design.to_dict()
     assert load_design(result["rejected"]["design_file"]).to_dict() == ev1.design.to_dict()
-    seen.clear()  # with l0 fixed the bend at the grasp, so eq. (8), hardly moves: 1.45 cannot be met
-    first, fixed_l0 = 1.45, _write(tmp_path, CI_TASK_TOML, "fixed_l0.toml")
+    seen.clear()  # with l0 fixed the bend at the grasp, so eq. (8), hardly moves: 1.55 cannot be met
+    first, fixed_l0 = 1.55, _write(tmp_path, CI_TASK_TOML, "fixed_l0.toml")
     assert main(["design", "--task", str(fixed_l0), "--json", "--out", str(tmp_path / "o1"), "--seed", "3"]) == 1
     result = json.loads(capsys.readouterr().out)
     assert len(seen) == 1 and result["report"].startswith("The task cannot be met")
-    assert "binding constraint is max_principal_stretch" in result["report"] and "nearest design" in result["report"]
+    assert "binding constraint is rubber_stretch of the tube" in result["report"] and "nearest design" in result["report"]
     # --no-correct keeps the first optimum and its exit code 1
     seen.clear()
     assert main(["design", "--task", str(task), "--json", "--out", str(tmp_path / "o2"), "--seed", "3",
@@ -182,7 +182,7 @@ def test_the_pareto_knee_goes_through_the_fem_too(tmp_path, monkeypatch, capsys)
 
     def prove(ev, task, options, out=None, progress=None, tick=None):
         seen.append((ev, out))
-        fem = {"max_principal_stretch": ev.stretch, "P_grasp_MPa": ev.P_grasp, "F_v_N": ev.F_v}
+        fem = {"rubber_stretch": ev.stretch, "sheet_rubber_stretch": 1.0, "P_grasp_MPa": ev.P_grasp, "F_v_N": ev.F_v}
         return {**fem, "constraints": fem_constraints(fem, task)}
 
     monkeypatch.setattr(proof, "prove", prove)
@@ -195,8 +195,8 @@ def test_the_pareto_knee_goes_through_the_fem_too(tmp_path, monkeypatch, capsys)
     assert pareto["knee"] > 0 and len(seen) == 2 and seen[1][1].name == "knee" and seen[1][1].parent.parent == out
     proof_of_knee = pareto["knee_proof"]
     predicted = proof_of_knee["predicted"]  # the front's axis: the larger of the tube's and the sheet's
-    assert max(predicted["max_principal_stretch"], predicted["sheet_stretch"]) == \
-        pytest.approx(knee["max_principal_stretch"], rel=1e-9)
+    assert max(predicted["rubber_stretch"], predicted["sheet_stretch"]) == \
+        pytest.approx(knee["rubber_stretch"], rel=1e-9)
     assert proof_of_knee["fem"]["P_grasp_MPa"] == pytest.approx(knee["P_grasp_MPa"], rel=1e-9)
     assert load_design(proof_of_knee["design_file"]).to_dict() == seen[1][0].design.to_dict()
 

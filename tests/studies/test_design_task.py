@@ -19,7 +19,7 @@ CI_TASK = {
     "object": {"diameter_mm": 180.0, "mass_kg": 2.0},
     "grasp": {"force_factor": 2.0},
     "pump": {"max_pressure_MPa": 2.0},
-    "limits": {"max_principal_stretch": 1.4},
+    "limits": {"rubber_stretch": 1.5},  # the paper's sheet at V0: 1.454 (FEM-calibrated)
     "free": {"d_mm": [10.0, 20.0], "V0_mm3": [12000.0, 30000.0]},
 }
 FAST = design_opt.OptimiserOptions(seed=3)
@@ -47,7 +47,8 @@ def test_task_file_reads_the_paper_task():
     ({"grasp": {"force_factor": 2.0, "margin_N": 1.0}}, "grasp.margin_N"),
     ({"grasp": {"objective": "cheapest"}}, "grasp.objective"),
     ({"pump": {"max_pressure_MPa": "high"}}, "pump.max_pressure_MPa"),
-    ({"limits": {"max_principal_stretch": 0.9}}, "limits.max_principal_stretch"),
+    ({"limits": {"rubber_stretch": 0.9}}, "limits.rubber_stretch"),
+    ({"limits": {"max_principal_stretch": 1.5}}, "limits.max_principal_stretch"),  # renamed: refused
     ({"colour": "red"}, "colour"),
     ({"base_design": "nowhere.toml"}, "base_design"),
     ({"design": {"b_mm": -5.0}}, "b_mm"),
@@ -200,14 +201,15 @@ def test_a_sliver_of_feasible_designs_is_found_not_called_infeasible():
     """A pump limit a hair above the optimum's pressure leaves a sliver of the box feasible:
     DE's first generations meet no constraint, but their violation falls fast (by orders of
     magnitude), so the stall rule lets DE go on to the sliver."""
-    best = design_opt.optimise(task_from_dict(CI_TASK), FAST).evaluation.P_grasp
+    loose = {**CI_TASK, "limits": {"rubber_stretch": 2.0}}  # the pump's sliver alone
+    best = design_opt.optimise(task_from_dict(loose), FAST).evaluation.P_grasp
     for factor in (1.00001, 1.001):
-        task = task_from_dict({**CI_TASK, "pump": {"max_pressure_MPa": best * factor}})
+        task = task_from_dict({**loose, "pump": {"max_pressure_MPa": best * factor}})
         opt = design_opt.optimise(task, design_opt.OptimiserOptions(seed=1))
         assert opt.evaluation.feasible and "stopped" not in opt.message
         assert opt.evaluation.P_grasp == pytest.approx(best, rel=1e-6)
     # a hair below: no design meets it, and the stall rule ends DE before its last generation
-    task = task_from_dict({**CI_TASK, "pump": {"max_pressure_MPa": best * 0.99999}})
+    task = task_from_dict({**loose, "pump": {"max_pressure_MPa": best * 0.99999}})
     opt = design_opt.optimise(task, design_opt.OptimiserOptions(seed=1))
     assert not opt.evaluation.feasible and opt.generations < 60
 
@@ -252,7 +254,7 @@ force_factor = 2.0
 [pump]
 max_pressure_MPa = 2.0
 [limits]
-max_principal_stretch = 1.4
+rubber_stretch = 1.5
 [free]
 d_mm = [10.0, 20.0]
 V0_mm3 = [12000.0, 30000.0]
@@ -267,7 +269,7 @@ def test_cli_json_no_fem_writes_a_design_every_verb_reads(tmp_path):
     result = json.loads(proc.stdout)
     for key in ("design", "predicted", "fem", "constraints", "design_file"):
         assert key in result
-    assert set(result["predicted"]) >= {"P_grasp_MPa", "theta_grasp_deg", "F_v_N", "max_principal_stretch"}
+    assert set(result["predicted"]) >= {"P_grasp_MPa", "theta_grasp_deg", "F_v_N", "rubber_stretch"}
     assert all({"name", "value", "limit", "satisfied"} <= set(c) for c in result["constraints"])
     assert result["fem"] is None
     design = load_design(result["design_file"])
@@ -285,7 +287,7 @@ def test_cli_pareto_plot(tmp_path):
     assert proc.returncode == 0, proc.stderr
     rows = json.loads(proc.stdout)["pareto"]["rows"]
     assert plot.stat().st_size > 1000
-    lam = [r["max_principal_stretch"] for r in rows]
+    lam = [r["rubber_stretch"] for r in rows]
     P = [r["P_grasp_MPa"] for r in rows]
     assert np.all(np.diff(lam) < 0) and np.all(np.diff(P) >= -1e-9)  # less stretch costs pressure
 
@@ -393,7 +395,7 @@ def test_a_massless_object_is_held_where_the_fingers_touch_it():
 def test_every_point_of_the_box_has_the_same_constraints():
     """A design without an answer (V0 = 1 mm^3 holds no oil) had one constraint more than one
     with an answer: scipy's 'array returned from a Constraint has the wrong shape'."""
-    task = task_from_dict({**CI_TASK, "free": {"V0_mm3": [1.0, 1e8]}})
+    task = task_from_dict({**CI_TASK, "free": {"V0_mm3": [1.0, 1e8]}, "limits": {"rubber_stretch": 2.0}})
     problem = design_opt.Problem(task)
     lengths = {len(problem.slacks([v])) for v in np.geomspace(1.0, 1e8, 12)}
     assert len(lengths) == 1
@@ -504,7 +506,7 @@ def test_the_hand_at_rest_does_not_reach_into_the_objects_place():
     object could pass the open tips but not reach its grasp place (pad 2 in the way) unless
     the pump sucked oil out. Such a design (P_contact = -0.033 MPa, a thin 3 mm wall, a thick
     sheet) was reported feasible; the free hand's pump pressure at the grasp angle is now >= 0."""
-    task = task_from_dict({**CI_TASK, "limits": {"min_wall_mm": 3.0},
+    task = task_from_dict({**CI_TASK, "limits": {"min_wall_mm": 3.0, "rubber_stretch": 2.0},  # contact alone
                            "free": {"a_mm": [3.0, 6.0], "b_mm": [3.0, 7.0], "d_mm": [10.0, 20.0],
                                     "t_mm": [0.5, 3.0], "V0_mm3": [10000.0, 40000.0]}})
     pre_bent = design_opt.evaluate(task.base.replace(a=6.0, b=3.0, d=20.0, t=2.0, V0=22000.0), task)

@@ -1,7 +1,10 @@
 """``softhand bend``: free bending of the finger FEM under pressure, against eqs. (28) and (2).
 
-Per cavity pressure: P_cavity_MPa, theta_deg, hinge_deg, dQ_mm3, radial_stretch_max,
-max_principal_stretch, theta_reduced_deg (eq. (28) at the same P), dQ_reduced_mm3 (eq. (2)
+Per cavity pressure: P_cavity_MPa, theta_deg, hinge_deg, dQ_mm3, radial_stretch_max, radial_stretch_q99,
+radial_stretch (the windings' hoop stretch averaged like rubber_stretch), rubber_stretch (the
+principal stretch averaged over a 2 mm ball at its worst place: converges under mesh
+refinement), max_principal_stretch (the pointwise peak at a bonded corner: mesh-dependent),
+theta_reduced_deg (eq. (28) at the same P), dQ_reduced_mm3 (eq. (2)
 at the FEM's theta), max_von_mises_MPa, newton_iterations. Then, unless ``--peak-mpa 0``,
 the path goes on to 2.0 MPa and the peak stretch and stress there are reported.
 Files in ``--out DIR``: result.json, table.csv, the VTK series finger.pvd (one .vtm scene per
@@ -204,9 +207,10 @@ def run(args) -> int:
             if p["failure"]:
                 print(f"# Newton gave up on the way to {p['target_P_cavity_MPa']} MPa ({p['failure']}); "
                       f"last converged state:")
-            print(f"# at {p['P_cavity_MPa']:.2f} MPa: theta {p['theta_deg']:.1f} deg, max principal "
-                  f"stretch {p['max_principal_stretch']:.3f}, max von Mises "
-                  f"{p['max_von_mises_MPa']:.2f} MPa, hoop stretch {p['radial_stretch_max']:.4f}")
+            print(f"# at {p['P_cavity_MPa']:.2f} MPa: theta {p['theta_deg']:.1f} deg, rubber stretch "
+                  f"{p['rubber_stretch']:.3f} (corner peak {p['max_principal_stretch']:.3f}, mesh-dependent), "
+                  f"max von Mises {p['max_von_mises_MPa']:.2f} MPa, hoop stretch {p['radial_stretch']:.4f} "
+                  f"(peak {p['radial_stretch_max']:.4f})")
         print(f"# files in {out}")
     return 0
 

@@ -102,6 +102,9 @@ def _print(result: dict, task, opt) -> None:
     free = ", ".join(f"{k} = {v:.5g}" for k, v in result["free"].items())
     print(f"task {task.name}: {task.diameter:g} mm, {task.mass:g} kg, F_v >= {task.required_F_v():.4g} N "
           f"per finger, pump <= {task.max_pressure:g} MPa; objective: {task.objective}")
+    m = result["models"]
+    print(f"models: finger {m['finger_model']!r}, reservoir {m['reservoir_model']!r}; rubber stretch of the "
+          f"tube: {m['tube_stretch']}, of the sheet: {m['sheet_stretch']}")
     print(f"optimum: {free}  ({opt.evaluations} model evaluations, {opt.seconds:.1f} s wall, "
           f"{opt.cpu_seconds:.1f} s CPU)")
     if not opt.evaluation.feasible:  # why the search ended where it did
@@ -119,7 +122,7 @@ def _print(result: dict, task, opt) -> None:
     rows = [{"constraint": c["name"], "value": c["value"], "sense": c["sense"], "limit": c["limit"],
              "satisfied": c["satisfied"]} for c in result["constraints"]]
     print_table(rows)
-    keys = ("P_grasp_MPa", "P_contact_MPa", "theta_grasp_deg", "F_v_N", "max_principal_stretch", "w") + \
+    keys = ("P_grasp_MPa", "P_contact_MPa", "theta_grasp_deg", "F_v_N", "rubber_stretch", "w") + \
         (("F_v_at_pump_limit_N", "margin_N") if task.objective == "margin" else ())
     fem = result.get("fem") or {}
     base = result["base_design"]["predicted"]
@@ -142,7 +145,7 @@ def _print(result: dict, task, opt) -> None:
     if "pareto" in result:
         k = result["pareto"]["knee"]
         print(f"Pareto front: {len(result['pareto']['rows'])} points, knee at stretch "
-              f"{result['pareto']['rows'][k]['max_principal_stretch']:.4g}; plot {result['pareto']['plot']}")
+              f"{result['pareto']['rows'][k]['rubber_stretch']:.4g}; plot {result['pareto']['plot']}")
         knee = result["pareto"].get("knee_proof")
         if knee and "P_grasp_MPa" in knee["fem"]:
             print(knee_line(knee))
