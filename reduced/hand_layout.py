@@ -23,6 +23,7 @@ normal there (vectorised over fingers and pads). Units: mm, rad.
 """
 from __future__ import annotations
 
+from functools import lru_cache
 from typing import NamedTuple
 
 import numpy as np
@@ -59,7 +60,12 @@ class FingerFrames(NamedTuple):
 
 def finger_frames(design: HandDesign) -> FingerFrames:
     """The fingers' planes (:class:`FingerFrames`) for the design's layout."""
-    phi = azimuths(design)
+    return _frames(tuple(azimuths(design)))
+
+
+@lru_cache(maxsize=64)
+def _frames(phi: tuple) -> FingerFrames:
+    phi = np.asarray(phi, float)
     e_out = np.stack([np.cos(phi), np.zeros_like(phi), -np.sin(phi)], axis=-1)
     e_down = np.tile([0.0, 1.0, 0.0], (len(phi), 1))
     return FingerFrames(e_out, e_down, np.cross(e_out, e_down))
@@ -83,10 +89,13 @@ class Pads(NamedTuple):
     joints: np.ndarray   #: (nf, n_s+2, 3) base, hinges, tip [mm]
 
 
-def pads(q, design: HandDesign) -> Pads:
-    """Every finger's pads at hinge angles q (nf, n_s) [rad] (:class:`Pads`)."""
+def pads(q, design: HandDesign, fingers=None) -> Pads:
+    """Every finger's pads at hinge angles q (nf, n_s) [rad] (:class:`Pads`); ``fingers``: only
+    those (indices; q then has one row per finger named)."""
     q = np.asarray(q, float)
     frames = finger_frames(design)
+    if fingers is not None:
+        frames = FingerFrames(*(f[np.asarray(fingers)] for f in frames))
     alpha = kinematics.link_angles(q, design)                           # (nf, n_s+1)
     joints = to_hand(kinematics.positions_at(alpha, design), frames)    # (nf, n_s+2, 3)
     along_2d = np.stack([-np.sin(alpha), np.cos(alpha)], axis=-1)
