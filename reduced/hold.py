@@ -46,7 +46,7 @@ def pull_unit(pull, field: str = "--pull") -> np.ndarray:
         raise InputError(field, pull, "must be three numbers x,y,z (hand frame, y down)")
     size = float(np.linalg.norm(v))
     if not size > 1e-12:
-        raise InputError(field, list(v), "must not have zero length (a direction x,y,z; y down)")
+        raise InputError(field, [float(x) for x in v], "must not have zero length (a direction x,y,z; y down)")
     return v / size
 
 
@@ -124,7 +124,8 @@ def solve_hold(design: HandDesign, obj: GraspObject, *, P_cavity_MPa: float, pul
         extra={"finger_model": d.finger_model, "hinge_residual": residual,
                "limit_contacts": [c._asdict() if hasattr(c, "_asdict") else c.__dict__
                                   for c in _contacts(cs, limit, held)] if held else [],
-               "friction_polygon": hold_lp.GENERATORS, "object_centre_mm": placed.centre.tolist()})
+               "friction_polygon": hold_lp.GENERATORS, "object_centre_mm": placed.centre.tolist(),
+               "limit_pull_N": float(limit.pull_N) if limit is not None else None})
 
 
 def cavity_pressure(P_pump: float, placed: Placed, design: HandDesign, *, finger_model: str = "fem",
@@ -133,15 +134,25 @@ def cavity_pressure(P_pump: float, placed: Placed, design: HandDesign, *, finger
     if not reservoir:
         return float(P_pump)
     d = hold_fast.finger_design(design, finger_model)
-    pump = lambda P: hold_fast.close_hand(P, placed, d).P_pump - P_pump  # noqa: E731
-    lo, hi = float(P_pump), float(P_pump) + 0.5
+    f = lambda P: hold_fast.close_hand(P, placed, d).P_pump - P_pump  # noqa: E731
     top = float(hand.pressure_span(d, reservoir=False)[1])
-    while pump(hi) < 0.0:
+    # secant: P_pump(P_cavity) has a slope near 1 (the reservoir's pressure changes slowly with the oil)
+    x0, x1 = float(P_pump), float(P_pump) + 0.1
+    f0, f1 = f(x0), f(x1)
+    for _ in range(12):
+        if abs(f1) < 1e-10 or f1 == f0:
+            break
+        x0, x1, f0 = x1, min(x1 - f1 * (x1 - x0) / (f1 - f0), top), f1
+        f1 = f(x1)
+    if abs(f1) < 1e-9:
+        return float(x1)
+    lo, hi = float(P_pump), float(P_pump) + 0.5
+    while f(hi) < 0.0:
         lo, hi = hi, hi + 0.5
         if hi > top:
             raise InputError("pressure_MPa", P_pump, f"needs a cavity pressure above the finger model's "
                              f"highest, {top:.4g} MPa")
-    return float(brentq(pump, lo, hi, xtol=1e-10))
+    return float(brentq(f, lo, hi, xtol=1e-10))
 
 
 class NotHeldError(InputError):

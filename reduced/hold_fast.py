@@ -126,8 +126,17 @@ def close_finger(i: int, P: float, placed: Placed, design: HandDesign) -> Finger
     first = _first_touch(i, theta_free, placed, design)
     if first is None:
         return _free(i, q_free, P, placed, design)
-    state = _active_set(i, first, P, placed, design)
-    return state if state is not None else _by_slsqp(i, first, P, placed, design)
+    found = _active_set(i, first, P, placed, design)
+    if found is None:  # Newton from the first touch missed: follow the pressure up from the touch
+        P_touch = float(hand.finger_pressure(float(np.sum(first)), design))
+        found = (first, None, None)
+        for P_k in np.linspace(P_touch, P, 6)[1:]:
+            found = _active_set(i, found[0], P_k, placed, design, found[1], found[2])
+            if found is None:
+                break
+    if found is not None:
+        return _state_of(i, found[0], found[2], P, placed, design)
+    return _by_slsqp(i, first, P, placed, design)
 
 
 def _kkt(i, P, placed, design, active, n_s):
@@ -165,13 +174,15 @@ def _newton(fun, z0, scale, *, tol: float = 1e-11, max_iter: int = 30):
     return None
 
 
-def _active_set(i, q0, P, placed, design) -> FingerState | None:
-    """Finger i's contact equations with a growing / shrinking set of touching pads, from the
-    first touch q0 (the pad nearest there); None if it does not settle."""
+def _active_set(i, q0, P, placed, design, active=None, N=None):
+    """Finger i's contact equations with a growing / shrinking set of touching pads, from q0 and
+    the pads ``active`` (default: the one nearest the object at q0) with forces N: (q, active, N)
+    or None if it does not settle."""
     n_s = design.n_s
-    g0 = finger_geometry(q0, i, placed, design)
-    active = [int(np.argmin(np.where(np.isfinite(g0.gap[1:]), g0.gap[1:], np.inf))) + 1]
-    q, N = q0, {}
+    if not active:
+        g0 = finger_geometry(q0, i, placed, design)
+        active = [int(np.argmin(np.where(np.isfinite(g0.gap[1:]), g0.gap[1:], np.inf))) + 1]
+    q, N = q0, dict(N or {})
     for _ in range(2 * n_s + 2):
         fun = _kkt(i, P, placed, design, active, n_s)
         M0 = hinge_moments(q, P, design)
@@ -193,7 +204,7 @@ def _active_set(i, q0, P, placed, design) -> FingerState | None:
         gaps[active] = np.inf
         k = int(np.argmin(gaps))
         if gaps[k] >= -TOUCH:
-            return _state_of(i, q, N, P, placed, design)
+            return q, active, N
         same = [a for a in active if np.linalg.norm(geo.point[a] - geo.point[k]) < 1e-6]
         if same:  # two pads meeting at their hinge touch at one point: one constraint, the new pad's
             active = sorted([a for a in active if a not in same] + [k])
