@@ -34,8 +34,10 @@ from .design import HandDesign
 from .errors import InputError
 from .objects import CLEARANCE, PALM_GAP, GraspObject, Placed, place
 
+#: an object's edge or corner more than half this far behind a pad's face is not in front of it [mm]
+_DEPTH = 20.0
 #: points sampled along and across a pad for a non-spherical object (then refined by parabolas)
-PAD_SAMPLES = (33, 5)
+PAD_SAMPLES = (17, 3)
 
 
 def azimuths(design: HandDesign) -> np.ndarray:
@@ -118,7 +120,9 @@ def pad_distance(placed: Placed, p: Pads) -> PadDistance:
     """Gap of every pad to the object: exact for a sphere (the pad rectangle's point nearest the
     centre); otherwise the least distance on a :data:`PAD_SAMPLES` grid of the pad refined by a
     parabola through the least sample and its neighbours, along then across (exact for a flat
-    face; error O(h^3) on a curved one, h = 1/32 of the link)."""
+    face; error O(h^3) on a curved one, h = 1/16 of the link); and an object's edges and corners
+    (:func:`reduced.objects.feature_points`) over the pad's face, by their height above it, where
+    the distance is not smooth (a box's corner on a pad: then the contact normal is the pad's)."""
     if placed.obj.shape == "sphere":
         d = placed.centre - p.centre
         s = np.clip(np.einsum("fki,fki->fk", d, p.along), -p.half[:, 0], p.half[:, 0])
@@ -129,7 +133,26 @@ def pad_distance(placed: Placed, p: Pads) -> PadDistance:
         x, gap = _sampled_closest(placed, p)
     n = placed.normal(x)
     facing = np.einsum("fki,fki->fk", n, p.normal) < 0.0
-    return PadDistance(np.where(facing, gap, np.inf), x, n)
+    gap = np.where(facing, gap, np.inf)
+    F = placed.features()
+    if len(F):  # an edge or corner of the object against the pad's face: its height over the pad
+        rel = F[None, None] - p.centre[:, :, None, :]                    # (nf, k, m, 3)
+        s = np.einsum("fkmi,fki->fkm", rel, p.along)
+        w = np.einsum("fkmi,fki->fkm", rel, p.across)
+        h = np.einsum("fkmi,fki->fkm", rel, p.normal)
+        over = (np.abs(s) <= p.half[None, :, None, 0]) & (np.abs(w) <= p.half[None, :, None, 1]) \
+            & (h > -0.5 * _DEPTH)
+        h = np.where(over, h, np.inf)
+        j = np.argmin(h, axis=-1)
+        hf = np.take_along_axis(h, j[..., None], -1)[..., 0]
+        better = hf < gap
+        if np.any(better):
+            point = p.centre + np.take_along_axis(s, j[..., None], -1) * p.along \
+                + np.take_along_axis(w, j[..., None], -1) * p.across
+            x = np.where(better[..., None], point, x)
+            n = np.where(better[..., None], -p.normal, n)
+            gap = np.where(better, hf, gap)
+    return PadDistance(gap, x, n)
 
 
 def _sampled_closest(placed: Placed, p: Pads):

@@ -496,6 +496,51 @@ def surface(obj: GraspObject, *, resolution: int = 32) -> tuple[np.ndarray, np.n
     return np.asarray(pts), np.asarray(tris)
 
 
+#: points along each box edge and around each cylinder rim among an object's features
+FEATURE_POINTS = 65
+
+
+def feature_points(obj: GraspObject) -> np.ndarray:
+    """Points (m, 3) of the object's edges and corners in its own frame [mm] (a box's edges, a
+    cylinder's rims, a mesh's vertices where its surface folds by more than 20 deg; none for the
+    smooth sphere and capsule): where a flat pad may touch it at a point its distance is not smooth."""
+    if obj.shape == "box":
+        h = 0.5 * np.asarray(obj.size_mm)
+        t = np.linspace(-1.0, 1.0, FEATURE_POINTS)
+        out = []
+        for axis in range(3):
+            others = [i for i in range(3) if i != axis]
+            for sa in (-1.0, 1.0):
+                for sb in (-1.0, 1.0):
+                    p = np.zeros((len(t), 3))
+                    p[:, axis] = t * h[axis]
+                    p[:, others[0]], p[:, others[1]] = sa * h[others[0]], sb * h[others[1]]
+                    out.append(p)
+        return np.vstack(out)
+    if obj.shape == "cylinder":
+        a = np.linspace(0.0, 2.0 * np.pi, 2 * FEATURE_POINTS, endpoint=False)
+        r, h = 0.5 * obj.diameter_mm, 0.5 * obj.length_mm
+        return np.vstack([np.stack([r * np.cos(a), np.full_like(a, y), r * np.sin(a)], -1) for y in (-h, h)])
+    if obj.shape == "mesh":
+        return _mesh_features(obj.file)
+    return np.zeros((0, 3))
+
+
+@lru_cache(maxsize=8)
+def _mesh_features(path: str) -> np.ndarray:
+    m = read_mesh(path)
+    V, F = m.vertices, m.faces
+    n = np.cross(V[F[:, 1]] - V[F[:, 0]], V[F[:, 2]] - V[F[:, 0]])
+    n /= np.linalg.norm(n, axis=1, keepdims=True)
+    edges = np.sort(np.concatenate([F[:, [0, 1]], F[:, [1, 2]], F[:, [2, 0]]]), axis=1)
+    owner = np.tile(np.arange(len(F)), 3)
+    order = np.lexsort((edges[:, 1], edges[:, 0]))
+    e, o = edges[order], owner[order]
+    pair = np.all(e[:-1] == e[1:], axis=1)                  # closed mesh: each edge twice
+    fold = np.einsum("ij,ij->i", n[o[:-1][pair]], n[o[1:][pair]]) < np.cos(np.radians(20.0))
+    return V[np.unique(e[:-1][pair][fold])]
+
+
 @dataclass(frozen=True)
 class Placed:
     """An object at its pose in the hand frame: centre (3,) [mm] and rotation R (object -> hand)."""
@@ -524,6 +569,10 @@ class Placed:
             g = np.stack([local_sdf(self.obj, q + e[i]) - local_sdf(self.obj, q - e[i]) for i in range(3)], axis=-1)
         g = g @ self.R.T
         return g / np.maximum(np.linalg.norm(g, axis=-1, keepdims=True), 1e-300)
+
+    def features(self) -> np.ndarray:
+        """:func:`feature_points` in the hand frame (m, 3) [mm]."""
+        return self.centre + feature_points(self.obj) @ self.R.T
 
     def surface(self, *, resolution: int = 32) -> tuple[np.ndarray, np.ndarray]:
         """The surface as (points (m, 3) in the hand frame [mm], triangles (k, 3))."""

@@ -127,3 +127,17 @@ def test_box_and_cylinder_hold_every_finger():
 def test_zero_pull_is_refused():
     with pytest.raises(InputError, match="zero length"):
         hold.pull_unit((0, 0, 0))
+
+
+def test_box_corner_contact_does_not_depend_on_the_pad_sampling(monkeypatch):
+    """A box's top corner on a pad: the corner is a feature point, so the closing force and the
+    holding limit are the same with a coarse and a fine sampling of the pads (to the Newton tolerance)."""
+    from softhand.reduced import hand_layout
+
+    d = hold_fast.finger_design(HandDesign())
+    box = objects.GraspObject(shape="box", size_mm=(110, 110, 110), mass_kg=0.3, rotation_deg=(0, 45, 0))
+    limits = []
+    for samples in ((17, 3), (65, 9)):
+        monkeypatch.setattr(hand_layout, "PAD_SAMPLES", samples)
+        limits.append(hold.solve_hold(d, box, P_cavity_MPa=1.5).holding_limit_N)
+    assert limits[0] == pytest.approx(limits[1], rel=1e-8)
