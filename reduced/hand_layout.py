@@ -232,7 +232,23 @@ def place_object(obj: GraspObject, design: HandDesign) -> Placed:
     return placed
 
 
-def symmetric(obj: GraspObject, design: HandDesign) -> bool:
-    """Whether every finger sees the object alike (one finger solved for all): the object is
-    symmetric about the palm's axis and centred on it."""
-    return obj.axisymmetric_about_y and obj.offset_mm[0] == 0.0 and obj.offset_mm[2] == 0.0
+def symmetric(placed: Placed, design: HandDesign) -> bool:
+    """Whether every finger sees the object alike (one finger solved for all): its distance field
+    is unchanged, to 1e-9 of its size, by turning it about the palm's axis onto each finger
+    (at 600 points around it). True for a centred sphere, upright cylinder or capsule, and a
+    box or mesh with the layout's symmetry (a square box under four fingers at 90 deg)."""
+    if placed.obj.shape == "sphere" and placed.centre[0] == 0.0 and placed.centre[2] == 0.0:
+        return True
+    pts, _ = placed.surface(resolution=16)
+    size = float(np.max(np.ptp(pts, axis=0)))
+    k = np.arange(200) + 0.5
+    u = np.stack([np.cos(np.pi * (1 + 5 ** 0.5) * k) * np.sqrt(1 - (1 - 2 * k / 200) ** 2),
+                  1 - 2 * k / 200, np.sin(np.pi * (1 + 5 ** 0.5) * k) * np.sqrt(1 - (1 - 2 * k / 200) ** 2)], -1)
+    probe = np.concatenate([r * size * u for r in (0.3, 0.55, 0.8)]) + np.array([0.0, placed.centre[1], 0.0])
+    base = placed.sdf(probe)
+    for phi in azimuths(design)[1:]:
+        c, s_ = np.cos(phi), np.sin(phi)
+        turned = probe @ np.array([[c, 0.0, -s_], [0.0, 1.0, 0.0], [s_, 0.0, c]])  # p -> R_y(-phi) p
+        if np.max(np.abs(placed.sdf(turned) - base)) > 1e-9 * size:
+            return False
+    return True

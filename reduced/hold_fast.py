@@ -21,8 +21,8 @@ capacities (-M_j at the closed state) go to the limit analysis of :mod:`reduced.
 Finger models: ``"fem"`` (default), the calibrated finger of :mod:`reduced.grasp_fem` (hinge by
 hinge, from the finger FEM); ``"paper"``, the paper's finger (W_f, Q of eqs. (2), (10)) with its
 energy shared equally by the hinges, M_j = -dQ/dtheta (P - P_free(n_s theta_hat_j)).
-Where the object is symmetric about the palm's axis and centred (:func:`reduced.hand_layout.symmetric`),
-one finger is solved and its state turned to the others. Units: mm, N, MPa, rad.
+Where every finger sees the object alike (:func:`reduced.hand_layout.symmetric`: a centred sphere,
+an upright cylinder, a square box under four fingers), one finger is solved and its state turned to the others. Units: mm, N, MPa, rad.
 """
 from __future__ import annotations
 
@@ -123,7 +123,7 @@ def close_finger(i: int, P: float, placed: Placed, design: HandDesign) -> Finger
     q_free = np.full(n_s, theta_free / n_s)
     if theta_free <= 0.0:
         return _free(i, q_free, P, placed, design)
-    first = _first_touch(i, theta_free, placed, design)
+    first = first_touch(i, theta_free, placed, design)
     if first is None:
         return _free(i, q_free, P, placed, design)
     found = _active_set(i, first, P, placed, design)
@@ -250,7 +250,7 @@ def _free(i, q, P, placed, design) -> FingerState:
     return FingerState(q, np.zeros(design.n_s + 1), geo, M, float(np.max(np.abs(M))))
 
 
-def _first_touch(i: int, theta_free: float, placed: Placed, design: HandDesign):
+def first_touch(i: int, theta_free: float, placed: Placed, design: HandDesign):
     """Uniform hinge angles (n_s,) at which finger i closing with equal hinges first touches the
     object below its free bend, or None."""
     n_s = design.n_s
@@ -313,7 +313,7 @@ class Closed(NamedTuple):
 def close_hand(P_cavity: float, placed: Placed, design: HandDesign, *, reservoir_on: bool = True) -> Closed:
     """Every finger closed on the object at cavity pressure P [MPa] (``design`` with its finger
     model, :func:`finger_design`); the pump pressure is P less the reservoir's at the oil taken."""
-    sym = hand_layout.symmetric(placed.obj, design)
+    sym = hand_layout.symmetric(placed, design)
     if sym:
         one = close_finger(0, P_cavity, placed, design)
         states = tuple(_turned(one, i, placed, design) for i in range(design.n))
