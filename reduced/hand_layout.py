@@ -135,6 +135,8 @@ def pad_distance(placed: Placed, p: Pads) -> PadDistance:
     facing = np.einsum("fki,fki->fk", n, p.normal) < 0.0
     gap = np.where(facing, gap, np.inf)
     F = placed.features()
+    if len(F):  # only those within a pad's half width of some finger's plane can be over a pad
+        F = F[np.any(np.abs(F @ p.across[:, 0, :].T) <= float(np.max(p.half[:, 1])), axis=1)]
     if len(F):  # an edge or corner of the object against the pad's face: its height over the pad
         rel = F[None, None] - p.centre[:, :, None, :]                    # (nf, k, m, 3)
         s = np.einsum("fkmi,fki->fkm", rel, p.along)

@@ -48,7 +48,7 @@ _GX, _GW = 0.5 * (_GX + 1.0), 0.5 * _GW
 #: a gap of a pad facing away, given to the optimiser in place of +inf [mm]
 _FAR = 1e3
 #: uniform-hinge bends scanned for the first touch
-_SCAN = 65
+_SCAN = 33
 
 
 def finger_design(design: HandDesign, finger_model: str = "fem") -> HandDesign:

@@ -109,19 +109,27 @@ def test_friction_hold_residual_cones_and_monotone_in_mu():
     assert limits[0] < limits[1] < limits[2]
 
 
-def test_box_and_cylinder_hold_every_finger():
-    """Non-symmetric objects are solved finger by finger; a box turned 45 deg about y is seen alike
-    by the four fingers at 90 deg (a check of the layout's turning)."""
+def test_symmetry_shortcut_equals_solving_every_finger(monkeypatch):
+    """A square box turned 45 deg about the palm's axis is seen alike by the four fingers at 90 deg:
+    found symmetric, one finger solved; solving all four gives the same hold (to the Newton
+    tolerance). A box of unequal sides is not symmetric and every finger is solved."""
+    from softhand.reduced import hand_layout
+
     d = HandDesign()
     box = objects.GraspObject(shape="box", size_mm=(110, 110, 110), mass_kg=0.3, friction=0.5, rotation_deg=(0, 45, 0))
     r = hold.solve_hold(d, box, P_cavity_MPa=1.5)
-    assert not r.symmetric
-    dd = hold_fast.finger_design(d)
-    cs = hold.contact_set(hold_fast.close_hand(1.5, place_object(box, dd), dd), dd)
-    assert sorted(set(cs.finger.tolist())) == [0, 1, 2, 3]
-    per_finger = [cs.closing_N[cs.finger == i].sum() for i in range(4)]
-    assert np.allclose(per_finger, per_finger[0], rtol=1e-6)
-    _check_state(r, 0.3 * G) if r.held else None
+    assert r.symmetric and r.held
+    _check_state(r, 0.3 * G)
+    monkeypatch.setattr(hand_layout, "symmetric", lambda placed, design: False)
+    full = hold.solve_hold(d, box, P_cavity_MPa=1.5)
+    assert not full.symmetric
+    assert full.holding_limit_N == pytest.approx(r.holding_limit_N, rel=1e-7)
+    monkeypatch.undo()
+    odd = objects.GraspObject(shape="box", size_mm=(120, 110, 100), mass_kg=0.3, friction=0.5, rotation_deg=(0, 30, 0))
+    r_odd = hold.solve_hold(d, odd, P_cavity_MPa=1.5)
+    assert not r_odd.symmetric
+    if r_odd.held:
+        _check_state(r_odd, 0.3 * G)
 
 
 def test_zero_pull_is_refused():
@@ -141,3 +149,17 @@ def test_box_corner_contact_does_not_depend_on_the_pad_sampling(monkeypatch):
         monkeypatch.setattr(hand_layout, "PAD_SAMPLES", samples)
         limits.append(hold.solve_hold(d, box, P_cavity_MPa=1.5).holding_limit_N)
     assert limits[0] == pytest.approx(limits[1], rel=1e-8)
+
+
+def test_mesh_object_holds_as_the_sphere_it_approximates(tmp_path):
+    """A triangulated sphere (icosphere, 2562 vertices, r = 90 mm) read from STL against the 180 mm
+    sphere: the holding limit within 3 % (the facets lie up to 0.05 mm inside the sphere, the
+    distance grid's step 4.7 mm: measured 1.6 %; with 642 vertices, 7 %)."""
+    trimesh = pytest.importorskip("trimesh")
+    trimesh.creation.icosphere(subdivisions=4, radius=90.0).export(tmp_path / "ball.stl")
+    mesh = objects.object_from_table({"shape": "mesh", "file": "ball.stl", "mass_kg": 0.5}, base_dir=tmp_path)
+    d = HandDesign()
+    rm = hold.solve_hold(d, mesh, P_cavity_MPa=1.5)
+    rs = hold.solve_hold(d, objects.GraspObject(diameter_mm=180.0, mass_kg=0.5), P_cavity_MPa=1.5)
+    assert rm.held and rs.held
+    assert rm.holding_limit_N == pytest.approx(rs.holding_limit_N, rel=0.03)

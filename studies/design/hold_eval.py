@@ -51,11 +51,21 @@ def evaluate_hold(design: HandDesign, task: Task) -> Evaluation:
     P_grasp, theta_hold, shortfall, link = math.inf, float(np.mean([s.q.sum() for s in closed_top.fingers])), None, -1
     if F_lim >= required:
         lo, hi = float(hand.finger_pressure(theta_touch, d)), Pc_top
+        f_lo, f_hi = -required - task.mass * d.g, F_lim - required  # below the touch: nothing held
         best = closed_top
-        while hi - lo > PRESSURE_TOL:
-            mid = 0.5 * (lo + hi)
-            F_mid, _, c_mid = _limit(d, task, placed, mid)
-            lo, hi, best = (lo, mid, c_mid) if F_mid >= required else (mid, hi, best)
+        for n in range(40):  # regula falsi (Illinois) on the raw pull's surplus, kept bracketing
+            if hi - lo <= PRESSURE_TOL:
+                break
+            mid = hi - f_hi * (hi - lo) / (f_hi - f_lo) if n % 3 != 2 else 0.5 * (lo + hi)
+            mid = min(max(mid, lo + 0.1 * PRESSURE_TOL), hi - 0.1 * PRESSURE_TOL)
+            F_mid, raw_mid, c_mid = _limit(d, task, placed, mid)
+            f_mid = (F_mid if math.isfinite(F_mid) else raw_mid) - required
+            if F_mid >= required:
+                hi, f_hi, best = mid, f_mid, c_mid
+                f_lo *= 0.5
+            else:
+                lo, f_lo = mid, f_mid
+                f_hi *= 0.5
         P_grasp = best.P_pump
         theta_hold = float(np.mean([s.q.sum() for s in best.fingers]))
         link = int(np.argmax(best.fingers[0].N))
