@@ -77,7 +77,8 @@ class HoldMap:
                              f"is {count} points; at most {MAX_MAP_POINTS} (e.g. 50 x 50)")
 
 
-def _point(m: HoldMap, values: dict):
+def map_point(m: HoldMap, values: dict):
+    """(object, pump pressure [MPa], pull direction) at a map point {axis: value}."""
     obj = m.obj
     if "size" in values:
         obj = scaled(obj, values["size"])
@@ -97,7 +98,7 @@ def run_map(m: HoldMap, progress=None) -> list[dict]:
     total, done = len(xs) * len(ys), 0
     for yv in ys:
         for xv in xs:
-            obj, P_pump, pull = _point(m, {xn: float(xv), yn: float(yv)})
+            obj, P_pump, pull = map_point(m, {xn: float(xv), yn: float(yv)})
             key = (round(float(P_pump), 12), obj.shape, obj.diameter_mm, obj.length_mm, obj.size_mm)
             if key not in cache:
                 placed = place_object(obj, d)

@@ -102,12 +102,13 @@ def _object(args):
     return replace(obj, **changes) if changes else obj
 
 
-def _fem_solver():
+def _fem_solver(field: str = "--model", value="fem"):
+    """``softhand.fem.hand.hold.solve_hold`` (imported when asked), or one line if it is not installed."""
     try:
         from softhand.fem.hand.hold import solve_hold
     except ModuleNotFoundError:
-        raise InputError("--model", "fem", "the whole-hand FEM hold is not in this installation; "
-                                           "use --model reduced") from None
+        raise InputError(field, value, "the whole-hand FEM hold is not in this installation; "
+                                       "use the fast model (--model reduced, no --check)") from None
     return solve_hold
 
 
@@ -226,6 +227,8 @@ def _run_map(args, design, obj, pull, max_pump) -> int:
         raise InputError("--pressure-mpa", None, "is required when pressure is not an axis of the map")
     m = HoldMap(design, obj, x, y, pressure_MPa=pressure if pressure is not None else 0.0, pull=tuple(pull),
                 max_pump_MPa=max_pump, finger_model=args.finger)
+    if args.check:
+        _fem_solver("--check", True)  # before the map, not after it
     bar, update = _bar(not args.no_progress, "hold map")
     try:
         rows = run_map(m, progress=update)
@@ -250,18 +253,16 @@ def _run_map(args, design, obj, pull, max_pump) -> int:
 
 def _map_checks(m, rows, design) -> list[dict]:
     """The FEM at the map's corners and centre (the FEM's solver is required)."""
-    from softhand.reduced import hold
-    from softhand.studies.hold import _point
+    from softhand.studies.hold import map_point
 
-    solve = _fem_solver()
+    solve = _fem_solver("--check", True)
     (xn, xs), (yn, ys) = m.x, m.y
     picks = {(xs[0], ys[0]), (xs[-1], ys[0]), (xs[0], ys[-1]), (xs[-1], ys[-1]), (xs[len(xs) // 2], ys[len(ys) // 2])}
     out = []
     for xv, yv in sorted(picks):
         row = next(r for r in rows if r[xn] == xv and r[yn] == yv)
-        obj, _, pull = _point(m, {xn: xv, yn: yv})
+        obj, _, pull = map_point(m, {xn: xv, yn: yv})
         r = solve(design, obj, P_cavity_MPa=row["P_cavity_MPa"], pull_direction=tuple(pull))
         out.append({"at": {xn: xv, yn: yv}, "reduced_N": row["holding_limit_N"], "fem_N": r.holding_limit_N,
                     "reduced_held": row["held"], "fem_held": r.held})
-    _ = hold
     return out
