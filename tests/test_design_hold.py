@@ -39,3 +39,19 @@ def test_hold_task_bad_input():
         task_from_dict({**base, "object": {"diameter_mm": 100.0, "mass_kg": 1.0}, "hold": {"pull": [0, 0, 0]}})
     with pytest.raises(InputError, match="friction"):
         task_from_dict({**base, "object": {"shape": "sphere", "diameter_mm": 100.0, "mass_kg": 1.0, "friction": -1}})
+
+
+def test_hold_proof_says_so_without_the_fem_hold():
+    """The proof step calls the whole-hand FEM hold; where it is not installed it reports that the
+    hold is not proven (and gives the fast model's hold at the least pressure)."""
+    import importlib.util
+
+    if importlib.util.find_spec("softhand.fem.hand.hold") is not None:
+        pytest.skip("the FEM hold is installed: its proof is tested with it")
+    from softhand.studies.design.hold_eval import prove_hold
+
+    task = load_task(TASKS / "hold_box.toml")
+    ev = evaluate(task.base, task)
+    proof = prove_hold(ev, task, say=lambda text: None)
+    assert "not installed" in proof["report"]
+    assert proof["reduced"]["held"] and proof["reduced"]["holding_limit_N"] >= task.required_hold_N() * (1 - 1e-6)
