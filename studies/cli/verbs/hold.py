@@ -17,7 +17,8 @@ Three questions about one design (``--design``, default the paper's) and one obj
   corners and centre.
 
 ``--model reduced`` (default) is the fast model (:mod:`reduced.hold`); ``--model fem`` the
-whole-hand FEM (``softhand.fem.hand.hold``). Both print the same ``--json`` keys.
+whole-hand FEM (``softhand.fem.hand.hold``), at the cavity pressure given, or at the one the fast
+model finds for the pump pressure given. Both print the same ``--json`` keys.
 """
 from __future__ import annotations
 
