@@ -30,7 +30,7 @@ from softhand.reduced.vocabulary.versions import package_version
 VERBS = (
     "curve", "grasp", "control", "fit",
     "verify", "reservoir", "bend", "weights",
-    "design", "study", "calibrate", "inspect", "reproduce", "material",
+    "design", "study", "calibrate", "inspect", "reproduce", "material", "hold",
 )
 
 
