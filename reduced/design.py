@@ -99,9 +99,15 @@ class HandDesign:
     tie_width: float = 10.0
     #: calibration table of finger_model "fem" (a CSV file); "" = the one in the package
     finger_table: str = ""
+    #: the hand's layout: each finger's azimuth about the palm's axis, finger 0 first [rad];
+    #: () = n fingers evenly spaced from 0 (the paper's four at 0, 90, 180, 270 deg). Not in the paper
+    finger_azimuths: tuple[float, ...] = ()
+    #: width of each link's pad across the finger [mm]; 0 = the tube's outer diameter 2 (a + b)
+    pad_width: float = 0.0
 
     def __post_init__(self):
         object.__setattr__(self, "hinge_s", tuple(float(s) for s in self.hinge_s))
+        object.__setattr__(self, "finger_azimuths", tuple(float(s) for s in self.finger_azimuths))
         self.validate()
 
     # ------------------------------------------------------------------ validation
@@ -122,6 +128,7 @@ class HandDesign:
                 or any(not s1 > s0 for s0, s1 in zip(s, s[1:])):  # nan compares false both ways
             raise InputError("hinge_s_mm", list(self.hinge_s),
                              f"must be finite and increase strictly within (0, l0 = {self.l0:g}) mm")
+        _check_layout(self)
         for check in CONSISTENCY:
             check(self)
         _check_model("reservoir_model", self.reservoir_model, RESERVOIR_MODELS,
@@ -175,7 +182,8 @@ class HandDesign:
     def to_dict(self) -> dict:
         """Public (unit-suffixed) keys -> values, as in a design TOML file; a part with a
         material table adds ``{"finger": {"material": {"model": ..., parameters}}}``."""
-        out = {key: _to_public(name, getattr(self, name)) for name, key in _KEY_OF.items()}
+        out = {key: _to_public(name, getattr(self, name)) for name, key in _KEY_OF.items()
+               if not (name in _OMITTED_AT_DEFAULT and getattr(self, name) == _default(name))}
         for part in PARTS:
             if getattr(self, f"{part}_material") is not None:
                 material = getattr(self, f"{part}_rubber")
@@ -207,7 +215,29 @@ _KEY_OF = {
     "mu_sf": "mu_sf_MPa", "mu_sr": "mu_sr_MPa", "hinge_s": "hinge_s_mm",
     "base_offset": "base_offset_mm", "g": "g_N_per_kg", "reservoir_model": "reservoir_model",
     "finger_model": "finger_model", "tie_width": "tie_width_mm", "finger_table": "finger_table",
+    "finger_azimuths": "finger_azimuths_deg", "pad_width": "pad_width_mm",
 }
+#: the hand layout's fields: written only when set, so that every design's hash stays what it was
+_OMITTED_AT_DEFAULT = ("finger_azimuths", "pad_width")
+
+
+def _default(name: str):
+    return HandDesign.__dataclass_fields__[name].default
+
+
+def _check_layout(design: "HandDesign") -> None:
+    """The hand layout's fields: n distinct finite azimuths (or none), a pad width >= 0."""
+    az = design.finger_azimuths
+    if az:
+        turns = sorted(a % (2.0 * math.pi) for a in az) if all(math.isfinite(a) for a in az) else None
+        if len(az) != design.n or turns is None or any(b - a < 1e-9 for a, b in zip(turns, turns[1:])) \
+                or (len(turns) > 1 and turns[0] + 2.0 * math.pi - turns[-1] < 1e-9):
+            raise InputError("finger_azimuths_deg", [round(math.degrees(a), 9) for a in az],
+                             f"must be n = {design.n} distinct finite angles [deg] (or left out: evenly spaced)")
+    if not (isinstance(design.pad_width, (int, float)) and math.isfinite(design.pad_width)
+            and 0.0 <= design.pad_width <= 1000.0):
+        raise InputError("pad_width_mm", design.pad_width, "must be a number in [0, 1000] mm "
+                                                           "(0: the tube's outer diameter)")
 _FIELD_OF = {key: name for name, key in _KEY_OF.items()}
 PUBLIC_KEYS = tuple(_KEY_OF.values())
 #: parts that may carry a ``[<part>.material]`` table, and the modulus key it sets
@@ -253,6 +283,8 @@ def _to_public(name: str, value):
         return math.degrees(value)
     if name == "hinge_s":
         return list(value)
+    if name == "finger_azimuths":
+        return [math.degrees(v) for v in value]
     return value
 
 
@@ -264,6 +296,10 @@ def _from_public(key: str, value):
         if not isinstance(value, list) or not all(_is_number(v) for v in value):
             raise InputError(key, value, "must be a list of numbers [mm]")
         return tuple(float(v) for v in value)
+    if name == "finger_azimuths":
+        if not isinstance(value, list) or not all(_is_number(v) for v in value):
+            raise InputError(key, value, "must be a list of numbers [deg]")
+        return tuple(math.radians(float(v)) for v in value)
     if isinstance(default, str):
         if not isinstance(value, str):
             raise InputError(key, value, "must be a string")

@@ -21,7 +21,8 @@ def test_toml_round_trip(tmp_path):
     path = tmp_path / "d.toml"
     path.write_text(d.to_toml())
     assert load_design(path) == d
-    assert set(d.to_dict()) == set(PUBLIC_KEYS)
+    # the hand layout's keys are written only when set (every older design keeps its hash)
+    assert set(d.to_dict()) == set(PUBLIC_KEYS) - {"finger_azimuths_deg", "pad_width_mm"}
 
 
 @pytest.mark.parametrize("values, field", [
