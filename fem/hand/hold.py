@@ -71,6 +71,8 @@ class HoldOptions:
     q_tol: float = 1e-8              #: FEM vs contact hinge angles at convergence [rad]
     max_stagger: int = 30            #: contact/FEM iterations per load step
     symmetry: bool = True            #: solve one finger per symmetry orbit where the case allows
+    min_weight_step: float = 1 / 16  #: not held when letting go of this share of the weight fails
+    pull_floor: float = 0.1          #: the holding limit's resolution is at least this [N]
 
     def __post_init__(self):
         if not self.close_steps >= 1:
@@ -116,7 +118,7 @@ class StepRecord:
     stage: str            #: "close", "release" or "pull"
     P: float              #: cavity pressure [MPa]
     pull_N: float         #: external pull beyond the weight [N]
-    gravity: bool         #: the object's weight acts (support released)
+    gravity: float        #: share of the object's weight acting (0: held by its support)
     pose: np.ndarray      #: (6,) translation [mm] and rotation vector [rad] from the placement
     contacts: list        #: per pad of every finger: dict (finger, link, normal_N, friction_N, state, ...)
     residual_N: float     #: object equilibrium residual (free components) [N, N mm]
@@ -215,24 +217,24 @@ class HoldModel:
         self.P = P
         free = self.free if gravity else np.zeros(0, dtype=int)
         load = np.zeros(6)
-        load[:3] = (self.weight if gravity else 0.0) * np.array([0.0, 1.0, 0.0]) + pull * self.pull_direction
+        load[:3] = self.weight * float(gravity) * np.array([0.0, 1.0, 0.0]) + pull * self.pull_direction
         if len(free):
             self._settle(load, hist)
         x = np.concatenate([f.q for f in self.fingers] + [self.pose[free]])
         for it in range(1, o.max_stagger + 1):
             problem = Problem(self.body, self._fingers_view(), self.pose.copy(), free, load, hist, self.scale)
-            x, cs, updates, its, _ = solve_contact(problem, x, o.contact)
+            x, cs, updates, its, R = solve_contact(problem, x, o.contact)
             qs, pose = problem.unpack(x)
             if self._slid(pose):
                 raise NoEquilibrium(f"the object slid more than {self._slide_limit():.3g} mm: slipped out")
             for f, Qc in zip(self.fingers, cs.Q):
-                f.solve(P, Qc)
+                f.solve(P, Qc, stiffness=it > 2)  # S of the step's start, renewed if it is slow
             mismatch = max(float(np.max(np.abs(f.q - q))) for f, q in zip(self.fingers, qs))
             if mismatch <= o.q_tol:
                 p = self.pose.copy()
                 p[free] = x[len(x) - len(free):]
                 self.pose, self.cs = p, cs
-                return self._record(stage, P, pull, gravity, cs, problem, x, mismatch, it)
+                return self._record(stage, P, pull, gravity, cs, problem, R, mismatch, it)
             x = np.concatenate([f.q for f in self.fingers] + [x[len(x) - len(free):]])
         raise NotConverged(f"contact and fingers disagree by {mismatch:.3g} rad after {o.max_stagger} "
                            "iterations", [], x)
@@ -269,15 +271,14 @@ class HoldModel:
     def _slid(self, pose) -> bool:
         return bool(np.linalg.norm(pose.t - getattr(self, "released", pose.t)) > self._slide_limit())
 
-    def _record(self, stage, P, pull, gravity, cs, problem, x, mismatch, it) -> StepRecord:
-        R = problem.residual(x, self.options.contact.penalty, self.options.contact.tangent_penalty)[0]
+    def _record(self, stage, P, pull, gravity, cs, problem, R, mismatch, it) -> StepRecord:
         touching = cs.N > 0
         mu = self.body.friction
         T = np.linalg.norm(cs.T, axis=1)
         cone = float(np.max(T[touching] / (mu * cs.N[touching]), initial=0.0)) if mu > 0 else \
             float(np.max(T, initial=0.0))
         return StepRecord(
-            stage, float(P), float(pull), bool(gravity), self.pose.copy(), self.contacts(cs),
+            stage, float(P), float(pull), float(gravity), self.pose.copy(), self.contacts(cs),
             float(np.linalg.norm(R[len(R) - len(problem.free):])) if len(problem.free) else 0.0, cone,
             float(np.max(-cs.g[touching], initial=0.0)),
             float(np.max(np.linalg.norm(cs.slip[cs.stick], axis=1), initial=0.0)), float(mismatch),
@@ -325,15 +326,21 @@ def run_hold(model: HoldModel, P: float, *, progress=None) -> HoldPath:
         steps.append(model.step(float(P_k), gravity=False, pull=0.0, stage="close"))
         tick(steps[-1])
     model.released = Pose(model.body.centre, model.pose).t.copy()
-    try:
-        steps.append(model.step(P, gravity=True, pull=0.0, stage="release"))
-        tick(steps[-1])
-    except (NotConverged, NoEquilibrium) as err:
-        return HoldPath(model, steps, False, 0.0, True, str(err), time.perf_counter() - t0)
+    share, d_share = 0.0, 1.0  # of the weight: let go at once, in smaller parts if that fails
+    while share < 1.0:
+        try:
+            steps.append(model.step(P, gravity=min(share + d_share, 1.0), pull=0.0, stage="release"))
+            tick(steps[-1])
+            share = min(share + d_share, 1.0)
+        except (NotConverged, NoEquilibrium) as err:
+            d_share *= 0.5
+            if d_share < o.min_weight_step:
+                return HoldPath(model, steps, False, 0.0, True, str(err).split("; residual history")[0],
+                                time.perf_counter() - t0)
     F, failure = 0.0, ""
     dF = o.pull_step or max(0.5 * model.weight, 1.0)
     while F < o.max_pull:
-        if dF < max(o.pull_resolution * F, 0.1):
+        if dF < max(o.pull_resolution * F, o.pull_floor):
             return HoldPath(model, steps, True, F, True, failure, time.perf_counter() - t0)
         try:
             steps.append(model.step(P, gravity=True, pull=F + dF, stage="pull"))
@@ -342,3 +349,21 @@ def run_hold(model: HoldModel, P: float, *, progress=None) -> HoldPath:
         except (NotConverged, NoEquilibrium) as err:
             failure, dF = str(err).split("; residual history")[0], 0.5 * dF
     return HoldPath(model, steps, True, F, False, "", time.perf_counter() - t0)
+
+
+def solve_hold(design: HandDesign, obj, *, P_cavity_MPa: float, pull_direction=(0.0, 1.0, 0.0),
+               options: HoldOptions = HoldOptions(), progress=None, keep_path: bool = False):
+    """The FEM hold of ``obj`` (a :class:`reduced.objects.GraspObject`, placed by its table) at
+    cavity pressure P_cavity_MPa: the common :class:`reduced.hold_result.HoldResult`; with
+    ``keep_path`` also the :class:`HoldPath` (for :func:`fem.hand.hold_output.write_hold`)."""
+    from softhand.fem.hand.hold_body import body_of
+    from softhand.fem.hand.hold_output import to_result
+    from softhand.fem.hand.hold_geometry import FingerFrame
+    from softhand.reduced.hand_layout import azimuths
+
+    body = body_of(obj, design)
+    layout = tuple(FingerFrame(float(a)) for a in azimuths(design))
+    model = HoldModel(design, body, options=options, layout=layout, pull_direction=pull_direction)
+    path = run_hold(model, float(P_cavity_MPa), progress=progress)
+    result = to_result(path, obj=obj)
+    return (result, path) if keep_path else result

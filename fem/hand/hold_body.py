@@ -125,3 +125,46 @@ def _grid_triangles(rows: int, n: int) -> np.ndarray:
     a, b = i * n + j, i * n + (j + 1) % n
     c, d = a + n, b + n
     return np.concatenate([np.stack([a, b, d], -1).reshape(-1, 3), np.stack([a, d, c], -1).reshape(-1, 3)])
+
+
+@dataclass(frozen=True)
+class PlacedBody:
+    """Any placed object of :mod:`reduced.objects` (capsule, mesh, rotated box) through its own
+    distance queries (its normal by central differences)."""
+
+    placed: object
+    mass_kg: float
+    friction: float
+    radius: float
+
+    @property
+    def centre(self):
+        return tuple(self.placed.centre)
+
+    def signed_distance(self, x):
+        x = np.atleast_2d(np.asarray(x, dtype=float))
+        return self.placed.sdf(x), self.placed.normal(x)
+
+    def surface(self, n: int = 48):
+        return self.placed.surface(resolution=n // 2)
+
+
+def body_of(obj, design):
+    """The FEM's body for a :class:`reduced.objects.GraspObject` at its placement (checked:
+    InputError if it overlaps the open fingers or the palm): analytic for a sphere, a cylinder
+    and an unrotated box, else the object's own distance queries."""
+    from softhand.reduced.hand_layout import place_object
+    from softhand.reduced.objects import local_extent
+
+    placed = place_object(obj, design)
+    centre = tuple(float(c) for c in placed.centre)
+    common = dict(mass_kg=float(obj.mass_kg), friction=float(obj.friction))
+    if obj.shape == "sphere":
+        return Body("sphere", centre, (obj.diameter_mm,), **common)
+    if obj.shape == "cylinder":
+        return Body("cylinder", centre, (obj.diameter_mm, obj.length_mm),
+                    axis=tuple(placed.R @ [0.0, 1.0, 0.0]), **common)
+    if obj.shape == "box" and not any(obj.rotation_deg):
+        return Body("box", centre, tuple(obj.size_mm), **common)
+    lo, hi = local_extent(obj)
+    return PlacedBody(placed, radius=0.5 * float(np.linalg.norm(hi - lo)), **common)

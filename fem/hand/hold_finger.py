@@ -48,8 +48,9 @@ class HeldFinger:
     def restore(self, state: tuple) -> None:
         self.y, self.P, self.Q, self.S = state[0].copy(), state[1], state[2].copy(), state[3]
 
-    def solve(self, P: float, Q, steps: int = 1) -> None:
-        """Move to pressure P [MPa] under physical generalised forces Q [N mm]; raises NotConverged."""
+    def solve(self, P: float, Q, steps: int = 1, *, stiffness: bool = True) -> None:
+        """Move to pressure P [MPa] under physical generalised forces Q [N mm]; raises NotConverged.
+        ``stiffness``: update S (else the last S is kept: a quasi-Newton iteration on the fingers)."""
         P0, Q0, Q1 = self.P, self.Q.copy(), np.asarray(Q, dtype=float)
         if P == P0 and np.array_equal(Q0, Q1) and self.S is not None:
             return
@@ -62,7 +63,8 @@ class HeldFinger:
                          residual_t=lambda y, t: self.model.residual(y, pressure(t), load(t)))
         self.y, self.P, self.Q = res.x[-1], float(P), Q1.copy()
         self.iterations += res.total_iterations
-        self.S = self.stiffness()
+        if stiffness or self.S is None:
+            self.S = self.stiffness()
 
     def stiffness(self) -> np.ndarray:
         """Condensed stiffness S [N mm/rad] of the whole finger from the last factorisation."""

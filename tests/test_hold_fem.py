@@ -1,0 +1,117 @@
+"""The whole-hand FEM hold (coarse CI mesh): the one-finger grasp as its special case, two pads
+pinching a box (2 mu N), a frictionless sphere caged below its equator, the tolerances at
+every step, the result and its files."""
+import json
+import math
+
+import numpy as np
+import pytest
+
+from softhand.fem.hand.finger import FingerModel, FingerOptions
+from softhand.fem.hand.grasp import GraspModel, GraspOptions, weight_vector
+from softhand.fem.hand.hold import HoldModel, HoldOptions, NoEquilibrium, run_hold
+from softhand.fem.hand.hold_body import Body
+from softhand.fem.hand.hold_contact import ContactOptions
+from softhand.fem.hand.hold_geometry import FingerFrame, Pose, pad_contacts
+from softhand.fem.newton import NotConverged
+from softhand.reduced.design import HandDesign
+
+DESIGN = HandDesign()
+CI = FingerOptions(mesher="gmsh", mesh_size=10.0)  # the coarsest finger mesh (as tests/test_grasp.py)
+P, DP = 0.45, 0.05  # MPa; the fingers touch the 180 mm object from 0.3 MPa on (CI mesh)
+
+
+@pytest.fixture(scope="module")
+def finger():
+    return FingerModel(DESIGN, CI)
+
+
+def _check_tolerances(model, record):
+    """What every converged step guarantees (the options' tolerances)."""
+    c = model.options.contact
+    assert record.residual_N <= c.rtol * model.scale        # the object's equilibrium (Newton tol)
+    assert record.cone <= 1.0 + 1e-12                       # |T| <= mu N: the return map
+    assert record.penetration_mm <= c.gap_tol               # Uzawa's stop on the gap
+    assert record.stick_slip_mm <= c.slip_tol               # ... and on a sticking pad's slip
+    assert record.q_mismatch <= model.options.q_tol         # contact and finger FEM agree
+    assert record.fem_residual <= 1e-6 * model.scale        # the finger FEM's own equilibrium
+
+
+def _F_v(model) -> float:
+    """F . n_out of the tip link (eq. (29)) from the hold's contact state (one finger, frame 0)."""
+    cs, frame = model.cs, model.frames[0]
+    F = ((cs.N[:, None] * cs.normal + cs.T) @ frame.matrix(DESIGN)).sum(axis=0)  # finger frame
+    theta = model.fingers[0].q.sum()
+    return float(-F @ [-math.sin(theta), math.cos(theta)])
+
+
+@pytest.mark.slow
+def test_frictionless_circle_is_the_one_finger_grasp(finger):
+    """A frictionless cylinder normal to the bending plane, object held: the hold's contact is the
+    grasp FEM's circle. Both converged to gaps of 1e-9 mm: the same q, F_v and w to 1e-6."""
+    grasp = GraspModel(finger, 180.0, options=GraspOptions(gap_tol=1e-9))
+    a = grasp.solve(P)
+    b = grasp.solve(P + DP, start=a)
+    body = Body("cylinder", (0.0, grasp.depth, 0.0), (180.0, 400.0), axis=(0.0, 0.0, 1.0))
+    hold = HoldModel(DESIGN, body, layout=[FingerFrame(0.0)], finger_model=finger,
+                     options=HoldOptions(symmetry=False, q_tol=1e-10, contact=ContactOptions(gap_tol=1e-9)))
+    for P_k in (0.5 * P, P):
+        _check_tolerances(hold, hold.step(P_k, gravity=0.0, pull=0.0, stage="close"))
+    qa, Fa = hold.fingers[0].q, _F_v(hold)
+    hold.step(P + DP, gravity=0.0, pull=0.0, stage="close")
+    qb, Fb = hold.fingers[0].q, _F_v(hold)
+    np.testing.assert_allclose(qa, a.q, rtol=1e-6)
+    assert Fa == pytest.approx(a.F_v, rel=1e-6) and Fb == pytest.approx(b.F_v, rel=1e-6)
+    w_hold = (qb - qa) / (qb - qa).sum()
+    np.testing.assert_allclose(w_hold, weight_vector(a, b), atol=1e-6)
+
+
+@pytest.mark.slow
+def test_two_pads_pinching_a_box_hold_two_mu_N(finger):
+    """Two facing fingers close their tips on a box's vertical faces (normals horizontal): the
+    largest vertical load held is the friction's 2 mu N, N the pads' normal force reported."""
+    mu = 0.5
+    box = Body("box", (0.0, 130.0, 0.0), (150.0, 140.0, 40.0), mass_kg=0.005, friction=mu)
+    model = HoldModel(DESIGN, box, layout=[FingerFrame(0.0), FingerFrame(math.pi)], finger_model=finger,
+                      options=HoldOptions(close_steps=3, pull_step=0.02, pull_floor=0.002))
+    assert model.symmetric and model.n_solved == 1
+    path = run_hold(model, 1.2)
+    assert path.held and path.limit_reached
+    for record in path.steps:
+        _check_tolerances(model, record)
+    last = path.steps[-1]
+    touching = [c for c in last.contacts if c["normal_N"] > 0]
+    assert all(abs(c["normal_force_N"][1]) < 1e-9 * c["normal_N"] for c in touching)  # horizontal
+    N = sum(c["normal_N"] for c in touching)                 # both pads
+    load = model.weight + path.holding_limit_N
+    # the limit is resolved to pull_resolution (2 %) of the pull, or pull_floor: within that of 2 mu N / 2
+    assert load <= mu * N * (1 + 1e-9)
+    assert load >= mu * N - max(0.02 * path.holding_limit_N, 0.002) - 1e-9
+
+
+@pytest.mark.slow
+def test_frictionless_sphere_caged_below_its_equator_drops_when_the_fingers_open(finger):
+    """mu = 0: only the normals' upward parts can carry the weight, so the sphere is held only
+    while pads touch it below its centre; opening the fingers (lower pressure) drops it."""
+    sphere = Body("sphere", (0.0, 140.0, 0.0), (160.0,), mass_kg=0.02, friction=0.0)
+    model = HoldModel(DESIGN, sphere, finger_model=finger, options=HoldOptions(close_steps=3))
+    path = run_hold(model, 1.2)
+    assert path.held
+    release = [s for s in path.steps if s.stage == "release"][-1]
+    centre = Pose(sphere.centre, release.pose).centre
+    touching = [c for c in release.contacts if c["normal_N"] > 0]
+    assert touching and all(c["point_mm"][1] > centre[1] for c in touching)   # below the equator
+    assert all(c["friction_N"] == 0.0 for c in release.contacts)
+    for record in path.steps:
+        _check_tolerances(model, record)
+    P_k, dP, dropped = 1.2, 0.1, None
+    while dP >= 0.0125 and P_k > 0:
+        try:
+            model.step(P_k - dP, gravity=1.0, pull=0.0, stage="open")
+            P_k -= dP
+        except (NotConverged, NoEquilibrium):
+            dropped, dP = P_k - dP, 0.5 * dP
+    assert dropped is not None and dropped > 0.0
+    # at the pressure it drops, the open fingers no longer reach under the centre of the last held pose
+    held_at = Pose(sphere.centre, model.pose).centre
+    assert held_at[1] > centre[1] - 1e-9   # it had sunk (or stayed) while the fingers opened
