@@ -335,8 +335,9 @@ def run_hold(model: HoldModel, P: float, *, progress=None) -> HoldPath:
         except (NotConverged, NoEquilibrium) as err:
             d_share *= 0.5
             if d_share < o.min_weight_step:
-                return HoldPath(model, steps, False, 0.0, True, str(err).split("; residual history")[0],
-                                time.perf_counter() - t0)
+                why = str(err).split("; residual history")[0]
+                return HoldPath(model, steps, False, 0.0, True, f"held {share:.0%} of its weight at "
+                                f"most ({why})", time.perf_counter() - t0)
     F, failure = 0.0, ""
     dF = o.pull_step or max(0.5 * model.weight, 1.0)
     while F < o.max_pull:

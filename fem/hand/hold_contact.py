@@ -57,7 +57,7 @@ class ContactOptions:
     max_updates: int = 40         #: Uzawa updates per solve
     #: object and hinge equilibrium, relative to the force scale mu a^2 l0 of the finger [-]
     rtol: float = 1e-10
-    max_iter: int = 25            #: Newton iterations per Uzawa update
+    max_iter: int = 40            #: Newton iterations per Uzawa update
     keep_gap: float = 0.01        #: the Newton tangent keeps pads this near touching in contact [mm]
 
 
@@ -125,7 +125,8 @@ def anchors_now(fingers: Fingers, qs, pose: Pose, hist: ContactHistory):
 def evaluate(body, fingers: Fingers, qs, pose: Pose, hist: ContactHistory, eps_N: float,
              eps_T: float, keep=None) -> ContactState:
     """Contact forces, generalised forces and the object's wrench at (qs, pose); ``keep``
-    (bool per pad): pads whose normal force is not clamped at 0 (for the Newton tangent only)."""
+    (bool per pad): pads whose normal force is not clamped at 0 and whose friction is not
+    clamped to the cone (for the Newton tangent only)."""
     pc = pad_contacts(body, pose, fingers.frames, fingers.padsets, qs)
     n = pc.normal
     with np.errstate(invalid="ignore"):
@@ -142,7 +143,9 @@ def evaluate(body, fingers: Fingers, qs, pose: Pose, hist: ContactHistory, eps_N
     cap = body.friction * N
     stick = size <= cap
     T = np.where(stick[:, None], trial, trial * (cap / np.where(size > 0, size, 1.0))[:, None])
-    T = np.where((N > 0)[:, None], T, 0.0)
+    if keep is not None:  # the tangent sticks the kept pads (a stick predictor): it stays regular
+        T = np.where(keep[:, None], trial, T)  # when every pad slips at the start of a load reversal
+    T = np.where((N > 0)[:, None] | (keep[:, None] if keep is not None else False), T, 0.0)
     F = N[:, None] * n + T
     Q, i = [], 0
     for frame, pads, q in zip(fingers.frames, fingers.padsets, qs):
