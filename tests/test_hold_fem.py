@@ -4,6 +4,7 @@ every step, the result and its files."""
 import json
 import math
 
+import meshio
 import numpy as np
 import pytest
 
@@ -12,9 +13,11 @@ from softhand.fem.hand.grasp import GraspModel, GraspOptions, weight_vector
 from softhand.fem.hand.hold import HoldModel, HoldOptions, NoEquilibrium, run_hold
 from softhand.fem.hand.hold_body import Body
 from softhand.fem.hand.hold_contact import ContactOptions
-from softhand.fem.hand.hold_geometry import FingerFrame, Pose, pad_contacts
+from softhand.fem.hand.hold_geometry import FingerFrame, Pose
+from softhand.fem.hand.hold_output import to_result, write_hold
 from softhand.fem.newton import NotConverged
 from softhand.reduced.design import HandDesign
+from softhand.reduced.hold_result import result_from_json
 
 DESIGN = HandDesign()
 CI = FingerOptions(mesher="gmsh", mesh_size=10.0)  # the coarsest finger mesh (as tests/test_grasp.py)
@@ -67,7 +70,7 @@ def test_frictionless_circle_is_the_one_finger_grasp(finger):
 
 
 @pytest.mark.slow
-def test_two_pads_pinching_a_box_hold_two_mu_N(finger):
+def test_two_pads_pinching_a_box_hold_two_mu_N(finger, tmp_path):
     """Two facing fingers close their tips on a box's vertical faces (normals horizontal): the
     largest vertical load held is the friction's 2 mu N, N the pads' normal force reported."""
     mu = 0.5
@@ -87,6 +90,17 @@ def test_two_pads_pinching_a_box_hold_two_mu_N(finger):
     # the limit is resolved to pull_resolution (2 %) of the pull, or pull_floor: within that of 2 mu N / 2
     assert load <= mu * N * (1 + 1e-9)
     assert load >= mu * N - max(0.02 * path.holding_limit_N, 0.002) - 1e-9
+    # the common result and its files: result.json with every step, one VTK scene per step
+    result = to_result(path)
+    write_hold(path, result, tmp_path)
+    data = json.loads((tmp_path / "result.json").read_text())
+    assert data["model"] == "fem" and data["held"] and data["holding_limit_N"] == path.holding_limit_N
+    assert data["symmetric"] and len(data["steps"]) == len(path.steps)
+    assert {c["finger"] for c in data["contacts"]} == {0, 1} and all(c["state"] == "stick" for c in data["contacts"])
+    assert result_from_json(data).holding_limit_N == result.holding_limit_N
+    scene = meshio.read(tmp_path / "hold" / f"hold_{len(path.steps) - 1:04d}" / "contact_forces.vtu")
+    np.testing.assert_allclose(np.abs(scene.point_data["normal_force_N"][:, 0]), [c["normal_N"] for c in touching])
+    assert (tmp_path / "hold" / "hold_0000" / "finger1_tube.vtu").exists()
 
 
 @pytest.mark.slow
