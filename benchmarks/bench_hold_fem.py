@@ -27,7 +27,7 @@ def main() -> None:
     parser.add_argument("--mass-kg", type=float, default=0.2)
     parser.add_argument("--friction", type=float, default=0.5)
     parser.add_argument("--pressure-mpa", type=float, default=1.2)
-    parser.add_argument("--offset-mm", type=float, default=3.0)
+    parser.add_argument("--offset-mm", type=float, default=1.5)
     args = parser.parse_args()
     finger = FingerOptions() if args.mesh == "default" else FingerOptions(mesher="gmsh", mesh_size=10.0)
     design = HandDesign()

@@ -100,6 +100,7 @@ def test_two_pads_pinching_a_box_hold_two_mu_N(finger, tmp_path):
     assert result_from_json(data).holding_limit_N == result.holding_limit_N
     scene = meshio.read(tmp_path / "hold" / f"hold_{len(path.steps) - 1:04d}" / "contact_forces.vtu")
     np.testing.assert_allclose(np.abs(scene.point_data["normal_force_N"][:, 0]), [c["normal_N"] for c in touching])
+    assert (tmp_path / "hold" / "hold_0000" / "tube.vtu").exists()
     assert (tmp_path / "hold" / "hold_0000" / "finger1_tube.vtu").exists()
 
 

@@ -40,7 +40,7 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -53,6 +53,7 @@ from softhand.fem.hand.hold_geometry import PadSet, Pose, default_layout, pad_co
 from softhand.fem.newton import NotConverged
 from softhand.reduced.design import HandDesign
 from softhand.reduced.errors import InputError
+from softhand.reduced.hand_layout import pad_width
 
 
 @dataclass(frozen=True)
@@ -62,7 +63,7 @@ class HoldOptions:
     finger: FingerOptions = field(default_factory=FingerOptions)
     contact: ContactOptions = field(default_factory=ContactOptions)
     placement: GraspOptions = field(default_factory=GraspOptions)  #: palm_gap, clearance, pad_offset
-    pad_width: float | None = None   #: pad width across the finger [mm]; None: the tube's 2 (a + b)
+    pad_width: float | None = None   #: pad width across the finger [mm]; None: the design's
     close_steps: int = 4             #: pressure steps from 0 to the grasp pressure
     pull_step: float | None = None   #: first pull increment [N]; None: half the weight, at least 1 N
     pull_resolution: float = 0.02    #: the holding limit's resolution, relative to it (>= 0.1 N)
@@ -144,7 +145,7 @@ class HoldModel:
         self.frames = tuple(layout or default_layout(design.n))
         self.model = finger_model or FingerModel(design, options.finger)
         chain = self.model.chain
-        width = options.pad_width or 2.0 * (design.a + design.b)
+        width = options.pad_width or pad_width(design)
         self.pads = PadSet(chain, (0.0, *design.hinge_s, design.l0),
                            design.d + options.placement.pad_offset, width, design)
         orbits = symmetry_orbits(body, self.frames, self.pull_direction) if options.symmetry \
@@ -353,10 +354,12 @@ def run_hold(model: HoldModel, P: float, *, progress=None) -> HoldPath:
 
 
 def solve_hold(design: HandDesign, obj, *, P_cavity_MPa: float, pull_direction=(0.0, 1.0, 0.0),
-               options: HoldOptions = HoldOptions(), progress=None, keep_path: bool = False):
+               options: HoldOptions = HoldOptions(), progress=None, keep_path: bool = False,
+               P_pump_MPa: float = math.nan):
     """The FEM hold of ``obj`` (a :class:`reduced.objects.GraspObject`, placed by its table) at
-    cavity pressure P_cavity_MPa: the common :class:`reduced.hold_result.HoldResult`; with
-    ``keep_path`` also the :class:`HoldPath` (for :func:`fem.hand.hold_output.write_hold`)."""
+    cavity pressure P_cavity_MPa: the common :class:`reduced.hold_result.HoldResult` (P_pump_MPa
+    only reported); ``progress(record)`` after every converged load step; with ``keep_path``
+    also the :class:`HoldPath` (for :func:`fem.hand.hold_output.write_hold`)."""
     from softhand.fem.hand.hold_body import body_of
     from softhand.fem.hand.hold_output import to_result
     from softhand.fem.hand.hold_geometry import FingerFrame
@@ -366,5 +369,5 @@ def solve_hold(design: HandDesign, obj, *, P_cavity_MPa: float, pull_direction=(
     layout = tuple(FingerFrame(float(a)) for a in azimuths(design))
     model = HoldModel(design, body, options=options, layout=layout, pull_direction=pull_direction)
     path = run_hold(model, float(P_cavity_MPa), progress=progress)
-    result = to_result(path, obj=obj)
+    result = replace(to_result(path, obj=obj), P_pump_MPa=float(P_pump_MPa))
     return (result, path) if keep_path else result

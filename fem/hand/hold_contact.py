@@ -143,7 +143,7 @@ def evaluate(body, fingers: Fingers, qs, pose: Pose, hist: ContactHistory, eps_N
     cap = body.friction * N
     stick = size <= cap
     T = np.where(stick[:, None], trial, trial * (cap / np.where(size > 0, size, 1.0))[:, None])
-    if keep is not None:  # the tangent sticks the kept pads (a stick predictor): it stays regular
+    if keep is not None and body.friction > 0:  # the tangent sticks the kept pads (a stick predictor): regular
         T = np.where(keep[:, None], trial, T)  # when every pad slips at the start of a load reversal
     T = np.where((N > 0)[:, None] | (keep[:, None] if keep is not None else False), T, 0.0)
     F = N[:, None] * n + T

@@ -86,14 +86,17 @@ def _rotated(block: Block, R: np.ndarray, prefix: str) -> Block:
 
 
 def scene_blocks(model, record) -> list[Block]:
-    """Every finger (a solved finger's state rotated onto its images), the object at its pose,
-    and the contact forces (point vectors ``normal_force_N``, ``friction_force_N``)."""
+    """Every finger (a solved finger's state rotated onto its images; finger 0's blocks named as
+    a one-finger scene's -- ``tube``, ``link_k``, ``hinge_k`` -- the others' prefixed
+    ``finger<j>_``), the object at its pose,
+    and the contact forces (point vectors ``force_N`` of the object on each pad, its parts
+    ``normal_force_N`` and ``friction_force_N``, and ``stick``)."""
     blocks = []
     for (j, images), y in zip(model.orbits, record.states):
         base = finger_blocks(model.model, y)
         for k in images:
             R = rot_y(model.frames[k].azimuth)
-            blocks += [_rotated(b, R, f"finger{k}_") for b in base]
+            blocks += [_rotated(b, R, f"finger{k}_" if k else "") for b in base]
     pts, tris = model.body.surface()
     pose = Pose(model.body.centre, record.pose)
     blocks.append(Block("object", pose.to_hand(np.asarray(pts)), {"triangle": np.asarray(tris)}))
@@ -102,7 +105,8 @@ def scene_blocks(model, record) -> list[Block]:
         blocks.append(Block(
             "contact_forces", np.array([c["point_mm"] for c in touching]),
             {"vertex": np.arange(len(touching))[:, None]},
-            point_data={"normal_force_N": np.array([c["normal_force_N"] for c in touching]),
+            point_data={"force_N": np.array([np.add(c["normal_force_N"], c["friction_force_N"]) for c in touching]),
+                        "normal_force_N": np.array([c["normal_force_N"] for c in touching]),
                         "friction_force_N": np.array([c["friction_force_N"] for c in touching]),
                         "stick": np.array([c["state"] == "stick" for c in touching], dtype=np.int8),
                         "finger": np.array([c["finger"] for c in touching]),
@@ -121,8 +125,7 @@ def write_hold(path, result: HoldResult, out_dir, *, vtk: bool = True) -> Path:
         series = SceneSeries(out / "hold.pvd")
         for i, record in enumerate(path.steps):
             series.write(float(i), scene_blocks(path.model, record),
-                         {"pressure_MPa": record.P, "pull_N": record.pull_N,
-                          "n_fingers": len(path.model.frames)})
+                         {"pressure_MPa": record.P, "pull_N": record.pull_N, "n_fingers": 1})
     target = out / "result.json"
     with atomic_path(target) as tmp:
         tmp.write_text(json.dumps(result.to_json(), indent=1, allow_nan=True))
