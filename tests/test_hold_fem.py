@@ -13,7 +13,7 @@ from softhand.fem.hand.grasp import GraspModel, GraspOptions, weight_vector
 from softhand.fem.hand.hold import HoldModel, HoldOptions, NoEquilibrium, run_hold
 from softhand.fem.hand.hold_body import Body
 from softhand.fem.hand.hold_contact import ContactOptions
-from softhand.fem.hand.hold_geometry import FingerFrame, Pose
+from softhand.fem.hand.hold_geometry import FingerFrame, Pose, pad_contacts
 from softhand.fem.hand.hold_output import to_result, write_hold
 from softhand.fem.newton import NotConverged
 from softhand.reduced.design import HandDesign
@@ -130,3 +130,35 @@ def test_frictionless_sphere_caged_below_its_equator_drops_when_the_fingers_open
     # at the pressure it drops, the open fingers no longer reach under the centre of the last held pose
     held_at = Pose(sphere.centre, model.pose).centre
     assert held_at[1] > centre[1] - 1e-9   # it had sunk (or stayed) while the fingers opened
+
+
+def test_pad_contact_of_a_sphere_off_the_bending_plane():
+    """A pad is a plate of the tube's width: a sphere beside the finger's plane touches its
+    edge, at sqrt(in-plane distance^2 + (|z| - w/2)^2) - R (closed form), base link, q = 0."""
+    from softhand.fem.constraints import PlanarChain
+    from softhand.fem.hand.hold_geometry import PadSet
+
+    d = DESIGN
+    chain = PlanarChain(np.c_[d.hinge_s, np.full(d.n_s, d.d)])
+    pads = PadSet(chain, (0.0, *d.hinge_s, d.l0), d.d, 18.0, d)
+    frame = FingerFrame(0.0)
+    X = np.array([15.0, d.d + 30.0])  # above the middle of link 0's pad, 30 mm on the closing side
+    for z, R in ((5.0, 20.0), (25.0, 20.0)):
+        c = frame.to_hand(d, X, z)[0]
+        pc = pad_contacts(Body("sphere", tuple(c), (2 * R,)), Pose(c), [frame], [pads], [np.zeros(d.n_s)])
+        expect = math.hypot(30.0, max(abs(z) - 9.0, 0.0)) - R
+        assert pc.g[0] == pytest.approx(expect, abs=1e-9)
+        np.testing.assert_allclose(pc.X[0], [15.0, d.d], atol=1e-9)
+
+
+def test_symmetry_orbits_follow_the_object():
+    from softhand.fem.hand.hold import symmetry_orbits
+    from softhand.fem.hand.hold_geometry import default_layout
+
+    frames = default_layout(4)
+    down = (0.0, 1.0, 0.0)
+    assert symmetry_orbits(Body("sphere", (0, 150, 0), (180,)), frames, down) == [(0, [0, 1, 2, 3])]
+    lying = Body("cylinder", (0, 150, 0), (100, 200), axis=(1, 0, 0))
+    assert symmetry_orbits(lying, frames, down) == [(0, [0, 2]), (1, [1, 3])]
+    assert len(symmetry_orbits(Body("sphere", (2, 150, 0), (180,)), frames, down)) == 4   # off-axis
+    assert len(symmetry_orbits(Body("sphere", (0, 150, 0), (180,)), frames, (1, 0, 0))) == 4  # pulled sideways
