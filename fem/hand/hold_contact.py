@@ -192,8 +192,7 @@ def solve_contact(problem: Problem, x0, options: ContactOptions):
     """Newton + Uzawa on the condensed hold from x0; returns (x, ContactState, updates, iterations,
     residual at x); raises NotConverged when no equilibrium is found."""
     eps_N, eps_T = options.penalty, options.tangent_penalty
-    hist0 = problem.hist
-    hist = replace(hist0)
+    hist = replace(problem.hist)
     problem = replace(problem, hist=hist)
     x, its, last = np.array(x0, dtype=float), 0, np.inf
     n_q = len(problem.fingers.frames) * problem.fingers.n_s
