@@ -17,6 +17,7 @@ from pathlib import Path
 
 from softhand.fem.hand.finger import FingerOptions
 from softhand.fem.hand.hold import HoldOptions, solve_hold
+from softhand.fem.newton import NotConverged
 from softhand.reduced.design import HandDesign
 from softhand.reduced.errors import InputError
 from softhand.reduced.objects import parse_object
@@ -51,6 +52,8 @@ def main() -> None:
                                         for c in r.contacts]}
                 except InputError as err:
                     row = {"refused": str(err)}
+                except NotConverged as err:
+                    row = {"failed": str(err).split("; residual history")[0]}
                 row.update(case=case, wall_seconds=time.perf_counter() - t0)
                 with out.open("a") as f:
                     f.write(json.dumps(row) + "\n")

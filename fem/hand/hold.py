@@ -323,9 +323,16 @@ def run_hold(model: HoldModel, P: float, *, progress=None) -> HoldPath:
         raise InputError("P_cavity_MPa", P, "must be a positive pressure [MPa]")
     t0, o, steps = time.perf_counter(), model.options, []
     tick = progress or (lambda record: None)
-    for P_k in np.linspace(0.0, P, o.close_steps + 1)[1:]:
-        steps.append(model.step(float(P_k), gravity=False, pull=0.0, stage="close"))
-        tick(steps[-1])
+    P_k, dP = 0.0, P / o.close_steps
+    while P_k < P:  # close; a step that fails is halved, down to a sixteenth
+        try:
+            steps.append(model.step(min(P_k + dP, P), gravity=0.0, pull=0.0, stage="close"))
+            tick(steps[-1])
+            P_k = min(P_k + dP, P)
+        except NotConverged:
+            dP *= 0.5
+            if dP < P / (16 * o.close_steps):
+                raise
     model.released = Pose(model.body.centre, model.pose).t.copy()
     share, d_share = 0.0, 1.0  # of the weight: let go at once, in smaller parts if that fails
     while share < 1.0:

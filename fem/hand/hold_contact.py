@@ -216,9 +216,17 @@ def solve_contact(problem: Problem, x0, options: ContactOptions):
             K[n_q:, n_q:] += 1e-9 * problem.scale * np.eye(len(x) - n_q)  # a free rotation of a frictionless sphere
             return R, sp.csr_matrix(K)
 
-        res = newton(fun, x, NewtonOptions(rtol=0.0, atol=tol, max_iter=options.max_iter, merit="finite",
-                                           forcing=None, xtol=1e-14, max_backtracks=30),
-                     solver=solver, residual=lambda x: problem.residual(x, eps_N, eps_T)[0])
+        # full steps first (a softly held pad keeps its gap window); when they cycle between
+        # contact states, again from the same start with Armijo backtracking on ||R||
+        for merit in ("finite", "residual"):
+            try:
+                res = newton(fun, x, NewtonOptions(rtol=0.0, atol=tol, max_iter=options.max_iter, merit=merit,
+                                                   forcing=None, xtol=1e-14, max_backtracks=30),
+                             solver=solver, residual=lambda x: problem.residual(x, eps_N, eps_T)[0])
+                break
+            except NotConverged:
+                if merit == "residual":
+                    raise
         x, its = res.x, its + res.iterations
         cs = problem.residual(x, eps_N, eps_T)[1]
         touching = cs.N > 0
