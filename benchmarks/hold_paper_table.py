@@ -31,11 +31,14 @@ def main() -> None:
     parser.add_argument("--out", default="hold_paper_table.jsonl")
     parser.add_argument("--shapes", default="sphere,cylinder")
     parser.add_argument("--mu", default="0.8,0.5,0.3")
+    parser.add_argument("--diameters", default="180,240")
     args = parser.parse_args()
     finger = FingerOptions() if args.mesh == "default" else FingerOptions(mesher="gmsh", mesh_size=10.0)
     out = Path(args.out)
     done = {json.loads(line)["case"] for line in out.read_text().splitlines()} if out.exists() else set()
     for D, m, P in CASES:
+        if str(D) not in args.diameters.split(","):
+            continue
         for shape in args.shapes.split(","):
             for mu in (float(x) for x in args.mu.split(",")):
                 case = f"{shape}:{D} m={m} P={P} mu={mu} mesh={args.mesh}"
