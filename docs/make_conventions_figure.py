@@ -1,6 +1,9 @@
-"""Draw docs/conventions.png: axes, signs, hinges, gravity and tip forces of the reduced model.
+"""Draw docs/conventions.png: axes, signs, hinges, gravity and tip forces of the reduced model,
+and docs/hand_layout.png: the hand's layout seen from below (fingers, azimuths, pads) and an
+object at its default placement.
 
-Run: python docs/make_conventions_figure.py [OUT.png]   (default: docs/conventions.png)
+Run: python docs/make_conventions_figure.py [OUT.png]   (default: docs/conventions.png; the
+layout figure is written next to it as hand_layout.png)
 """
 from __future__ import annotations
 
@@ -69,10 +72,59 @@ def draw(design: HandDesign, theta_deg: float = 50.0):
     return fig
 
 
+def draw_layout(design: HandDesign):
+    """The hand seen from below (x right, z up in the picture) and from the side of finger 0, the
+    paper's four fingers open, their pads, and a 180 mm sphere at its default placement."""
+    from softhand.reduced import hand_layout
+    from softhand.reduced.objects import GraspObject
+
+    fig, (top, side) = plt.subplots(1, 2, figsize=(11, 5))
+    q = np.zeros((design.n, design.n_s))
+    p = hand_layout.pads(q, design)
+    placed = hand_layout.place_object(GraspObject(diameter_mm=180.0), design)
+    for i, phi in enumerate(hand_layout.azimuths(design)):
+        j = p.joints[i]
+        top.plot(j[:, 0], j[:, 2], "-o", color="#4a4f57", ms=3)
+        for k in range(design.n_s + 1):
+            c, a, w = p.centre[i, k], p.along[i, k], p.across[i, k]
+            hl, hw = p.half[k]
+            corners = np.array([c - hl * a - hw * w, c + hl * a - hw * w, c + hl * a + hw * w, c - hl * a + hw * w])
+            top.fill(corners[:, 0], corners[:, 2], color="#b0b4bb", alpha=0.5)
+        top.text(*(1.3 * j[-1, [0, 2]]), f"finger {i}\n{np.degrees(phi):.0f} deg", ha="center", fontsize=8)
+    circle = plt.Circle((0, 0), 90.0, color="#e0a060", alpha=0.3)
+    top.add_patch(circle)
+    _arrow(top, np.zeros(2), np.array([60.0, 0.0]), "x", "black", (2, 4))
+    _arrow(top, np.zeros(2), np.array([0.0, 60.0]), "z = x cross y", "black", (-30, 6))
+    top.set_aspect("equal")
+    top.set_xlim(-175, 175)
+    top.set_ylim(-175, 175)
+    top.set_title("from above (y, the palm's axis, points into the page)", fontsize=10)
+    top.set_xlabel("x [mm]")
+    top.set_ylabel("z [mm]")
+    for i in (0, 2):
+        j = p.joints[i]
+        xs = j @ hand_layout.finger_frames(design).e_out[0]
+        side.plot(xs, j[:, 1], "-o", color="#4a4f57", ms=3)
+    side.add_patch(plt.Circle((0, placed.centre[1]), 90.0, color="#e0a060", alpha=0.3))
+    side.axhline(0.0, color="k", lw=2)
+    side.text(5, -4, "palm (y = 0)", fontsize=8)
+    side.annotate("", xy=(0, placed.centre[1] - 90), xytext=(0, 0), arrowprops=dict(arrowstyle="<->"))
+    side.text(4, 0.5 * (placed.centre[1] - 90), "10 mm", fontsize=8)
+    side.set_ylim(220, -30)
+    side.set_aspect("equal")
+    side.set_title("side, fingers 0 and 2 open; 180 mm sphere placed")
+    side.set_xlabel("x [mm]")
+    side.set_ylabel("y [mm] (down)")
+    return fig
+
+
 def main(argv: list[str]) -> None:
     out = Path(argv[0]) if argv else Path(__file__).with_name("conventions.png")
     save_figure(draw(HandDesign()), out, dpi=110)
     print(out)
+    layout = out.with_name("hand_layout.png")
+    save_figure(draw_layout(HandDesign()), layout, dpi=110)
+    print(layout)
 
 
 if __name__ == "__main__":

@@ -23,6 +23,7 @@ normal there (vectorised over fingers and pads). Units: mm, rad.
 """
 from __future__ import annotations
 
+from functools import lru_cache
 from typing import NamedTuple
 
 import numpy as np
@@ -33,8 +34,10 @@ from .design import HandDesign
 from .errors import InputError
 from .objects import CLEARANCE, PALM_GAP, GraspObject, Placed, place
 
+#: an object's edge or corner more than half this far behind a pad's face is not in front of it [mm]
+_DEPTH = 20.0
 #: points sampled along and across a pad for a non-spherical object (then refined by parabolas)
-PAD_SAMPLES = (33, 5)
+PAD_SAMPLES = (17, 3)
 
 
 def azimuths(design: HandDesign) -> np.ndarray:
@@ -59,7 +62,12 @@ class FingerFrames(NamedTuple):
 
 def finger_frames(design: HandDesign) -> FingerFrames:
     """The fingers' planes (:class:`FingerFrames`) for the design's layout."""
-    phi = azimuths(design)
+    return _frames(tuple(azimuths(design)))
+
+
+@lru_cache(maxsize=64)
+def _frames(phi: tuple) -> FingerFrames:
+    phi = np.asarray(phi, float)
     e_out = np.stack([np.cos(phi), np.zeros_like(phi), -np.sin(phi)], axis=-1)
     e_down = np.tile([0.0, 1.0, 0.0], (len(phi), 1))
     return FingerFrames(e_out, e_down, np.cross(e_out, e_down))
@@ -83,10 +91,13 @@ class Pads(NamedTuple):
     joints: np.ndarray   #: (nf, n_s+2, 3) base, hinges, tip [mm]
 
 
-def pads(q, design: HandDesign) -> Pads:
-    """Every finger's pads at hinge angles q (nf, n_s) [rad] (:class:`Pads`)."""
+def pads(q, design: HandDesign, fingers=None) -> Pads:
+    """Every finger's pads at hinge angles q (nf, n_s) [rad] (:class:`Pads`); ``fingers``: only
+    those (indices; q then has one row per finger named)."""
     q = np.asarray(q, float)
     frames = finger_frames(design)
+    if fingers is not None:
+        frames = FingerFrames(*(f[np.asarray(fingers)] for f in frames))
     alpha = kinematics.link_angles(q, design)                           # (nf, n_s+1)
     joints = to_hand(kinematics.positions_at(alpha, design), frames)    # (nf, n_s+2, 3)
     along_2d = np.stack([-np.sin(alpha), np.cos(alpha)], axis=-1)
@@ -109,7 +120,9 @@ def pad_distance(placed: Placed, p: Pads) -> PadDistance:
     """Gap of every pad to the object: exact for a sphere (the pad rectangle's point nearest the
     centre); otherwise the least distance on a :data:`PAD_SAMPLES` grid of the pad refined by a
     parabola through the least sample and its neighbours, along then across (exact for a flat
-    face; error O(h^3) on a curved one, h = 1/32 of the link)."""
+    face; error O(h^3) on a curved one, h = 1/16 of the link); and an object's edges and corners
+    (:func:`reduced.objects.feature_points`) over the pad's face, by their height above it, where
+    the distance is not smooth (a box's corner on a pad: then the contact normal is the pad's)."""
     if placed.obj.shape == "sphere":
         d = placed.centre - p.centre
         s = np.clip(np.einsum("fki,fki->fk", d, p.along), -p.half[:, 0], p.half[:, 0])
@@ -120,7 +133,28 @@ def pad_distance(placed: Placed, p: Pads) -> PadDistance:
         x, gap = _sampled_closest(placed, p)
     n = placed.normal(x)
     facing = np.einsum("fki,fki->fk", n, p.normal) < 0.0
-    return PadDistance(np.where(facing, gap, np.inf), x, n)
+    gap = np.where(facing, gap, np.inf)
+    F = placed.features()
+    if len(F):  # only those within a pad's half width of some finger's plane can be over a pad
+        F = F[np.any(np.abs(F @ p.across[:, 0, :].T) <= float(np.max(p.half[:, 1])), axis=1)]
+    if len(F):  # an edge or corner of the object against the pad's face: its height over the pad
+        rel = F[None, None] - p.centre[:, :, None, :]                    # (nf, k, m, 3)
+        s = np.einsum("fkmi,fki->fkm", rel, p.along)
+        w = np.einsum("fkmi,fki->fkm", rel, p.across)
+        h = np.einsum("fkmi,fki->fkm", rel, p.normal)
+        over = (np.abs(s) <= p.half[None, :, None, 0]) & (np.abs(w) <= p.half[None, :, None, 1]) \
+            & (h > -0.5 * _DEPTH)
+        h = np.where(over, h, np.inf)
+        j = np.argmin(h, axis=-1)
+        hf = np.take_along_axis(h, j[..., None], -1)[..., 0]
+        better = hf < gap
+        if np.any(better):
+            point = p.centre + np.take_along_axis(s, j[..., None], -1) * p.along \
+                + np.take_along_axis(w, j[..., None], -1) * p.across
+            x = np.where(better[..., None], point, x)
+            n = np.where(better[..., None], -p.normal, n)
+            gap = np.where(better, hf, gap)
+    return PadDistance(gap, x, n)
 
 
 def _sampled_closest(placed: Placed, p: Pads):
@@ -200,7 +234,23 @@ def place_object(obj: GraspObject, design: HandDesign) -> Placed:
     return placed
 
 
-def symmetric(obj: GraspObject, design: HandDesign) -> bool:
-    """Whether every finger sees the object alike (one finger solved for all): the object is
-    symmetric about the palm's axis and centred on it."""
-    return obj.axisymmetric_about_y and obj.offset_mm[0] == 0.0 and obj.offset_mm[2] == 0.0
+def symmetric(placed: Placed, design: HandDesign) -> bool:
+    """Whether every finger sees the object alike (one finger solved for all): its distance field
+    is unchanged, to 1e-9 of its size, by turning it about the palm's axis onto each finger
+    (at 600 points around it). True for a centred sphere, upright cylinder or capsule, and a
+    box or mesh with the layout's symmetry (a square box under four fingers at 90 deg)."""
+    if placed.obj.shape == "sphere" and placed.centre[0] == 0.0 and placed.centre[2] == 0.0:
+        return True
+    pts, _ = placed.surface(resolution=16)
+    size = float(np.max(np.ptp(pts, axis=0)))
+    k = np.arange(200) + 0.5
+    u = np.stack([np.cos(np.pi * (1 + 5 ** 0.5) * k) * np.sqrt(1 - (1 - 2 * k / 200) ** 2),
+                  1 - 2 * k / 200, np.sin(np.pi * (1 + 5 ** 0.5) * k) * np.sqrt(1 - (1 - 2 * k / 200) ** 2)], -1)
+    probe = np.concatenate([r * size * u for r in (0.3, 0.55, 0.8)]) + np.array([0.0, placed.centre[1], 0.0])
+    base = placed.sdf(probe)
+    for phi in azimuths(design)[1:]:
+        c, s_ = np.cos(phi), np.sin(phi)
+        turned = probe @ np.array([[c, 0.0, -s_], [0.0, 1.0, 0.0], [s_, 0.0, c]])  # p -> R_y(-phi) p
+        if np.max(np.abs(placed.sdf(turned) - base)) > 1e-9 * size:
+            return False
+    return True

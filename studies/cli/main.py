@@ -29,7 +29,7 @@ from softhand.reduced.versions import package_version
 VERBS = (
     "curve", "grasp", "control", "fit",
     "verify", "reservoir", "bend", "weights",
-    "design", "study", "calibrate", "inspect", "reproduce", "material",
+    "design", "study", "calibrate", "inspect", "reproduce", "material", "hold",
 )
 
 

@@ -177,7 +177,9 @@ def limit_point_volume(design: HandDesign) -> float:
 
 def evaluate(design: HandDesign, task: Task, *, exact: bool = True) -> Evaluation:
     """Grasp angle, pressures, forces, stretch and every constraint of ``design`` for ``task``
-    (``exact=False``: the kinematics interpolated in l0, see :func:`grasp_geometry`)."""
+    (``exact=False``: the kinematics interpolated in l0, see :func:`grasp_geometry`); a hold task
+    (an object of any shape) is judged by :func:`studies.design.hold_eval.evaluate_hold` instead
+    (:func:`studies.design.optimise.evaluate` chooses)."""
     depth, theta, link, w, theta_open = grasp_geometry(design, task, exact=exact)
     F_req = task.required_F_v()
     P_margin, edge, no_grasp, F_reached = task.max_pressure, "", "", math.nan
@@ -196,13 +198,13 @@ def evaluate(design: HandDesign, task: Task, *, exact: bool = True) -> Evaluatio
     sheet = float(reservoir.stretch(design.V0, design))
     # no P_grasp: how far short of F_req the finger comes (for the optimiser)
     shortfall = min(1.0, 1.0 - max(F_reached, 0.0) / F_req) if no_grasp and F_reached < F_req else None
-    cons = _constraints(design, task, oil, stretch, sheet, P_grasp, P_contact, F_lim, P_open, shortfall)
+    cons = design_constraints(design, task, oil, stretch, sheet, P_grasp, P_contact, F_lim, P_open, shortfall)
     return Evaluation(design, depth, theta, link, w, P_grasp, P_contact, F_req, F_lim, stretch, sheet,
                       tuple(cons), theta_hold, P_margin, edge, no_grasp)
 
 
-def _constraints(design: HandDesign, task: Task, oil, stretch, sheet, P_grasp, P_contact, F_lim, P_open,
-                 grasp_shortfall: float | None = None) -> list:
+def design_constraints(design: HandDesign, task: Task, oil, stretch, sheet, P_grasp, P_contact, F_lim,
+                       P_open, grasp_shortfall: float | None = None) -> list:
     """Every constraint of a design; how many depends on the task and the finger model alone.
     ``grasp_shortfall``: the pump pressure's :attr:`Constraint.shortfall` (no P_grasp)."""
     return [
@@ -235,7 +237,7 @@ def unanswered(task: Task) -> Evaluation:
     :func:`evaluate` for the task, each violated (value nan: slack -1e3), so that the optimiser
     sees as many constraints as anywhere else and leaves the point."""
     base, nan = task.base, math.nan
-    cons = _constraints(base, task, nan, nan, nan, math.inf, nan, nan, nan)
+    cons = design_constraints(base, task, nan, nan, nan, math.inf, nan, nan, nan)
     return Evaluation(base, nan, nan, -1, np.full(base.n_s, nan), math.inf, math.inf, task.required_F_v(),
                       nan, nan, nan, tuple(replace(c, value=nan) for c in cons), nan)
 
@@ -257,7 +259,7 @@ def asks_force_at_limit(design: HandDesign, task: Task) -> bool:
     the FEM-informed grasp only with the "margin" objective. Decided by the task and the finger
     model alone, never by an evaluation's outcome, so that every design of one optimisation has
     the same constraints (the optimiser needs a constraint vector of fixed length)."""
-    return design.finger_model != "fem" or task.objective == "margin"
+    return design.finger_model != "fem" or task.objective == "margin" or task.obj is not None
 
 
 def grasp_relation(design: HandDesign, task: Task, theta: float, w, theta_open: float) -> GraspRelation:

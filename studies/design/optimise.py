@@ -24,11 +24,21 @@ import numpy as np
 from scipy.optimize import NonlinearConstraint, differential_evolution, minimize
 
 from softhand.reduced.errors import InputError
-from softhand.studies.design.evaluate import Constraint, Evaluation, design_at, evaluate, unanswered
+from softhand.studies.design.evaluate import Constraint, Evaluation, design_at, unanswered
+from softhand.studies.design.evaluate import evaluate as grasp_evaluate
+from softhand.studies.design.hold_eval import evaluate_hold
 from softhand.studies.design.task import Task
 
 __all__ = ["Constraint", "Evaluation", "design_at", "evaluate", "objective", "Problem", "OptimiserOptions",
            "Optimum", "Stall", "optimise", "on_bounds", "polish", "binding", "infeasible_report", "open_span"]
+
+
+def evaluate(design, task: Task, *, exact: bool = True) -> Evaluation:
+    """A design judged for the task: a hold task (an object of any shape) by the fast hold model
+    (:func:`studies.design.hold_eval.evaluate_hold`), else by :func:`studies.design.evaluate.evaluate`."""
+    if task.obj is not None:
+        return evaluate_hold(design, task)
+    return grasp_evaluate(design, task, exact=exact)
 
 
 def objective(ev: Evaluation, task: Task) -> float:

@@ -22,10 +22,17 @@ A task is a TOML file (``studies/designs/tasks/paper_task.toml`` is the paper's)
     reservoir_model = "fem"
     [free]                    # design variables and their bounds
     a_mm = [3.0, 6.0]
+    [hold]                    # optional: judge the task by the fast hold model (any [object] shape)
+    margin = 2.0              # the hold bears 2 x the weight along the pull (or pull_N = 10.0: newtons beyond it)
+    pull = [0.0, 1.0, 0.0]    # the pull's direction, hand frame (y down); default straight down
     [fem]                     # optional: the FEM proof's finger mesh (gmsh)
     mesh_size_mm = 6.0
     edge_ratio = 0.5          # element size at the ring edges / mesh_size (1: uniform)
 
+An ``[object]`` with any key of the object table beyond ``diameter_mm`` and ``mass_kg``
+(``shape``, ``size_mm``, ``friction``, ...) or a ``[hold]`` table makes a **hold task**: the
+design is judged by the fast hold model (:mod:`reduced.hold`): the least pump pressure whose
+holding limit along the pull reaches the margin, the holding limit at the pump's limit.
 ``base_design`` is looked up as given, then next to the task file, then in the package.
 A task designs on the FEM-calibrated models (``finger_model = "fem"``, ``reservoir_model =
 "fem"``, :data:`MODELS`) unless its ``[design]`` table names others: those are the models the
@@ -38,17 +45,22 @@ from __future__ import annotations
 
 import math
 import os
+
+import numpy as np
 from dataclasses import dataclass, field
 from pathlib import Path
 
 from softhand.reduced.design import BOUNDS, PAPER_DESIGN_FILE, PUBLIC_KEYS, HandDesign, design_from_dict, load_design, read_toml
 from softhand.reduced.errors import InputError
+from softhand.reduced.objects import GraspObject
 
 #: design keys the optimiser may vary; "l0_mm" scales the hinge positions with the tube
 FREE_KEYS = ("a_mm", "b_mm", "d_mm", "l0_mm", "R_mm", "t_mm", "V0_mm3", "tie_width_mm")
 OBJECTIVES = ("pressure", "margin")
 _SECTIONS = {
-    "object": {"diameter_mm", "mass_kg"},
+    "object": {"diameter_mm", "mass_kg", "shape", "length_mm", "size_mm", "file", "offset_mm", "rotation_deg",
+               "friction"},
+    "hold": {"margin", "pull_N", "pull"},
     "grasp": {"force_factor", "margin_N", "objective", "opening_mm"},
     "pump": {"max_pressure_MPa"},
     "limits": {"max_principal_stretch", "min_wall_mm"},
@@ -72,7 +84,9 @@ LOWER = {"mesh_size_mm": 0.5, "edge_ratio": 0.05, "dP_MPa": 0.001, "force_factor
 #: press with m g / n, or just touch), a positive value below it asks for a force the grasp
 #: model does not resolve (a root at 1e-300 N ran for minutes)
 LEAST_NONZERO = {"mass_kg": 1e-3, "margin_N": 1e-3}
-_TOP = {"base_design", "object", "grasp", "pump", "limits", "material", "design", "free", "fem"}
+_TOP = {"base_design", "object", "grasp", "pump", "limits", "material", "design", "free", "fem", "hold"}
+UPPER.update({"margin": 100.0, "pull_N": 1e5})
+LOWER.update({"margin": 1.0})
 
 
 @dataclass(frozen=True)
@@ -96,11 +110,22 @@ class Task:
     edge_ratio: float = 0.5                #: FEM proof: element size at the ring edges / mesh_size
     dP: float = 0.05                       #: FEM proof: pressure step of the secant [MPa]
     name: str = "task"
+    #: a hold task (an [object] of any shape or a [hold] table): the object, judged by the fast hold model
+    obj: GraspObject | None = None
+    hold_margin: float = 2.0               #: the hold bears hold_margin x the weight along the pull ...
+    hold_pull_N: float | None = None       #: ... or this pull beyond the weight [N]
+    hold_pull: tuple = (0.0, 1.0, 0.0)     #: the pull's direction (hand frame, y down)
     source: dict = field(default_factory=dict, compare=False, repr=False)  #: the file's tables
     clipped: tuple[tuple[str, float, float], ...] = ()  #: free bounds as given, where clipped
 
+    def required_hold_N(self) -> float:
+        """A hold task's holding limit along the pull beyond the weight [N]."""
+        return self.hold_pull_N if self.hold_pull_N is not None else (self.hold_margin - 1.0) * self.mass * self.base.g
+
     def required_F_v(self) -> float:
-        """The normal force each finger must press with [N]."""
+        """The normal force each finger must press with [N] (a hold task: its holding limit)."""
+        if self.obj is not None:
+            return self.required_hold_N()
         share = self.mass * self.base.g / self.base.n
         return share + self.margin if self.margin is not None else self.force_factor * share
 
@@ -148,7 +173,8 @@ def task_from_dict(data: dict, *, folder: Path = Path("."), name: str = "task") 
     objective = grasp.get("objective", "pressure")
     if objective not in OBJECTIVES:
         raise InputError("grasp.objective", objective, f"must be one of {', '.join(OBJECTIVES)}")
-    diameter = _number(obj, "object", "diameter_mm", required=True)
+    held = _hold_object(obj, tables["hold"], folder)
+    diameter = held[1] if held[0] is not None else _number(obj, "object", "diameter_mm", required=True)
     opening = _number(grasp, "grasp", "opening_mm", default=None)
     if opening is not None and opening < diameter:
         raise InputError("grasp.opening_mm", grasp["opening_mm"], f"must be >= the object's diameter_mm "
@@ -157,6 +183,7 @@ def task_from_dict(data: dict, *, folder: Path = Path("."), name: str = "task") 
         base=base, name=name, source=data,
         diameter=diameter,
         mass=_number(obj, "object", "mass_kg", required=True, positive=False),
+        obj=held[0], **held[2],
         free=free, clipped=clipped,
         max_pressure=_number(pump, "pump", "max_pressure_MPa", required=True),
         force_factor=_number(grasp, "grasp", "force_factor", default=2.0),
@@ -168,6 +195,29 @@ def task_from_dict(data: dict, *, folder: Path = Path("."), name: str = "task") 
         mesh_size=_number(fem, "fem", "mesh_size_mm", default=6.0),
         edge_ratio=_number(fem, "fem", "edge_ratio", default=0.5),
         dP=_number(fem, "fem", "dP_MPa", default=0.05))
+
+
+def _hold_object(obj: dict, hold: dict, folder: Path):
+    """(GraspObject or None, its span across the palm's axis [mm], the Task's hold fields): a hold
+    task when [object] has more than today's diameter and mass, or [hold] is given."""
+    if set(obj) <= {"diameter_mm", "mass_kg"} and not hold:
+        return None, None, {}
+    from softhand.reduced.objects import object_from_table, place
+
+    if "mass_kg" not in obj:
+        raise InputError("object.mass_kg", None, "is required")
+    thing = object_from_table(obj, source="object", base_dir=folder)
+    pts = place(thing, (0.0, 0.0, 0.0)).surface(resolution=32)[0]
+    span = 2.0 * float(np.max(np.hypot(pts[:, 0], pts[:, 2])))
+    if "margin" in hold and "pull_N" in hold:
+        raise InputError("hold.pull_N", hold["pull_N"], "give margin or pull_N, not both")
+    fields = {"hold_margin": _number(hold, "hold", "margin", default=2.0),
+              "hold_pull_N": _number(hold, "hold", "pull_N", default=None, positive=False)}
+    if "pull" in hold:
+        from softhand.reduced.hold import pull_unit
+
+        fields["hold_pull"] = tuple(float(v) for v in pull_unit(hold["pull"], "hold.pull"))
+    return thing, span, fields
 
 
 def _table(data: dict, section: str) -> dict:

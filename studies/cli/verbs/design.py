@@ -130,6 +130,13 @@ def _prove_and_correct(result, task, opt, base, args, out, say, options) -> dict
     from softhand.studies.io.files import write_atomic
 
     ev = opt.evaluation
+    if task.obj is not None:  # a hold task: the whole-hand FEM hold confirms the fast model's holding limit
+        from softhand.studies.design.hold_eval import prove_hold
+
+        result["fem"] = prove_hold(ev, task, say)
+        if "report" in result["fem"]:
+            result["fem_report"] = result["fem"]["report"]
+        return result
     result["fem"] = _prove(ev, task, args, out, say)
     report = fem_report(result["fem"], ev)
     if not report:

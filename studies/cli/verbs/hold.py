@@ -1,0 +1,269 @@
+"""``softhand hold``: does the hand hold this object, by how much, and at what pressure.
+
+Three questions about one design (``--design``, default the paper's) and one object
+(``--object FILE.toml`` with an ``[object]`` table, or ``sphere:150``, ``cylinder:120x200``,
+``box:80x60x100``, ``capsule:60x150``; ``--mass-kg`` and ``--friction`` override the table's):
+
+* ``--pressure-mpa P`` (the pump's) or ``--cavity-pressure-mpa P`` (the fingers' oil): held or
+  not under the object's own weight, the holding limit along ``--pull`` (beyond the weight),
+  each touching pad's forces;
+* no pressure (or ``--margin`` / ``--pull-n``): the least pump pressure, and its cavity pressure,
+  that holds the object with the margin asked (the weight times ``--margin`` borne in all along
+  the pull, default 1; or ``--pull-n`` newtons beyond the weight), up to ``--max-pump-mpa``;
+  or why no pressure within the pump's limit does;
+* ``--map X=RANGE Y=RANGE`` over two of pressure, mass, size, friction, pull (the angle of the
+  pull from straight down towards finger 0, deg): the held region and the holding margin, as
+  ``hold_map.csv`` and ``hold_map.png`` in ``--out``; ``--check`` runs the FEM at the map's
+  corners and centre.
+
+``--model reduced`` (default) is the fast model (:mod:`reduced.hold`); ``--model fem`` the
+whole-hand FEM (``softhand.fem.hand.hold``), at the cavity pressure given, or at the one the fast
+model finds for the pump pressure given. Both print the same ``--json`` keys.
+"""
+from __future__ import annotations
+
+import sys
+
+import numpy as np
+
+from softhand.reduced.errors import InputError
+from softhand.studies.cli.args import add_design_option, add_json_option, add_progress_option, \
+    design_from_args, parse_values, print_json
+
+HELP = "does the hand hold an object: held or not, holding limit, least pump pressure, hold map"
+MODELS = ("reduced", "fem")
+#: named pull directions (hand frame: y down, x outward through finger 0, z = x cross y)
+PULLS = {"down": (0, 1, 0), "up": (0, -1, 0), "x": (1, 0, 0), "-x": (-1, 0, 0), "z": (0, 0, 1), "-z": (0, 0, -1)}
+#: option -> (lowest, highest)
+LIMITS = {"--pressure-mpa": (-1.0, 5.0), "--cavity-pressure-mpa": (0.0, 5.0), "--mass-kg": (0.0, 100.0),
+          "--friction": (0.0, 10.0), "--margin": (1.0, 100.0), "--pull-n": (0.0, 1e5), "--max-pump-mpa": (0.01, 5.0)}
+
+
+def configure(parser) -> None:
+    parser.add_argument("--object", required=True, metavar="FILE.toml|SHAPE:DIMS",
+                        help="the object: a TOML file with an [object] table, or sphere:D, cylinder:DxL, "
+                             "box:XxYxZ, capsule:DxL [mm]")
+    parser.add_argument("--model", default="reduced", choices=MODELS,
+                        help="reduced: the fast hold model (default); fem: the whole-hand FEM")
+    which = parser.add_mutually_exclusive_group()
+    which.add_argument("--pressure-mpa", metavar="P", type=float, help="pump pressure [MPa]")
+    which.add_argument("--cavity-pressure-mpa", metavar="P", type=float,
+                       help="the fingers' cavity (oil) pressure [MPa] instead of the pump's")
+    parser.add_argument("--mass-kg", metavar="M", type=float, help="object mass [kg] (over the table's)")
+    parser.add_argument("--friction", metavar="MU", type=float, help="Coulomb coefficient pad-object (over the table's)")
+    parser.add_argument("--pull", default="down", metavar="DIR",
+                        help=f"pull direction x,y,z in the hand frame (y down) or one of {', '.join(PULLS)}")
+    margin = parser.add_mutually_exclusive_group()
+    margin.add_argument("--margin", metavar="K", type=float,
+                        help="least pressure for a hold bearing K times the weight along the pull (default 1)")
+    margin.add_argument("--pull-n", metavar="F", type=float,
+                        help="least pressure for a hold bearing a pull of F newtons beyond the weight")
+    parser.add_argument("--max-pump-mpa", metavar="P", type=float, default=2.0,
+                        help="the pump's limit [MPa] (default 2.0)")
+    parser.add_argument("--finger", default="fem", choices=("fem", "paper"),
+                        help="the reduced model's finger: fem (calibrated, default) or paper")
+    parser.add_argument("--map", nargs=2, metavar=("X=RANGE", "Y=RANGE"),
+                        help="map over two of pressure, mass, size, friction, pull (RANGE start:stop:step or a,b,c)")
+    parser.add_argument("--check", action="store_true", help="with --map: the FEM at the corners and centre too")
+    parser.add_argument("--out", metavar="DIR", help="write result.json (or hold_map.csv, hold_map.png) here")
+    add_design_option(parser)
+    add_json_option(parser)
+    add_progress_option(parser)
+
+
+def _checked(args, option: str):
+    value = getattr(args, option[2:].replace("-", "_"))
+    if value is None:
+        return None
+    lo, hi = LIMITS[option]
+    if not lo <= value <= hi:
+        raise InputError(option, value, f"must be a number in [{lo:g}, {hi:g}]")
+    return float(value)
+
+
+def _pull(text: str):
+    from softhand.reduced.hold import pull_unit
+
+    if text in PULLS:
+        return pull_unit(PULLS[text])
+    values = parse_values(text, "--pull", 3, "x,y,z")
+    if len(values) != 3:
+        raise InputError("--pull", text, f"must be three numbers x,y,z or one of {', '.join(PULLS)}")
+    return pull_unit(values, "--pull")
+
+
+def _object(args):
+    from dataclasses import replace
+
+    from softhand.reduced.objects import parse_object
+
+    obj = parse_object(args.object)
+    changes = {k: v for k, v in (("mass_kg", _checked(args, "--mass-kg")), ("friction", _checked(args, "--friction")))
+               if v is not None}
+    return replace(obj, **changes) if changes else obj
+
+
+def _fem_solver(field: str = "--model", value="fem"):
+    """``softhand.fem.hand.hold.solve_hold`` (imported when asked), or one line if it is not installed."""
+    try:
+        from softhand.fem.hand.hold import solve_hold
+    except ModuleNotFoundError:
+        raise InputError(field, value, "the whole-hand FEM hold is not in this installation; "
+                                       "use the fast model (--model reduced, no --check)") from None
+    return solve_hold
+
+
+def _bar(show: bool, desc: str):
+    from tqdm import tqdm
+
+    bar = tqdm(desc=desc, unit="point", file=sys.stderr, leave=False, disable=not show)
+
+    def update(done, total):
+        bar.total = total
+        bar.n = done
+        bar.refresh()
+    return bar, update
+
+
+def run(args) -> int:
+    from softhand.reduced import hold
+
+    design = design_from_args(args)
+    obj = _object(args)
+    pull = _pull(args.pull)
+    max_pump = _checked(args, "--max-pump-mpa")
+    if args.map:
+        return _run_map(args, design, obj, pull, max_pump)
+    if args.check:
+        raise InputError("--check", True, "runs the FEM at points of a map; give --map too")
+    P_pump, P_cav = _checked(args, "--pressure-mpa"), _checked(args, "--cavity-pressure-mpa")
+    if P_pump is None and P_cav is None:
+        return _run_least(args, design, obj, pull, max_pump)
+    if args.margin is not None or args.pull_n is not None:
+        raise InputError("--margin" if args.margin is not None else "--pull-n", args.margin or args.pull_n,
+                         "asks for the least pressure; give no --pressure-mpa with it")
+    d = hold.hold_fast.finger_design(design, args.finger)
+    placed = hold.place_object(obj, d)
+    if P_cav is None:
+        P_cav = hold.cavity_pressure(P_pump, placed, d)
+    if args.model == "fem":
+        result = _fem_solver()(design, obj, P_cavity_MPa=P_cav, pull_direction=tuple(pull))
+    else:
+        result = hold.solve_hold(design, obj, P_cavity_MPa=P_cav, pull_direction=pull, finger_model=args.finger,
+                                 placed=placed)
+    _write(args, result.to_json(), "result.json")
+    if args.json:
+        print_json(result.to_json())
+    else:
+        _print(result)
+    return 0
+
+
+def _write(args, data: dict, name: str) -> None:
+    if not args.out:
+        return
+    from pathlib import Path
+
+    from softhand.studies.io.files import kept_if_unwritable, write_json
+
+    with kept_if_unwritable(args.out, "hold"):
+        Path(args.out).mkdir(parents=True, exist_ok=True)
+        write_json(Path(args.out) / name, data)
+
+
+def _print(r) -> None:
+    weight = r.mass_kg * 9.80665
+    print(f"model {r.model}: {r.object.get('shape')} {r.mass_kg:g} kg, mu = {r.friction:g}, "
+          f"P_pump_MPa = {r.P_pump_MPa:.4g}, P_cavity_MPa = {r.P_cavity_MPa:.4g}")
+    print(f"held: {'yes' if r.held else 'no'}; holding limit along the pull {[round(float(v), 4) for v in r.pull_direction]}: "
+          f"{r.holding_limit_N:.4g} N ({r.holding_limit_kg:.4g} kg) beyond the weight {weight:.4g} N")
+    for c in r.contacts:
+        print(f"  finger {c.finger} pad {c.link}: normal {c.normal_N:.4g} N, friction {c.friction_N:.4g} N, {c.state}")
+    for note in r.notes:
+        print(f"  note: {note}")
+
+
+def _run_least(args, design, obj, pull, max_pump) -> int:
+    from softhand.reduced import hold
+
+    if args.model == "fem":
+        raise InputError("--model", "fem", "the least pressure is searched with the fast model; give "
+                                           "--pressure-mpa to run the FEM at one pressure")
+    margin = _checked(args, "--margin")
+    pull_n = _checked(args, "--pull-n")
+    bar, update = _bar(not args.no_progress, "hold: least pressure")
+    try:
+        least = hold.least_pressure(design, obj, max_pump_MPa=max_pump, margin=margin or 1.0, pull_N=pull_n,
+                                    pull_direction=pull, finger_model=args.finger, progress=update)
+    finally:
+        bar.close()
+    data = {**least.result.to_json(), "least_P_pump_MPa": least.P_pump_MPa,
+            "least_P_cavity_MPa": least.P_cavity_MPa, "required_holding_limit_N": least.required_N,
+            "max_pump_MPa": max_pump}
+    _write(args, data, "result.json")
+    if args.json:
+        print_json(data)
+    else:
+        print(f"least pump pressure P_pump_MPa = {least.P_pump_MPa:.4g} (cavity P_cavity_MPa = "
+              f"{least.P_cavity_MPa:.4g}) holds it with a holding limit >= {least.required_N:.4g} N along the pull")
+        _print(least.result)
+    return 0
+
+
+def _axis(text: str):
+    from softhand.studies.hold import AXES
+
+    name, eq, values = text.partition("=")
+    if not eq or name not in AXES:
+        raise InputError("--map", text, f"must be NAME=RANGE with NAME one of {', '.join(AXES)}")
+    return name, tuple(float(v) for v in parse_values(values, f"--map {name}", 2500))
+
+
+def _run_map(args, design, obj, pull, max_pump) -> int:
+    from softhand.studies.hold import HoldMap, run_map, write_map
+
+    x, y = (_axis(t) for t in args.map)
+    pressure = _checked(args, "--pressure-mpa")
+    if pressure is None and "pressure" not in (x[0], y[0]):
+        raise InputError("--pressure-mpa", None, "is required when pressure is not an axis of the map")
+    m = HoldMap(design, obj, x, y, pressure_MPa=pressure if pressure is not None else 0.0, pull=tuple(pull),
+                max_pump_MPa=max_pump, finger_model=args.finger)
+    if args.check:
+        _fem_solver("--check", True)  # before the map, not after it
+    bar, update = _bar(not args.no_progress, "hold map")
+    try:
+        rows = run_map(m, progress=update)
+    finally:
+        bar.close()
+    checks = _map_checks(m, rows, design) if args.check else []
+    if args.out:
+        from softhand.studies.io.files import kept_if_unwritable
+
+        with kept_if_unwritable(args.out, "hold"):
+            write_map(m, rows, args.out)
+    if args.json:
+        print_json({"rows": rows, "checks": checks, "max_pump_MPa": max_pump})
+    else:
+        held = sum(r["held"] for r in rows)
+        print(f"hold map {x[0]} x {y[0]}: {held} of {len(rows)} points held"
+              + (f"; written to {args.out}" if args.out else ""))
+        for c in checks:
+            print(f"  check at {c['at']}: reduced {c['reduced_N']:.4g} N, fem {c['fem_N']:.4g} N")
+    return 0
+
+
+def _map_checks(m, rows, design) -> list[dict]:
+    """The FEM at the map's corners and centre (the FEM's solver is required)."""
+    from softhand.studies.hold import map_point
+
+    solve = _fem_solver("--check", True)
+    (xn, xs), (yn, ys) = m.x, m.y
+    picks = {(xs[0], ys[0]), (xs[-1], ys[0]), (xs[0], ys[-1]), (xs[-1], ys[-1]), (xs[len(xs) // 2], ys[len(ys) // 2])}
+    out = []
+    for xv, yv in sorted(picks):
+        row = next(r for r in rows if r[xn] == xv and r[yn] == yv)
+        obj, _, pull = map_point(m, {xn: xv, yn: yv})
+        r = solve(design, obj, P_cavity_MPa=row["P_cavity_MPa"], pull_direction=tuple(pull))
+        out.append({"at": {xn: xv, yn: yv}, "reduced_N": row["holding_limit_N"], "fem_N": r.holding_limit_N,
+                    "reduced_held": row["held"], "fem_held": r.held})
+    return out
