@@ -147,16 +147,51 @@ def run(args) -> int:
     if P_cav is None:
         P_cav = hold.cavity_pressure(P_pump, placed, d)
     if args.model == "fem":
-        result = _fem_solver()(design, obj, P_cavity_MPa=P_cav, pull_direction=tuple(pull))
+        result = _fem_hold(args, design, obj, P_cav, P_pump, pull)
+        if result is None:
+            return 1
     else:
         result = hold.solve_hold(design, obj, P_cavity_MPa=P_cav, pull_direction=pull, finger_model=args.finger,
                                  placed=placed)
-    _write(args, result.to_json(), "result.json")
+        _write(args, result.to_json(), "result.json")
     if args.json:
         print_json(result.to_json())
     else:
         _print(result)
     return 0
+
+
+def _fem_hold(args, design, obj, P_cav, P_pump, pull):
+    """The whole-hand FEM hold with a progress bar (one tick per converged load step); with
+    --out its result.json and hold.pvd (every finger, the object, the contact forces per load
+    step). None (after one line) when the FEM stops while the fingers close."""
+    import math
+
+    from tqdm import tqdm
+
+    from softhand.fem.newton import NotConverged
+
+    bar = tqdm(desc="hold (FEM)", unit="step", file=sys.stderr, leave=False, disable=args.json)
+
+    def tick(record):
+        bar.update(1)
+        bar.set_postfix_str(f"{record.stage} P={record.P:.3g} MPa pull={record.pull_N:.3g} N")
+    try:
+        result, path = _fem_solver()(design, obj, P_cavity_MPa=P_cav, pull_direction=tuple(pull), progress=tick,
+                                     keep_path=True, P_pump_MPa=math.nan if P_pump is None else P_pump)
+    except NotConverged as exc:
+        print(f"softhand hold: error: the FEM did not converge while the fingers closed: "
+              f"{str(exc).split(';')[0]}", file=sys.stderr)
+        return None
+    finally:
+        bar.close()
+    if args.out:
+        from softhand.fem.hand.hold_output import write_hold
+        from softhand.studies.io.files import kept_if_unwritable
+
+        with kept_if_unwritable(args.out, "hold"):
+            write_hold(path, result, args.out)
+    return result
 
 
 def _write(args, data: dict, name: str) -> None:

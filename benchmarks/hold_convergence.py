@@ -1,0 +1,58 @@
+"""Convergence of the FEM hold's holding limit with the finger mesh and the contact tolerance.
+
+A case (default: two facing fingers pinching a 150 mm box, mu 0.5, 5 g, at 1.2 MPa -- the
+closed-form check of tests/test_hold_fem.py -- or ``--object`` for the four-finger hand) on
+two meshes (gmsh 10 mm, the CI mesh, and ``--fine-mm``) and two contact tolerances (gap and
+stick slip 1e-4 and 1e-6 mm). Prints the holding limit of each; a long run (nice, background).
+
+    nice python benchmarks/hold_convergence.py [--fine-mm 7] [--object sphere:150 --mass-kg 0.2]
+"""
+from __future__ import annotations
+
+import argparse
+import math
+import time
+from dataclasses import replace
+
+from softhand.fem.hand.finger import FingerModel, FingerOptions
+from softhand.fem.hand.hold import HoldModel, HoldOptions, run_hold, solve_hold
+from softhand.fem.hand.hold_body import Body
+from softhand.fem.hand.hold_contact import ContactOptions
+from softhand.fem.hand.hold_geometry import FingerFrame
+from softhand.reduced.vocabulary.design import HandDesign
+from softhand.reduced.holding.objects import parse_object
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--fine-mm", type=float, default=7.0)
+    parser.add_argument("--object", default="")
+    parser.add_argument("--mass-kg", type=float, default=0.2)
+    parser.add_argument("--friction", type=float, default=0.5)
+    parser.add_argument("--pressure-mpa", type=float, default=1.2)
+    args = parser.parse_args()
+    design = HandDesign()
+    for h in (10.0, args.fine_mm):
+        finger = FingerOptions(mesher="gmsh", mesh_size=h)
+        model = FingerModel(design, finger)
+        for tol in (1e-4, 1e-6):
+            contact = ContactOptions(gap_tol=tol, slip_tol=tol)
+            t0 = time.perf_counter()
+            if args.object:
+                obj = replace(parse_object(args.object), mass_kg=args.mass_kg, friction=args.friction)
+                r = solve_hold(design, obj, P_cavity_MPa=args.pressure_mpa,
+                               options=HoldOptions(finger=finger, contact=contact))
+                held, limit = r.held, r.holding_limit_N
+            else:
+                box = Body("box", (0.0, 130.0, 0.0), (150.0, 140.0, 40.0), mass_kg=0.005, friction=args.friction)
+                hold = HoldModel(design, box, layout=[FingerFrame(0.0), FingerFrame(math.pi)], finger_model=model,
+                                 options=HoldOptions(finger=finger, contact=contact, close_steps=3,
+                                                     pull_step=0.02, pull_floor=0.002))
+                path = run_hold(hold, args.pressure_mpa)
+                held, limit = path.held, path.holding_limit_N
+            print(f"mesh {h:g} mm ({model.ndofs} unknowns), tol {tol:g} mm: held {held}, "
+                  f"limit {limit:.4g} N ({time.perf_counter() - t0:.0f} s)", flush=True)
+
+
+if __name__ == "__main__":
+    main()

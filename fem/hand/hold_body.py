@@ -1,0 +1,170 @@
+r"""The rigid object of a hold as the FEM sees it: signed distance and outward normal in its
+placed pose, its centre of mass, mass, friction and surface triangles.
+
+:class:`Body` wraps the analytic primitives here (sphere, cylinder of any axis, box); any
+object with the same methods (``signed_distance(points) -> (d, normals)``, ``centre``,
+``mass_kg``, ``friction``, ``surface() -> (points, triangles)``) can be held.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from softhand.reduced.vocabulary.errors import InputError
+
+SHAPES = ("sphere", "cylinder", "box")
+
+
+@dataclass(frozen=True)
+class Body:
+    """A placed rigid primitive (hand frame, mm, kg)."""
+
+    shape: str                      #: "sphere", "cylinder" or "box"
+    centre: tuple                   #: centre (= centre of mass) in its placed pose [mm]
+    size: tuple                     #: sphere (D,), cylinder (D, length), box (x, y, z edges) [mm]
+    axis: tuple = (0.0, 0.0, 1.0)   #: cylinder axis (unit, hand frame)
+    mass_kg: float = 0.0
+    friction: float = 0.0           #: Coulomb coefficient against the pads
+
+    def __post_init__(self):
+        if self.shape not in SHAPES:
+            raise InputError("shape", self.shape, f"must be one of {', '.join(SHAPES)}")
+        if not all(s > 0 for s in self.size):
+            raise InputError("size_mm", self.size, "must be positive")
+        if not self.friction >= 0:
+            raise InputError("friction", self.friction, "must be >= 0")
+        if not self.mass_kg >= 0:
+            raise InputError("mass_kg", self.mass_kg, "must be >= 0")
+        a = np.asarray(self.axis, dtype=float)
+        object.__setattr__(self, "axis", tuple(a / np.linalg.norm(a)))
+
+    @property
+    def radius(self) -> float:
+        """Half the diameter (sphere, cylinder) or the half diagonal of the box [mm]."""
+        if self.shape == "box":
+            return 0.5 * float(np.linalg.norm(self.size))
+        return 0.5 * self.size[0]
+
+    def signed_distance(self, x):
+        """(d (m,), n (m, 3)): signed distance [mm] (negative inside) and outward unit normal."""
+        r = np.atleast_2d(np.asarray(x, dtype=float)) - np.asarray(self.centre)
+        if self.shape == "sphere":
+            rho = np.linalg.norm(r, axis=1)
+            return rho - 0.5 * self.size[0], r / np.where(rho > 0, rho, 1.0)[:, None]
+        if self.shape == "cylinder":
+            return _cylinder(r, np.asarray(self.axis), 0.5 * self.size[0], 0.5 * self.size[1])
+        return _box(r, 0.5 * np.asarray(self.size, dtype=float))
+
+    def surface(self, n: int = 48):
+        """(points (m, 3), triangles (k, 3)) of the surface in its placed pose."""
+        if self.shape == "sphere":
+            return _sphere_surface(np.asarray(self.centre), 0.5 * self.size[0], n)
+        if self.shape == "cylinder":
+            return _cylinder_surface(np.asarray(self.centre), np.asarray(self.axis),
+                                     0.5 * self.size[0], self.size[1], n)
+        return _box_surface(np.asarray(self.centre), 0.5 * np.asarray(self.size, dtype=float))
+
+
+def _cylinder(r, e, R, h):
+    a = r @ e
+    radial = r - a[:, None] * e
+    rho = np.linalg.norm(radial, axis=1)
+    er = radial / np.where(rho > 0, rho, 1.0)[:, None]
+    dr, da = rho - R, np.abs(a) - h
+    ea = np.sign(a)[:, None] * e
+    out = (dr > 0) & (da > 0)
+    d = np.where(out, np.hypot(np.maximum(dr, 0), np.maximum(da, 0)), np.maximum(dr, da))
+    n_out = (dr[:, None] * er + da[:, None] * ea) / np.where(out, d, 1.0)[:, None]
+    n = np.where(out[:, None], n_out, np.where((dr >= da)[:, None], er, ea))
+    return d, n
+
+
+def _box(r, h):
+    q = np.abs(r) - h
+    outside = np.linalg.norm(np.maximum(q, 0.0), axis=1)
+    inside = np.minimum(q.max(axis=1), 0.0)
+    d = outside + inside
+    n_out = np.sign(r) * np.maximum(q, 0.0) / np.where(outside > 0, outside, 1.0)[:, None]
+    face = np.argmax(q, axis=1)
+    n_in = np.zeros_like(r)
+    n_in[np.arange(len(r)), face] = np.sign(r[np.arange(len(r)), face])
+    return d, np.where((outside > 0)[:, None], n_out, n_in)
+
+
+def _sphere_surface(c, R, n):
+    t = np.linspace(0.0, math.pi, n // 2 + 1)
+    p = np.linspace(0.0, 2 * math.pi, n, endpoint=False)
+    T, Pp = np.meshgrid(t, p, indexing="ij")
+    pts = np.stack([np.sin(T) * np.cos(Pp), np.cos(T), np.sin(T) * np.sin(Pp)], -1).reshape(-1, 3)
+    return c + R * pts, _grid_triangles(len(t), n)
+
+
+def _cylinder_surface(c, e, R, length, n):
+    u = np.cross(e, [1.0, 0.0, 0.0] if abs(e[0]) < 0.9 else [0.0, 1.0, 0.0])
+    u /= np.linalg.norm(u)
+    v = np.cross(e, u)
+    p = np.linspace(0.0, 2 * math.pi, n, endpoint=False)
+    ring = R * (np.cos(p)[:, None] * u + np.sin(p)[:, None] * v)
+    rows = [c - 0.5 * length * e + 0 * ring, c - 0.5 * length * e + ring,
+            c + 0.5 * length * e + ring, c + 0.5 * length * e + 0 * ring]
+    return np.concatenate(rows), _grid_triangles(4, n)
+
+
+def _box_surface(c, h):
+    corners = np.array([[i, j, k] for i in (-1, 1) for j in (-1, 1) for k in (-1, 1)], dtype=float)
+    faces = [(0, 1, 3, 2), (4, 6, 7, 5), (0, 4, 5, 1), (2, 3, 7, 6), (0, 2, 6, 4), (1, 5, 7, 3)]
+    tris = [[a, b, c_] for a, b, c_, d in faces] + [[a, c_, d] for a, b, c_, d in faces]
+    return c + corners * h, np.array(tris)
+
+
+def _grid_triangles(rows: int, n: int) -> np.ndarray:
+    """Triangles of a (rows x n) grid periodic in its second index."""
+    i, j = np.meshgrid(np.arange(rows - 1), np.arange(n), indexing="ij")
+    a, b = i * n + j, i * n + (j + 1) % n
+    c, d = a + n, b + n
+    return np.concatenate([np.stack([a, b, d], -1).reshape(-1, 3), np.stack([a, d, c], -1).reshape(-1, 3)])
+
+
+@dataclass(frozen=True)
+class PlacedBody:
+    """Any placed object of :mod:`reduced.objects` (capsule, mesh, rotated box) through its own
+    distance queries (its normal by central differences)."""
+
+    placed: object
+    mass_kg: float
+    friction: float
+    radius: float
+
+    @property
+    def centre(self):
+        return tuple(self.placed.centre)
+
+    def signed_distance(self, x):
+        x = np.atleast_2d(np.asarray(x, dtype=float))
+        return self.placed.sdf(x), self.placed.normal(x)
+
+    def surface(self, n: int = 48):
+        return self.placed.surface(resolution=n // 2)
+
+
+def body_of(obj, design):
+    """The FEM's body for a :class:`reduced.objects.GraspObject` at its placement (checked:
+    InputError if it overlaps the open fingers or the palm): analytic for a sphere, a cylinder
+    and an unrotated box, else the object's own distance queries."""
+    from softhand.reduced.holding.hand_layout import place_object
+    from softhand.reduced.holding.objects import local_extent
+
+    placed = place_object(obj, design)
+    centre = tuple(float(c) for c in placed.centre)
+    common = dict(mass_kg=float(obj.mass_kg), friction=float(obj.friction))
+    if obj.shape == "sphere":
+        return Body("sphere", centre, (obj.diameter_mm,), **common)
+    if obj.shape == "cylinder":
+        return Body("cylinder", centre, (obj.diameter_mm, obj.length_mm),
+                    axis=tuple(placed.R @ [0.0, 1.0, 0.0]), **common)
+    if obj.shape == "box" and not any(obj.rotation_deg):
+        return Body("box", centre, tuple(obj.size_mm), **common)
+    lo, hi = local_extent(obj)
+    return PlacedBody(placed, radius=0.5 * float(np.linalg.norm(hi - lo)), **common)

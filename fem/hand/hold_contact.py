@@ -1,0 +1,243 @@
+r"""Frictional contact of rigid pads on a rigid free object, with the fingers condensed.
+
+Unknowns: the hinge angles :math:`q_f` of every solved finger and the object's free pose
+components p. Each finger enters through its condensed response at the cavity pressure,
+the physical generalised force its links need to be held at q (:mod:`fem.hand.hold_finger`),
+linearised at its last FEM state: :math:`Q^{int}_f(q) = Q_f + S_f (q - q_f)`.
+
+Contact of pad i (gap :math:`g_i`, object's outward normal :math:`n_i` at the pad's
+closest point :math:`x_i`, :mod:`fem.hand.hold_geometry`), augmented Lagrangian with
+Coulomb friction (Simo and Laursen 1992; Alart and Curnier's return map):
+
+.. math:: N_i = \langle \lambda_{N,i} - \epsilon_N g_i \rangle,\qquad
+          T^*_i = P_i\lambda_{T,i} - \epsilon_T P_i s_i,\qquad
+          T_i = T^*_i \min(1, \mu N_i / |T^*_i|),
+
+with :math:`P_i = I - n_i n_i^T` and :math:`s_i` the slip of the step: the displacement
+of the pad's material point anchored at the step's start relative to the object's material
+point anchored there. The object pushes the pad with :math:`F_i = N_i n_i + T_i`, the pad
+pushes the object with :math:`-F_i`. A finger's generalised force is
+:math:`Q_{c,f} = \sum_{i \in f} J_i^T E_f^T F_i` (in-plane part, :math:`E_f` its plane's
+basis, :math:`J_i` the link point's Jacobian at the pad point): out-of-plane components are
+reacted by the hinges. Equations:
+
+.. math:: Q^{int}_f(q_f) - Q_{c,f}(q, p) = 0, \qquad
+          \sum_f m_f \sum_{i\in f} W_i(-F_i) + (m g + F_{pull}) e = 0 \text{ (free components)},
+
+:math:`m_f` the multiplicity of a finger standing for its symmetric images. Newton
+(:func:`fem.newton.newton`) with a central-difference Jacobian (the system is small), the
+multipliers fixed; Uzawa updates :math:`\lambda \leftarrow (N, T)` until every touching pad's
+penetration is below ``gap_tol`` and every sticking pad's slip below ``slip_tol``; the
+friction cone :math:`|T| \le \mu N` holds by construction (the return map).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+import scipy.sparse as sp
+
+from softhand.fem.hand.hold_geometry import Pose, pad_contacts
+from softhand.fem.linsolve import make_solver
+from softhand.fem.newton import NewtonOptions, NotConverged, newton
+
+
+@dataclass(frozen=True)
+class ContactOptions:
+    """Contact treatment and tolerances of the hold."""
+
+    #: normal penalty epsilon_N to start with [N/mm]: ~50 times a finger tip's stiffness on the
+    #: CI mesh (0.2 N/mm), so an Uzawa update cuts the gap ~50-fold while a soft contact (the
+    #: weight's share on a nearly vertical pad) keeps a gap window Newton's full steps do not jump
+    penalty: float = 10.0
+    tangent_penalty: float = 10.0  #: tangential penalty epsilon_T [N/mm]
+    max_penalty: float = 1e6      #: the penalties grow x10 while Uzawa stagnates, up to this [N/mm]
+    gap_tol: float = 1e-6         #: largest penetration of a touching pad at convergence [mm]
+    slip_tol: float = 1e-6        #: largest slip of a sticking pad within a step [mm]
+    max_updates: int = 40         #: Uzawa updates per solve
+    #: object and hinge equilibrium, relative to the force scale mu a^2 l0 of the finger [-]
+    rtol: float = 1e-10
+    max_iter: int = 40            #: Newton iterations per Uzawa update
+    keep_gap: float = 0.01        #: the Newton tangent keeps pads this near touching in contact [mm]
+
+
+@dataclass
+class ContactHistory:
+    """What a contact carries from one load step to the next (one row per pad)."""
+
+    lam_N: np.ndarray  #: (m,) normal multipliers [N]
+    lam_T: np.ndarray  #: (m, 3) tangential multipliers (force on the pad) [N]
+    X: np.ndarray      #: (m, 2) pad anchors, finger frame reference [mm]
+    zeta: np.ndarray   #: (m,) pad anchors' distance from the bending plane [mm]
+    Xo: np.ndarray     #: (m, 3) object anchors, placed body frame [mm]
+    xp0: np.ndarray    #: (m, 3) pad anchors at the step's start, hand frame [mm]
+    xo0: np.ndarray    #: (m, 3) object anchors at the step's start, hand frame [mm]
+
+
+@dataclass
+class Fingers:
+    """The solved fingers as the contact problem sees them (lists over fingers)."""
+
+    frames: list       #: :class:`fem.hand.hold_geometry.FingerFrame`
+    padsets: list      #: :class:`fem.hand.hold_geometry.PadSet`
+    mult: np.ndarray   #: how many fingers each stands for
+    q0: list           #: hinge angles of the last FEM state [rad]
+    Q0: list           #: physical generalised forces applied there [N mm]
+    S: list            #: condensed stiffness there, physical [N mm/rad]
+
+    @property
+    def n_s(self) -> int:
+        return self.padsets[0].chain.n_s
+
+    def split(self, x) -> list:
+        n = self.n_s
+        return [x[i * n:(i + 1) * n] for i in range(len(self.frames))]
+
+
+@dataclass
+class ContactState:
+    """Forces at (q, pose): per pad rows, finger by finger."""
+
+    g: np.ndarray
+    N: np.ndarray
+    T: np.ndarray          #: (m, 3) friction force on the pad [N]
+    normal: np.ndarray     #: (m, 3)
+    x: np.ndarray          #: (m, 3) contact points on the pads [mm]
+    X: np.ndarray
+    zeta: np.ndarray
+    slip: np.ndarray       #: (m, 3) tangential slip of the step [mm]
+    stick: np.ndarray      #: (m,) bool
+    Q: list = field(default_factory=list)  #: generalised force on each finger [N mm]
+    wrench: np.ndarray = None  #: (6,) force and moment of the pads on the object (one of each finger) [N, N mm]
+
+
+def anchors_now(fingers: Fingers, qs, pose: Pose, hist: ContactHistory):
+    """Current hand-frame positions (pad anchors, object anchors)."""
+    xp, i = [], 0
+    for frame, pads, q in zip(fingers.frames, fingers.padsets, qs):
+        m = pads.n_links
+        xy = pads.chain.point_map(q, np.arange(m), hist.X[i:i + m], order=0)[0]
+        xp.append(frame.to_hand(pads.design, xy, hist.zeta[i:i + m]))
+        i += m
+    return np.concatenate(xp), pose.to_hand(hist.Xo)
+
+
+def evaluate(body, fingers: Fingers, qs, pose: Pose, hist: ContactHistory, eps_N: float,
+             eps_T: float, keep=None) -> ContactState:
+    """Contact forces, generalised forces and the object's wrench at (qs, pose); ``keep``
+    (bool per pad): pads whose normal force is not clamped at 0 and whose friction is not
+    clamped to the cone (for the Newton tangent only)."""
+    pc = pad_contacts(body, pose, fingers.frames, fingers.padsets, qs)
+    n = pc.normal
+    with np.errstate(invalid="ignore"):
+        trial = hist.lam_N - eps_N * pc.g
+        N = np.where(np.isfinite(pc.g), np.maximum(trial, 0.0), 0.0)
+        if keep is not None:
+            N = np.where(keep & np.isfinite(pc.g), trial, N)
+    xp, xo = anchors_now(fingers, qs, pose, hist)
+    s = (xp - hist.xp0) - (xo - hist.xo0)
+    proj = lambda v: v - np.einsum("ki,ki->k", v, n)[:, None] * n  # noqa: E731
+    s_T = proj(s)
+    trial = proj(hist.lam_T) - eps_T * s_T
+    size = np.linalg.norm(trial, axis=1)
+    cap = body.friction * N
+    stick = size <= cap
+    T = np.where(stick[:, None], trial, trial * (cap / np.where(size > 0, size, 1.0))[:, None])
+    if keep is not None and body.friction > 0:  # the tangent sticks the kept pads (a stick predictor): regular
+        T = np.where(keep[:, None], trial, T)  # when every pad slips at the start of a load reversal
+    T = np.where((N > 0)[:, None] | (keep[:, None] if keep is not None else False), T, 0.0)
+    F = N[:, None] * n + T
+    Q, i = [], 0
+    for frame, pads, q in zip(fingers.frames, fingers.padsets, qs):
+        m = pads.n_links
+        f2 = F[i:i + m] @ frame.matrix(pads.design)              # in-plane components
+        _, J, _ = pads.chain.point_map(q, np.arange(m), pc.X[i:i + m], order=1)
+        Q.append(np.einsum("maj,ma->j", J, f2))
+        i += m
+    mult = np.repeat(fingers.mult, [p.n_links for p in fingers.padsets])
+    force = -(mult[:, None] * F).sum(axis=0)
+    moment = -(mult[:, None] * np.cross(pc.x - pose.centre, F)).sum(axis=0)
+    return ContactState(pc.g, N, T, n, pc.x, pc.X, pc.zeta, s_T, stick & (N > 0), Q,
+                        np.r_[force, moment])
+
+
+@dataclass
+class Problem:
+    """The condensed hold at one load: fingers, object, external load and free pose components."""
+
+    body: object
+    fingers: Fingers
+    pose0: np.ndarray      #: (6,) the pose the free components start from (the fixed ones stay)
+    free: np.ndarray       #: indices into the pose's 6 components that are unknowns
+    load: np.ndarray       #: (6,) external wrench on the object about its centre [N, N mm]
+    hist: ContactHistory
+    scale: float           #: force scale for the tolerance [N mm]
+
+    def unpack(self, x):
+        n = len(self.fingers.frames) * self.fingers.n_s
+        p = self.pose0.copy()
+        p[self.free] = x[n:]
+        return self.fingers.split(x[:n]), Pose(self.body.centre, p)
+
+    def residual(self, x, eps_N, eps_T, keep=None):
+        qs, pose = self.unpack(x)
+        cs = evaluate(self.body, self.fingers, qs, pose, self.hist, eps_N, eps_T, keep)
+        f = self.fingers
+        R = [Q0 + S @ (q - q0) - Qc for Q0, S, q, q0, Qc in zip(f.Q0, f.S, qs, f.q0, cs.Q)]
+        R.append((cs.wrench + self.load)[self.free])
+        return np.concatenate(R), cs
+
+
+def solve_contact(problem: Problem, x0, options: ContactOptions):
+    """Newton + Uzawa on the condensed hold from x0; returns (x, ContactState, updates, iterations,
+    residual at x); raises NotConverged when no equilibrium is found."""
+    eps_N, eps_T = options.penalty, options.tangent_penalty
+    hist = replace(problem.hist)
+    problem = replace(problem, hist=hist)
+    x, its, last = np.array(x0, dtype=float), 0, np.inf
+    n_q = len(problem.fingers.frames) * problem.fingers.n_s
+    steps = np.r_[np.full(n_q, 1e-7), np.where(problem.free < 3, 1e-5, 1e-7)]
+    solver = make_solver("superlu")
+    tol = options.rtol * problem.scale
+
+    for update in range(options.max_updates + 1):
+        def fun(x):
+            R, cs = problem.residual(x, eps_N, eps_T)
+            # the tangent keeps pads within keep_gap of touching in contact (a generalised
+            # Jacobian): a step that opens a softly held pad is pulled back, not lost
+            with np.errstate(invalid="ignore"):
+                kept = np.isfinite(cs.g) & (problem.hist.lam_N - eps_N * cs.g > -eps_N * options.keep_gap)
+            K = np.empty((len(x), len(x)))
+            for j, h in enumerate(steps):
+                e = np.zeros(len(x))
+                e[j] = h
+                K[:, j] = (problem.residual(x + e, eps_N, eps_T, kept)[0]
+                           - problem.residual(x - e, eps_N, eps_T, kept)[0]) / (2 * h)
+            K[n_q:, n_q:] += 1e-9 * problem.scale * np.eye(len(x) - n_q)  # a free rotation of a frictionless sphere
+            return R, sp.csr_matrix(K)
+
+        # full steps first (a softly held pad keeps its gap window); when they cycle between
+        # contact states, again from the same start with Armijo backtracking on ||R||
+        for merit in ("finite", "residual"):
+            try:
+                res = newton(fun, x, NewtonOptions(rtol=0.0, atol=tol, max_iter=options.max_iter, merit=merit,
+                                                   forcing=None, xtol=1e-14, max_backtracks=30),
+                             solver=solver, residual=lambda x: problem.residual(x, eps_N, eps_T)[0])
+                break
+            except NotConverged:
+                if merit == "residual":
+                    raise
+        x, its = res.x, its + res.iterations
+        cs = problem.residual(x, eps_N, eps_T)[1]
+        touching = cs.N > 0
+        penetration = float(np.max(-cs.g[touching], initial=0.0))
+        slip = float(np.max(np.linalg.norm(cs.slip[cs.stick], axis=1), initial=0.0))
+        if penetration <= options.gap_tol and slip <= options.slip_tol:
+            return x, cs, update, its, problem.residual(x, eps_N, eps_T)[0]
+        measure = max(penetration / options.gap_tol, slip / options.slip_tol)
+        if measure > 0.25 * last:  # slow Uzawa (near-dependent contacts): stiffen
+            eps_N, eps_T = min(10 * eps_N, options.max_penalty), min(10 * eps_T, options.max_penalty)
+        last = measure
+        hist.lam_N, hist.lam_T = cs.N.copy(), cs.T.copy()
+    raise NotConverged(f"contact: penetration {penetration:.3g} mm, stick slip {slip:.3g} mm after "
+                       f"{options.max_updates} augmented-Lagrangian updates", [], x)

@@ -1,0 +1,180 @@
+r"""Geometry of the whole-hand hold: the fingers' frames, their pads as rigid plates, the
+object as a rigid body, and the pads' closest points to it.
+
+Hand frame (3D, as ``softhand inspect`` draws the hand): y down along the palm axis; finger
+j stands at azimuth :math:`\psi_j` about y, its bending plane spanned by its outward
+direction :math:`R_y(\psi_j) e_x` and y, its plane normal :math:`R_y(\psi_j) e_z`. A point
+of finger j's finger frame (:mod:`fem.hand.frame`: x along the finger, the hinge plate at
+y = d) at distance :math:`\zeta` from its bending plane is at
+:math:`R_y(\psi_j)\,(h(x, y), \zeta)` with h the in-plane map to the hand frame.
+
+Pads: link k's grasping face is the rectangle of the finger frame's line y = d (+ pad
+offset) between the link's ends (as the one-finger grasp's pads), ``width`` across the
+finger (:math:`|\zeta| \le` width / 2). Object: a rigid body whose pose is a translation t
+and a rotation vector r from its placed (reference) pose; a point X of the placed body is at
+:math:`c_0 + t + R(r)(X - c_0)`, c_0 its centre of mass. Its signed distance (negative
+inside) and outward normal come from the object's own geometry queries in its placed pose.
+
+Contact point of a pad: the pad point where the object's signed distance is smallest
+(:func:`pad_contacts`): started at the projection of the object's centre onto the pad,
+clamped to the rectangle (exact for a sphere, and for a cylinder whose axis is normal to
+the bending plane -- the one-finger grasp's circle), then improved by projected gradient
+steps with backtracking on the signed distance (a convex object's signed distance is convex,
+so this finds the deepest point of a box or a tilted cylinder). A pad whose plane has the
+object's centre behind it cannot touch: its gap is +inf (as in :mod:`fem.contact`).
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.spatial.transform import Rotation
+
+from softhand.fem.constraints import PlanarChain
+from softhand.fem.hand.frame import hand_frame
+
+
+def rot_y(psi: float) -> np.ndarray:
+    """Rotation by psi [rad] about the hand's y axis (the palm axis, pointing down)."""
+    c, s = math.cos(psi), math.sin(psi)
+    return np.array([[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]])
+
+
+@dataclass(frozen=True)
+class FingerFrame:
+    """Where finger j stands: the map of its finger frame into the 3D hand frame."""
+
+    azimuth: float  #: about the palm axis, from finger 0 [rad]
+
+    def matrix(self, design) -> np.ndarray:
+        """E (3, 2): finger-frame in-plane vectors -> hand-frame 3D vectors."""
+        M, _ = hand_frame(design)
+        return rot_y(self.azimuth) @ np.vstack([M, np.zeros((1, 2))])
+
+    def normal(self) -> np.ndarray:
+        """Unit normal of the bending plane in the hand frame (the pads' width direction)."""
+        return rot_y(self.azimuth)[:, 2]
+
+    def origin(self, design) -> np.ndarray:
+        """Hand-frame position of the finger frame's origin [mm]."""
+        M, origin = hand_frame(design)
+        return rot_y(self.azimuth) @ np.r_[origin - M @ [0.0, design.d], 0.0]
+
+    def to_hand(self, design, xy, zeta=0.0) -> np.ndarray:
+        """Finger-frame points xy (m, 2) at distance zeta (m,) from the plane -> hand frame (m, 3)."""
+        xy = np.atleast_2d(np.asarray(xy, dtype=float))
+        return self.origin(design) + xy @ self.matrix(design).T + np.multiply.outer(zeta, self.normal())
+
+
+def default_layout(n: int) -> tuple[FingerFrame, ...]:
+    """The paper's hand: n identical fingers evenly spaced about the palm axis (2 pi j / n)."""
+    return tuple(FingerFrame(2.0 * math.pi * j / n) for j in range(n))
+
+
+@dataclass(frozen=True)
+class PadSet:
+    """The pads of one finger: link k's rectangle between ends[k] and ends[k + 1] on y = y."""
+
+    chain: PlanarChain
+    ends: tuple[float, ...]  #: n_s + 2 arc positions: base, hinges, tip [mm]
+    y: float                 #: the pads' line in the finger frame [mm]
+    width: float             #: across the finger [mm]
+    design: object = None    #: the HandDesign (for the finger frame's placement)
+
+    @property
+    def n_links(self) -> int:
+        return len(self.ends) - 1
+
+
+class Pose:
+    """A rigid body's pose: translation t [mm] and rotation vector r [rad] from its placed pose."""
+
+    def __init__(self, centre, p=None):
+        self.c0 = np.asarray(centre, dtype=float)
+        p = np.zeros(6) if p is None else np.asarray(p, dtype=float)
+        self.t, self.r = p[:3], p[3:]
+        self.R = Rotation.from_rotvec(self.r).as_matrix()
+
+    @property
+    def centre(self) -> np.ndarray:
+        return self.c0 + self.t
+
+    def to_body(self, x) -> np.ndarray:
+        """Hand-frame points (m, 3) -> the placed body's frame."""
+        return self.c0 + (np.asarray(x) - self.centre) @ self.R
+
+    def to_hand(self, X) -> np.ndarray:
+        """Placed-body points (m, 3) -> the hand frame now."""
+        return self.centre + (np.asarray(X) - self.c0) @ self.R.T
+
+
+def signed_distance(body, pose: Pose, x):
+    """(d (m,), outward normal (m, 3)) of hand-frame points x at the body's current pose."""
+    d, n = body.signed_distance(pose.to_body(x))
+    return d, np.asarray(n) @ pose.R.T
+
+
+@dataclass
+class PadContacts:
+    """The closest points of all pads (of the solved fingers) to the object."""
+
+    g: np.ndarray      #: (m,) gap [mm], +inf facing away
+    normal: np.ndarray  #: (m, 3) the object's outward normal there
+    x: np.ndarray      #: (m, 3) the pad point, hand frame [mm]
+    X: np.ndarray      #: (m, 2) its finger-frame reference position on its link [mm]
+    zeta: np.ndarray   #: (m,) its distance from the bending plane [mm]
+
+
+def pad_corners(pads: PadSet, q):
+    """Start A and end B (n_links, 2) of every pad line, finger frame, current, and their references."""
+    links = np.arange(pads.n_links)
+    ends = np.asarray(pads.ends, dtype=float)
+    A0 = np.c_[ends[:-1], np.full(pads.n_links, pads.y)]
+    B0 = np.c_[ends[1:], np.full(pads.n_links, pads.y)]
+    A = pads.chain.point_map(q, links, A0, order=0)[0]
+    B = pads.chain.point_map(q, links, B0, order=0)[0]
+    return A, B, A0, B0
+
+
+def pad_contacts(body, pose: Pose, frames, padsets, qs, *, iterations: int = 40) -> PadContacts:
+    """Closest pad points of every pad of every finger (frames, padsets, hinge angles qs) to
+    the body at pose (see the module docstring); rows finger by finger, base link first."""
+    A, B, A0, B0, e_n, half = [], [], [], [], [], []
+    for frame, pads, q in zip(frames, padsets, qs):
+        a, b, a0, b0 = pad_corners(pads, q)
+        design = pads.design
+        A.append(frame.to_hand(design, a)), B.append(frame.to_hand(design, b))
+        A0.append(a0), B0.append(b0)
+        e_n.append(np.tile(frame.normal(), (pads.n_links, 1)))
+        half.append(np.full(pads.n_links, 0.5 * pads.width))
+    A, B, A0, B0, e_n, half = map(np.concatenate, (A, B, A0, B0, e_n, half))
+    AB = B - A
+    L2 = np.einsum("ki,ki->k", AB, AB)
+    c = pose.centre
+    sigma = np.clip(np.einsum("ki,ki->k", c - A, AB) / L2, 0.0, 1.0)
+    zeta = np.clip(np.einsum("ki,ki->k", c - A, e_n), -half, half)
+    point = lambda s, z: A + s[:, None] * AB + z[:, None] * e_n  # noqa: E731
+    d, n = signed_distance(body, pose, point(sigma, zeta))
+    step = 0.25 * np.sqrt(L2)
+    active = np.ones(len(sigma), dtype=bool)
+    for _ in range(iterations):
+        ds = -step * np.einsum("ki,ki->k", n, AB) / L2
+        dz = -step * np.einsum("ki,ki->k", n, e_n)
+        s1, z1 = np.clip(sigma + ds, 0.0, 1.0), np.clip(zeta + dz, -half, half)
+        # stationary on the rectangle (a sphere's start, a clamped corner, a parallel face): done
+        active &= np.hypot((s1 - sigma) * np.sqrt(L2), z1 - zeta) > 1e-12
+        if not active.any():
+            break
+        d1, n1 = signed_distance(body, pose, point(s1, z1))
+        better = active & (d1 < d - 1e-13 * (1.0 + np.abs(d)))
+        sigma, zeta = np.where(better, s1, sigma), np.where(better, z1, zeta)
+        d, n = np.where(better, d1, d), np.where(better[:, None], n1, n)
+        step = np.where(better, step, 0.5 * step)
+        active &= step > 1e-10
+    x = point(sigma, zeta)
+    facing = np.cross(e_n, AB)  # the pad's normal towards the closing side (finger frame +y)
+    facing /= np.linalg.norm(facing, axis=1)[:, None]
+    g = np.where(np.einsum("ki,ki->k", facing, c - x) > 0.0, d, np.inf)
+    X = A0 + sigma[:, None] * (B0 - A0)
+    return PadContacts(g, n, x, X, zeta)

@@ -1,0 +1,164 @@
+"""The whole-hand FEM hold (coarse CI mesh): the one-finger grasp as its special case, two pads
+pinching a box (2 mu N), a frictionless sphere caged below its equator, the tolerances at
+every step, the result and its files."""
+import json
+import math
+
+import meshio
+import numpy as np
+import pytest
+
+from softhand.fem.hand.finger import FingerModel, FingerOptions
+from softhand.fem.hand.grasp import GraspModel, GraspOptions, weight_vector
+from softhand.fem.hand.hold import HoldModel, HoldOptions, NoEquilibrium, run_hold
+from softhand.fem.hand.hold_body import Body
+from softhand.fem.hand.hold_contact import ContactOptions
+from softhand.fem.hand.hold_geometry import FingerFrame, Pose, pad_contacts
+from softhand.fem.hand.hold_output import to_result, write_hold
+from softhand.fem.newton import NotConverged
+from softhand.reduced.vocabulary.design import HandDesign
+from softhand.reduced.holding.hold_result import result_from_json
+
+DESIGN = HandDesign()
+CI = FingerOptions(mesher="gmsh", mesh_size=10.0)  # the coarsest finger mesh (as tests/test_grasp.py)
+P, DP = 0.45, 0.05  # MPa; the fingers touch the 180 mm object from 0.3 MPa on (CI mesh)
+
+
+@pytest.fixture(scope="module")
+def finger():
+    return FingerModel(DESIGN, CI)
+
+
+def _check_tolerances(model, record):
+    """What every converged step guarantees (the options' tolerances)."""
+    c = model.options.contact
+    assert record.residual_N <= c.rtol * model.scale        # the object's equilibrium (Newton tol)
+    assert record.cone <= 1.0 + 1e-12                       # |T| <= mu N: the return map
+    assert record.penetration_mm <= c.gap_tol               # Uzawa's stop on the gap
+    assert record.stick_slip_mm <= c.slip_tol               # ... and on a sticking pad's slip
+    assert record.q_mismatch <= model.options.q_tol         # contact and finger FEM agree
+    assert record.fem_residual <= 1e-6 * model.scale        # the finger FEM's own equilibrium
+
+
+def _F_v(model) -> float:
+    """F . n_out of the tip link (eq. (29)) from the hold's contact state (one finger, frame 0)."""
+    cs, frame = model.cs, model.frames[0]
+    F = ((cs.N[:, None] * cs.normal + cs.T) @ frame.matrix(DESIGN)).sum(axis=0)  # finger frame
+    theta = model.fingers[0].q.sum()
+    return float(-F @ [-math.sin(theta), math.cos(theta)])
+
+
+@pytest.mark.slow
+def test_frictionless_circle_is_the_one_finger_grasp(finger):
+    """A frictionless cylinder normal to the bending plane, object held: the hold's contact is the
+    grasp FEM's circle. Both converged to gaps of 1e-9 mm: the same q, F_v and w to 1e-6."""
+    grasp = GraspModel(finger, 180.0, options=GraspOptions(gap_tol=1e-9))
+    a = grasp.solve(P)
+    b = grasp.solve(P + DP, start=a)
+    body = Body("cylinder", (0.0, grasp.depth, 0.0), (180.0, 400.0), axis=(0.0, 0.0, 1.0))
+    hold = HoldModel(DESIGN, body, layout=[FingerFrame(0.0)], finger_model=finger,
+                     options=HoldOptions(symmetry=False, q_tol=1e-10, contact=ContactOptions(gap_tol=1e-9)))
+    for P_k in (0.5 * P, P):
+        _check_tolerances(hold, hold.step(P_k, gravity=0.0, pull=0.0, stage="close"))
+    qa, Fa = hold.fingers[0].q, _F_v(hold)
+    hold.step(P + DP, gravity=0.0, pull=0.0, stage="close")
+    qb, Fb = hold.fingers[0].q, _F_v(hold)
+    np.testing.assert_allclose(qa, a.q, rtol=1e-6)
+    assert Fa == pytest.approx(a.F_v, rel=1e-6) and Fb == pytest.approx(b.F_v, rel=1e-6)
+    w_hold = (qb - qa) / (qb - qa).sum()
+    np.testing.assert_allclose(w_hold, weight_vector(a, b), atol=1e-6)
+
+
+@pytest.mark.slow
+def test_two_pads_pinching_a_box_hold_two_mu_N(finger, tmp_path):
+    """Two facing fingers close their tips on a box's vertical faces (normals horizontal): the
+    largest vertical load held is the friction's 2 mu N, N the pads' normal force reported."""
+    mu = 0.5
+    box = Body("box", (0.0, 130.0, 0.0), (150.0, 140.0, 40.0), mass_kg=0.005, friction=mu)
+    model = HoldModel(DESIGN, box, layout=[FingerFrame(0.0), FingerFrame(math.pi)], finger_model=finger,
+                      options=HoldOptions(close_steps=3, pull_step=0.02, pull_floor=0.002))
+    assert model.symmetric and model.n_solved == 1
+    path = run_hold(model, 1.2)
+    assert path.held and path.limit_reached
+    for record in path.steps:
+        _check_tolerances(model, record)
+    last = path.steps[-1]
+    touching = [c for c in last.contacts if c["normal_N"] > 0]
+    assert all(abs(c["normal_force_N"][1]) < 1e-9 * c["normal_N"] for c in touching)  # horizontal
+    N = sum(c["normal_N"] for c in touching)                 # both pads
+    load = model.weight + path.holding_limit_N
+    # the limit is resolved to pull_resolution (2 %) of the pull, or pull_floor: within that of 2 mu N / 2
+    assert load <= mu * N * (1 + 1e-9)
+    assert load >= mu * N - max(0.02 * path.holding_limit_N, 0.002) - 1e-9
+    # the common result and its files: result.json with every step, one VTK scene per step
+    result = to_result(path)
+    write_hold(path, result, tmp_path)
+    data = json.loads((tmp_path / "result.json").read_text())
+    assert data["model"] == "fem" and data["held"] and data["holding_limit_N"] == path.holding_limit_N
+    assert data["symmetric"] and len(data["steps"]) == len(path.steps)
+    assert {c["finger"] for c in data["contacts"]} == {0, 1} and all(c["state"] == "stick" for c in data["contacts"])
+    assert result_from_json(data).holding_limit_N == result.holding_limit_N
+    scene = meshio.read(tmp_path / "hold" / f"hold_{len(path.steps) - 1:04d}" / "contact_forces.vtu")
+    np.testing.assert_allclose(np.abs(scene.point_data["normal_force_N"][:, 0]), [c["normal_N"] for c in touching])
+    assert (tmp_path / "hold" / "hold_0000" / "tube.vtu").exists()
+    assert (tmp_path / "hold" / "hold_0000" / "finger1_tube.vtu").exists()
+
+
+@pytest.mark.slow
+def test_frictionless_sphere_caged_below_its_equator_drops_when_the_fingers_open(finger):
+    """mu = 0: only the normals' upward parts can carry the weight, so the sphere is held only
+    while pads touch it below its centre; opening the fingers (lower pressure) drops it."""
+    sphere = Body("sphere", (0.0, 140.0, 0.0), (160.0,), mass_kg=0.02, friction=0.0)
+    model = HoldModel(DESIGN, sphere, finger_model=finger, options=HoldOptions(close_steps=3))
+    path = run_hold(model, 1.2)
+    assert path.held
+    release = [s for s in path.steps if s.stage == "release"][-1]
+    centre = Pose(sphere.centre, release.pose).centre
+    touching = [c for c in release.contacts if c["normal_N"] > 0]
+    assert touching and all(c["point_mm"][1] > centre[1] for c in touching)   # below the equator
+    assert all(c["friction_N"] == 0.0 for c in release.contacts)
+    for record in path.steps:
+        _check_tolerances(model, record)
+    P_k, dP, dropped = 1.2, 0.1, None
+    while dP >= 0.0125 and P_k > 0:
+        try:
+            model.step(P_k - dP, gravity=1.0, pull=0.0, stage="open")
+            P_k -= dP
+        except (NotConverged, NoEquilibrium):
+            dropped, dP = P_k - dP, 0.5 * dP
+    assert dropped is not None and dropped > 0.0
+    # at the pressure it drops, the open fingers no longer reach under the centre of the last held pose
+    held_at = Pose(sphere.centre, model.pose).centre
+    assert held_at[1] > centre[1] - 1e-9   # it had sunk (or stayed) while the fingers opened
+
+
+def test_pad_contact_of_a_sphere_off_the_bending_plane():
+    """A pad is a plate of the tube's width: a sphere beside the finger's plane touches its
+    edge, at sqrt(in-plane distance^2 + (|z| - w/2)^2) - R (closed form), base link, q = 0."""
+    from softhand.fem.constraints import PlanarChain
+    from softhand.fem.hand.hold_geometry import PadSet
+
+    d = DESIGN
+    chain = PlanarChain(np.c_[d.hinge_s, np.full(d.n_s, d.d)])
+    pads = PadSet(chain, (0.0, *d.hinge_s, d.l0), d.d, 18.0, d)
+    frame = FingerFrame(0.0)
+    X = np.array([15.0, d.d + 30.0])  # above the middle of link 0's pad, 30 mm on the closing side
+    for z, R in ((5.0, 20.0), (25.0, 20.0)):
+        c = frame.to_hand(d, X, z)[0]
+        pc = pad_contacts(Body("sphere", tuple(c), (2 * R,)), Pose(c), [frame], [pads], [np.zeros(d.n_s)])
+        expect = math.hypot(30.0, max(abs(z) - 9.0, 0.0)) - R
+        assert pc.g[0] == pytest.approx(expect, abs=1e-9)
+        np.testing.assert_allclose(pc.X[0], [15.0, d.d], atol=1e-9)
+
+
+def test_symmetry_orbits_follow_the_object():
+    from softhand.fem.hand.hold import symmetry_orbits
+    from softhand.fem.hand.hold_geometry import default_layout
+
+    frames = default_layout(4)
+    down = (0.0, 1.0, 0.0)
+    assert symmetry_orbits(Body("sphere", (0, 150, 0), (180,)), frames, down) == [(0, [0, 1, 2, 3])]
+    lying = Body("cylinder", (0, 150, 0), (100, 200), axis=(1, 0, 0))
+    assert symmetry_orbits(lying, frames, down) == [(0, [0, 2]), (1, [1, 3])]
+    assert len(symmetry_orbits(Body("sphere", (2, 150, 0), (180,)), frames, down)) == 4   # off-axis
+    assert len(symmetry_orbits(Body("sphere", (0, 150, 0), (180,)), frames, (1, 0, 0))) == 4  # pulled sideways
