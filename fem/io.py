@@ -7,7 +7,7 @@ Fields written (3D displacement bases ``ElementVector`` of P1/P2 tetrahedra):
   row-major), ``von_mises_MPa`` (:math:`\sqrt{3/2\, s:s}`, s = dev σ), ``J`` and, when the
   law has a fiber family, ``fiber_stretch`` :math:`|F a_0|` (the name carries the unit;
   stretches and J have none); a model may add its own (the finger: ``rubber_stretch``, the
-  principal stretch averaged over a ball, :mod:`fem.rubber_stretch`);
+  principal stretch averaged over a ball, :mod:`softhand.fem.rubber_stretch`);
 * cell data: the same stress-like quantities averaged over each element's quadrature points.
 
 Quadratic meshes are written as **quadratic cells** (``tetra10``), so ParaView and pyvista

@@ -1,7 +1,7 @@
 """Hold studies: one hold (its files), and the hold map over two of pressure, mass, object size,
 friction and pull direction.
 
-:class:`HoldMap` runs the fast hold model (:mod:`reduced.hold`) on a grid: at each point the
+:class:`HoldMap` runs the fast hold model (:mod:`softhand.reduced.holding.hold`) on a grid: at each point the
 holding margin, the load the hand bears along the pull over the object's weight ((m g + limit)
 / m g; >= 1: held), the holding limit [N], and both pressures. The closed hand depends only on
 the pressure and the object's geometry, so it is computed once per pressure and size and

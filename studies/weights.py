@@ -154,7 +154,7 @@ def compute(case: WeightsCase, out=None, progress=None) -> dict:
 
 def rubber_stretches(finger, state) -> dict:
     """The tube's converged ``rubber_stretch`` and its corner peak ``max_principal_stretch``
-    (mesh-dependent) at a grasp state (:mod:`fem.rubber_stretch`)."""
+    (mesh-dependent) at a grasp state (:mod:`softhand.fem.rubber_stretch`)."""
     fs = finger.state(state.y, state.P)
     return {"rubber_stretch": fs.rubber_stretch, "max_principal_stretch": fs.max_principal_stretch}
 

@@ -1,16 +1,16 @@
 r"""The whole hand holding a rigid object with friction, in the FEM: close, let go, pull.
 
-Every finger of the layout is the finger FEM (:mod:`fem.hand.finger`, the half model in its
+Every finger of the layout is the finger FEM (:mod:`softhand.fem.hand.finger`, the half model in its
 own bending plane) on the one hydraulic circuit (the same cavity pressure). Its links' pads
-are rigid plates (:mod:`fem.hand.hold_geometry`) pressing on a rigid object, a free body
+are rigid plates (:mod:`softhand.fem.hand.hold_geometry`) pressing on a rigid object, a free body
 under gravity, the pads' forces and an external pull, with Coulomb friction
-(:mod:`fem.hand.hold_contact`).
+(:mod:`softhand.fem.hand.hold_contact`).
 
 Scheme (staggered, with the fingers condensed). The object couples the fingers only
 through the contact forces, and pads and object are rigid, so a finger enters the contact
 problem only through its hinge angles: its condensed response :math:`Q^{int}_f(q)`, the
 generalised force that holds its links at q, linearised at its last FEM state with the exact
-condensed stiffness (:mod:`fem.hand.hold_finger`). A load step:
+condensed stiffness (:mod:`softhand.fem.hand.hold_finger`). A load step:
 
 1. each finger's FEM moves to the step's pressure under its last contact forces;
 2. the small contact problem (hinge angles of every solved finger, the object's free pose
@@ -22,7 +22,7 @@ condensed stiffness (:mod:`fem.hand.hold_finger`). A load step:
    finger's FEM equilibrium hold together (a Newton iteration on the fingers' responses:
    it converges quadratically).
 
-The path: the hand comes down over the object (the placement of :mod:`fem.hand.grasp`:
+The path: the hand comes down over the object (the placement of :mod:`softhand.fem.hand.grasp`:
 its top ``palm_gap`` below the palm, or the open fingers ``clearance`` from it), the
 pressure rises to the grasp pressure in ``close_steps`` while the object's support holds
 it (pose fixed), gravity is switched on and the support removed (pose free), then a pull
@@ -123,10 +123,10 @@ class StepRecord:
     pose: np.ndarray      #: (6,) translation [mm] and rotation vector [rad] from the placement
     contacts: list        #: per pad of every finger: dict (finger, link, normal_N, friction_N, state, ...)
     residual_N: float     #: object equilibrium residual (free components) [N, N mm]
-    cone: float           #: max |T| / (mu N) over touching pads (<= 1)
+    cone: float           #: max ``|T|`` / (mu N) over touching pads (<= 1)
     penetration_mm: float  #: max penetration of a touching pad
     stick_slip_mm: float  #: max slip of a sticking pad within the step
-    q_mismatch: float     #: max |q_FEM - q_contact| [rad]
+    q_mismatch: float     #: max ``|q_FEM - q_contact|`` [rad]
     fem_residual: float   #: max finger FEM residual norm [N mm]
     iterations: int       #: contact/FEM (stagger) iterations
     states: list = field(repr=False, default_factory=list)  #: the solved fingers' FEM states y
@@ -363,10 +363,10 @@ def run_hold(model: HoldModel, P: float, *, progress=None) -> HoldPath:
 def solve_hold(design: HandDesign, obj, *, P_cavity_MPa: float, pull_direction=(0.0, 1.0, 0.0),
                options: HoldOptions = HoldOptions(), progress=None, keep_path: bool = False,
                P_pump_MPa: float = math.nan):
-    """The FEM hold of ``obj`` (a :class:`reduced.objects.GraspObject`, placed by its table) at
-    cavity pressure P_cavity_MPa: the common :class:`reduced.hold_result.HoldResult` (P_pump_MPa
+    """The FEM hold of ``obj`` (a :class:`softhand.reduced.holding.objects.GraspObject`, placed by its table) at
+    cavity pressure P_cavity_MPa: the common :class:`softhand.reduced.holding.hold_result.HoldResult` (P_pump_MPa
     only reported); ``progress(record)`` after every converged load step; with ``keep_path``
-    also the :class:`HoldPath` (for :func:`fem.hand.hold_output.write_hold`)."""
+    also the :class:`HoldPath` (for :func:`softhand.fem.hand.hold_output.write_hold`)."""
     from softhand.fem.hand.hold_body import body_of
     from softhand.fem.hand.hold_output import to_result
     from softhand.fem.hand.hold_geometry import FingerFrame

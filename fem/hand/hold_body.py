@@ -129,7 +129,7 @@ def _grid_triangles(rows: int, n: int) -> np.ndarray:
 
 @dataclass(frozen=True)
 class PlacedBody:
-    """Any placed object of :mod:`reduced.objects` (capsule, mesh, rotated box) through its own
+    """Any placed object of :mod:`softhand.reduced.holding.objects` (capsule, mesh, rotated box) through its own
     distance queries (its normal by central differences)."""
 
     placed: object
@@ -150,7 +150,7 @@ class PlacedBody:
 
 
 def body_of(obj, design):
-    """The FEM's body for a :class:`reduced.objects.GraspObject` at its placement (checked:
+    """The FEM's body for a :class:`softhand.reduced.holding.objects.GraspObject` at its placement (checked:
     InputError if it overlaps the open fingers or the palm): analytic for a sphere, a cylinder
     and an unrotated box, else the object's own distance queries."""
     from softhand.reduced.holding.hand_layout import place_object

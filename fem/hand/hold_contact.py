@@ -2,11 +2,11 @@ r"""Frictional contact of rigid pads on a rigid free object, with the fingers co
 
 Unknowns: the hinge angles :math:`q_f` of every solved finger and the object's free pose
 components p. Each finger enters through its condensed response at the cavity pressure,
-the physical generalised force its links need to be held at q (:mod:`fem.hand.hold_finger`),
+the physical generalised force its links need to be held at q (:mod:`softhand.fem.hand.hold_finger`),
 linearised at its last FEM state: :math:`Q^{int}_f(q) = Q_f + S_f (q - q_f)`.
 
 Contact of pad i (gap :math:`g_i`, object's outward normal :math:`n_i` at the pad's
-closest point :math:`x_i`, :mod:`fem.hand.hold_geometry`), augmented Lagrangian with
+closest point :math:`x_i`, :mod:`softhand.fem.hand.hold_geometry`), augmented Lagrangian with
 Coulomb friction (Simo and Laursen 1992; Alart and Curnier's return map):
 
 .. math:: N_i = \langle \lambda_{N,i} - \epsilon_N g_i \rangle,\qquad
@@ -25,7 +25,7 @@ reacted by the hinges. Equations:
           \sum_f m_f \sum_{i\in f} W_i(-F_i) + (m g + F_{pull}) e = 0 \text{ (free components)},
 
 :math:`m_f` the multiplicity of a finger standing for its symmetric images. Newton
-(:func:`fem.newton.newton`) with a central-difference Jacobian (the system is small), the
+(:func:`softhand.fem.newton.newton`) with a central-difference Jacobian (the system is small), the
 multipliers fixed; Uzawa updates :math:`\lambda \leftarrow (N, T)` until every touching pad's
 penetration is below ``gap_tol`` and every sticking pad's slip below ``slip_tol``; the
 friction cone :math:`|T| \le \mu N` holds by construction (the return map).
@@ -78,8 +78,8 @@ class ContactHistory:
 class Fingers:
     """The solved fingers as the contact problem sees them (lists over fingers)."""
 
-    frames: list       #: :class:`fem.hand.hold_geometry.FingerFrame`
-    padsets: list      #: :class:`fem.hand.hold_geometry.PadSet`
+    frames: list       #: :class:`softhand.fem.hand.hold_geometry.FingerFrame`
+    padsets: list      #: :class:`softhand.fem.hand.hold_geometry.PadSet`
     mult: np.ndarray   #: how many fingers each stands for
     q0: list           #: hinge angles of the last FEM state [rad]
     Q0: list           #: physical generalised forces applied there [N mm]

@@ -1,9 +1,9 @@
 r"""One finger of the hold: the finger FEM under the cavity pressure and dead generalised
 forces on its hinge angles, and its condensed stiffness.
 
-The finger FEM (:class:`fem.hand.finger.FingerModel`, the half model on the bending plane)
+The finger FEM (:class:`softhand.fem.hand.finger.FingerModel`, the half model on the bending plane)
 at pressure P under physical generalised forces Q on its hinge angles q (the half model
-carries Q / 2, as in :mod:`fem.hand.grasp`) has the equilibrium :math:`r(y; P) = (0, Q/2)`
+carries Q / 2, as in :mod:`softhand.fem.hand.grasp`) has the equilibrium :math:`r(y; P) = (0, Q/2)`
 with y = (u_free, q). The generalised force that holds the links at q,
 :math:`Q^{int}(q; P)`, has the derivative (the condensed stiffness)
 
@@ -12,7 +12,7 @@ with y = (u_free, q). The generalised force that holds the links at q,
 the inverse of the q-block of the reduced tangent's inverse (a Schur complement), taken
 from the factorisation the last Newton step left (five back-substitutions, no new
 factorisation). Loads move along a straight path from the last (P, Q) to the new one
-(:func:`fem.newton.solve_path`, tangent predictor, cut-back).
+(:func:`softhand.fem.newton.solve_path`, tangent predictor, cut-back).
 """
 from __future__ import annotations
 

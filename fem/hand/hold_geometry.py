@@ -4,7 +4,7 @@ object as a rigid body, and the pads' closest points to it.
 Hand frame (3D, as ``softhand inspect`` draws the hand): y down along the palm axis; finger
 j stands at azimuth :math:`\psi_j` about y, its bending plane spanned by its outward
 direction :math:`R_y(\psi_j) e_x` and y, its plane normal :math:`R_y(\psi_j) e_z`. A point
-of finger j's finger frame (:mod:`fem.hand.frame`: x along the finger, the hinge plate at
+of finger j's finger frame (:mod:`softhand.fem.hand.frame`: x along the finger, the hinge plate at
 y = d) at distance :math:`\zeta` from its bending plane is at
 :math:`R_y(\psi_j)\,(h(x, y), \zeta)` with h the in-plane map to the hand frame.
 
@@ -21,7 +21,7 @@ clamped to the rectangle (exact for a sphere, and for a cylinder whose axis is n
 the bending plane -- the one-finger grasp's circle), then improved by projected gradient
 steps with backtracking on the signed distance (a convex object's signed distance is convex,
 so this finds the deepest point of a box or a tilted cylinder). A pad whose plane has the
-object's centre behind it cannot touch: its gap is +inf (as in :mod:`fem.contact`).
+object's centre behind it cannot touch: its gap is +inf (as in :mod:`softhand.fem.contact`).
 """
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""What a FEM hold gives back: the common :class:`reduced.hold_result.HoldResult`, its
+"""What a FEM hold gives back: the common :class:`softhand.reduced.holding.hold_result.HoldResult`, its
 ``result.json`` and the VTK scene of every load step (every finger, the object's surface,
 arrows for the normal and friction forces at each contact)."""
 from __future__ import annotations
@@ -41,7 +41,7 @@ def _step_row(record) -> LoadStep:
 
 
 def to_result(path, *, obj=None) -> HoldResult:
-    """The common result of a :class:`fem.hand.hold.HoldPath`: contacts and pose under the
+    """The common result of a :class:`softhand.fem.hand.hold.HoldPath`: contacts and pose under the
     object's own weight (the release step; the last closed state when not held)."""
     m = path.model
     released = [s for s in path.steps if s.stage == "release" and s.gravity == 1.0]

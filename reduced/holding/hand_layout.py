@@ -6,7 +6,7 @@ Hand frame (docs/conventions.md): origin on the palm's axis at the height of the
 ``finger_azimuths_deg``; default n fingers evenly spaced from 0, the paper's four at 0, 90, 180,
 270 deg as ``softhand inspect`` draws them): its outward direction is finger 0's turned about
 +y by phi_i, e_out = (cos phi, 0, -sin phi), its bending plane spanned by e_out and y, its plane
-normal e_n = e_out x e_y. A point (x, y) of the finger's plane (:mod:`reduced.kinematics`: base
+normal e_n = e_out x e_y. A point (x, y) of the finger's plane (:mod:`softhand.reduced.equations.kinematics`: base
 at (base_offset, 0), base link mounted theta0 = 20 deg outward) is x e_out + y e_y in the hand frame.
 
 Each link k's **pad** is the rigid plate between its joints (the hinge plate side, facing the
@@ -121,7 +121,7 @@ def pad_distance(placed: Placed, p: Pads) -> PadDistance:
     centre); otherwise the least distance on a :data:`PAD_SAMPLES` grid of the pad refined by a
     parabola through the least sample and its neighbours, along then across (exact for a flat
     face; error O(h^3) on a curved one, h = 1/16 of the link); and an object's edges and corners
-    (:func:`reduced.objects.feature_points`) over the pad's face, by their height above it, where
+    (:func:`softhand.reduced.holding.objects.feature_points`) over the pad's face, by their height above it, where
     the distance is not smooth (a box's corner on a pad: then the contact normal is the pad's)."""
     if placed.obj.shape == "sphere":
         d = placed.centre - p.centre
@@ -196,7 +196,7 @@ def _open_gap(obj: GraspObject, depth: float, design: HandDesign) -> float:
 
 def default_depth(obj: GraspObject, design: HandDesign) -> float:
     """Depth [mm] of the object's centre at its default placement (module doc); for a sphere
-    exactly :func:`reduced.contact.object_depth` of its diameter (the one-finger grasp's)."""
+    exactly :func:`softhand.reduced.equations.contact.object_depth` of its diameter (the one-finger grasp's)."""
     if obj.shape == "sphere":
         try:
             return contact.object_depth(obj.diameter_mm, design)

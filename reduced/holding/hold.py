@@ -2,10 +2,10 @@ r"""The fast hold, posed as a user asks it: does the hand hold this object at th
 much more can it take along a pull, and what pump pressure holds it with a margin.
 
 :func:`solve_hold` runs the path of the FEM hold in the fast model: close at the cavity pressure
-(:func:`reduced.hold_fast.close_hand`), let go (the object's weight: the admissible state nearest
-the closing forces, :func:`reduced.hold_lp.weight_state`), pull along a direction until no
-admissible state is left (:func:`reduced.hold_lp.holding_limit`). It returns the common
-:class:`reduced.hold_result.HoldResult` (model ``"reduced"``). The rigid object does not move in
+(:func:`softhand.reduced.holding.hold_fast.close_hand`), let go (the object's weight: the admissible state nearest
+the closing forces, :func:`softhand.reduced.holding.hold_lp.weight_state`), pull along a direction until no
+admissible state is left (:func:`softhand.reduced.holding.hold_lp.holding_limit`). It returns the common
+:class:`softhand.reduced.holding.hold_result.HoldResult` (model ``"reduced"``). The rigid object does not move in
 this model (displacement and rotation 0; the FEM reports them).
 
 :func:`least_pressure` answers the inverse question: the least pump pressure (and its cavity

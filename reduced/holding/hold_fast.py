@@ -8,20 +8,20 @@ energy least with no pad inside the object,
           \ (k = 1..n_s),
 
 E = sum_j int M_j the hinges' energy at cavity pressure P (:func:`hinge_moments`), g_k the gap
-of pad k to the object (:func:`reduced.hand_layout.pad_distance`). Its optimality conditions
+of pad k to the object (:func:`softhand.reduced.holding.hand_layout.pad_distance`). Its optimality conditions
 are the hinge equilibrium with the pads' contact forces, M_j = sum_k N_k dg_k/d theta_hat_j,
-N_k >= 0, N_k g_k = 0: exactly the one-finger grasp's equations (:mod:`reduced.grasp_fem`,
+N_k >= 0, N_k g_k = 0: exactly the one-finger grasp's equations (:mod:`softhand.reduced.calibrated.grasp_fem`,
 whose frictionless circle in the bending plane is the special case, a test) for any number of
 touching pads. Solved by SLSQP from the pose where the finger, closing with equal hinges, first
 touches; then the active pads' equations by Newton (scipy's hybrid method) to 1e-10.
 
 **Holding**: the touching pads, their normals and closing forces, and each finger's hinge
-capacities (-M_j at the closed state) go to the limit analysis of :mod:`reduced.hold_lp`.
+capacities (-M_j at the closed state) go to the limit analysis of :mod:`softhand.reduced.holding.hold_lp`.
 
-Finger models: ``"fem"`` (default), the calibrated finger of :mod:`reduced.grasp_fem` (hinge by
+Finger models: ``"fem"`` (default), the calibrated finger of :mod:`softhand.reduced.calibrated.grasp_fem` (hinge by
 hinge, from the finger FEM); ``"paper"``, the paper's finger (W_f, Q of eqs. (2), (10)) with its
 energy shared equally by the hinges, M_j = -dQ/dtheta (P - P_free(n_s theta_hat_j)).
-Where every finger sees the object alike (:func:`reduced.hand_layout.symmetric`: a centred sphere,
+Where every finger sees the object alike (:func:`softhand.reduced.holding.hand_layout.symmetric`: a centred sphere,
 an upright cylinder, a square box under four fingers), one finger is solved and its state turned to the others. Units: mm, N, MPa, rad.
 """
 from __future__ import annotations
@@ -115,7 +115,7 @@ class FingerState(NamedTuple):
     N: np.ndarray         #: (n_s+1,) closing normal force on each pad [N] (0: not touching)
     geometry: FingerGeometry
     moments: np.ndarray   #: (n_s,) M_j at q [N mm/rad]
-    residual: float       #: hinge equilibrium residual, max |M - dg^T N| / max |M| [-]
+    residual: float       #: hinge equilibrium residual, max ``|M - dg^T N|`` / max ``|M|`` [-]
 
 
 def close_finger(i: int, P: float, placed: Placed, design: HandDesign) -> FingerState:

@@ -1,7 +1,7 @@
 r"""The holding limit of a closed hand as a linear program (limit analysis of the grasp).
 
 The fingers have closed on the object at the cavity pressure P (frictionless, the object held
-in place: :mod:`reduced.hold_fast`), each touching pad c at x_c with the object's outward normal
+in place: :mod:`softhand.reduced.holding.hold_fast`), each touching pad c at x_c with the object's outward normal
 n_c. Then the object is let go and pulled along d. Unknowns: each pad's normal force N_c >= 0
 and its friction force F_c (in the tangent plane), and the pull lam beyond the weight W = m g:
 
@@ -16,7 +16,7 @@ and its friction force F_c (in the tangent plane), and the pull lam beyond the w
 
 The last line is each finger's hinge equilibrium read as a capacity: the force of the object on
 the finger's pads may push hinge j open with at most the moment the pressure holds it with at
-the grasp state, -M_j >= 0 (:func:`reduced.hold_fast.hinge_moments`; in the closed state it is
+the grasp state, -M_j >= 0 (:func:`softhand.reduced.holding.hold_fast.hinge_moments`; in the closed state it is
 met with equality by the closing forces). The fingers stay at their grasp configuration (small
 displacements: the object and the pads are rigid, the compliance is the hinges'), so the
 holding limit is the largest lam for which some set of contact forces satisfies all of the
@@ -27,8 +27,8 @@ along the pad is bounded exactly by mu N): elsewhere the friction the polygon al
 1 - cos(pi / GENERATORS) = 1.9 % below the cone's.
 
 The state reported under the object's own weight (lam = 0) is the admissible one whose normal
-forces are closest (sum of |N_c - N*_c|) to the closing forces N*_c, the friction shared as evenly
-as it can be (the largest |F_c| / (mu N*_c) least). Units: N, mm.
+forces are closest (sum of ``|N_c - N*_c|``) to the closing forces N*_c, the friction shared as evenly
+as it can be (the largest ``|F_c|`` / (mu N*_c) least). Units: N, mm.
 """
 from __future__ import annotations
 

@@ -14,7 +14,7 @@ The hand frame (docs/conventions.md): origin on the palm's axis at the height of
 bases, y down along the palm's axis (gravity), x outward through finger 0, z = x cross y.
 **Placement**: the object's centre on the palm's axis, its top ``PALM_GAP`` below the palm,
 lowered until the open fingers' pads clear it by ``CLEARANCE`` (as the one-finger grasp places
-its circle, :func:`reduced.contact.object_depth`); then turned by ``rotation_deg = [rx, ry, rz]``
+its circle, :func:`softhand.reduced.equations.contact.object_depth`); then turned by ``rotation_deg = [rx, ry, rz]``
 (about the hand frame's x, then y, then z, through the centre) and shifted by ``offset_mm``.
 A table with only ``diameter_mm`` and ``mass_kg`` (the one-finger grasp's object) is a
 **sphere**: its section by every finger's bending plane is the circle the one-finger models see.
@@ -22,7 +22,7 @@ A table with only ``diameter_mm`` and ``mass_kg`` (the one-finger grasp's object
 Geometry queries are vectorised over points (..., 3) in the hand frame: :meth:`Placed.sdf`
 (signed distance, negative inside) and :meth:`Placed.normal` (outward unit normal, the
 distance's gradient). Primitives use their closed-form distance; a mesh, trilinear
-interpolation of its distance sampled once on a grid (:mod:`reduced.object_mesh`, points on its longest
+interpolation of its distance sampled once on a grid (:mod:`softhand.reduced.holding.object_mesh`, points on its longest
 edge; error ~ the grid step squared over the surface's radius of curvature). Units: mm, kg, rad.
 """
 from __future__ import annotations

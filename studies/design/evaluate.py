@@ -220,8 +220,8 @@ def limit_point_volume(design: HandDesign) -> float:
 def evaluate(design: HandDesign, task: Task, *, exact: bool = True) -> Evaluation:
     """Grasp angle, pressures, forces, stretch and every constraint of ``design`` for ``task``
     (``exact=False``: the kinematics interpolated in l0, see :func:`grasp_geometry`); a hold task
-    (an object of any shape) is judged by :func:`studies.design.hold_eval.evaluate_hold` instead
-    (:func:`studies.design.optimise.evaluate` chooses)."""
+    (an object of any shape) is judged by :func:`softhand.studies.design.hold_eval.evaluate_hold` instead
+    (:func:`softhand.studies.design.optimise.evaluate` chooses)."""
     depth, theta, link, w, theta_open = grasp_geometry(design, task, exact=exact)
     F_req = task.required_F_v()
     P_margin, edge, no_grasp, F_reached = task.max_pressure, "", "", math.nan

@@ -1,4 +1,4 @@
-"""A design judged for a hold task by the fast hold model (:mod:`reduced.hold`).
+"""A design judged for a hold task by the fast hold model (:mod:`softhand.reduced.holding.hold`).
 
 A hold task names an object of any shape, its friction, and the margin the hold must have
 (the weight times ``margin`` borne along the pull, or a pull of ``pull_N`` beyond the weight).
@@ -7,7 +7,7 @@ reaches the margin (``P_grasp``; bisection on the cavity pressure between the fi
 the pump's limit, to :data:`PRESSURE_TOL`), the holding limit at the pump's limit
 (``F_v_at_limit``; its requirement is ``F_v``), the free hand's pump pressure where a pad first
 touches (``P_contact``), and the tube's stretch and the oil at the least pressure. The
-constraints are the design's (:func:`studies.design.evaluate.design_constraints`); the opening
+constraints are the design's (:func:`softhand.studies.design.evaluate.design_constraints`); the opening
 is met by construction (the placement refuses an object the open fingers do not clear, and the
 evaluation then has no answer). Units: mm, N, MPa.
 """
@@ -39,7 +39,7 @@ def _limit(d, task, placed, P_cavity):
 
 
 def evaluate_hold(design: HandDesign, task: Task) -> Evaluation:
-    """The :class:`studies.design.evaluate.Evaluation` of ``design`` for a hold task (module doc)."""
+    """The :class:`softhand.studies.design.evaluate.Evaluation` of ``design`` for a hold task (module doc)."""
     d = hold_fast.finger_design(design, "fem" if design.finger_model == "fem" else "paper")
     try:
         placed = place_object(task.obj, d)

@@ -35,7 +35,7 @@ __all__ = ["Constraint", "Evaluation", "design_at", "evaluate", "objective", "Pr
 
 def evaluate(design, task: Task, *, exact: bool = True) -> Evaluation:
     """A design judged for the task: a hold task (an object of any shape) by the fast hold model
-    (:func:`studies.design.hold_eval.evaluate_hold`), else by :func:`studies.design.evaluate.evaluate`."""
+    (:func:`softhand.studies.design.hold_eval.evaluate_hold`), else by :func:`softhand.studies.design.evaluate.evaluate`."""
     if task.obj is not None:
         return evaluate_hold(design, task)
     return grasp_evaluate(design, task, exact=exact)

@@ -2,7 +2,7 @@
 
 The stretch is the rubber's: the larger of the tube's and the reservoir sheet's (their
 calibrated converged stretches where the models' tables hold them, else eqs. (8) and (16);
-:mod:`studies.design.evaluate`). A fuller sheet or a longer lever arm needs less pump pressure but stretches the
+:mod:`softhand.studies.design.evaluate`). A fuller sheet or a longer lever arm needs less pump pressure but stretches the
 rubber more.
 The front is traced by the epsilon-constraint method: the least stretch any feasible design
 reaches (differential evolution on the stretch, polished by SLSQP), then the task's objective with the stretch

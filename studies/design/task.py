@@ -31,7 +31,7 @@ A task is a TOML file (``studies/designs/tasks/paper_task.toml`` is the paper's)
 
 An ``[object]`` with any key of the object table beyond ``diameter_mm`` and ``mass_kg``
 (``shape``, ``size_mm``, ``friction``, ...) or a ``[hold]`` table makes a **hold task**: the
-design is judged by the fast hold model (:mod:`reduced.hold`): the least pump pressure whose
+design is judged by the fast hold model (:mod:`softhand.reduced.holding.hold`): the least pump pressure whose
 holding limit along the pull reaches the margin, the holding limit at the pump's limit.
 ``base_design`` is looked up as given, then next to the task file, then in the package.
 A task designs on the FEM-calibrated models (``finger_model = "fem"``, ``reservoir_model =

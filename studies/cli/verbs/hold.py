@@ -16,7 +16,7 @@ Three questions about one design (``--design``, default the paper's) and one obj
   ``hold_map.csv`` and ``hold_map.png`` in ``--out``; ``--check`` runs the FEM at the map's
   corners and centre.
 
-``--model reduced`` (default) is the fast model (:mod:`reduced.hold`); ``--model fem`` the
+``--model reduced`` (default) is the fast model (:mod:`softhand.reduced.holding.hold`); ``--model fem`` the
 whole-hand FEM (``softhand.fem.hand.hold``), at the cavity pressure given, or at the one the fast
 model finds for the pump pressure given. Both print the same ``--json`` keys.
 """
