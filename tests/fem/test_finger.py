@@ -11,6 +11,8 @@ from softhand.fem.newton import NewtonOptions
 from softhand.reduced.equations import hand, kinematics
 from softhand.reduced.vocabulary.design import HandDesign
 
+from conftest import CI_FINGER, CI_MESH_ARGS
+
 DESIGN = HandDesign()
 CI = FingerOptions(**CI_FINGER)
 PRESSURES = (0.4, 0.8)
