@@ -125,7 +125,7 @@ def write_hold(path, result: HoldResult, out_dir, *, vtk: bool = True) -> Path:
         series = SceneSeries(out / "hold.pvd")
         for i, record in enumerate(path.steps):
             series.write(float(i), scene_blocks(path.model, record),
-                         {"pressure_MPa": record.P, "pull_N": record.pull_N, "n_fingers": 1})
+                         {"P_cavity_MPa": record.P, "pull_N": record.pull_N, "n_fingers": 1})
     target = out / "result.json"
     with atomic_path(target) as tmp:
         tmp.write_text(json.dumps(result.to_json(), indent=1, allow_nan=True))

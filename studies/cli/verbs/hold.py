@@ -22,7 +22,10 @@ model finds for the pump pressure given. Both print the same ``--json`` keys.
 """
 from __future__ import annotations
 
+from contextlib import contextmanager
+
 import sys
+from pathlib import Path
 
 import numpy as np
 
@@ -132,6 +135,10 @@ def run(args) -> int:
     obj = _object(args)
     pull = _pull(args.pull)
     max_pump = _checked(args, "--max-pump-mpa")
+    if args.out:  # a file or folder of the user's where an output goes: refused before any work
+        from softhand.studies.io.files import check_owned
+
+        check_owned(args.out, OUTPUT_NAMES, "--out")
     if args.map:
         return _run_map(args, design, obj, pull, max_pump)
     if args.check:
@@ -171,7 +178,11 @@ def _fem_hold(args, design, obj, P_cav, P_pump, pull):
 
     from softhand.fem.newton import NotConverged
 
-    bar = tqdm(desc="hold (FEM)", unit="step", file=sys.stderr, leave=False, disable=args.json)
+    from softhand.fem.hand.hold import check_hold
+
+    check_hold(design, obj, tuple(pull))  # what the FEM hold refuses: one line, before its bar
+    bar = tqdm(desc="hold (FEM)", unit="step", file=sys.stderr, leave=False,
+               disable=args.json or args.no_progress)
 
     def tick(record):
         bar.update(1)
@@ -187,23 +198,33 @@ def _fem_hold(args, design, obj, P_cav, P_pump, pull):
         bar.close()
     if args.out:
         from softhand.fem.hand.hold_output import write_hold
-        from softhand.studies.io.files import kept_if_unwritable
 
-        with kept_if_unwritable(args.out, "hold"):
-            write_hold(path, result, args.out)
+        with _staged(args) as stage:
+            write_hold(path, result, stage)
     return result
+
+
+#: what ``hold --out DIR`` writes (its manifest: an earlier run's are replaced whole, nothing else)
+OUTPUT_NAMES = ("result.json", "hold.pvd", "hold", "hold_map.csv", "hold_map.png")
+
+
+@contextmanager
+def _staged(args):
+    """The run's outputs staged and renamed into --out when whole (the project's output rule)."""
+    from softhand.studies.io.files import kept_if_unwritable, replaced_outputs
+
+    with replaced_outputs(args.out, OUTPUT_NAMES, verb="hold") as stage, \
+            kept_if_unwritable(Path(args.out), "hold"):
+        yield stage
 
 
 def _write(args, data: dict, name: str) -> None:
     if not args.out:
         return
-    from pathlib import Path
+    from softhand.studies.io.files import write_json
 
-    from softhand.studies.io.files import kept_if_unwritable, write_json
-
-    with kept_if_unwritable(args.out, "hold"):
-        Path(args.out).mkdir(parents=True, exist_ok=True)
-        write_json(Path(args.out) / name, data)
+    with _staged(args) as stage:
+        write_json(stage / name, data)
 
 
 def _print(r) -> None:
@@ -272,10 +293,8 @@ def _run_map(args, design, obj, pull, max_pump) -> int:
         bar.close()
     checks = _map_checks(m, rows, design) if args.check else []
     if args.out:
-        from softhand.studies.io.files import kept_if_unwritable
-
-        with kept_if_unwritable(args.out, "hold"):
-            write_map(m, rows, args.out)
+        with _staged(args) as stage:
+            write_map(m, rows, stage)
     if args.json:
         print_json({"rows": rows, "checks": checks, "max_pump_MPa": max_pump})
     else:
