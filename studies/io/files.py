@@ -239,6 +239,7 @@ def replaced_outputs(folder: str | Path | None, names, *, verb: str = "softhand"
             print(f"softhand {verb}: warning: another run finished into {folder} while this one ran; "
                   f"its outputs are replaced by this run's", file=sys.stderr)
         _commit(folder, stage, record)
+    print(f"softhand {verb}: wrote {folder}: {', '.join(record['outputs'])}", file=sys.stderr)
 
 
 def _commit(folder: Path, stage: Path, record: dict) -> None:
@@ -352,7 +353,8 @@ def kept_if_unwritable(what, verb: str, *, say_written: bool = True):
     after the computation, a one-line warning instead of losing the results, which the verb
     still prints; the CLI then exits with :data:`EXIT_UNWRITTEN`. Once written, one line on
     stderr says where (``softhand VERB: wrote FILE``), unless ``say_written`` is False (a
-    study's many cases: its index and report say where they are)."""
+    study's many cases: its index and report say where they are) or the run is staged
+    (:func:`replaced_outputs` says it once, when the run is whole)."""
     try:
         yield
     except OSError as exc:
@@ -361,7 +363,7 @@ def kept_if_unwritable(what, verb: str, *, say_written: bool = True):
             print(f"softhand {verb}: warning: {UNWRITTEN[-1]} not written; the results are printed "
                   f"on stdout", file=sys.stderr)
     else:
-        if say_written:
+        if say_written and not _STAGED:  # a staged run says what it wrote once, when it is whole
             print(f"softhand {verb}: wrote {what}", file=sys.stderr)
 
 
