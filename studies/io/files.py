@@ -206,7 +206,8 @@ def replaced_outputs(folder: str | Path | None, names, *, verb: str = "softhand"
     limit), the pieces written go to ``folder/incomplete/`` and the earlier result stays too.
     An output of the user's of the same name is refused (:func:`check_owned`). Two runs into
     one folder: each stages its own; the last to finish replaces the other's result whole (a
-    warning says so). ``folder`` None: no outputs asked; yields None.
+    warning says so). ``folder`` None: no outputs asked; yields None. The verb says where its
+    folder is (its pieces written inside are not announced one by one).
     """
     if folder is None:
         yield None
@@ -239,7 +240,6 @@ def replaced_outputs(folder: str | Path | None, names, *, verb: str = "softhand"
             print(f"softhand {verb}: warning: another run finished into {folder} while this one ran; "
                   f"its outputs are replaced by this run's", file=sys.stderr)
         _commit(folder, stage, record)
-    print(f"softhand {verb}: wrote {folder}: {', '.join(record['outputs'])}", file=sys.stderr)
 
 
 def _commit(folder: Path, stage: Path, record: dict) -> None:
@@ -354,7 +354,7 @@ def kept_if_unwritable(what, verb: str, *, say_written: bool = True):
     still prints; the CLI then exits with :data:`EXIT_UNWRITTEN`. Once written, one line on
     stderr says where (``softhand VERB: wrote FILE``), unless ``say_written`` is False (a
     study's many cases: its index and report say where they are) or the run is staged
-    (:func:`replaced_outputs` says it once, when the run is whole)."""
+    (:func:`replaced_outputs`: the verb names its folder)."""
     try:
         yield
     except OSError as exc:
@@ -363,7 +363,7 @@ def kept_if_unwritable(what, verb: str, *, say_written: bool = True):
             print(f"softhand {verb}: warning: {UNWRITTEN[-1]} not written; the results are printed "
                   f"on stdout", file=sys.stderr)
     else:
-        if say_written and not _STAGED:  # a staged run says what it wrote once, when it is whole
+        if say_written and not _STAGED:  # a staged run's verb names its folder itself
             print(f"softhand {verb}: wrote {what}", file=sys.stderr)
 
 

@@ -211,11 +211,14 @@ OUTPUT_NAMES = ("result.json", "hold.pvd", "hold", "hold_map.csv", "hold_map.png
 @contextmanager
 def _staged(args):
     """The run's outputs staged and renamed into --out when whole (the project's output rule)."""
-    from softhand.studies.io.files import kept_if_unwritable, replaced_outputs
+    from softhand.studies.io.files import UNWRITTEN, kept_if_unwritable, replaced_outputs
 
+    refused = len(UNWRITTEN)
     with replaced_outputs(args.out, OUTPUT_NAMES, verb="hold") as stage, \
             kept_if_unwritable(Path(args.out), "hold"):
         yield stage
+    if len(UNWRITTEN) == refused:
+        print(f"softhand hold: wrote {args.out}", file=sys.stderr)
 
 
 def _write(args, data: dict, name: str) -> None:
