@@ -113,7 +113,7 @@ def test_a_signalled_rerun_leaves_the_earlier_result_whole(earlier, tmp_path, si
     assert rerun.returncode == 0, err
     assert not any(p.name.startswith(".softhand-stage-") for p in out.iterdir())
     result = json.loads((out / "result.json").read_text())
-    assert [row["P_MPa"] for row in result["rows"]] == pytest.approx([0.15, 0.25])
+    assert [row["P_cavity_MPa"] for row in result["rows"]] == pytest.approx([0.15, 0.25])
 
 
 def test_two_runs_into_one_folder_leave_one_whole_result(tmp_path):
@@ -126,7 +126,7 @@ def test_two_runs_into_one_folder_leave_one_whole_result(tmp_path):
     assert [run.returncode for run in runs] == [0, 0], [e for _, e in outputs]
     assert sum("another run finished into" in err for _, err in outputs) == 1
     rows = json.loads((out / "result.json").read_text())["rows"]
-    pressures = [row["P_MPa"] for row in rows]
+    pressures = [row["P_cavity_MPa"] for row in rows]
     assert pressures in ([0.1, 0.2], [0.15, 0.25, 0.3])
     steps = re.findall(r'timestep="([^"]+)"[^>]*file="([^"]+)"', (out / "finger.pvd").read_text())
     assert [float(t) for t, _ in steps] == pytest.approx(pressures)
@@ -149,7 +149,7 @@ def test_a_file_size_limit_is_one_warning_the_results_printed_and_the_pieces_kep
     assert "0.15" in stdout and "0.25" in stdout  # the rows
     assert {k: v for k, v in _visible(out).items() if not k.startswith(INCOMPLETE)} == before
     kept = json.loads((out / INCOMPLETE / "result.json").read_text())
-    assert [row["P_MPa"] for row in kept["rows"]] == pytest.approx([0.15, 0.25])
+    assert [row["P_cavity_MPa"] for row in kept["rows"]] == pytest.approx([0.15, 0.25])
     record = json.loads((out / INCOMPLETE / MANIFEST).read_text())
     assert record["complete"] is False and "finger.pvd" in record["missing"][0]
 
@@ -177,7 +177,8 @@ def test_other_verbs_under_a_file_size_limit(earlier, tmp_path, verb):
     argv, limit, printed = {
         "design": (["design", "--task", str(task), "--no-fem", "--no-progress", "--out", "d"], 100, "optimum:"),
         "material": (["material", "fit", "--data", "m.csv", "--model", "yeoh", "--out", "m.toml"], 20, "C10"),
-        "inspect": (["inspect", str(earlier / "finger.pvd"), "--out", "x.png"], 1000, "von_mises_MPa"),
+        # inspect colours by the converged rubber stretch by default and prints its range
+        "inspect": (["inspect", str(earlier / "finger.pvd"), "--out", "x.png"], 1000, "rubber_stretch"),
         "study": (["study", "run", "s.toml", "--workers", "1", "--results", "r", "--no-progress"], 300,
                   "0 done"),
     }[verb]
