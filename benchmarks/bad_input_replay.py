@@ -21,7 +21,7 @@ import time
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT / "tests"))
+sys.path[:0] = [str(ROOT / "tests"), str(ROOT / "tests" / "studies")]  # the cases and their files
 
 from test_bad_inputs import FILES, STUDIES, _design_files  # noqa: E402
 from bad_input_cases import EXTRA_FILES, replay_cases  # noqa: E402

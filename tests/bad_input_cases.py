@@ -272,6 +272,44 @@ EXTRA_FILES.update({
 
 GOOD_TASK, GOOD_SPACE = "good_task.toml", "good_space.toml"
 
+#: an open triangle mesh (one facet): not a closed surface, so no object
+OPEN_STL = ("solid t\nfacet normal 0 0 1\n outer loop\n  vertex 0 0 0\n  vertex 10 0 0\n  vertex 0 10 0\n"
+            " endloop\nendfacet\nendsolid t\n")
+EXTRA_FILES.update({
+    "obj_open.stl": OPEN_STL,
+    "obj_open.toml": '[object]\nshape = "mesh"\nfile = "obj_open.stl"\nmass_kg = 0.5\n',
+    "obj_missing_file.toml": '[object]\nshape = "mesh"\nfile = "no_such.stl"\nmass_kg = 0.5\n',
+    "obj_negative_mu.toml": '[object]\nshape = "sphere"\ndiameter_mm = 150.0\nmass_kg = 0.5\nfriction = -0.2\n',
+    "obj_unknown_key.toml": '[object]\nshape = "sphere"\ndiameter_mm = 150.0\ncolour = "red"\n',
+    "obj_in_palm.toml": '[object]\nshape = "sphere"\ndiameter_mm = 150.0\noffset_mm = [0.0, -500.0, 0.0]\n',
+    "obj_cone.toml": '[object]\nshape = "cone"\ndiameter_mm = 150.0\n',
+    "obj_no_table.toml": 'shape = "sphere"\ndiameter_mm = 150.0\n',
+    "obj_binary.toml": b"\x00\xff\xfe\x89PNG\r\n",
+    "task_open_mesh.toml": TASK.replace("[object]\ndiameter_mm = 180.0\n",
+                                        '[object]\nshape = "mesh"\nfile = "obj_open.stl"\n'),
+})
+
+
+def hold_cases() -> list[tuple[str, list[str]]]:
+    """The whole-hand hold's inputs: objects (tables, short forms, mesh files), pulls, maps, the
+    FEM off the hand's symmetry; each refused before any computation."""
+    at = ["--pressure-mpa", "1.2", "--no-progress"]
+    cases = [["hold", "--object", f, *at] for f in (
+        "obj_open.toml", "obj_missing_file.toml", "obj_negative_mu.toml", "obj_unknown_key.toml",
+        "obj_in_palm.toml", "obj_cone.toml", "obj_no_table.toml", "obj_binary.toml", "obj_open.stl",
+        "missing.toml", "sphere:abc", "sphere:-150", "box:400x50x400", "cylinder:120")]
+    cases += [["hold", "--object", "sphere:150", "--pull", "0,0,0", *at],
+              ["hold", "--object", "sphere:150", "--pull", "sideways", *at],
+              ["hold", "--object", "sphere:150", "--friction", "nan", *at],
+              ["hold", "--object", "sphere:150", "--mass-kg", "-1", *at],
+              ["hold", "--object", "sphere:150", "--map", "pressure=0:2:0.001", "mass=0:5:0.001"],
+              ["hold", "--object", "sphere:150", "--map", "pressure=0.5:1:0.5", "colour=1,2"],
+              ["hold", "--object", "sphere:150", "--check"],
+              ["hold", "--object", "sphere:150", "--model", "fem", "--pull", "x", *at],
+              ["hold", "--object", "sphere:150", "--model", "fem", "--margin", "2", "--no-progress"],
+              ["design", "--task", "task_open_mesh.toml", "--no-fem", "--no-progress"]]
+    return [("hold", c) for c in cases]
+
 
 def outputs_cases() -> list[tuple[str, list[str]]]:
     """The outputs rule's refusals: before any work, one line, nothing written."""
@@ -472,4 +510,5 @@ def replay_cases() -> list[tuple[str, list[str]]]:
               ["weights", "--diameter-mm", "180", "--plot", "w.png"]]
     cases += [("files", f) for f in files]
     cases += outputs_cases()
+    cases += hold_cases()
     return [(f"{name}-{k}-{' '.join(argv[1:])[:40]}", argv) for k, (name, argv) in enumerate(cases)]
