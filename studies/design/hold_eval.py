@@ -117,19 +117,23 @@ def prove_hold(ev: Evaluation, task: Task, say=print) -> dict:
     """The FEM proof of a hold task's optimum: the whole-hand FEM hold
     (``softhand.fem.hand.hold.solve_hold``) at the cavity pressure of the fast model's least pump
     pressure; proven when the FEM holds the object and its holding limit is the fast model's
-    within :data:`PROOF_RTOL`. ``{"report": why}`` when it is not (or the FEM hold is not installed)."""
+    within :data:`PROOF_RTOL`. ``{"report": why}`` when it is not, or when the FEM hold does not
+    answer (a placement off the hand's symmetry, where it is not validated; a closing that does
+    not converge)."""
     d = ev.design
     placed = place_object(task.obj, d)
     P_cavity = hold.cavity_pressure(ev.P_grasp, placed, d)
     fast = hold.solve_hold(d, task.obj, P_cavity_MPa=P_cavity, pull_direction=task.hold_pull, placed=placed)
     out = {"P_pump_MPa": ev.P_grasp, "P_cavity_MPa": P_cavity, "reduced": fast.to_json()}
-    try:
-        from softhand.fem.hand.hold import solve_hold as fem_solve_hold
-    except ModuleNotFoundError:
-        return {**out, "report": "the whole-hand FEM hold (softhand.fem.hand.hold) is not installed: "
-                                 "the hold is not proven"}
+    from softhand.fem.hand.hold import solve_hold as fem_solve_hold
+    from softhand.fem.newton import NotConverged
+
     say(f"FEM proof of the hold at P_cavity_MPa = {P_cavity:.4g}")
-    fem = fem_solve_hold(d, task.obj, P_cavity_MPa=P_cavity, pull_direction=task.hold_pull)
+    try:
+        fem = fem_solve_hold(d, task.obj, P_cavity_MPa=P_cavity, pull_direction=task.hold_pull)
+    except (InputError, NotConverged) as exc:
+        return {**out, "report": f"the whole-hand FEM hold did not answer ({str(exc)[:300]}): the hold is "
+                                 f"not proven"}
     out["fem"] = fem.to_json()
     error = abs(fem.holding_limit_N - fast.holding_limit_N) / max(fast.holding_limit_N, 1e-9)
     out["holding_limit_error"] = error

@@ -41,17 +41,16 @@ def test_hold_task_bad_input():
         task_from_dict({**base, "object": {"shape": "sphere", "diameter_mm": 100.0, "mass_kg": 1.0, "friction": -1}})
 
 
-def test_hold_proof_says_so_without_the_fem_hold():
-    """The proof step calls the whole-hand FEM hold; where it is not installed it reports that the
-    hold is not proven (and gives the fast model's hold at the least pressure)."""
-    import importlib.util
+def test_a_hold_proof_the_fem_does_not_answer_is_reported_not_raised():
+    """A hold task whose object sits off the hand's symmetry: the FEM hold refuses it (not yet
+    validated there) before building a model, and the proof reports the hold as not proven."""
+    from dataclasses import replace
 
-    if importlib.util.find_spec("softhand.fem.hand.hold") is not None:
-        pytest.skip("the FEM hold is installed: its proof is tested with it")
     from softhand.studies.design.hold_eval import prove_hold
 
     task = load_task(TASKS / "hold_box.toml")
+    task = replace(task, obj=replace(task.obj, offset_mm=(1.0, 0.0, 0.0)))
     ev = evaluate(task.base, task)
     proof = prove_hold(ev, task, say=lambda text: None)
-    assert "not installed" in proof["report"]
-    assert proof["reduced"]["held"] and proof["reduced"]["holding_limit_N"] >= task.required_hold_N() * (1 - 1e-6)
+    assert "did not answer" in proof["report"] and "symmetric" in proof["report"]
+    assert "fem" not in proof and proof["reduced"]["model"] == "reduced"
