@@ -127,7 +127,6 @@ def changes(rows: list[dict], key: str) -> str:
 
 def report(groups: dict) -> None:
     """Print the table (markdown) and, per group, each measure's change between the finest two."""
-    keys = ("P_MPa", "level", "ndofs", "wall_seconds")
     print("| design | P [MPa] | level | unknowns | wall [s] | theta [deg] | rubber_stretch | "
           "radial_stretch | peak (mesh-dependent) |\n|---|---|---|---|---|---|---|---|---|")
     for (name, _), rows in groups.items():

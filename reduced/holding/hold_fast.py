@@ -285,7 +285,7 @@ def _polish(i, q, P, placed, design) -> FingerState:
     if not active.size:
         return _free(i, q, P, placed, design)
     N_A, _ = nnls(geo.dg[active].T, M)
-    n_s, m = design.n_s, len(active)
+    n_s = design.n_s
 
     def residual(z):
         qq, NA = z[:n_s], z[n_s:]

@@ -35,7 +35,7 @@ from pathlib import Path
 import numpy as np
 
 from softhand.reduced.vocabulary.errors import InputError
-from softhand.reduced.holding.object_mesh import MESH_SUFFIXES, MeshData, grid_sdf, mesh_features, mesh_sdf, read_mesh, self_intersection
+from softhand.reduced.holding.object_mesh import MeshData, grid_sdf, mesh_features, mesh_sdf, read_mesh, self_intersection
 
 __all__ = ["SHAPES", "KEYS", "GraspObject", "Placed", "MeshData", "check_object", "object_from_table",
            "object_from_short", "load_object", "parse_object", "read_mesh", "mesh_sdf", "self_intersection",

@@ -18,7 +18,6 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from softhand.reduced.vocabulary.design import HandDesign
-from softhand.reduced.vocabulary.errors import InputError
 from softhand.studies.batch.studyfile import Study
 from softhand.studies.calibration.space import PATH_KEYS, VARIABLES, DesignSpace, finger_design
 

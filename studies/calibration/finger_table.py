@@ -18,7 +18,7 @@ from softhand.reduced.vocabulary.design import HandDesign
 from softhand.reduced.calibrated.finger_fem import COLUMNS, GROUPS, STRETCH, groups_of
 from softhand.studies.calibration.finger import MIN_GAP_SLICES, cavity_pressures
 from softhand.studies.calibration.space import DesignSpace, VARIABLES, finger_design
-from softhand.studies.calibration.tables import table_text, written_by
+from softhand.studies.calibration.tables import written_by
 from softhand.studies.io.files import write_atomic
 
 

@@ -10,7 +10,6 @@ picture) run on the tutorial task's CI-sized mesh and take minutes: marked slow.
 """
 from __future__ import annotations
 
-import os
 import re
 import shlex
 import subprocess

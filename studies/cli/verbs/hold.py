@@ -27,7 +27,6 @@ from contextlib import contextmanager
 import sys
 from pathlib import Path
 
-import numpy as np
 
 from softhand.reduced.vocabulary.errors import InputError
 from softhand.studies.cli.args import add_design_option, add_json_option, add_progress_option, \
@@ -106,16 +105,6 @@ def _object(args):
     return replace(obj, **changes) if changes else obj
 
 
-def _fem_solver(field: str = "--model", value="fem"):
-    """``softhand.fem.hand.hold.solve_hold`` (imported when asked), or one line if it is not installed."""
-    try:
-        from softhand.fem.hand.hold import solve_hold
-    except ModuleNotFoundError:
-        raise InputError(field, value, "the whole-hand FEM hold is not in this installation; "
-                                       "use the fast model (--model reduced, no --check)") from None
-    return solve_hold
-
-
 def _bar(show: bool, desc: str):
     from tqdm import tqdm
 
@@ -178,7 +167,7 @@ def _fem_hold(args, design, obj, P_cav, P_pump, pull):
 
     from softhand.fem.newton import NotConverged
 
-    from softhand.fem.hand.hold import check_hold
+    from softhand.fem.hand.hold import check_hold, solve_hold
 
     check_hold(design, obj, tuple(pull))  # what the FEM hold refuses: one line, before its bar
     bar = tqdm(desc="hold (FEM)", unit="step", file=sys.stderr, leave=False,
@@ -188,8 +177,8 @@ def _fem_hold(args, design, obj, P_cav, P_pump, pull):
         bar.update(1)
         bar.set_postfix_str(f"{record.stage} P={record.P:.3g} MPa pull={record.pull_N:.3g} N")
     try:
-        result, path = _fem_solver()(design, obj, P_cavity_MPa=P_cav, pull_direction=tuple(pull), progress=tick,
-                                     keep_path=True, P_pump_MPa=math.nan if P_pump is None else P_pump)
+        result, path = solve_hold(design, obj, P_cavity_MPa=P_cav, pull_direction=tuple(pull), progress=tick,
+                                  keep_path=True, P_pump_MPa=math.nan if P_pump is None else P_pump)
     except NotConverged as exc:
         print(f"softhand hold: error: the FEM did not converge while the fingers closed: "
               f"{str(exc).split(';')[0]}", file=sys.stderr)
@@ -287,8 +276,10 @@ def _run_map(args, design, obj, pull, max_pump) -> int:
         raise InputError("--pressure-mpa", None, "is required when pressure is not an axis of the map")
     m = HoldMap(design, obj, x, y, pressure_MPa=pressure if pressure is not None else 0.0, pull=tuple(pull),
                 max_pump_MPa=max_pump, finger_model=args.finger)
-    if args.check:
-        _fem_solver("--check", True)  # before the map, not after it
+    if args.check:  # what the FEM hold refuses, before the map, not after it
+        from softhand.fem.hand.hold import check_hold
+
+        check_hold(design, obj, tuple(pull))
     bar, update = _bar(not args.no_progress, "hold map")
     try:
         rows = run_map(m, progress=update)
@@ -313,7 +304,8 @@ def _map_checks(m, rows, design) -> list[dict]:
     """The FEM at the map's corners and centre (the FEM's solver is required)."""
     from softhand.studies.hold import map_point
 
-    solve = _fem_solver("--check", True)
+    from softhand.fem.hand.hold import solve_hold as solve
+
     (xn, xs), (yn, ys) = m.x, m.y
     picks = {(xs[0], ys[0]), (xs[-1], ys[0]), (xs[0], ys[-1]), (xs[-1], ys[-1]), (xs[len(xs) // 2], ys[len(ys) // 2])}
     out = []
