@@ -95,7 +95,7 @@ def own_study_dir(study: Study, results_root: str | Path = "results", *, write: 
     name (whose index.csv and report this one would overwrite); ``write``: record this kind
     there (a run, a report). InputError naming the study's name."""
     from softhand.reduced.vocabulary.errors import InputError
-    from softhand.studies.io.files import check_output_tree
+    from softhand.studies.io.outputs import check_output_tree
 
     sdir = study_dir(study, results_root)
     check_output_tree(sdir, "--results", files=(OWNER, "index.csv", "report.md"), folders=(".claims", "report"))

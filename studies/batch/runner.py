@@ -41,7 +41,8 @@ from softhand.studies.batch.cases import (FAILED, RESULT, Case, case_key, case_s
 from softhand.studies.batch.claims import Claims
 from softhand.studies.batch.index import index_rows, other_sources, status, write_index  # noqa: F401
 from softhand.studies.batch.studyfile import Study
-from softhand.studies.io.files import check_output_tree, kept_if_unwritable
+from softhand.studies.io.files import kept_if_unwritable
+from softhand.studies.io.outputs import check_output_tree
 
 
 @dataclass

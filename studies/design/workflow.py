@@ -14,7 +14,8 @@ import numpy as np
 from softhand.reduced.vocabulary.errors import MeshRejected, MeshTooLarge
 from softhand.studies.design import optimise as design_opt
 from softhand.studies.design import evaluate, proof
-from softhand.studies.io.files import kept_if_unwritable, replaced_outputs, write_atomic, write_json
+from softhand.studies.io.files import kept_if_unwritable, write_atomic, write_json
+from softhand.studies.io.outputs import replaced_outputs
 
 #: what a design run writes into its folder (its manifest: an earlier run's are replaced whole)
 OUTPUT_FILES = ("result.json", "design.toml", "rejected_design.toml", "pareto.png", "grasp.pvd")

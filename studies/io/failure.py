@@ -11,7 +11,9 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
-from softhand.studies.io.files import replaced_outputs, write_json
+from softhand.studies.io.files import write_json
+
+from softhand.studies.io.outputs import replaced_outputs
 
 
 def save_last_converged(out: Path, verb: str, what: str, message: str, reached: str,
@@ -19,7 +21,7 @@ def save_last_converged(out: Path, verb: str, what: str, message: str, reached: 
                         shown: Path | None = None) -> int:
     """Write ``record`` (+ failed, error) to ``out/result.json`` and ``write_files(folder)``'s
     files; one error line naming ``reached`` (e.g. 'P = 0.55 MPa'); returns the exit code 1.
-    ``names``: the verb's outputs, written as one run's whole result (:func:`~softhand.studies.io.files.replaced_outputs`);
+    ``names``: the verb's outputs, written as one run's whole result (:func:`~softhand.studies.io.outputs.replaced_outputs`);
     None: ``out`` is already the run's staging folder, its outputs named as in ``shown``."""
     shown = Path(out) if shown is None else Path(shown)
     where = f"{shown}/result.json" + (f" and {shown}/{files}" if files else "")

@@ -32,6 +32,7 @@ from softhand.reduced.vocabulary import paper
 from softhand.reduced.vocabulary.design import HandDesign
 from softhand.reduced.vocabulary.errors import InputError
 from softhand.studies.io.files import write_atomic, write_csv
+from softhand.studies.io.outputs import check_owned, record_outputs
 from softhand.studies.reproduce.section import Context, Section
 from softhand.studies.batch.runner import FAILED, RESULT, code_version, commit, execute_case, outcome_record
 
@@ -100,15 +101,25 @@ def check_design(design: HandDesign) -> None:
                                             f"use the paper's weight vectors w, one weight per hinge")
 
 
+#: the files a run writes beside the section folders
+REPORT_FILES = ("report.md", "summary.csv")
+
+
 def reproduce(out: str | Path = "results/reproduce", *, quick: bool = False,
               design: HandDesign | None = None, only: tuple[str, ...] | None = None,
               fresh: bool = False, progress: bool = True,
               section_list: list[Section] | None = None) -> list[Outcome]:
-    """Build every section (or those in ``only``) and write ``<out>/report.md``."""
+    """Build every section (or those in ``only``) and write ``<out>/report.md``.
+
+    Each section's folder is renamed into ``out`` whole as it finishes and recorded in the
+    folder's manifest (:func:`softhand.studies.io.outputs.record_outputs`): a rerun resumes
+    from it, and a file or folder of the user's named like an output is refused before any
+    work (InputError), never replaced."""
     out = Path(out)
     ctx = Context(design=design or HandDesign(), quick=quick, progress=progress)
     _SHOW["progress"] = progress
     todo = section_list if section_list is not None else sections()
+    check_owned(out, [*REPORT_FILES, *(s.key for s in todo)], "--out")
     _ACTIVE.clear()
     _ACTIVE.update((s.key, s) for s in todo)
     outcomes = []
@@ -154,6 +165,7 @@ def _one(section: Section, ctx: Context, out: Path, only, fresh: bool) -> Outcom
     output = execute_case(run_section, params, ctx.design)
     commit(folder, {"section": section.key, "case": key,
                     **outcome_record(params, ctx.design, output)}, output.get("files", {}))
+    record_outputs(out, [section.key], verb="reproduce")
     if output["status"] != "done":
         return Outcome(section, "failed", output["error"], output["wall_time_s"])
     return Outcome(section, "done", "", output["wall_time_s"], output["numbers"])
@@ -194,8 +206,11 @@ def write_report(out: Path, ctx: Context, outcomes: list[Outcome]) -> Path:
               f"{o.wall_time_s:.1f} | {_one_line(o.detail)} |" for o in outcomes]
     for o in outcomes:
         lines += ["", f"## {o.section.title}", ""] + _body(out, o)
+    out.mkdir(parents=True, exist_ok=True)
     write_csv(out / "summary.csv", _summary_rows(outcomes), ["section", "status", "name", "value"])
-    return write_atomic(out / "report.md", "\n".join(lines) + "\n")
+    report = write_atomic(out / "report.md", "\n".join(lines) + "\n")
+    record_outputs(out, REPORT_FILES, verb="reproduce")
+    return report
 
 
 def _body(out: Path, o: Outcome) -> list[str]:

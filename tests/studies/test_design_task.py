@@ -468,7 +468,7 @@ def test_a_design_run_stopped_mid_proof_leaves_none_of_its_files_and_the_earlier
     VTK) shows; other files stay."""
     from softhand.studies.cli import main as cli
     from softhand.studies.design import workflow
-    from softhand.studies.io.files import MANIFEST
+    from softhand.studies.io.outputs import MANIFEST
 
     task, out = _write(tmp_path, CI_TASK_TOML), tmp_path / "out"
     out.mkdir()

@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 from softhand.studies.io.files import write_atomic, write_csv, write_json
+from softhand.studies.io.outputs import MANIFEST
 from conftest import CI_MESH_ARGS
 
 
@@ -125,7 +126,7 @@ def test_a_design_run_replaces_the_last_runs_outputs_and_keeps_them_whole_when_s
     (out / "knee" / "design.toml").unlink()
     (out / "knee").rmdir()
     assert main(argv) == 0
-    assert sorted(p.name for p in out.iterdir()) == [files.MANIFEST, "design.toml", "notes.txt", "result.json"]
+    assert sorted(p.name for p in out.iterdir()) == [MANIFEST, "design.toml", "notes.txt", "result.json"]
     before = {p.name: p.read_bytes() for p in out.iterdir()}
 
     def stopped(path, data):

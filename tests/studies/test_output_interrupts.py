@@ -13,7 +13,9 @@ from pathlib import Path
 
 import pytest
 
-from softhand.studies.io.files import EXIT_UNWRITTEN, INCOMPLETE, MANIFEST
+from softhand.studies.io.files import EXIT_UNWRITTEN
+
+from softhand.studies.io.outputs import INCOMPLETE, MANIFEST
 
 ROOT = Path(__file__).resolve().parents[2]
 #: real bend FEM runs in subprocesses: 2 to 8 minutes in all (part of the CI suite)

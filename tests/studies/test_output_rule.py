@@ -14,7 +14,8 @@ import pytest
 from softhand.reduced.vocabulary.errors import InputError
 from softhand.studies.cli.main import main
 from softhand.studies.io import files
-from softhand.studies.io.files import EXIT_UNWRITTEN, INCOMPLETE, MANIFEST, replaced_outputs
+from softhand.studies.io.files import EXIT_UNWRITTEN
+from softhand.studies.io.outputs import INCOMPLETE, MANIFEST, replaced_outputs
 
 ROOT = Path(__file__).resolve().parents[2]
 TASK = ROOT / "studies" / "designs" / "tasks" / "paper_task.toml"
@@ -29,6 +30,15 @@ def _listing(folder: Path) -> dict:
 def _run_into(folder, names, write, **kw):
     with replaced_outputs(folder, names, **kw) as stage:
         write(stage)
+
+
+def _partly(out, code, message):
+    """A run's writing that writes b.txt, then finds the disk refusing a.txt."""
+    def write(stage):
+        (stage / "b.txt").write_text("written")
+        with files.kept_if_unwritable(out / "a.txt", "test"):
+            raise OSError(code, message)
+    return write
 
 
 # ------------------------------------------------------------------ the mechanism itself
@@ -84,12 +94,7 @@ def test_a_write_the_disk_refuses_keeps_the_earlier_result_and_the_pieces_writte
     before = _listing(out)
     files.reset_unwritten()
 
-    def partly(stage):
-        (stage / "b.txt").write_text("written")
-        with files.kept_if_unwritable(out / "a.txt", "test"):
-            raise OSError(errno.EFBIG, "File too large")
-
-    _run_into(out, ("a.txt", "b.txt"), partly, verb="test")
+    _run_into(out, ("a.txt", "b.txt"), _partly(out, errno.EFBIG, "File too large"), verb="test")
     err = capsys.readouterr().err
     lines = err.strip().splitlines()
     assert len(lines) == 1 and "a.txt (File too large) not written" in err and f"exit code {EXIT_UNWRITTEN}" in err
@@ -104,6 +109,46 @@ def test_a_write_the_disk_refuses_keeps_the_earlier_result_and_the_pieces_writte
     # the next complete run replaces the incomplete one's folder too: it was a run's
     _run_into(out, ("a.txt", "b.txt"), lambda stage: (stage / "a.txt").write_text("third"))
     assert not (out / INCOMPLETE).exists() and (out / "a.txt").read_text() == "third"
+
+
+def test_a_users_folder_named_incomplete_neither_blocks_a_run_nor_is_touched(tmp_path, capsys):
+    out = tmp_path / "out"
+    (out / INCOMPLETE).mkdir(parents=True)
+    (out / INCOMPLETE / "draft.txt").write_text("the user's")
+    _run_into(out, ("a.txt", "b.txt"), lambda stage: (stage / "a.txt").write_text("complete"))
+    assert (out / "a.txt").read_text() == "complete"
+    files.reset_unwritten()
+
+    _run_into(out, ("a.txt", "b.txt"), _partly(out, errno.ENOSPC, "No space left on device"), verb="test")
+    files.reset_unwritten()
+    kept = [p for p in out.iterdir() if p.name.startswith(f"{INCOMPLETE}-")]
+    assert len(kept) == 1 and (kept[0] / "b.txt").read_text() == "written"
+    assert str(kept[0]) in capsys.readouterr().err  # the warning says where the pieces are
+    assert _listing(out / INCOMPLETE) == {"draft.txt": b"the user's"}
+    # the next complete run replaces its own incomplete pieces, never the user's folder
+    _run_into(out, ("a.txt", "b.txt"), lambda stage: (stage / "a.txt").write_text("third"))
+    assert not kept[0].exists() and _listing(out / INCOMPLETE) == {"draft.txt": b"the user's"}
+
+
+def test_reproduce_refuses_an_output_name_the_user_holds_and_resumes_its_own(tmp_path):
+    from softhand.studies.reproduce.core import reproduce
+
+    out = tmp_path / "out"
+    (out / "fig7_reduced").mkdir(parents=True)
+    (out / "fig7_reduced" / "mine.txt").write_text("the user's")
+    (out / "report.md").write_text("the user's report")
+    only = ("fig7_reduced",)
+    with pytest.raises(InputError, match="report.md.*not written by an earlier softhand run"):
+        reproduce(out, quick=True, only=only, progress=False)
+    (out / "report.md").unlink()
+    with pytest.raises(InputError, match="fig7_reduced.*not written by an earlier softhand run"):
+        reproduce(out, quick=True, only=only, progress=False)
+    assert _listing(out) == {"fig7_reduced": "folder", "fig7_reduced/mine.txt": b"the user's"}
+    (out / "fig7_reduced" / "mine.txt").unlink()
+    (out / "fig7_reduced").rmdir()
+    assert [o.status for o in reproduce(out, quick=True, only=only, progress=False)][0] == "done"
+    assert set(json.loads((out / MANIFEST).read_text())["outputs"]) == {"fig7_reduced", "report.md", "summary.csv"}
+    assert [o.status for o in reproduce(out, quick=True, only=only, progress=False)][0] == "reused"
 
 
 def test_a_killed_runs_staging_folder_is_removed_by_the_next_run(tmp_path):

@@ -13,7 +13,7 @@ import pytest
 from softhand.studies.cli.main import main
 from softhand.studies.batch.runner import RESULT, plan, study_dir
 from softhand.studies.batch.studyfile import load_study
-from softhand.studies.io.files import MANIFEST
+from softhand.studies.io.outputs import MANIFEST
 
 from conftest import CI_MESH_ARGS
 from test_runner import _default_sigint, install_kind

@@ -27,7 +27,7 @@ def verb_json(argv: list[str]) -> dict:
 
 def same_files(a: Path, b: Path) -> list[str]:
     """The same outputs, byte for byte (a verb's folder also holds its run's manifest)."""
-    from softhand.studies.io.files import MANIFEST
+    from softhand.studies.io.outputs import MANIFEST
 
     names = sorted(p.name for p in a.iterdir() if p.name != MANIFEST)
     assert names == sorted(p.name for p in b.iterdir() if p.name != MANIFEST)

@@ -139,7 +139,8 @@ def run(args) -> int:
 
     from softhand.fem.newton import NotConverged
     from softhand.studies.bending import BendingStudy, run as run_study, vtk_writer
-    from softhand.studies.io.files import check_owned, kept_if_unwritable, replaced_outputs, unwritable_tolerant
+    from softhand.studies.io.files import kept_if_unwritable, unwritable_tolerant
+    from softhand.studies.io.outputs import check_owned, replaced_outputs
 
     pressures = _check(args)
     out = Path(args.out)

@@ -142,7 +142,7 @@ def study_from_args(args):
 
 def run(args) -> int:
     from softhand.studies.control import FILES, run as run_study
-    from softhand.studies.io.files import check_output_tree, check_owned, replaced_outputs
+    from softhand.studies.io.outputs import check_output_tree, check_owned, replaced_outputs
 
     study = study_from_args(args)
     if args.out:

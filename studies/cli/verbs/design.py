@@ -43,7 +43,7 @@ def run(args) -> int:
     from softhand.studies.cli.checks import check_writable
     from softhand.studies.design.task import LOWER, UPPER, load_task
     from softhand.studies.design.workflow import OUTPUT_FILES, OUTPUT_FOLDERS, DesignRun, run_task
-    from softhand.studies.io.files import check_output_tree, check_owned
+    from softhand.studies.io.outputs import check_output_tree, check_owned
 
     lo, hi = LOWER["mesh_size_mm"], UPPER["mesh_size_mm"]
     if args.mesh_size_mm is not None and not lo <= args.mesh_size_mm <= hi:

@@ -125,7 +125,7 @@ def run(args) -> int:
     pull = _pull(args.pull)
     max_pump = _checked(args, "--max-pump-mpa")
     if args.out:  # a file or folder of the user's where an output goes: refused before any work
-        from softhand.studies.io.files import check_owned
+        from softhand.studies.io.outputs import check_owned
 
         check_owned(args.out, OUTPUT_NAMES, "--out")
     if args.map:
@@ -200,7 +200,8 @@ OUTPUT_NAMES = ("result.json", "hold.pvd", "hold", "hold_map.csv", "hold_map.png
 @contextmanager
 def _staged(args):
     """The run's outputs staged and renamed into --out when whole (the project's output rule)."""
-    from softhand.studies.io.files import UNWRITTEN, kept_if_unwritable, replaced_outputs
+    from softhand.studies.io.files import UNWRITTEN, kept_if_unwritable
+    from softhand.studies.io.outputs import replaced_outputs
 
     refused = len(UNWRITTEN)
     with replaced_outputs(args.out, OUTPUT_NAMES, verb="hold") as stage, \

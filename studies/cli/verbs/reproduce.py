@@ -25,8 +25,8 @@ def configure(parser) -> None:
 def run(args) -> int:
     from softhand.reduced.vocabulary.errors import InputError
     from softhand.studies.cli.checks import check_choices
-    from softhand.studies.io.files import check_output_tree
-    from softhand.studies.reproduce.core import check_design, exit_code, reproduce, sections
+    from softhand.studies.io.outputs import check_output_tree
+    from softhand.studies.reproduce.core import REPORT_FILES, check_design, exit_code, reproduce, sections
 
     keys = [s.key for s in sections()]
     only = None
@@ -37,7 +37,7 @@ def run(args) -> int:
         if args.quick and len(skipped) == len(only):
             raise InputError("--only", args.only, f"names only sections --quick skips ({', '.join(skipped)}); "
                                                   "drop --quick to build them")
-    check_output_tree(args.out, "--out", files=("report.md", "summary.csv"), folders=keys)
+    check_output_tree(args.out, "--out", files=REPORT_FILES, folders=keys)
     design = design_from_args(args)
     check_design(design)
     outcomes = reproduce(args.out, quick=args.quick, design=design, only=only,

@@ -15,7 +15,8 @@ from pathlib import Path
 from softhand.reduced.vocabulary.errors import InputError
 from softhand.studies.cli.args import MAX_FEM_POINTS, MOST_FEM_POINTS, add_design_option, add_json_option, \
     add_max_cases_option, add_progress_option, design_from_args, max_cases, parse_values, print_json, print_table
-from softhand.studies.io.files import replaced_outputs, write_outputs
+from softhand.studies.io.files import write_outputs
+from softhand.studies.io.outputs import replaced_outputs
 
 HELP = "inflate the reservoir sheet (FEM) and measure the ellipse assumption (eqs. 11-18)"
 
@@ -66,7 +67,7 @@ OUTPUT_NAMES = ("result.json", "rows.csv", "sheet.pvd", "sheet", "sheet_V*_rz.vt
 def run(args) -> int:
     study = _study(args)
     if args.out:
-        from softhand.studies.io.files import check_owned
+        from softhand.studies.io.outputs import check_owned
 
         check_owned(args.out, OUTPUT_NAMES, "--out")  # a folder of the user's named sheet/: before the FEM
     if args.write_calibration:

@@ -1,0 +1,256 @@
+"""Where a run's outputs go and what it may replace there: the one rule every verb follows.
+
+A run into a folder writes only the names it declares (its manifest,
+``.softhand-outputs.json``), stages them in a private folder inside and renames them into place
+when the run is whole; it replaces only what an earlier softhand run wrote there, never a file
+or folder of the user's, and never deletes what it did not write (:func:`replaced_outputs`).
+A run that keeps its pieces as they finish (``reproduce``'s sections) records each in the
+manifest as it lands (:func:`record_outputs`).
+"""
+from __future__ import annotations
+
+import fnmatch
+import glob
+import json
+import os
+import shutil
+import sys
+import time
+import uuid
+from contextlib import contextmanager
+from pathlib import Path
+
+from softhand.studies.io.files import STAGED_RUNS, UNWRITTEN, EXIT_UNWRITTEN, read_bounded, write_json
+
+
+def check_output_tree(folder: str | Path, field: str, *, files=(), folders=()) -> None:
+    """Before any work: the output ``folder`` and the named ``files`` and ``folders`` in it
+    that a run writes are each of their kind or not there yet (a file where a folder goes
+    fails its first write after the computation, a folder where a file goes its last); the
+    folder's ancestors are folders; a named folder is no symbolic link (a run would write through
+    it out of ``folder``). InputError naming ``field`` and the path otherwise."""
+    from softhand.reduced.vocabulary.errors import InputError
+
+    folder = Path(folder)
+    for ancestor in (folder, *folder.parents):
+        if ancestor.exists() and not ancestor.is_dir():
+            raise InputError(field, str(ancestor), "is a file where the output folder goes; move it "
+                                                   "away or give another folder")
+        if ancestor.is_symlink() and not ancestor.exists():
+            raise InputError(field, str(ancestor), "is a broken symbolic link where the output "
+                                                   "folder goes")
+    for name in folders:
+        path = folder / name
+        if (path.exists() or path.is_symlink()) and not path.is_dir():
+            raise InputError(field, str(path), "is not a folder, and the run writes a folder there; "
+                                               "move it away or give another folder")
+        if path.is_symlink():
+            raise InputError(field, str(path), "is a symbolic link, and the run writes a folder there; "
+                                               "it does not follow it out of the folder: replace it by "
+                                               "a folder")
+    for name in files:
+        if (folder / name).is_dir():
+            raise InputError(field, str(folder / name), "is a folder, and the run writes a file "
+                                                        "there; move it away or give another folder")
+
+
+#: the record of what the last run into a folder wrote there (see :func:`replaced_outputs`)
+MANIFEST = ".softhand-outputs.json"
+#: where a run that could not write all its outputs keeps the ones it did (if the user has a
+#: folder of that name, ``incomplete-<run>`` beside it)
+INCOMPLETE = "incomplete"
+_STAGE = ".softhand-stage-"
+
+
+def owned_outputs(folder: str | Path) -> set[str]:
+    """The names an earlier softhand run wrote into ``folder`` (its manifest); empty if none."""
+    try:
+        record = json.loads(read_bounded(Path(folder) / MANIFEST, 1 << 20))
+        names = record.get("outputs") if isinstance(record, dict) else None
+    except (OSError, ValueError, RecursionError):
+        return set()
+    # plain names only: a damaged or edited manifest cannot point a run outside the folder
+    return {n for n in names if isinstance(n, str) and n not in ("", ".", "..", MANIFEST) and "/" not in n
+            and "\0" not in n} if isinstance(names, list) else set()
+
+
+def check_owned(folder: str | Path, names, field: str) -> None:
+    """Before any work: every output ``names`` that already stands in ``folder`` was written
+    there by an earlier softhand run (its manifest names it); else InputError: a run replaces
+    only its own earlier outputs, never a file or folder of the user's of the same name."""
+    from softhand.reduced.vocabulary.errors import InputError
+
+    folder = Path(folder)
+    if not folder.is_dir():
+        return
+    record = folder / MANIFEST
+    if record.is_symlink() or record.exists() and not record.is_file():
+        raise InputError(field, str(record), "is where a run records its outputs, and is no plain file; "
+                                             "remove it or give another folder")
+    owned = owned_outputs(folder)
+    for name in names:
+        for path in folder.glob(name) if glob.has_magic(name) else [folder / name]:
+            if (path.exists() or path.is_symlink()) and path.name not in owned:
+                raise InputError(field, str(path), "was not written by an earlier softhand run into "
+                                                   "this folder and the run writes there; move it away "
+                                                   "or give another folder")
+
+
+@contextmanager
+def replaced_outputs(folder: str | Path | None, names, *, verb: str = "softhand", field: str = "--out"):
+    """A verb's run into ``folder``, writing only the files and folders ``names`` (its manifest;
+    a name may be a pattern, e.g. ``sheet_V*_rz.vtu``).
+
+    Yields a private staging folder inside ``folder``; the verb writes its outputs there. When
+    the block finishes, each output is renamed into place in one step and the earlier run's
+    outputs (those its manifest names, nothing else) are removed: the folder holds one run's
+    whole result, a reader never sees a half-written one. If the block does not finish (an
+    error, Ctrl-C, SIGTERM) the staging folder is removed and the earlier result stays as it
+    was. If some output could not be written (:func:`kept_if_unwritable`: disk full, file-size
+    limit), the pieces written go to ``folder/incomplete/`` and the earlier result stays too.
+    An output of the user's of the same name is refused (:func:`check_owned`). Two runs into
+    one folder: each stages its own; the last to finish replaces the other's result whole (a
+    warning says so). ``folder`` None: no outputs asked; yields None. The verb says where its
+    folder is (its pieces written inside are not announced one by one).
+    """
+    if folder is None:
+        yield None
+        return
+    folder, names = Path(folder), tuple(names)
+    check_owned(folder, names, field)
+    made = not folder.exists()
+    _remove_dead_stages(folder)
+    stage = folder / f"{_STAGE}{os.getpid()}-{uuid.uuid4().hex[:8]}"
+    stage.mkdir(parents=True)
+    seen, unwritten = _manifest_run(folder), len(UNWRITTEN)
+    STAGED_RUNS.append(stage)  # the warnings of writes refused in it: one line when it ends
+    try:
+        yield stage
+    except BaseException:
+        STAGED_RUNS.pop()
+        shutil.rmtree(stage, ignore_errors=True)
+        if made:
+            _rmdir_quietly(folder)
+        raise
+    record = {"run": uuid.uuid4().hex, "verb": verb, "pid": os.getpid(),
+              "finished_utc": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime()),
+              "outputs": sorted(p.name for p in stage.iterdir() if any(fnmatch.fnmatchcase(p.name, n) for n in names))}
+    STAGED_RUNS.pop()
+    with _folder_lock(folder):
+        if len(UNWRITTEN) > unwritten:
+            _keep_incomplete(folder, stage, record, UNWRITTEN[unwritten:], verb)
+            return
+        if _manifest_run(folder) != seen:
+            print(f"softhand {verb}: warning: another run finished into {folder} while this one ran; "
+                  f"its outputs are replaced by this run's", file=sys.stderr)
+        _commit(folder, stage, record)
+
+
+def _commit(folder: Path, stage: Path, record: dict) -> None:
+    """Rename the staged outputs into ``folder`` and the earlier run's away (each in one step;
+    a folder cannot be replaced by a rename, so an earlier one goes first); the manifest last."""
+    trash = stage / ".earlier"
+    trash.mkdir()
+    new = set(record["outputs"])
+    for k, name in enumerate(sorted(owned_outputs(folder))):
+        path = folder / name
+        if (path.exists() or path.is_symlink()) and (name not in new or path.is_dir() and not path.is_symlink()):
+            os.replace(path, trash / str(k))
+    for name in record["outputs"]:
+        os.replace(stage / name, folder / name)
+    write_json(stage / MANIFEST, record)
+    os.replace(stage / MANIFEST, folder / MANIFEST)
+    shutil.rmtree(stage, ignore_errors=True)
+
+
+def _keep_incomplete(folder: Path, stage: Path, record: dict, missing, verb: str) -> None:
+    """A run that wrote only some outputs: those it wrote go to ``folder/incomplete/`` (an
+    earlier incomplete run's is replaced; a folder of the user's of that name stays, and the
+    pieces go to ``incomplete-<run>/`` beside it); the earlier result stays; its own manifest
+    says what is missing."""
+    try:
+        write_json(stage / MANIFEST, {**record, "complete": False, "missing": list(missing)})
+    except OSError:
+        pass  # the disk is full: the pieces still go where the warning says
+    owned = owned_outputs(folder)
+    target = folder / INCOMPLETE
+    if target.exists() or target.is_symlink():
+        if INCOMPLETE in owned and target.is_dir() and not target.is_symlink():
+            shutil.rmtree(target, ignore_errors=True)  # an earlier incomplete run's: ours
+        else:
+            target = folder / f"{INCOMPLETE}-{record['run'][:8]}"  # the user's: left alone
+    try:
+        os.replace(stage, target)
+    except OSError:
+        target = stage  # the pieces stay where they are; the warning says where
+    else:
+        try:
+            write_json(folder / MANIFEST, {**_manifest(folder), "outputs": sorted(owned | {target.name})})
+        except OSError:
+            pass
+    print(f"softhand {verb}: warning: {'; '.join(missing)} not written; the results are printed on "
+          f"stdout, the outputs written are in {target} (the earlier result in {folder} is kept); "
+          f"exit code {EXIT_UNWRITTEN}", file=sys.stderr)
+
+
+def record_outputs(folder: str | Path, names, *, verb: str) -> None:
+    """Add ``names`` (outputs just renamed into ``folder`` whole, one by one, by a run that keeps
+    its pieces as they finish) to the folder's manifest, so that a later run replaces them and
+    :func:`check_owned` knows them for softhand's. Call :func:`check_owned` before the work."""
+    folder = Path(folder)
+    with _folder_lock(folder):
+        record = _manifest(folder)
+        owned = owned_outputs(folder)
+        write_json(folder / MANIFEST, {"run": record.get("run") or uuid.uuid4().hex, "verb": verb,
+                                       "pid": os.getpid(),
+                                       "finished_utc": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime()),
+                                       "outputs": sorted(owned | set(names))})
+
+
+def _manifest(folder: Path) -> dict:
+    try:
+        record = json.loads(read_bounded(folder / MANIFEST, 1 << 20))
+    except (OSError, ValueError, RecursionError):
+        return {}
+    return record if isinstance(record, dict) else {}
+
+
+def _manifest_run(folder: Path):
+    return _manifest(folder).get("run")
+
+
+@contextmanager
+def _folder_lock(folder: Path):
+    """An exclusive lock on ``folder`` itself while a run commits into it (the kernel drops it
+    if the process dies; no lock file is left)."""
+    import fcntl
+
+    fd = os.open(folder, os.O_RDONLY | os.O_DIRECTORY)
+    try:
+        fcntl.flock(fd, fcntl.LOCK_EX)
+        yield
+    finally:
+        os.close(fd)
+
+
+def _remove_dead_stages(folder: Path) -> None:
+    """Staging folders of runs into ``folder`` whose process is gone (SIGKILL, a power cut)."""
+    for stage in folder.glob(f"{_STAGE}*") if folder.is_dir() else ():
+        pid = stage.name[len(_STAGE):].split("-")[0]
+        try:
+            if not pid.isdigit() or stage.is_symlink() or stage.lstat().st_uid != os.getuid():
+                continue
+            os.kill(int(pid), 0)
+        except ProcessLookupError:
+            shutil.rmtree(stage, ignore_errors=True)
+        except OSError:
+            continue
+
+
+def _rmdir_quietly(folder: Path) -> None:
+    try:
+        folder.rmdir()
+    except OSError:
+        pass
+
+
