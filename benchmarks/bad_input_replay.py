@@ -1,6 +1,6 @@
 """Replay bad inputs against the installed ``softhand`` command, one subprocess per case.
 
-    PYTHONPATH=$PWD python benchmarks/bad_input_replay.py [--timeout 60] [--only VERB] [-v]
+    python benchmarks/bad_input_replay.py [--timeout 60] [--only VERB] [-v]
 
 Every case must exit 2 with exactly one line on stderr (``softhand ...: error: ...``), no
 traceback, nothing on stdout and nothing written in its scratch folder. Each case runs in a
@@ -45,7 +45,7 @@ def _one(argv, template: Path, timeout: float) -> str | None:
     try:
         shutil.copytree(template, work, dirs_exist_ok=True, symlinks=True)
         before = _snapshot(work)
-        env = {**os.environ, "SOFTHAND_CACHE": str(work / "cache"), "PYTHONPATH": str(ROOT)}
+        env = {**os.environ, "SOFTHAND_CACHE": str(work / "cache")}
         start = time.monotonic()
         try:
             proc = subprocess.Popen([sys.executable, "-m", "softhand.studies.cli", *argv], cwd=work,

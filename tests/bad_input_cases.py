@@ -149,6 +149,8 @@ EXTRA_FILES = {
     "kind/rep/fig7_reduced": "a file where a section's folder goes",
     "kind/rep2/report.md/keep": "",
     "kind/ctl/summary.json/keep": "",
+    "mine/rep/fig7_reduced/notes.txt": "the user's notes in a folder named like a section",
+    "mine/rep2/report.md": "the user's report, named like reproduce's",
     # designs a section of the report cannot run: the fingers' oil at 90 deg, the paper's w
     "rep_small_reservoir.toml": "V0_mm3 = 100.0\n",
     "rep_three_hinges.toml": "n_s = 3\nhinge_s_mm = [40.0, 80.0, 120.0]\n",
@@ -470,7 +472,9 @@ def replay_cases() -> list[tuple[str, list[str]]]:
               ["design", "--task", GOOD_TASK, "--no-fem", "--out", "kind/design_json"],
               ["design", "--task", GOOD_TASK, "--no-fem", "--pareto", "--out", "kind/knee_file"],
               ["reproduce", "--only", "fig7_reduced", "--out", "kind/rep"],
-              ["reproduce", "--only", "fig7_reduced", "--out", "kind/rep2"], [*control, "--out", "kind/ctl"]]
+              ["reproduce", "--only", "fig7_reduced", "--out", "kind/rep2"], [*control, "--out", "kind/ctl"],
+              ["reproduce", "--only", "fig7_reduced", "--out", "mine/rep"],
+              ["reproduce", "--only", "fig7_reduced", "--out", "mine/rep2"]]
     cases += [("kind", k) for k in kinds]
     cases += [("study", ["study", "run", s, "--workers", "1"]) for s in ("st_table_unused.toml", "st_table_swept.toml",
                                                                           "st_curve_pressure.toml")]
