@@ -123,10 +123,10 @@ def anchors_now(fingers: Fingers, qs, pose: Pose, hist: ContactHistory):
 
 
 def evaluate(body, fingers: Fingers, qs, pose: Pose, hist: ContactHistory, eps_N: float,
-             eps_T: float, keep=None) -> ContactState:
+             eps_T: float, keep=None, stuck=None) -> ContactState:
     """Contact forces, generalised forces and the object's wrench at (qs, pose); ``keep``
-    (bool per pad): pads whose normal force is not clamped at 0 and whose friction is not
-    clamped to the cone (for the Newton tangent only)."""
+    (bool per pad): pads whose normal force is not clamped at 0 (for the Newton tangent only);
+    ``stuck`` (default ``keep``): pads whose friction is not clamped to the cone there."""
     pc = pad_contacts(body, pose, fingers.frames, fingers.padsets, qs)
     n = pc.normal
     with np.errstate(invalid="ignore"):
@@ -143,8 +143,9 @@ def evaluate(body, fingers: Fingers, qs, pose: Pose, hist: ContactHistory, eps_N
     cap = body.friction * N
     stick = size <= cap
     T = np.where(stick[:, None], trial, trial * (cap / np.where(size > 0, size, 1.0))[:, None])
-    if keep is not None and body.friction > 0:  # the tangent sticks the kept pads (a stick predictor): regular
-        T = np.where(keep[:, None], trial, T)  # when every pad slips at the start of a load reversal
+    stuck = keep if stuck is None else stuck
+    if stuck is not None and body.friction > 0:  # the tangent sticks these pads (a stick predictor)
+        T = np.where(stuck[:, None], trial, T)
     T = np.where((N > 0)[:, None] | (keep[:, None] if keep is not None else False), T, 0.0)
     F = N[:, None] * n + T
     Q, i = [], 0
@@ -179,9 +180,9 @@ class Problem:
         p[self.free] = x[n:]
         return self.fingers.split(x[:n]), Pose(self.body.centre, p)
 
-    def residual(self, x, eps_N, eps_T, keep=None):
+    def residual(self, x, eps_N, eps_T, keep=None, stuck=None):
         qs, pose = self.unpack(x)
-        cs = evaluate(self.body, self.fingers, qs, pose, self.hist, eps_N, eps_T, keep)
+        cs = evaluate(self.body, self.fingers, qs, pose, self.hist, eps_N, eps_T, keep, stuck)
         f = self.fingers
         R = [Q0 + S @ (q - q0) - Qc for Q0, S, q, q0, Qc in zip(f.Q0, f.S, qs, f.q0, cs.Q)]
         R.append((cs.wrench + self.load)[self.free])
@@ -201,31 +202,39 @@ def solve_contact(problem: Problem, x0, options: ContactOptions):
     tol = options.rtol * problem.scale
 
     for update in range(options.max_updates + 1):
-        def fun(x):
+        def fun(x, tangent):
             R, cs = problem.residual(x, eps_N, eps_T)
             # the tangent keeps pads within keep_gap of touching in contact (a generalised
             # Jacobian): a step that opens a softly held pad is pulled back, not lost
             with np.errstate(invalid="ignore"):
                 kept = np.isfinite(cs.g) & (problem.hist.lam_N - eps_N * cs.g > -eps_N * options.keep_gap)
+            # "stick": every kept pad sticks in the tangent (regular when every pad slips at the
+            # start of a load reversal); "slip": a pad slipping at x has the return map's own
+            # derivative (no stiffness along its slip), else a slipping mode, e.g. an off-axis
+            # sphere turning in its pads, keeps the stick stiffness and Newton stalls
+            stuck = kept if tangent == "stick" else kept & ~((cs.N > 0) & ~cs.stick)
             K = np.empty((len(x), len(x)))
             for j, h in enumerate(steps):
                 e = np.zeros(len(x))
                 e[j] = h
-                K[:, j] = (problem.residual(x + e, eps_N, eps_T, kept)[0]
-                           - problem.residual(x - e, eps_N, eps_T, kept)[0]) / (2 * h)
+                K[:, j] = (problem.residual(x + e, eps_N, eps_T, kept, stuck)[0]
+                           - problem.residual(x - e, eps_N, eps_T, kept, stuck)[0]) / (2 * h)
             K[n_q:, n_q:] += 1e-9 * problem.scale * np.eye(len(x) - n_q)  # a free rotation of a frictionless sphere
             return R, sp.csr_matrix(K)
 
         # full steps first (a softly held pad keeps its gap window); when they cycle between
-        # contact states, again from the same start with Armijo backtracking on ||R||
-        for merit in ("finite", "residual"):
+        # contact states, again from the same start with Armijo backtracking on ||R||; then
+        # both again with the slipping pads' own tangent
+        attempts = [(t, m) for t in ("stick", "slip") for m in ("finite", "residual")]
+        for k, (tangent, merit) in enumerate(attempts):
             try:
-                res = newton(fun, x, NewtonOptions(rtol=0.0, atol=tol, max_iter=options.max_iter, merit=merit,
-                                                   forcing=None, xtol=1e-14, max_backtracks=30),
+                res = newton(lambda x: fun(x, tangent), x,
+                             NewtonOptions(rtol=0.0, atol=tol, max_iter=options.max_iter, merit=merit,
+                                           forcing=None, xtol=1e-14, max_backtracks=30),
                              solver=solver, residual=lambda x: problem.residual(x, eps_N, eps_T)[0])
                 break
             except NotConverged:
-                if merit == "residual":
+                if k == len(attempts) - 1:
                     raise
         x, its = res.x, its + res.iterations
         cs = problem.residual(x, eps_N, eps_T)[1]
