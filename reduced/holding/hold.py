@@ -30,7 +30,8 @@ from softhand.reduced.vocabulary.design import HandDesign
 from softhand.reduced.vocabulary.errors import InputError
 from softhand.reduced.holding.hand_layout import place_object
 from softhand.reduced.holding.hold_result import SLIP, STICK, Contact, HoldResult, LoadStep
-from softhand.reduced.holding.objects import GraspObject, Placed
+from softhand.reduced.holding.object_geometry import Placed
+from softhand.reduced.holding.objects import GraspObject
 
 #: the default pull: straight down (more weight)
 DOWN = (0.0, 1.0, 0.0)

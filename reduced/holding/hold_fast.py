@@ -38,7 +38,7 @@ from softhand.reduced.equations import finger, hand, reservoir
 from softhand.reduced.holding import hand_layout
 from softhand.reduced.vocabulary.design import HandDesign
 from softhand.reduced.vocabulary.errors import InputError
-from softhand.reduced.holding.objects import Placed
+from softhand.reduced.holding.object_geometry import Placed
 
 #: the finger models of the fast hold
 FINGER_MODELS = ("fem", "paper")
