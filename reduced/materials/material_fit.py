@@ -32,7 +32,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import least_squares
 
-from softhand.reduced.materials import rubber
+from softhand.reduced.materials import rubber, rubber_parameters
 from softhand.reduced.materials.stress_data import StressData, check_data
 from softhand.reduced.vocabulary.errors import InputError
 from softhand.reduced.fitting.lsq import FitOptions, diagnose, jacobian
@@ -75,7 +75,7 @@ def model_residual_fn(fit_model: str, data: StressData):
     if fit_model not in FIT_MODELS:
         raise InputError("--model", fit_model, f"must be one of {', '.join(FIT_MODELS)}")
     model, terms = FIT_MODELS[fit_model]
-    names = rubber.parameter_names(model, terms)
+    names = rubber_parameters.parameter_names(model, terms)
 
     def material(x):
         if model == "ogden":

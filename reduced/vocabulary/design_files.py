@@ -15,7 +15,7 @@ import warnings
 from pathlib import Path
 
 from softhand.reduced.equations import finger
-from softhand.reduced.materials import rubber
+from softhand.reduced.materials import rubber, rubber_parameters
 from softhand.reduced.vocabulary.design import KEY_OF, MODULUS_OF, PARTS, HandDesign, field_changes
 from softhand.reduced.vocabulary.design_rules import in_bounds, is_number
 from softhand.reduced.vocabulary.errors import InputError, Note
@@ -32,7 +32,7 @@ def _material_changes(part: str, table, source: str, values: dict) -> dict:
     if not isinstance(model, str):
         raise InputError(f"{source}: {part}.material.model", model,
                          f"must be one of {', '.join(rubber.MODELS)}")
-    material = rubber.from_parameters(model, params, source=f"{source}: {part}.material")
+    material = rubber_parameters.from_parameters(model, params, source=f"{source}: {part}.material")
     name = MODULUS_OF[part]
     given = values.get(KEY_OF[name])
     if given is not None:  # overridden, but still a value of the file: a bad one is bad input
