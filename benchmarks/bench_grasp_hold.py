@@ -13,7 +13,7 @@ from __future__ import annotations
 import argparse
 import time
 
-from softhand.reduced.calibrated import grasp_fem, grasp_hold
+from softhand.reduced.calibrated import grasp_fem, grasp_hold, grasp_hold_fast, grasp_hold_solve
 from softhand.reduced.vocabulary.design import HandDesign
 
 PAPER = grasp_fem.fem_finger(HandDesign(reservoir_model="fem"))
@@ -39,15 +39,15 @@ def main() -> None:
     parser.add_argument("--repeat", type=int, default=20, help="calls per timing (the slow path: a quarter)")
     args = parser.parse_args()
     calls = [0]
-    residuals = grasp_hold._residuals
+    residuals = grasp_hold_solve._residuals
 
     def counted(*a):
         calls[0] += 1
         return residuals(*a)
 
-    grasp_hold._residuals = counted
+    grasp_hold_solve._residuals = counted
     for name, (design, diameter, mass, F_v) in CASES.items():
-        fast = lambda: grasp_hold.fast_hold(design, diameter, mass, "F_v", F_v)  # noqa: E731
+        fast = lambda: grasp_hold_fast.fast_hold(design, diameter, mass, "F_v", F_v)  # noqa: E731
         slow = lambda: grasp_hold.slow_hold(design, diameter, mass, "F_v", F_v)  # noqa: E731
         fast()
         calls[0] = 0

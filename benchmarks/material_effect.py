@@ -20,7 +20,8 @@ import numpy as np
 from softhand.reduced.equations import hand, reservoir
 from softhand.reduced.materials import rubber
 from softhand.reduced.vocabulary.design_files import load_design
-from softhand.reduced.materials.material_fit import fit_material, read_test_data
+from softhand.reduced.materials.material_fit import fit_material
+from softhand.reduced.materials.stress_data import read_test_data
 
 MU0 = 1.15
 PRESSURES = (0.5, 1.0, 1.5, 2.0)

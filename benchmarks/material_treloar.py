@@ -11,7 +11,8 @@ import time
 from pathlib import Path
 
 from softhand.reduced.materials import rubber
-from softhand.reduced.materials.material_fit import FIT_MODELS, fit_material, read_test_data
+from softhand.reduced.materials.material_fit import FIT_MODELS, fit_material
+from softhand.reduced.materials.stress_data import read_test_data
 from softhand.reduced.materials.rubber import drucker_check
 
 DATA = Path(__file__).resolve().parent.parent / "studies" / "data" / "treloar1944.csv"

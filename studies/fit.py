@@ -14,7 +14,8 @@ from dataclasses import dataclass, field
 
 from softhand.reduced.fitting.csvdata import Measurements
 from softhand.reduced.vocabulary.design import HandDesign
-from softhand.reduced.fitting.fit import FitResult, fit, make_predictor
+from softhand.reduced.fitting.fit import fit, make_predictor
+from softhand.reduced.fitting.fit_result import FitResult
 
 
 @dataclass(frozen=True)

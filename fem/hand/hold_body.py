@@ -154,7 +154,7 @@ def body_of(obj, design):
     InputError if it overlaps the open fingers or the palm): analytic for a sphere, a cylinder
     and an unrotated box, else the object's own distance queries."""
     from softhand.reduced.holding.hand_layout import place_object
-    from softhand.reduced.holding.objects import local_extent
+    from softhand.reduced.holding.object_geometry import local_extent
 
     placed = place_object(obj, design)
     centre = tuple(float(c) for c in placed.centre)

@@ -32,7 +32,8 @@ from scipy.optimize import brentq
 from softhand.reduced.equations import contact, kinematics
 from softhand.reduced.vocabulary.design import HandDesign
 from softhand.reduced.vocabulary.errors import InputError
-from softhand.reduced.holding.objects import CLEARANCE, PALM_GAP, GraspObject, Placed, place
+from softhand.reduced.holding.object_geometry import Placed, place
+from softhand.reduced.holding.objects import CLEARANCE, PALM_GAP, GraspObject
 
 #: an object's edge or corner more than half this far behind a pad's face is not in front of it [mm]
 _DEPTH = 20.0
@@ -121,7 +122,7 @@ def pad_distance(placed: Placed, p: Pads) -> PadDistance:
     centre); otherwise the least distance on a :data:`PAD_SAMPLES` grid of the pad refined by a
     parabola through the least sample and its neighbours, along then across (exact for a flat
     face; error O(h^3) on a curved one, h = 1/16 of the link); and an object's edges and corners
-    (:func:`softhand.reduced.holding.objects.feature_points`) over the pad's face, by their height above it, where
+    (:func:`softhand.reduced.holding.object_geometry.feature_points`) over the pad's face, by their height above it, where
     the distance is not smooth (a box's corner on a pad: then the contact normal is the pad's)."""
     if placed.obj.shape == "sphere":
         d = placed.centre - p.centre

@@ -25,12 +25,13 @@ import numpy as np
 from scipy.optimize import brentq
 
 from softhand.reduced.equations import hand
-from softhand.reduced.holding import hold_fast, hold_lp
+from softhand.reduced.holding import hold_fast, hold_finger, hold_lp
 from softhand.reduced.vocabulary.design import HandDesign
 from softhand.reduced.vocabulary.errors import InputError
 from softhand.reduced.holding.hand_layout import place_object
 from softhand.reduced.holding.hold_result import SLIP, STICK, Contact, HoldResult, LoadStep
-from softhand.reduced.holding.objects import GraspObject, Placed
+from softhand.reduced.holding.object_geometry import Placed
+from softhand.reduced.holding.objects import GraspObject
 
 #: the default pull: straight down (more weight)
 DOWN = (0.0, 1.0, 0.0)
@@ -55,7 +56,7 @@ def contact_set(closed: hold_fast.Closed, design: HandDesign) -> hold_lp.Contact
     """The touching pads of the closed hand and its fingers' hinge capacities for the LP."""
     rows = []
     for i, s in enumerate(closed.fingers):
-        for k in np.flatnonzero((s.N > 0.0) | (s.geometry.gap <= hold_fast.TOUCH)):
+        for k in np.flatnonzero((s.N > 0.0) | (s.geometry.gap <= hold_finger.TOUCH)):
             if k == 0:
                 continue
             rows.append((i, int(k)))

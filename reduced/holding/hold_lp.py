@@ -16,7 +16,7 @@ and its friction force F_c (in the tangent plane), and the pull lam beyond the w
 
 The last line is each finger's hinge equilibrium read as a capacity: the force of the object on
 the finger's pads may push hinge j open with at most the moment the pressure holds it with at
-the grasp state, -M_j >= 0 (:func:`softhand.reduced.holding.hold_fast.hinge_moments`; in the closed state it is
+the grasp state, -M_j >= 0 (:func:`softhand.reduced.holding.hold_finger.hinge_moments`; in the closed state it is
 met with equality by the closing forces). The fingers stay at their grasp configuration (small
 displacements: the object and the pads are rigid, the compliance is the hinges'), so the
 holding limit is the largest lam for which some set of contact forces satisfies all of the

@@ -19,11 +19,9 @@ its circle, :func:`softhand.reduced.equations.contact.object_depth`); then turne
 A table with only ``diameter_mm`` and ``mass_kg`` (the one-finger grasp's object) is a
 **sphere**: its section by every finger's bending plane is the circle the one-finger models see.
 
-Geometry queries are vectorised over points (..., 3) in the hand frame: :meth:`Placed.sdf`
-(signed distance, negative inside) and :meth:`Placed.normal` (outward unit normal, the
-distance's gradient). Primitives use their closed-form distance; a mesh, trilinear
-interpolation of its distance sampled once on a grid (:mod:`softhand.reduced.holding.object_mesh`, points on its longest
-edge; error ~ the grid step squared over the surface's radius of curvature). Units: mm, kg, rad.
+Here the object as given (checked, and read from a table, a short form or a TOML file); its
+geometry and the object placed in the hand frame: :mod:`softhand.reduced.holding.object_geometry`.
+Units: mm, kg, rad.
 """
 from __future__ import annotations
 
@@ -35,11 +33,11 @@ from pathlib import Path
 import numpy as np
 
 from softhand.reduced.vocabulary.errors import InputError
-from softhand.reduced.holding.object_mesh import MeshData, grid_sdf, mesh_features, mesh_sdf, read_mesh, self_intersection
+from softhand.reduced.holding.object_mesh import MeshData, mesh_sdf, read_mesh, self_intersection
 
-__all__ = ["SHAPES", "KEYS", "GraspObject", "Placed", "MeshData", "check_object", "object_from_table",
+__all__ = ["SHAPES", "KEYS", "GraspObject", "MeshData", "check_object", "object_from_table",
            "object_from_short", "load_object", "parse_object", "read_mesh", "mesh_sdf", "self_intersection",
-           "local_sdf", "local_extent", "surface", "feature_points", "place", "rotation_matrix"]
+           "rotation_matrix"]
 
 SHAPES = ("sphere", "cylinder", "box", "capsule", "mesh")
 #: keys of the ``[object]`` table
@@ -245,162 +243,3 @@ def parse_object(text: str, *, field: str = "--object") -> GraspObject:
                                           and text.split(":")[0] in SHORT_FORMS):
         return object_from_short(text, field=field)
     return load_object(text, field=field)
-
-
-# ---------------------------------------------------------------------------------- geometry
-def local_sdf(obj: GraspObject, p) -> np.ndarray:
-    """Signed distance [mm] (negative inside) at points p (..., 3) in the object's own frame
-    (centre at the origin, before rotation)."""
-    p = np.asarray(p, float)
-    if obj.shape == "sphere":
-        return np.linalg.norm(p, axis=-1) - 0.5 * obj.diameter_mm
-    if obj.shape == "box":
-        q = np.abs(p) - 0.5 * np.asarray(obj.size_mm)
-        return np.linalg.norm(np.maximum(q, 0.0), axis=-1) + np.minimum(np.max(q, axis=-1), 0.0)
-    if obj.shape == "cylinder":
-        d = np.stack([np.hypot(p[..., 0], p[..., 2]) - 0.5 * obj.diameter_mm,
-                      np.abs(p[..., 1]) - 0.5 * obj.length_mm], axis=-1)
-        return np.minimum(np.max(d, axis=-1), 0.0) + np.linalg.norm(np.maximum(d, 0.0), axis=-1)
-    if obj.shape == "capsule":
-        h = 0.5 * (obj.length_mm - obj.diameter_mm)
-        axis = np.zeros_like(p)
-        axis[..., 1] = np.clip(p[..., 1], -h, h)
-        return np.linalg.norm(p - axis, axis=-1) - 0.5 * obj.diameter_mm
-    mesh = read_mesh(obj.file)
-    return grid_sdf(mesh, p)
-
-
-def local_extent(obj: GraspObject) -> tuple[np.ndarray, np.ndarray]:
-    """(lowest, highest) corner (3,) of the object's bounding box in its own frame [mm]."""
-    if obj.shape == "sphere":
-        r = np.full(3, 0.5 * obj.diameter_mm)
-    elif obj.shape == "box":
-        r = 0.5 * np.asarray(obj.size_mm)
-    elif obj.shape in ("cylinder", "capsule"):
-        r = np.array([0.5 * obj.diameter_mm, 0.5 * obj.length_mm, 0.5 * obj.diameter_mm])
-    else:
-        v = read_mesh(obj.file).vertices
-        return v.min(axis=0), v.max(axis=0)
-    return -r, r
-
-
-def surface(obj: GraspObject, *, resolution: int = 32) -> tuple[np.ndarray, np.ndarray]:
-    """(points (m, 3), triangles (k, 3)) of the object's surface in its own frame [mm] (a
-    primitive tessellated with ``resolution`` segments around)."""
-    if obj.shape == "mesh":
-        m = read_mesh(obj.file)
-        return m.vertices, m.faces
-    if obj.shape == "box":
-        h = 0.5 * np.asarray(obj.size_mm)
-        pts = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)], float) * h
-        quads = [(0, 1, 3, 2), (4, 6, 7, 5), (0, 4, 5, 1), (2, 3, 7, 6), (0, 2, 6, 4), (1, 5, 7, 3)]
-        return pts, np.array([t for a, b, c, d in quads for t in ((a, b, c), (a, c, d))])
-    n = int(resolution)
-    phi = np.linspace(0.0, 2.0 * np.pi, n, endpoint=False)
-    r = 0.5 * obj.diameter_mm
-    if obj.shape == "sphere":
-        rows = [(r * math.sin(t), -r * math.cos(t)) for t in np.linspace(0, np.pi, n // 2 + 1)[1:-1]]
-        caps = (-r, r)
-    elif obj.shape == "cylinder":
-        h = 0.5 * obj.length_mm
-        rows, caps = [(r, -h), (r, h)], (-h, h)
-    else:
-        h = 0.5 * (obj.length_mm - obj.diameter_mm)
-        arc = np.linspace(0, 0.5 * np.pi, n // 4 + 1)[1:]
-        rows = [(r * math.sin(t), -h - r * math.cos(t)) for t in arc] + \
-               [(r * math.cos(t), h + r * math.sin(t)) for t in arc[::-1][1:]] + [(r, h)]
-        rows = sorted(set(rows), key=lambda x: x[1])
-        caps = (-h - r, h + r)
-    pts = [[0.0, caps[0], 0.0]]
-    for rad, y in rows:
-        pts += [[rad * math.cos(a), y, rad * math.sin(a)] for a in phi]
-    pts.append([0.0, caps[1], 0.0])
-    tris, last = [], len(pts) - 1
-    for j in range(n):
-        k = (j + 1) % n
-        tris.append((0, 1 + k, 1 + j))
-        for row in range(len(rows) - 1):
-            a, b = 1 + row * n, 1 + (row + 1) * n
-            tris += [(a + j, a + k, b + k), (a + j, b + k, b + j)]
-        base = 1 + (len(rows) - 1) * n
-        tris.append((last, base + j, base + k))
-    return np.asarray(pts), np.asarray(tris)
-
-
-#: points along each box edge and around each cylinder rim among an object's features
-FEATURE_POINTS = 65
-
-
-def feature_points(obj: GraspObject) -> np.ndarray:
-    """Points (m, 3) of the object's edges and corners in its own frame [mm] (a box's edges, a
-    cylinder's rims, a mesh's vertices where its surface folds by more than 20 deg; none for the
-    smooth sphere and capsule): where a flat pad may touch it at a point its distance is not smooth."""
-    if obj.shape == "box":
-        h = 0.5 * np.asarray(obj.size_mm)
-        t = np.linspace(-1.0, 1.0, FEATURE_POINTS)
-        out = []
-        for axis in range(3):
-            others = [i for i in range(3) if i != axis]
-            for sa in (-1.0, 1.0):
-                for sb in (-1.0, 1.0):
-                    p = np.zeros((len(t), 3))
-                    p[:, axis] = t * h[axis]
-                    p[:, others[0]], p[:, others[1]] = sa * h[others[0]], sb * h[others[1]]
-                    out.append(p)
-        return np.vstack(out)
-    if obj.shape == "cylinder":
-        a = np.linspace(0.0, 2.0 * np.pi, 2 * FEATURE_POINTS, endpoint=False)
-        r, h = 0.5 * obj.diameter_mm, 0.5 * obj.length_mm
-        return np.vstack([np.stack([r * np.cos(a), np.full_like(a, y), r * np.sin(a)], -1) for y in (-h, h)])
-    if obj.shape == "mesh":
-        return mesh_features(obj.file)
-    return np.zeros((0, 3))
-
-
-@dataclass(frozen=True)
-class Placed:
-    """An object at its pose in the hand frame: centre (3,) [mm] and rotation R (object -> hand)."""
-
-    obj: GraspObject
-    centre: np.ndarray
-    R: np.ndarray
-
-    def to_local(self, p) -> np.ndarray:
-        return (np.asarray(p, float) - self.centre) @ self.R
-
-    def sdf(self, p) -> np.ndarray:
-        """Signed distance [mm] at hand-frame points p (..., 3), negative inside."""
-        return local_sdf(self.obj, self.to_local(p))
-
-    def normal(self, p, *, step: float = 1e-4) -> np.ndarray:
-        """Outward unit normal (..., 3): the distance's gradient (central differences, ``step`` mm;
-        closed form for a sphere)."""
-        q = self.to_local(p)
-        if self.obj.shape == "sphere":
-            g = q
-        else:
-            step = max(step, 0.25 * (read_mesh(self.obj.file).grid[0][1] - read_mesh(self.obj.file).grid[0][0])) \
-                if self.obj.shape == "mesh" else step
-            e = np.eye(3) * step
-            g = np.stack([local_sdf(self.obj, q + e[i]) - local_sdf(self.obj, q - e[i]) for i in range(3)], axis=-1)
-        g = g @ self.R.T
-        return g / np.maximum(np.linalg.norm(g, axis=-1, keepdims=True), 1e-300)
-
-    def features(self) -> np.ndarray:
-        """:func:`feature_points` in the hand frame (m, 3) [mm]."""
-        return self.centre + feature_points(self.obj) @ self.R.T
-
-    def surface(self, *, resolution: int = 32) -> tuple[np.ndarray, np.ndarray]:
-        """The surface as (points (m, 3) in the hand frame [mm], triangles (k, 3))."""
-        pts, tris = surface(self.obj, resolution=resolution)
-        return self.centre + pts @ self.R.T, tris
-
-    def top(self) -> float:
-        """The object's highest point (least y) in the hand frame [mm] (its surface's vertices)."""
-        pts, _ = self.surface(resolution=64)
-        return float(np.min(pts[:, 1]))
-
-
-def place(obj: GraspObject, centre) -> Placed:
-    """The object with its centre at ``centre`` (3,) [mm] and its own rotation."""
-    return Placed(obj, np.asarray(centre, float), obj.rotation)

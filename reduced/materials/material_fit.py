@@ -1,18 +1,11 @@
-r"""Fit a rubber model (:mod:`softhand.reduced.materials.rubber`) to nominal stress vs stretch test data.
+r"""Fit a rubber model (:mod:`softhand.reduced.materials.rubber`) to nominal stress vs stretch test data
+(:mod:`softhand.reduced.materials.stress_data`, which reads and checks them).
 
-Data: a CSV file with the columns ``mode`` (``uniaxial``, ``equibiaxial``, ``pure-shear``;
-any mix), ``stretch`` [-] and ``stress_MPa`` (nominal stress: force per reference area,
-in the stretched direction); ``lambda`` and ``nominal_stress_MPa`` are accepted as other
-names of the last two, ``biaxial``, ``planar`` (and ``ut``, ``et``, ``ps``) of the modes.
-Lines starting with ``#`` are comments.
-
-Refused (one :class:`~softhand.reduced.vocabulary.errors.InputError`), as no rubber test gives them: a stretch
-outside :data:`STRETCH_LIMITS`, a stress beyond :data:`MAX_STRESS` MPa, data whose largest
-stress is below :data:`MIN_STRESS` MPa, a stress of the wrong sign (negative in tension,
-positive in compression, nonzero at stretch 1) beyond :data:`SIGN_SCATTER` of the largest,
-and fewer distinct (mode, stretch) points other than stretch 1 than the model has parameters
-(repeats only measure the scatter; at stretch 1 every model has zero stress). Data the model's
-numerics cannot fit (no finite optimum) are refused too, never printed.
+Refused (one :class:`~softhand.reduced.vocabulary.errors.InputError`): data the
+:mod:`softhand.reduced.materials.stress_data` checks refuse, and fewer distinct (mode, stretch)
+points other than stretch 1 than the model has parameters (repeats only measure the scatter;
+at stretch 1 every model has zero stress). Data the model's numerics cannot fit (no finite
+optimum) are refused too, never printed.
 
 Least squares in the stress itself (MPa), all rows with equal weight:
 
@@ -34,142 +27,24 @@ in uniaxial, equibiaxial and pure-shear deformation at stretches over a stated r
 """
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
-from pathlib import Path
 
 import numpy as np
 from scipy.optimize import least_squares
 
-from softhand.reduced.materials import rubber
-from softhand.reduced.fitting.csvdata import read_rows
+from softhand.reduced.materials import rubber, rubber_parameters
+from softhand.reduced.materials.stress_data import StressData, check_data
 from softhand.reduced.vocabulary.errors import InputError
-from softhand.reduced.vocabulary.inputfiles import plain_float
 from softhand.reduced.fitting.lsq import FitOptions, diagnose, jacobian
 
 #: ``--model`` -> (rubber model, Ogden terms)
 FIT_MODELS = {"neo-hookean": ("neo-hookean", 0), "mooney-rivlin": ("mooney-rivlin", 0),
               "yeoh": ("yeoh", 0), "gent": ("gent", 0), "ogden2": ("ogden", 2),
               "ogden3": ("ogden", 3)}
-_MODE_ALIASES = {"uniaxial": "uniaxial", "ut": "uniaxial", "equibiaxial": "equibiaxial",
-                 "biaxial": "equibiaxial", "et": "equibiaxial", "eb": "equibiaxial",
-                 "pure-shear": "pure-shear", "pure_shear": "pure-shear", "ps": "pure-shear",
-                 "planar": "pure-shear"}
-COLUMNS = ("mode", "stretch", "stress_MPa")
-_COLUMN_ALIASES = {"mode": "mode", "stretch": "stretch", "lambda": "stretch",
-                   "stress_mpa": "stress_MPa", "nominal_stress_mpa": "stress_MPa"}
 #: relative precision to which the solvers determine a parameter (of its value, or of mu0 for
 #: a modulus near zero); added in quadrature to the standard errors, so that data without
 #: scatter (S ~ round-off) do not report errors below what the numbers can resolve
 PRECISION = 1e-10
-#: stretches a rubber test can give [-]; also the bounds of ``--stability-range``
-STRETCH_LIMITS = (0.01, 100.0)
-#: largest ``|nominal stress|`` of a rubber test [MPa]
-MAX_STRESS = 1e4
-#: the data's largest ``|stress|`` must reach this [MPa] (1 Pa): else there is no stiffness to fit
-MIN_STRESS = 1e-6
-#: a stress of the wrong sign is allowed as scatter up to this fraction of the largest ``|stress|``
-SIGN_SCATTER = 0.01
-
-
-@dataclass(frozen=True)
-class StressData:
-    """Test points: mode per row, stretch [-], nominal stress [MPa]."""
-
-    mode: np.ndarray
-    stretch: np.ndarray
-    stress: np.ndarray
-    source: str = "data"
-    lines: np.ndarray | None = None  #: line number in the file per row (for messages)
-
-    def __len__(self):
-        return int(self.stretch.size)
-
-    def predict(self, material: rubber.Rubber) -> np.ndarray:
-        out = np.empty(len(self))
-        for m in np.unique(self.mode):
-            rows = self.mode == m
-            out[rows] = material.nominal_stress(m, self.stretch[rows])
-        return out
-
-
-def read_test_data(path) -> StressData:
-    """Read the CSV (see the module docstring); one InputError naming file, line, column."""
-    path = Path(path)
-    given, rows = read_rows(path)
-    header = [_COLUMN_ALIASES.get(c.lower(), c) for c in given]
-    if sorted(header) != sorted(COLUMNS):
-        raise InputError(f"{path.name}: columns", ",".join(given), f"must be {','.join(COLUMNS)}")
-    mode, lam, stress, lines = [], [], [], []
-    for line, cells in rows:
-        if len(cells) != len(header):
-            raise InputError(f"{path.name}: line {line}", ",".join(cells),
-                             f"has {len(cells)} cells; the header has {len(header)}")
-        cell = dict(zip(header, cells))
-        name = _MODE_ALIASES.get(cell["mode"].lower())
-        if name is None:
-            raise InputError(f"{path.name}: line {line}, column mode", cell["mode"],
-                             f"must be one of {', '.join(rubber.MODES)}")
-        mode.append(name)
-        lam.append(_number(path.name, line, "stretch", cell["stretch"], positive=True))
-        stress.append(_number(path.name, line, "stress_MPa", cell["stress_MPa"]))
-        lines.append(line)
-    data = StressData(np.array(mode), np.array(lam), np.array(stress), path.name, np.array(lines))
-    check_data(data)
-    return data
-
-
-def check_data(data: StressData) -> None:
-    """Refuse data no rubber test gives (see the module docstring); one InputError naming the row."""
-    lo, hi = STRETCH_LIMITS
-    bad = np.flatnonzero(~((data.stretch >= lo) & (data.stretch <= hi)))
-    if bad.size:
-        i = bad[0]
-        raise InputError(_cell(data, i, "stretch"), f"{data.stretch[i]:g}",
-                         f"must be in [{lo:g}, {hi:g}]: rubber tests never leave that range")
-    bad = np.flatnonzero(~(np.abs(data.stress) <= MAX_STRESS))
-    if bad.size:
-        i = bad[0]
-        raise InputError(_cell(data, i, "stress_MPa"), f"{data.stress[i]:g}",
-                         f"must be in [{-MAX_STRESS:g}, {MAX_STRESS:g}] MPa (nominal stress of a rubber)")
-    top = float(np.max(np.abs(data.stress)))
-    if not top >= MIN_STRESS:
-        raise InputError(f"{data.source}: column stress_MPa", f"largest ``|stress|`` {top:g} MPa",
-                         f"must be at least {MIN_STRESS:g} MPa (1 Pa): no stiffness to fit "
-                         "(stresses are in MPa)")
-    tol = SIGN_SCATTER * top
-    side = np.sign(data.stretch - 1.0)
-    wrong = np.where(side == 0, np.abs(data.stress) > tol, side * data.stress < -tol)
-    if np.any(wrong):
-        i = int(np.flatnonzero(wrong)[0])
-        lam, what = data.stretch[i], data.mode[i]
-        if side[i] == 0:
-            need = "must be 0 at stretch 1 (undeformed: every model has zero stress there)"
-        elif side[i] > 0:
-            need = f"must be positive in tension (stretch {lam:g} > 1, {what})"
-        else:
-            need = f"must be negative in compression (stretch {lam:g} < 1, {what})"
-        other = "nonzero" if side[i] == 0 else "the other sign"
-        raise InputError(_cell(data, i, "stress_MPa"), f"{data.stress[i]:g}",
-                         f"{need}; {other} only as scatter up to {SIGN_SCATTER:.0%} of the "
-                         f"largest ``|stress|`` ({top:g} MPa)")
-
-
-def _cell(data, i, col):
-    """Where row i is: the file's line, or the row number of data built in code."""
-    where = f"line {data.lines[i]}" if data.lines is not None else f"row {i + 1}"
-    return f"{data.source}: {where}, column {col}"
-
-
-def _number(name, line, col, text, positive=False):
-    try:
-        value = plain_float(text)
-    except ValueError:
-        value = math.nan
-    if not math.isfinite(value) or (positive and not value > 0):
-        raise InputError(f"{name}: line {line}, column {col}", text,
-                         "must be a positive number" if positive else "must be a finite number")
-    return value
 
 
 @dataclass(frozen=True)
@@ -200,7 +75,7 @@ def model_residual_fn(fit_model: str, data: StressData):
     if fit_model not in FIT_MODELS:
         raise InputError("--model", fit_model, f"must be one of {', '.join(FIT_MODELS)}")
     model, terms = FIT_MODELS[fit_model]
-    names = rubber.parameter_names(model, terms)
+    names = rubber_parameters.parameter_names(model, terms)
 
     def material(x):
         if model == "ogden":
@@ -340,5 +215,3 @@ def _stretch_triples(data):
         rows = data.mode == m
         l[:, rows] = rubber.stretches(m, data.stretch[rows])
     return l
-
-

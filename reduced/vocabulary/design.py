@@ -14,25 +14,11 @@ Ambiguities of the paper resolved here (see ``docs/conventions.md``):
   explicit parameters with documented defaults.
 
 Rubber. The paper's rubber is Neo-Hookean with the shear moduli ``mu_sf_MPa`` (finger)
-and ``mu_sr_MPa`` (reservoir sheet). A design file may give another strain energy per
-part (:mod:`softhand.reduced.materials.rubber`) as a table::
-
-    [finger.material]
-    model = "yeoh"            # neo-hookean | mooney-rivlin | yeoh | gent | ogden
-    C10_MPa = 0.18
-    C20_MPa = -1.4e-3
-    C30_MPa = 4.0e-5
-
-    [reservoir.material]
-    model = "mooney-rivlin"
-    C10_MPa = 0.5
-    C01_MPa = 0.075
-
-The parameter names are those of ``softhand material fit``. With a material table,
-``mu_sf_MPa`` / ``mu_sr_MPa`` become that material's initial shear modulus (computed; a
-value in the same file that disagrees is overridden, with a warning), and setting them
-later (``softhand fit --params mu_sf_MPa``, a study sweep) scales every modulus of the
-material, keeping the shape of W.
+and ``mu_sr_MPa`` (reservoir sheet). A part may have another strain energy
+(:mod:`softhand.reduced.materials.rubber`; in a design file a ``[finger.material]`` table,
+:mod:`softhand.reduced.vocabulary.design_files`): ``mu_sf_MPa`` / ``mu_sr_MPa`` are then its
+initial shear modulus, and setting them (``softhand fit --params mu_sf_MPa``, a study sweep)
+scales every modulus of the material, keeping the shape of W.
 """
 from __future__ import annotations
 
@@ -46,7 +32,8 @@ from pathlib import Path
 from softhand import reduced as reduced_layer
 
 from softhand.reduced.materials import rubber
-from softhand.reduced.vocabulary.design_rules import BOUNDS, CONSISTENCY, check_model, in_bounds, is_number
+from softhand.reduced.vocabulary.design_rules import (BOUNDS, CONSISTENCY, check_hinges, check_layout, check_model,
+                                                       in_bounds, is_number)
 from softhand.reduced.vocabulary.errors import InputError
 
 __all__ = ["RESERVOIR_MODELS", "FINGER_MODELS", "PAPER_DESIGN_FILE", "HandDesign", "PUBLIC_KEYS",
@@ -116,19 +103,8 @@ class HandDesign:
         for name, key in KEY_OF.items():
             if key in BOUNDS:
                 in_bounds(key, _to_public(name, getattr(self, name)))
-        for name in ("n", "n_s"):
-            value = getattr(self, name)
-            if isinstance(value, bool) or not isinstance(value, int):
-                raise InputError(name, value, "must be a whole number")
-        if len(self.hinge_s) != self.n_s:
-            raise InputError("hinge_s_mm", list(self.hinge_s),
-                             f"must have n_s = {self.n_s} values")
-        s = (0.0, *self.hinge_s, self.l0)
-        if not all(isinstance(v, (int, float)) and math.isfinite(v) for v in s) \
-                or any(not s1 > s0 for s0, s1 in zip(s, s[1:])):  # nan compares false both ways
-            raise InputError("hinge_s_mm", list(self.hinge_s),
-                             f"must be finite and increase strictly within (0, l0 = {self.l0:g}) mm")
-        _check_layout(self)
+        check_hinges(self)
+        check_layout(self)
         for check in CONSISTENCY:
             check(self)
         check_model("reservoir_model", self.reservoir_model, RESERVOIR_MODELS,
@@ -218,21 +194,6 @@ _OMITTED_AT_DEFAULT = ("finger_azimuths", "pad_width")
 
 def _default(name: str):
     return HandDesign.__dataclass_fields__[name].default
-
-
-def _check_layout(design: "HandDesign") -> None:
-    """The hand layout's fields: n distinct finite azimuths (or none), a pad width >= 0."""
-    az = design.finger_azimuths
-    if az:
-        turns = sorted(a % (2.0 * math.pi) for a in az) if all(math.isfinite(a) for a in az) else None
-        if len(az) != design.n or turns is None or any(b - a < 1e-9 for a, b in zip(turns, turns[1:])) \
-                or (len(turns) > 1 and turns[0] + 2.0 * math.pi - turns[-1] < 1e-9):
-            raise InputError("finger_azimuths_deg", [round(math.degrees(a), 9) for a in az],
-                             f"must be n = {design.n} distinct finite angles [deg] (or left out: evenly spaced)")
-    if not (isinstance(design.pad_width, (int, float)) and math.isfinite(design.pad_width)
-            and 0.0 <= design.pad_width <= 1000.0):
-        raise InputError("pad_width_mm", design.pad_width, "must be a number in [0, 1000] mm "
-                                                           "(0: the tube's outer diameter)")
 
 
 #: every key a design file may hold (the TOML names, with their units)

@@ -5,6 +5,24 @@ Every design built from a file or a study's keys passes :func:`design_from_dict`
 reads and fits a design's own finger calibration table at once (so a bad table is one line
 at load time, not an error deep inside a run); this is why it lives above the finger model
 and not beside the design vocabulary.
+
+Rubber. A design file may give a part another strain energy than the paper's Neo-Hooke
+(:mod:`softhand.reduced.materials.rubber`) as a table::
+
+    [finger.material]
+    model = "yeoh"            # neo-hookean | mooney-rivlin | yeoh | gent | ogden
+    C10_MPa = 0.18
+    C20_MPa = -1.4e-3
+    C30_MPa = 4.0e-5
+
+    [reservoir.material]
+    model = "mooney-rivlin"
+    C10_MPa = 0.5
+    C01_MPa = 0.075
+
+The parameter names are those of ``softhand material fit``. With a material table,
+``mu_sf_MPa`` / ``mu_sr_MPa`` become that material's initial shear modulus (computed; a
+value in the same file that disagrees is overridden, with a warning).
 """
 from __future__ import annotations
 
@@ -15,7 +33,7 @@ import warnings
 from pathlib import Path
 
 from softhand.reduced.equations import finger
-from softhand.reduced.materials import rubber
+from softhand.reduced.materials import rubber, rubber_parameters
 from softhand.reduced.vocabulary.design import KEY_OF, MODULUS_OF, PARTS, HandDesign, field_changes
 from softhand.reduced.vocabulary.design_rules import in_bounds, is_number
 from softhand.reduced.vocabulary.errors import InputError, Note
@@ -32,7 +50,7 @@ def _material_changes(part: str, table, source: str, values: dict) -> dict:
     if not isinstance(model, str):
         raise InputError(f"{source}: {part}.material.model", model,
                          f"must be one of {', '.join(rubber.MODELS)}")
-    material = rubber.from_parameters(model, params, source=f"{source}: {part}.material")
+    material = rubber_parameters.from_parameters(model, params, source=f"{source}: {part}.material")
     name = MODULUS_OF[part]
     given = values.get(KEY_OF[name])
     if given is not None:  # overridden, but still a value of the file: a bad one is bad input

@@ -7,7 +7,7 @@ import math
 
 from softhand.reduced.vocabulary.errors import InputError
 
-__all__ = ["BOUNDS", "CONSISTENCY", "check_model", "in_bounds", "is_number"]
+__all__ = ["BOUNDS", "CONSISTENCY", "check_hinges", "check_layout", "check_model", "in_bounds", "is_number"]
 
 
 #: public key -> (lowest, highest) allowed value, both included, in the key's unit. Every
@@ -60,6 +60,38 @@ def _ties_fit_links(design: "HandDesign") -> None:
 
 #: checks between fields, run after the bounds; each raises InputError naming one field
 CONSISTENCY = (_tube_fits, _sheet_thinner_than_radius, _ties_fit_links)
+
+
+def check_hinges(design: "HandDesign") -> None:
+    """The counts n and n_s whole numbers, and n_s hinge positions, finite and strictly
+    increasing within (0, l0)."""
+    for name in ("n", "n_s"):
+        value = getattr(design, name)
+        if isinstance(value, bool) or not isinstance(value, int):
+            raise InputError(name, value, "must be a whole number")
+    if len(design.hinge_s) != design.n_s:
+        raise InputError("hinge_s_mm", list(design.hinge_s),
+                         f"must have n_s = {design.n_s} values")
+    s = (0.0, *design.hinge_s, design.l0)
+    if not all(isinstance(v, (int, float)) and math.isfinite(v) for v in s) \
+            or any(not s1 > s0 for s0, s1 in zip(s, s[1:])):  # nan compares false both ways
+        raise InputError("hinge_s_mm", list(design.hinge_s),
+                         f"must be finite and increase strictly within (0, l0 = {design.l0:g}) mm")
+
+
+def check_layout(design: "HandDesign") -> None:
+    """The hand layout's fields: n distinct finite azimuths (or none), a pad width >= 0."""
+    az = design.finger_azimuths
+    if az:
+        turns = sorted(a % (2.0 * math.pi) for a in az) if all(math.isfinite(a) for a in az) else None
+        if len(az) != design.n or turns is None or any(b - a < 1e-9 for a, b in zip(turns, turns[1:])) \
+                or (len(turns) > 1 and turns[0] + 2.0 * math.pi - turns[-1] < 1e-9):
+            raise InputError("finger_azimuths_deg", [round(math.degrees(a), 9) for a in az],
+                             f"must be n = {design.n} distinct finite angles [deg] (or left out: evenly spaced)")
+    if not (isinstance(design.pad_width, (int, float)) and math.isfinite(design.pad_width)
+            and 0.0 <= design.pad_width <= 1000.0):
+        raise InputError("pad_width_mm", design.pad_width, "must be a number in [0, 1000] mm "
+                                                           "(0: the tube's outer diameter)")
 
 
 def check_model(field: str, name: str, models, neo_hookean: bool, part: str, body: str,

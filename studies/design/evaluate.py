@@ -42,7 +42,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from softhand.reduced.calibrated import finger_fem, grasp_hold, reservoir_fem
+from softhand.reduced.calibrated import finger_fem, grasp_hold, grasp_hold_solve, reservoir_fem
 from softhand.reduced.equations import contact, finger, grasp, hand, reservoir
 from softhand.reduced.vocabulary.design import HandDesign, hinges_for
 from softhand.reduced.vocabulary.design_files import design_from_dict
@@ -293,7 +293,7 @@ class GraspRelation(NamedTuple):
     F_at_limit: float  #: F_v at the pump limit (or at P_margin, see edge) [N]; nan: not asked (see grasp_relation)
     theta_hold: float  #: the finger's bend when it presses with the required F_v [rad]
     P_margin: float    #: the pump pressure of F_at_limit: the limit, or where the FEM-informed grasp ends [MPa]
-    edge: str = ""     #: why P_margin is below the limit (:attr:`softhand.reduced.calibrated.grasp_hold.Hold.edge`), or ""
+    edge: str = ""     #: why P_margin is below the limit (:attr:`softhand.reduced.calibrated.grasp_hold_solve.Hold.edge`), or ""
     no_grasp: str = ""  #: why P_grasp is inf (the required F_v not reached by the FEM-informed grasp), or ""
     F_reached: float = math.nan  #: with no_grasp: F_v where the FEM-informed grasp ends (how far it comes) [N]
 
@@ -337,13 +337,13 @@ def _fem_relation(design: HandDesign, task: Task, theta: float, theta_open: floa
     no_grasp, F_reached = "", math.nan
     try:
         held = grasp_hold.hold(design, task.diameter, task.mass, "F_v", F_req) if F_req > 0.0 else \
-            grasp_hold.Hold(math.nan, P_contact, 0.0, theta, -1, True)
+            grasp_hold_solve.Hold(math.nan, P_contact, 0.0, theta, -1, True)
     except grasp_hold.NotReached as refused:  # F_req beyond what the finger gives: no P_grasp, the rest stands
-        held, no_grasp = grasp_hold.Hold(math.nan, math.inf, math.nan, theta, -1, False), refused.allowed
+        held, no_grasp = grasp_hold_solve.Hold(math.nan, math.inf, math.nan, theta, -1, False), refused.allowed
         F_reached = refused.reached.F_v
     F_lim, P_margin, edge = math.nan, task.max_pressure, ""
     if asks_force_at_limit(design, task):
-        at = grasp_hold.Hold(math.nan, task.max_pressure, 0.0, theta, -1, True) \
+        at = grasp_hold_solve.Hold(math.nan, task.max_pressure, 0.0, theta, -1, True) \
             if task.max_pressure <= P_contact else \
             grasp_hold.at_pump(design, task.diameter, task.mass, task.max_pressure)
         F_lim, P_margin, edge = at.F_v, at.P_pump, at.edge

@@ -18,7 +18,7 @@ import math
 import numpy as np
 
 from softhand.reduced.equations import finger, hand, reservoir
-from softhand.reduced.holding import hold, hold_fast
+from softhand.reduced.holding import hold, hold_closing, hold_fast
 from softhand.reduced.vocabulary.design import HandDesign
 from softhand.reduced.vocabulary.errors import InputError
 from softhand.reduced.holding.hand_layout import place_object
@@ -105,7 +105,7 @@ def _touch(d: HandDesign, placed) -> float:
 
 
 def _first_bend(i, theta_free, placed, d):
-    q = hold_fast.first_touch(i, theta_free, placed, d)
+    q = hold_closing.first_touch(i, theta_free, placed, d)
     return None if q is None else float(np.sum(q))
 
 

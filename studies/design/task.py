@@ -211,7 +211,8 @@ def _hold_object(obj: dict, hold: dict, folder: Path):
     task when [object] has more than today's diameter and mass, or [hold] is given."""
     if set(obj) <= {"diameter_mm", "mass_kg"} and not hold:
         return None, None, {}
-    from softhand.reduced.holding.objects import object_from_table, place
+    from softhand.reduced.holding.object_geometry import place
+    from softhand.reduced.holding.objects import object_from_table
 
     if "mass_kg" not in obj:
         raise InputError("object.mass_kg", None, "is required")

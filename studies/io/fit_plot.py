@@ -7,7 +7,7 @@ import numpy as np
 
 from softhand.reduced.fitting.csvdata import Measurements
 from softhand.reduced.vocabulary.design_files import design_from_dict
-from softhand.reduced.fitting.fit import FitResult
+from softhand.reduced.fitting.fit_result import FitResult
 from softhand.studies.io.files import save_figure
 
 

@@ -5,8 +5,8 @@ import math
 import numpy as np
 import pytest
 
-from softhand.reduced.calibrated import grasp_fem, grasp_hold
-from softhand.reduced.equations import hand
+from softhand.reduced.calibrated import grasp_fem, grasp_hold, grasp_hold_end, grasp_hold_fast, grasp_hold_solve
+from softhand.reduced.equations import hand, kinematics
 from softhand.reduced.vocabulary.design import HandDesign
 
 PAPER = grasp_fem.fem_finger(HandDesign(reservoir_model="fem"))
@@ -37,7 +37,7 @@ def _count_states(monkeypatch) -> list:
 @pytest.mark.parametrize("target", ["F_v", "P_pump"])
 def test_fast_path_equals_the_slow_path(design, diameter, mass, F_v, P_pump, target):
     value = F_v if target == "F_v" else P_pump
-    fast = grasp_hold.fast_hold(design, diameter, mass, target, value)
+    fast = grasp_hold_fast.fast_hold(design, diameter, mass, target, value)
     slow = grasp_hold.slow_hold(design, diameter, mass, target, value)
     assert fast is not None and fast.fast and not slow.fast
     assert fast.link == slow.link
@@ -47,7 +47,7 @@ def test_fast_path_equals_the_slow_path(design, diameter, mass, F_v, P_pump, tar
 
 @pytest.mark.parametrize("design, diameter, mass, F_v, P_pump", CASES)
 def test_the_fast_state_is_grasp_states_at_its_pressure(design, diameter, mass, F_v, P_pump):
-    h = grasp_hold.fast_hold(design, diameter, mass, "F_v", 0.8 * F_v)
+    h = grasp_hold_fast.fast_hold(design, diameter, mass, "F_v", 0.8 * F_v)
     s = grasp_fem.grasp_state(design, diameter, h.P_cavity, mass)
     assert s.link == h.link
     assert s.F_v == pytest.approx(0.8 * F_v, rel=1e-9)
@@ -67,8 +67,8 @@ def test_pump_pressure_and_force_are_inverse():
 
 
 def test_hold_falls_back_to_the_slow_path(monkeypatch):
-    expected = grasp_hold.fast_hold(PAPER, 180.0, 2.0, "F_v", 9.80665)
-    monkeypatch.setattr(grasp_hold, "fast_hold", lambda *a, **k: None)
+    expected = grasp_hold_fast.fast_hold(PAPER, 180.0, 2.0, "F_v", 9.80665)
+    monkeypatch.setattr(grasp_hold_fast, "fast_hold", lambda *a, **k: None)
     h = grasp_hold.hold(PAPER, 180.0, 2.0, "F_v", 9.80665)
     assert not h.fast and h.P_pump == pytest.approx(expected.P_pump, rel=1e-10)
 
@@ -78,9 +78,9 @@ def test_the_equations_at_a_batch_are_those_of_each_state():
     depth = 104.14135964771822
     Z = np.array([[0.02, 0.03, 0.04, 5.0, 0.7], [0.03, 0.02, 0.05, 8.0, 0.9]])
     args = (2, depth, 90.0, 2.0 * PAPER.g / PAPER.n, "F_v", 9.0, PAPER, True)
-    batch, F = grasp_hold._residuals(Z, *args)
+    batch, F = grasp_hold_solve._residuals(Z, *args)
     for i in range(2):
-        one, F1 = grasp_hold._residuals(Z[i:i + 1], *args)
+        one, F1 = grasp_hold_solve._residuals(Z[i:i + 1], *args)
         np.testing.assert_allclose(batch[i], one[0], rtol=1e-14)
     # the moment of hinge 1 against grasp_fem's own hinge moment and lever (pad 2 at its closest point)
     q = np.array([0.02, 0.03, 0.04, 0.04, 0.04])
@@ -121,7 +121,7 @@ def test_a_pump_pressure_far_above_contact_is_found_by_the_fast_path():
     """Newton starts at the pump's pressure (plus the reservoir's at contact), not just past
     contact, from where it failed (the slow path's 14 equilibria then): the same state as the
     slow path."""
-    fast = grasp_hold.fast_hold(TIP_HOLD, 230.0, 3.5, "P_pump", 3.5)
+    fast = grasp_hold_fast.fast_hold(TIP_HOLD, 230.0, 3.5, "P_pump", 3.5)
     slow = grasp_hold.slow_hold(TIP_HOLD, 230.0, 3.5, "P_pump", 3.5)
     assert fast is not None and fast.link == slow.link == 5
     _same_hold(fast, slow)
@@ -133,11 +133,11 @@ def test_both_paths_stop_where_the_free_finger_has_no_pressure():
     on, gives no answer there either (it gave F_v = 93 N at 4.5 MPa)."""
     from softhand.reduced.vocabulary.errors import InputError
 
-    top = grasp_hold._largest_pressure(TIP_HOLD)
+    top = grasp_hold_solve.largest_pressure(TIP_HOLD)
     assert 3.9 < top < 4.1
     with pytest.raises(InputError):
         grasp_fem.grasp_state(TIP_HOLD, 230.0, top + 0.1, 3.5)
-    assert grasp_hold.fast_hold(TIP_HOLD, 230.0, 3.5, "P_pump", 4.5) is None
+    assert grasp_hold_fast.fast_hold(TIP_HOLD, 230.0, 3.5, "P_pump", 4.5) is None
     with pytest.raises(InputError, match="not reached"):
         grasp_hold.hold(TIP_HOLD, 230.0, 3.5, "P_pump", 4.5)
 
@@ -149,7 +149,7 @@ def test_a_fast_iterate_outside_the_models_does_not_end_the_hold(monkeypatch):
     from softhand.reduced.vocabulary.errors import InputError
 
     design = PAPER.replace(a=5.2, b=5.3, d=17.9, R=27.5, t=1.1, V0=5600.0, tie_width=14.1, l0=180.0)
-    raised, newton = [], grasp_hold._newton
+    raised, newton = [], grasp_hold_solve._newton
 
     def watched(*args, **kwargs):
         try:
@@ -158,8 +158,8 @@ def test_a_fast_iterate_outside_the_models_does_not_end_the_hold(monkeypatch):
             raised.append(err)
             raise
 
-    monkeypatch.setattr(grasp_hold, "_newton", watched)
-    held = grasp_hold.fast_hold(design, 230.0, 3.5, "P_pump", 3.5)
+    monkeypatch.setattr(grasp_hold_solve, "_newton", watched)
+    held = grasp_hold_fast.fast_hold(design, 230.0, 3.5, "P_pump", 3.5)
     assert raised and held is not None and held.link == 5
     slow = grasp_hold.slow_hold(design, 230.0, 3.5, "P_pump", 3.5)
     _same_hold(held, slow)
@@ -169,7 +169,7 @@ def _found_on_a_later_pad(monkeypatch, design, diameter, mass, P_pump, link):
     """fast_hold's answer at P_pump on pad ``link`` (not the first face): checked by one
     grasp_state, and the slow path's state."""
     calls = _count_states(monkeypatch)
-    held = grasp_hold.fast_hold(design, diameter, mass, "P_pump", P_pump)
+    held = grasp_hold_fast.fast_hold(design, diameter, mass, "P_pump", P_pump)
     assert held is not None and held.link == link and len(calls) == 1
     _same_hold(held, grasp_hold.slow_hold(design, diameter, mass, "P_pump", P_pump))
     return held
@@ -189,7 +189,7 @@ def test_a_force_on_a_later_pad_is_the_slow_paths_root(monkeypatch):
     root is kept only if F_v is below 30 N at every point of the slow path's grid below it
     (here 5 states, then its check): the slow path's state, 60 states fewer."""
     calls = _count_states(monkeypatch)
-    fast = grasp_hold.fast_hold(PAPER, 180.0, 1.0, "F_v", 30.0)
+    fast = grasp_hold_fast.fast_hold(PAPER, 180.0, 1.0, "F_v", 30.0)
     assert fast is not None and fast.link == 3 and len(calls) <= 8
     slow = grasp_hold.slow_hold(PAPER, 180.0, 1.0, "F_v", 30.0)
     assert slow.link == 3 and len(calls) > 20
@@ -215,7 +215,7 @@ def test_a_pump_pressure_beyond_the_one_pad_region_is_refused_at_once(monkeypatc
             s = state(PAPER, 180.0, P, 1.0)
         except InputError:
             break
-        reached.append(P - float(grasp_hold.reservoir_pressure(s.theta, PAPER)))
+        reached.append(P - float(grasp_hold_solve.reservoir_pressure(s.theta, PAPER)))
     assert 1.5 < len(reached) * 0.05 and max(reached) < 4.0
 
 
@@ -240,7 +240,7 @@ def test_the_one_pad_model_ends_where_a_second_pad_touches(monkeypatch):
     just touching the object, at the pressure a bisection on grasp_state's having a state finds;
     the scan-and-bisect route (the fast route's solve switched off) gives the same end."""
     held = grasp_hold.at_pump(PAPER, 180.0, 1.0, 4.0)
-    assert held.edge == grasp_hold.ONE_PAD_END and held.P_pump < 4.0 and held.fast
+    assert held.edge == grasp_hold_solve.ONE_PAD_END and held.P_pump < 4.0 and held.fast
     # grasp_state admits 1e-6 mm of another pad in the object: ~1e-7 MPa past the exact end
     edge = _existence_edge(PAPER, 180.0, 1.0, 2.0, 4.0)
     assert held.P_cavity == pytest.approx(edge, abs=2e-7)
@@ -249,10 +249,10 @@ def test_the_one_pad_model_ends_where_a_second_pad_touches(monkeypatch):
     gaps = grasp_hold.contact.pad_gaps(s.q, (0.0, s.depth), 90.0, grasp_fem.fem_finger(PAPER))
     gaps[s.link] = np.inf
     assert np.min(np.abs(gaps)) < 1e-8  # the second pad, at the object
-    assert held.P_pump == pytest.approx(held.P_cavity - float(grasp_hold.reservoir_pressure(s.theta, PAPER)))
-    slow = grasp_hold.one_pad_end(PAPER, 180.0, 1.0)  # no pump pressure to start from: the scan
+    assert held.P_pump == pytest.approx(held.P_cavity - float(grasp_hold_solve.reservoir_pressure(s.theta, PAPER)))
+    slow = grasp_hold_end.one_pad_end(PAPER, 180.0, 1.0)  # no pump pressure to start from: the scan
     assert slow.edge == held.edge and slow.P_cavity == pytest.approx(held.P_cavity, abs=1e-12)
-    monkeypatch.setattr(grasp_hold, "_end_on_pad", lambda *a, **k: None)
+    monkeypatch.setattr(grasp_hold_end, "_end_on_pad", lambda *a, **k: None)
     bisected = grasp_hold.at_pump(PAPER, 180.0, 1.0, 4.0)
     assert not bisected.fast and bisected.P_cavity == pytest.approx(edge, abs=1e-8)
     assert bisected.F_v == pytest.approx(held.F_v, rel=1e-6)
@@ -261,9 +261,9 @@ def test_the_one_pad_model_ends_where_a_second_pad_touches(monkeypatch):
 def test_the_one_pad_model_ends_at_the_calibrated_fingers_highest_pressure():
     """A big object held at the tip: one pad holds it up to the free finger's pressure at its
     largest bend (the finger model's highest), below the 4.5 MPa asked: the grasp there."""
-    top = grasp_hold._largest_pressure(TIP_HOLD)
+    top = grasp_hold_solve.largest_pressure(TIP_HOLD)
     held = grasp_hold.at_pump(TIP_HOLD, 230.0, 3.5, 4.5)
-    assert held.edge == grasp_hold.LARGEST_BEND and held.P_cavity == top and held.P_pump < 4.5
+    assert held.edge == grasp_hold_solve.LARGEST_BEND and held.P_cavity == top and held.P_pump < 4.5
     assert held.F_v == grasp_fem.grasp_state(TIP_HOLD, 230.0, top, 3.5).F_v
 
 
@@ -285,7 +285,7 @@ def test_a_pump_pressure_held_at_a_pads_far_end_is_found_by_the_fast_path(monkey
     s = state(design, 150.0, held.P_cavity, 1.0)
     gaps = grasp_hold.contact.pad_gaps(s.q, (0.0, s.depth), 75.0, design)
     assert gaps[3] < -0.1 and gaps[4] < -0.1  # the corner: both faces inside, the hinge on the circle
-    assert np.linalg.norm(s.point - grasp_hold.kinematics.joint_positions(s.q, design)[4]) < 1e-12
+    assert np.linalg.norm(s.point - kinematics.joint_positions(s.q, design)[4]) < 1e-12
 
 
 def test_a_reservoir_pressure_below_zero_does_not_hide_the_pump_pressure():
@@ -297,7 +297,7 @@ def test_a_reservoir_pressure_below_zero_does_not_hide_the_pump_pressure():
                            l0=155.3523, hinge_s=tuple(s * 155.3523 / PAPER.l0 for s in PAPER.hinge_s))
     slow = grasp_hold.slow_hold(design, 230.0, 3.5, "P_pump", 3.5)
     assert slow.P_cavity < 3.5 and slow.P_pump == pytest.approx(3.5, abs=1e-12)
-    fast = grasp_hold.fast_hold(design, 230.0, 3.5, "P_pump", 3.5)
+    fast = grasp_hold_fast.fast_hold(design, 230.0, 3.5, "P_pump", 3.5)
     _same_hold(fast, slow)
 
 
@@ -314,11 +314,11 @@ def test_a_pump_pressure_at_a_snap_is_the_state_just_below_it(monkeypatch, a, d,
     design = PAPER.replace(a=a, d=d, l0=l0, hinge_s=tuple(s * l0 / PAPER.l0 for s in PAPER.hinge_s))
     state = grasp_fem.grasp_state
     calls = _count_states(monkeypatch)
-    held = grasp_hold.fast_hold(design, 150.0, 1.0, "P_pump", 1.5)
+    held = grasp_hold_fast.fast_hold(design, 150.0, 1.0, "P_pump", 1.5)
     assert held is not None and held.link == 3 and len(calls) <= 4
     assert 1.5 - 2e-4 < held.P_pump < 1.5
     above = state(design, 150.0, held.P_cavity + 1e-6, 1.0)
-    assert above.P - float(grasp_hold.reservoir_pressure(above.theta, design)) > 1.5
+    assert above.P - float(grasp_hold_solve.reservoir_pressure(above.theta, design)) > 1.5
     slow = grasp_hold.slow_hold(design, 150.0, 1.0, "P_pump", 1.5)
     assert slow.P_cavity == pytest.approx(held.P_cavity, abs=1e-6)
     assert slow.F_v == pytest.approx(held.F_v, rel=1e-5)
@@ -332,7 +332,7 @@ def test_a_later_pads_force_is_the_first_root_where_the_root_finder_took_a_secon
     F_v stays below the asked force on a fine scan up to it."""
     design = PAPER.replace(b=3.13164975, V0=15384.3122, R=20.0, mu_sf=1.5, mu_sr=1.5)
     F_v = 17.3549875
-    fast = grasp_hold.fast_hold(design, 200.0, 3.0, "F_v", F_v)
+    fast = grasp_hold_fast.fast_hold(design, 200.0, 3.0, "F_v", F_v)
     slow = grasp_hold.slow_hold(design, 200.0, 3.0, "F_v", F_v)
     assert fast is not None and fast.link == slow.link == 3
     assert fast.P_cavity == pytest.approx(0.9701, abs=1e-3) and slow.P_cavity == pytest.approx(1.0788, abs=1e-3)

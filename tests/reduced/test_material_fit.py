@@ -5,6 +5,7 @@ import numpy as np
 import pytest
 
 from softhand.reduced.materials import material_fit as mf
+from softhand.reduced.materials import stress_data as sd
 from softhand.reduced.materials import rubber
 from softhand.studies.cli.main import main
 
@@ -23,9 +24,9 @@ def synthetic(material, sigma, seed=3):
            "pure-shear": np.linspace(1.1, 4.5, 15)}
     mode = np.concatenate([[m] * len(v) for m, v in lam.items()])
     stretch = np.concatenate(list(lam.values()))
-    clean = mf.StressData(mode, stretch, np.zeros_like(stretch)).predict(material)
+    clean = sd.StressData(mode, stretch, np.zeros_like(stretch)).predict(material)
     noise = sigma * np.random.default_rng(seed).standard_normal(stretch.size)
-    return mf.StressData(mode, stretch, clean + noise)
+    return sd.StressData(mode, stretch, clean + noise)
 
 
 @pytest.mark.parametrize("name", list(TRUTH))
@@ -50,7 +51,7 @@ def test_noise_free_data_give_the_parameters_back_within_the_errors(name):
 def test_column_and_mode_aliases(tmp_path):
     path = tmp_path / "d.csv"
     path.write_text("# comment\nlambda,nominal_stress_MPa,mode\n1.5,0.6,biaxial\n2.0,0.8,planar\n")
-    data = mf.read_test_data(path)
+    data = sd.read_test_data(path)
     assert list(data.mode) == ["equibiaxial", "pure-shear"] and list(data.stretch) == [1.5, 2.0]
 
 
@@ -105,7 +106,7 @@ def test_treloar_data_agree_with_ogdens_1972_parameters():
     within 0.06 MPa, the size of its two-decimal rounding plus the fit's own error)."""
     g = 0.0980665
     ogden = rubber.Ogden((6.3 * g, 0.012 * g, -0.1 * g), (1.3, 5.0, -2.0))
-    data = mf.read_test_data("studies/data/treloar1944.csv")
+    data = sd.read_test_data("studies/data/treloar1944.csv")
     gap = np.abs(data.predict(ogden) - data.stress)
     assert gap[data.stretch <= 7.0].max() < 0.15
     assert gap[data.mode == "pure-shear"].max() < 0.06
@@ -143,7 +144,7 @@ def test_a_stretch_no_rubber_test_gives_is_refused(tmp_path, capsys, stretch, mo
     """Was: SVD did not converge (exit 1), All-NaN slice (yeoh, 1e-5), Gent's bounds error."""
     _refused(tmp_path, capsys, _with(("uniaxial", stretch, 0.203 if stretch > 1 else -0.2)), model,
              "line 2, column stretch = ")
-    assert "[0.01, 100]" in str(pytest.raises(mf.InputError, mf.check_data, mf.StressData(
+    assert "[0.01, 100]" in str(pytest.raises(mf.InputError, sd.check_data, sd.StressData(
         np.array(["uniaxial"]), np.array([stretch]), np.array([0.1]))).value)
 
 
@@ -195,7 +196,7 @@ def test_one_stretch_is_enough_for_one_parameter(tmp_path, capsys):
 
 
 def test_data_built_in_code_are_checked_by_row():
-    data = mf.StressData(np.array(["uniaxial"] * 7), np.array([l for _, l, _ in GOOD]),
+    data = sd.StressData(np.array(["uniaxial"] * 7), np.array([l for _, l, _ in GOOD]),
                          np.array([s for _, _, s in GOOD]) * np.array([1, 1, -1, 1, 1, 1, 1]))
     with pytest.raises(mf.InputError, match=r"data: row 3, column stress_MPa"):
         mf.fit_material(data, "yeoh")
@@ -210,7 +211,7 @@ def test_a_failing_solver_is_one_line_never_a_traceback_or_nan(tmp_path, capsys,
     def broken(*args):
         if failure == "linalg":
             raise np.linalg.LinAlgError("SVD did not converge in Linear Least Squares")
-        k = len(mf.model_residual_fn(model, mf.StressData(np.array([]), np.array([]), np.array([])))[0])
+        k = len(mf.model_residual_fn(model, sd.StressData(np.array([]), np.array([]), np.array([])))[0])
         x = np.full(k, np.nan)
         return x if solver == "_linear_fit" else (x, np.full(k, -np.inf), np.full(k, np.inf))
 

@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from softhand.reduced.equations import contact
-from softhand.reduced.holding import hand_layout, objects
+from softhand.reduced.holding import hand_layout, object_geometry, objects
 from softhand.reduced.vocabulary.design import HandDesign
 from softhand.reduced.vocabulary.design_files import design_from_dict
 from softhand.reduced.vocabulary.errors import InputError
@@ -42,17 +42,17 @@ def test_primitive_distances_closed_form():
     """Signed distances of the primitives at points whose distance is known by hand."""
     p = np.array([[0, 0, 0], [100, 0, 0], [0, 130, 0], [50, 120, 0]], float)
     box = objects.GraspObject(shape="box", size_mm=(80, 60, 100))
-    assert np.allclose(objects.local_sdf(box, p), [-30, 60, 100, math.hypot(10, 90)])
+    assert np.allclose(object_geometry.local_sdf(box, p), [-30, 60, 100, math.hypot(10, 90)])
     cyl = objects.GraspObject(shape="cylinder", diameter_mm=100, length_mm=200)
-    assert np.allclose(objects.local_sdf(cyl, p), [-50, 50, 30, math.hypot(0, 20)])
+    assert np.allclose(object_geometry.local_sdf(cyl, p), [-50, 50, 30, math.hypot(0, 20)])
     cap = objects.GraspObject(shape="capsule", diameter_mm=100, length_mm=200)
-    assert np.allclose(objects.local_sdf(cap, p), [-50, 50, 130 - 100, math.hypot(50, 70) - 50])
+    assert np.allclose(object_geometry.local_sdf(cap, p), [-50, 50, 130 - 100, math.hypot(50, 70) - 50])
 
 
 def test_rotation_and_normal():
     """A box turned 90 deg about z swaps its x and y edges; the normal is the face's."""
     box = objects.GraspObject(shape="box", size_mm=(80, 20, 20), rotation_deg=(0, 0, 90))
-    placed = objects.place(box, (0, 50, 0))
+    placed = object_geometry.place(box, (0, 50, 0))
     assert placed.sdf(np.array([0, 50 - 41, 0])) == pytest.approx(1.0)
     assert np.allclose(placed.normal(np.array([0, 50 - 41, 0])), [0, -1, 0], atol=1e-9)
 
@@ -76,7 +76,7 @@ def test_sampled_pad_distance_is_close_to_exact_for_a_cylinder():
     O(h^3) error at h = 1/32 of a 30 mm link on a 50 mm radius."""
     d = HandDesign()
     cyl = objects.object_from_short("cylinder:100x300")
-    placed = objects.place(cyl, (0, 170, 0))
+    placed = object_geometry.place(cyl, (0, 170, 0))
     q = np.tile(np.full(d.n_s, 0.15), (d.n, 1))
     p = hand_layout.pads(q, d)
     pd = hand_layout.pad_distance(placed, p)
@@ -124,7 +124,7 @@ def test_mesh_reading_distance_and_checks(tmp_path):
     exact = np.linalg.norm(pts, axis=1) - 60.0
     # sag of a facet on r = 60: ~0.07 mm; trilinear interpolation of a curved field on a 3.1 mm
     # grid: ~0.1 mm near the surface (away from the kink at the centre)
-    assert np.allclose(objects.local_sdf(obj, pts), exact, atol=0.25)
+    assert np.allclose(object_geometry.local_sdf(obj, pts), exact, atol=0.25)
     open_mesh = ball.copy()
     open_mesh.update_faces(np.arange(len(ball.faces) - 1))
     with pytest.raises(InputError, match="not closed"):

@@ -172,10 +172,10 @@ def test_the_one_pad_grasp_ends_where_the_grasp_fem_touches_with_a_second_pad(da
     """The paper's hand on 180 mm at 1 kg: the grasp FEM holds the object with pad 3 alone up to
     2.8 MPa and touches it with the tip pad 5 too from 2.9 MPa on (stored states); the
     low-pressure task's optimum at a 4 MPa pump: pad 3 alone up to 3.55 MPa, the tip pad too
-    from 3.6 MPa. The reduced model's end of the one-pad grasp (reduced.calibrated.grasp_hold.one_pad_end)
+    from 3.6 MPa. The reduced model's end of the one-pad grasp (reduced.calibrated.grasp_hold_end.one_pad_end)
     lies between, on the FEM's holding pad, with the FEM's second pad the one touching, and its
     F_v within 10 % of the FEM's there."""
-    from softhand.reduced.calibrated import grasp_hold
+    from softhand.reduced.calibrated import grasp_hold_end
     from softhand.reduced.vocabulary.design_files import design_from_dict
 
     design = grasp_fem.fem_finger(design_from_dict(data["design"], DESIGN, source="stored")) \
@@ -186,7 +186,7 @@ def test_the_one_pad_grasp_ends_where_the_grasp_fem_touches_with_a_second_pad(da
     assert one and two and max(one) < min(two)
     holding = {int(np.argmax(r["contact_force_N"])) for r in rows}
     second = {i for r in rows for i in np.flatnonzero(r["contact_force_N"]) if i not in holding}
-    end = grasp_hold.one_pad_end(design, data["diameter_mm"], data["mass_kg"])
+    end = grasp_hold_end.one_pad_end(design, data["diameter_mm"], data["mass_kg"])
     assert max(one) < end.P_cavity < min(two) and {end.link} == holding
     s = grasp_fem.grasp_state(design, data["diameter_mm"], end.P_cavity, data["mass_kg"])
     gaps = contact.pad_gaps(s.q, (0.0, s.depth), 0.5 * data["diameter_mm"], design)

@@ -552,14 +552,14 @@ def test_a_margin_beyond_the_one_pad_grasp_is_measured_where_it_ends():
     """A 4 MPa pump on the paper's object at 1 kg: a second pad touches it near 2.8 MPa, where the
     FEM-informed grasp ends. The margin is F_v there (reduced.calibrated.grasp_hold.at_pump), flagged, not
     -inf (every such design was infeasible), and F_v at the pump limit is not claimed."""
-    from softhand.reduced.calibrated import grasp_hold
+    from softhand.reduced.calibrated import grasp_hold, grasp_hold_solve
 
     task = task_from_dict({**CI_TASK, "object": {"diameter_mm": 180.0, "mass_kg": 1.0},
                            "grasp": {"force_factor": 2.0, "objective": "margin"},
                            "pump": {"max_pressure_MPa": 4.0}})
     ev = design_opt.evaluate(task.base, task)
     end = grasp_hold.at_pump(task.base, 180.0, 1.0, 4.0)
-    assert end.edge == grasp_hold.ONE_PAD_END and 2.0 < end.P_pump < 4.0
+    assert end.edge == grasp_hold_solve.ONE_PAD_END and 2.0 < end.P_pump < 4.0
     assert (ev.margin_edge, ev.P_margin, ev.F_v_at_limit) == (end.edge, end.P_pump, end.F_v)
     predicted = json.loads(json.dumps(ev.predicted()))
     assert predicted["F_v_at_pump_limit_N"] is None
@@ -591,9 +591,9 @@ def test_a_force_one_pad_cannot_give_leaves_the_rest_of_the_evaluation_standing(
     assert "no bend opens" not in report
     # the optimiser sees how far short of F_v the finger comes (F_v where one pad stops holding
     # the object alone), not the -1e3 of a design the model has no answer for
-    from softhand.reduced.calibrated import grasp_hold
+    from softhand.reduced.calibrated import grasp_hold_end
 
-    end = grasp_hold.one_pad_end(task.base, 180.0, 20.0)
+    end = grasp_hold_end.one_pad_end(task.base, 180.0, 20.0)
     pump = next(c for c in ev.constraints if c.name.startswith("pump_pressure"))
     assert pump.slack == pytest.approx(-1.0 - (1.0 - end.F_v / ev.F_v), rel=1e-6)
     assert -2.0 < pump.slack < -1.0 and not pump.satisfied

@@ -44,7 +44,8 @@ def configure(parser) -> None:
 
 
 def run(args) -> int:
-    from softhand.reduced.materials.material_fit import fit_material, read_test_data
+    from softhand.reduced.materials.material_fit import fit_material
+    from softhand.reduced.materials.stress_data import read_test_data
     from softhand.reduced.materials.rubber import drucker_check
 
     data = read_test_data(args.data)
@@ -75,7 +76,7 @@ def run(args) -> int:
 
 def _stretch_range(text, data) -> tuple[float, float]:
     """``--stability-range`` LO:HI within the stretches of rubber tests (default: the data's)."""
-    from softhand.reduced.materials.material_fit import STRETCH_LIMITS
+    from softhand.reduced.materials.stress_data import STRETCH_LIMITS
 
     if text is None:
         top = float(np.max(np.maximum(data.stretch, 1.0 / data.stretch)))

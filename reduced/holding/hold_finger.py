@@ -1,0 +1,67 @@
+"""One finger in the fast hold (:mod:`softhand.reduced.holding.hold_fast`): its hinge moments
+and energy for the hold's finger models, and its pads against the object (gaps, closest
+points, normals and their rates in the hinge angles). Units: mm, N, MPa, rad.
+"""
+from __future__ import annotations
+
+from typing import NamedTuple
+
+import numpy as np
+
+from softhand.reduced.calibrated import grasp_fem
+from softhand.reduced.equations import finger, hand
+from softhand.reduced.holding import hand_layout
+from softhand.reduced.vocabulary.design import HandDesign
+from softhand.reduced.holding.object_geometry import Placed
+
+#: a pad within this gap [mm] of the object counts as touching
+TOUCH = 1e-6
+#: Gauss points of E's quadrature along each hinge
+_GX, _GW = np.polynomial.legendre.leggauss(16)
+_GX, _GW = 0.5 * (_GX + 1.0), 0.5 * _GW
+
+
+def hinge_moments(q, P, design: HandDesign) -> np.ndarray:
+    """M_j = dE/d theta_hat_j [N mm/rad] (..., n_s) at hinge angles q (..., n_s) [rad], cavity
+    pressure P [MPa], for the design's finger model (:mod:`softhand.reduced.holding.hold_fast`)."""
+    if design.finger_model == "fem":
+        return grasp_fem.hinge_moments(q, P, design)
+    theta = design.n_s * np.asarray(q, float)
+    return -finger.volume_rate(theta, design) * (P - hand.finger_pressure(theta, design))
+
+
+def hinge_energy(q, P, design: HandDesign) -> float:
+    """E = sum_j int_0^q_j M_j [N mm] (16-point Gauss along each hinge; M_j depends on q_j alone)."""
+    q = np.asarray(q, float)
+    M = hinge_moments(_GX[:, None] * q[None, :], P, design)
+    return float(np.sum(_GW[:, None] * M * q[None, :]))
+
+
+class FingerGeometry(NamedTuple):
+    """One finger's pads against the object at hinge angles q."""
+
+    gap: np.ndarray      #: (n_s+1,) [mm]
+    point: np.ndarray    #: (n_s+1, 3)
+    normal: np.ndarray   #: (n_s+1, 3) the object's outward normal
+    dx: np.ndarray       #: (n_s+1, n_s, 3) d point_k / d theta_hat_j [mm/rad]
+    dg: np.ndarray       #: (n_s+1, n_s) d gap_k / d theta_hat_j [mm/rad]
+
+
+def finger_geometry(q, i: int, placed: Placed, design: HandDesign) -> FingerGeometry:
+    """Finger i's pads at hinge angles q (n_s,) or a batch (B, n_s): gaps, closest points,
+    normals and their rates (a batch adds the leading axis B to every array)."""
+    q = np.asarray(q, float)
+    Q = q.reshape(-1, design.n_s)
+    p = hand_layout.pads(Q, design, fingers=[i] * len(Q))
+    pd = hand_layout.pad_distance(placed, p)
+    frames = hand_layout.finger_frames(design)
+    e_out, e_down = frames.e_out[i], frames.e_down[i]
+    x, hinges = pd.point, p.joints[:, 1:-1]                            # (B, k, 3), (B, n_s, 3)
+    r = x[:, :, None, :] - hinges[:, None, :, :]                       # (B, k, j, 3)
+    rx, ry = r @ e_out, r @ e_down
+    dx = -ry[..., None] * e_out + rx[..., None] * e_down               # rotation about hinge j
+    turns = np.arange(1, design.n_s + 1)[None, :] <= np.arange(design.n_s + 1)[:, None]
+    dx = np.where(turns[None, ..., None], dx, 0.0)
+    dg = np.einsum("bkji,bki->bkj", dx, pd.normal)
+    out = FingerGeometry(pd.gap, x, pd.normal, dx, dg)
+    return FingerGeometry(*(v[0] for v in out)) if q.ndim == 1 else out
