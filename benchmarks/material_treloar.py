@@ -10,7 +10,7 @@ from __future__ import annotations
 import time
 from pathlib import Path
 
-from softhand.reduced.materials import rubber
+from softhand.reduced.materials import rubber, rubber_base
 from softhand.reduced.materials.material_fit import FIT_MODELS, fit_material
 from softhand.reduced.materials.stress_data import read_test_data
 from softhand.reduced.materials.rubber import drucker_check
@@ -23,7 +23,7 @@ OGDEN_1972 = rubber.Ogden((6.3 * KGF_CM2, 0.012 * KGF_CM2, -0.1 * KGF_CM2), (1.3
 
 def rms_by_mode(data, material) -> dict:
     r = data.predict(material) - data.stress
-    return {m: float((r[data.mode == m] ** 2).mean() ** 0.5) for m in rubber.MODES}
+    return {m: float((r[data.mode == m] ** 2).mean() ** 0.5) for m in rubber_base.MODES}
 
 
 def main() -> None:
@@ -42,7 +42,7 @@ def main() -> None:
         params = ", ".join(f"{k} {v:.4g}" for k, v in material.parameters().items())
         rms = rms_by_mode(data, material)
         stable = drucker_check(material, (1.0 / top, top))["stable"]
-        print(f"| {name} | {params} | " + " | ".join(f"{rms[m]:.4f}" for m in rubber.MODES)
+        print(f"| {name} | {params} | " + " | ".join(f"{rms[m]:.4f}" for m in rubber_base.MODES)
               + f" | {'yes' if stable else 'no'} | {seconds} |")
 
 

@@ -30,7 +30,8 @@ import numpy as np
 from softhand.fem.axisym import AxisymSolid, RevolvedVolume
 from softhand.fem.hyperelastic import rubber_law
 from softhand.fem.rubber_stretch import Averager
-from softhand.reduced.materials.rubber import NeoHookean, Rubber
+from softhand.reduced.materials.rubber import NeoHookean
+from softhand.reduced.materials.rubber_base import Rubber
 from softhand.fem.volume_path import PathOptions, follow_volume, volume_path_options
 from softhand.meshes.reservoir import sheet_mesh
 

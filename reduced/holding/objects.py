@@ -35,9 +35,8 @@ import numpy as np
 from softhand.reduced.vocabulary.errors import InputError
 from softhand.reduced.holding.object_mesh import MeshData, mesh_sdf, read_mesh, self_intersection
 
-__all__ = ["SHAPES", "KEYS", "GraspObject", "MeshData", "check_object", "object_from_table",
-           "object_from_short", "load_object", "parse_object", "read_mesh", "mesh_sdf", "self_intersection",
-           "rotation_matrix"]
+__all__ = ["SHAPES", "KEYS", "GraspObject", "check_object", "object_from_table", "object_from_short",
+           "load_object", "parse_object", "rotation_matrix"]
 
 SHAPES = ("sphere", "cylinder", "box", "capsule", "mesh")
 #: keys of the ``[object]`` table

@@ -32,7 +32,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import least_squares
 
-from softhand.reduced.materials import rubber, rubber_parameters
+from softhand.reduced.materials import rubber, rubber_base, rubber_parameters
 from softhand.reduced.materials.stress_data import StressData, check_data
 from softhand.reduced.vocabulary.errors import InputError
 from softhand.reduced.fitting.lsq import FitOptions, diagnose, jacobian
@@ -52,7 +52,7 @@ class MaterialFit:
     """A fitted rubber model with its uncertainty and how it matches the data."""
 
     fit_model: str  #: the ``--model`` name (ogden2, ogden3, ...)
-    material: rubber.Rubber
+    material: rubber_base.Rubber
     names: tuple  #: public parameter names
     values: np.ndarray
     stderr: np.ndarray
@@ -63,7 +63,7 @@ class MaterialFit:
 
     def rms_by_mode(self) -> dict:
         return {m: float(np.sqrt(np.mean(self.residuals[self.data.mode == m] ** 2)))
-                for m in rubber.MODES if np.any(self.data.mode == m)}
+                for m in rubber_base.MODES if np.any(self.data.mode == m)}
 
     @property
     def rms(self) -> float:
@@ -213,5 +213,5 @@ def _stretch_triples(data):
     l = np.empty((3, len(data)))
     for m in np.unique(data.mode):
         rows = data.mode == m
-        l[:, rows] = rubber.stretches(m, data.stretch[rows])
+        l[:, rows] = rubber_base.stretches(m, data.stretch[rows])
     return l

@@ -42,8 +42,7 @@ import numpy as np
 
 from softhand.reduced.materials.rubber_base import MODES, InvariantRubber, Rubber, invariants, stretches
 
-__all__ = ["MODES", "Rubber", "InvariantRubber", "invariants", "stretches", "drucker_check", "NeoHookean",
-           "MooneyRivlin", "Yeoh", "Gent", "Ogden", "MODELS"]
+__all__ = ["drucker_check", "NeoHookean", "MooneyRivlin", "Yeoh", "Gent", "Ogden", "MODELS"]
 
 @dataclass(frozen=True)
 class NeoHookean(InvariantRubber):

@@ -21,7 +21,7 @@ from pathlib import Path
 
 import numpy as np
 
-from softhand.reduced.materials import rubber
+from softhand.reduced.materials import rubber_base
 from softhand.reduced.fitting.csvdata import read_rows
 from softhand.reduced.vocabulary.errors import InputError
 from softhand.reduced.vocabulary.inputfiles import plain_float
@@ -56,7 +56,7 @@ class StressData:
     def __len__(self):
         return int(self.stretch.size)
 
-    def predict(self, material: rubber.Rubber) -> np.ndarray:
+    def predict(self, material: rubber_base.Rubber) -> np.ndarray:
         out = np.empty(len(self))
         for m in np.unique(self.mode):
             rows = self.mode == m
@@ -80,7 +80,7 @@ def read_test_data(path) -> StressData:
         name = _MODE_ALIASES.get(cell["mode"].lower())
         if name is None:
             raise InputError(f"{path.name}: line {line}, column mode", cell["mode"],
-                             f"must be one of {', '.join(rubber.MODES)}")
+                             f"must be one of {', '.join(rubber_base.MODES)}")
         mode.append(name)
         lam.append(_number(path.name, line, "stretch", cell["stretch"], positive=True))
         stress.append(_number(path.name, line, "stress_MPa", cell["stress_MPa"]))

@@ -31,7 +31,7 @@ from pathlib import Path
 
 from softhand import reduced as reduced_layer
 
-from softhand.reduced.materials import rubber
+from softhand.reduced.materials import rubber, rubber_base
 from softhand.reduced.vocabulary.design_rules import (BOUNDS, CONSISTENCY, check_hinges, check_layout, check_model,
                                                        in_bounds, is_number)
 from softhand.reduced.vocabulary.errors import InputError
@@ -77,9 +77,9 @@ class HandDesign:
     g: float = 9.80665  #: gravitational acceleration [N/kg]
     reservoir_model: str = "ellipse"  #: reduced reservoir model, one of RESERVOIR_MODELS
     #: finger rubber's strain energy (its shape; scaled to mu_sf); None: Neo-Hookean
-    finger_material: rubber.Rubber | None = None
+    finger_material: rubber_base.Rubber | None = None
     #: reservoir sheet's strain energy (its shape; scaled to mu_sr); None: Neo-Hookean
-    reservoir_material: rubber.Rubber | None = None
+    reservoir_material: rubber_base.Rubber | None = None
     finger_model: str = "paper"  #: reduced finger model (W_f, Q), one of FINGER_MODELS
     #: width of the ring by which each link holds the tube, centred on the link [mm];
     #: not in the paper. The finger FEM ties these rings; finger_model "fem" is calibrated on it
@@ -115,12 +115,12 @@ class HandDesign:
 
     # ------------------------------------------------------------------ derived
     @property
-    def finger_rubber(self) -> rubber.Rubber:
+    def finger_rubber(self) -> rubber_base.Rubber:
         """The finger tube's strain energy, with initial shear modulus mu_sf."""
         return _scaled(self.finger_material, self.mu_sf)
 
     @property
-    def reservoir_rubber(self) -> rubber.Rubber:
+    def reservoir_rubber(self) -> rubber_base.Rubber:
         """The reservoir sheet's strain energy, with initial shear modulus mu_sr."""
         return _scaled(self.reservoir_material, self.mu_sr)
 
@@ -203,7 +203,7 @@ PARTS = ("finger", "reservoir")
 MODULUS_OF = {"finger": "mu_sf", "reservoir": "mu_sr"}
 
 
-def _scaled(material, mu0: float) -> rubber.Rubber:
+def _scaled(material, mu0: float) -> rubber_base.Rubber:
     if material is None:
         return rubber.NeoHookean(mu0)
     return material if material.mu0 == mu0 else material.scaled(mu0 / material.mu0)

@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from softhand.reduced.equations import contact
-from softhand.reduced.holding import hand_layout, object_geometry, objects
+from softhand.reduced.holding import hand_layout, object_geometry, object_mesh, objects
 from softhand.reduced.vocabulary.design import HandDesign
 from softhand.reduced.vocabulary.design_files import design_from_dict
 from softhand.reduced.vocabulary.errors import InputError
@@ -128,12 +128,12 @@ def test_mesh_reading_distance_and_checks(tmp_path):
     open_mesh = ball.copy()
     open_mesh.update_faces(np.arange(len(ball.faces) - 1))
     with pytest.raises(InputError, match="not closed"):
-        objects.read_mesh(_write(open_mesh, tmp_path / "open.stl"))
+        object_mesh.read_mesh(_write(open_mesh, tmp_path / "open.stl"))
     two = trimesh.util.concatenate([ball, ball.copy().apply_translation([23.7, 11.3, 5.1])])
     with pytest.raises(InputError, match="intersects itself"):
-        objects.read_mesh(_write(two, tmp_path / "two.stl"))
+        object_mesh.read_mesh(_write(two, tmp_path / "two.stl"))
     apart = trimesh.util.concatenate([ball, ball.copy().apply_translation([300, 0, 0])])
-    assert objects.self_intersection(apart.vertices, apart.faces) is None
+    assert object_mesh.self_intersection(apart.vertices, apart.faces) is None
 
 
 def test_result_json_round_trip():
