@@ -72,7 +72,7 @@ def test_replace_takes_the_design_files_names_with_its_rules():
 
 
 def test_a_proof_mesh_retried_on_a_finer_one_is_a_note(monkeypatch, capsys):
-    from softhand.studies.design import proof, workflow
+    from softhand.studies.design import proof, proof_sizes, workflow
 
     calls = []
 
@@ -84,7 +84,7 @@ def test_a_proof_mesh_retried_on_a_finer_one_is_a_note(monkeypatch, capsys):
         return {"ok": True}
 
     monkeypatch.setattr(proof, "prove", prove)
-    monkeypatch.setattr(proof, "proof_meshes", lambda design, size: [10.0, 6.0])
+    monkeypatch.setattr(proof_sizes, "proof_meshes", lambda design, size: [10.0, 6.0])
     task = Namespace(mesh_size=10.0, dP=0.05, edge_ratio=1.0)
     said = []
     fem = workflow.prove_on_meshes(Namespace(design=None), task, None, None, said.append)

@@ -88,7 +88,7 @@ def _default_out(task, path) -> Path:
 
 def _check_proof_size(task, args) -> None:
     """A proof mesh too large for this machine: one line now, not after the optimiser's minutes."""
-    from softhand.studies.design.proof import check_proof_size
+    from softhand.studies.design.proof_sizes import check_proof_size
 
     given = args.mesh_size_mm is not None
     size = args.mesh_size_mm if given else task.mesh_size
