@@ -167,7 +167,8 @@ def _fem_hold(args, design, obj, P_cav, P_pump, pull):
 
     from softhand.fem.newton import NotConverged
 
-    from softhand.fem.hand.hold import check_hold, solve_hold
+    from softhand.fem.hand.hold import solve_hold
+    from softhand.fem.hand.hold_options import check_hold
 
     check_hold(design, obj, tuple(pull))  # what the FEM hold refuses: one line, before its bar
     bar = tqdm(desc="hold (FEM)", unit="step", file=sys.stderr, leave=False,
@@ -277,7 +278,7 @@ def _run_map(args, design, obj, pull, max_pump) -> int:
     m = HoldMap(design, obj, x, y, pressure_MPa=pressure if pressure is not None else 0.0, pull=tuple(pull),
                 max_pump_MPa=max_pump, finger_model=args.finger)
     if args.check:  # what the FEM hold refuses, before the map, not after it
-        from softhand.fem.hand.hold import check_hold
+        from softhand.fem.hand.hold_options import check_hold
 
         check_hold(design, obj, tuple(pull))
     bar, update = _bar(not args.no_progress, "hold map")
