@@ -38,7 +38,7 @@ A task designs on the FEM-calibrated models (``finger_model = "fem"``, ``reservo
 "fem"``, :data:`~softhand.studies.design.task.MODELS`) unless its ``[design]`` table names others: those are the models the
 FEM proof checks. With the packaged finger table, the free bounds are clipped to the box the
 table was calibrated on (:data:`CALIBRATED_SPACE`, its ``[space]``); the table's group ranges
-are the optimiser's constraints (:func:`softhand.studies.design.evaluate.calibrated_range`).
+are the optimiser's constraints (:func:`softhand.studies.design.constraints.calibrated_range`).
 Every mistake is one :class:`~softhand.reduced.vocabulary.errors.InputError` naming the key.
 """
 from __future__ import annotations
