@@ -24,7 +24,7 @@ from softhand.studies.cli.main import main
 
 def test_eq25_far_from_the_fem_is_printed_with_why():
     """Within 10 % of the FEM's F_v: no note; beyond it, the ratio and the touching link."""
-    from softhand.studies.weights import NOTE_RTOL, reduced_note
+    from softhand.studies.weights_rows import NOTE_RTOL, reduced_note
 
     d = HandDesign()
     N = np.array([0.0, 0.0, 3.2, 0.0, 0.0, 0.0])  # the object on link 2 of 5
@@ -119,7 +119,7 @@ def test_weights_prints_eq25s_force_under_its_caveat(monkeypatch, capsys):
     from types import SimpleNamespace
 
     from softhand.studies import weights
-    from softhand.studies.weights import reduced_note
+    from softhand.studies.weights_rows import reduced_note
 
     N = [0.0, 0.0, 3.2, 0.0, 0.0, 0.0]
     row = {"diameter_mm": 240.0, "F_v_fem_N": 4.751, "F_v_reduced_N": 87.21, "contact_force_N": N,
