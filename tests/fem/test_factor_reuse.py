@@ -12,7 +12,8 @@ from softhand.fem.assembly import Restriction
 from softhand.fem.linsolve import make_solver
 from softhand.fem.loads import FollowerPressure
 from softhand.fem.materials import NeoHookean
-from softhand.fem.newton import NewtonOptions, PathOptions, solve_path
+from softhand.fem.newton import NewtonOptions
+from softhand.fem.newton_path import PathOptions, solve_path
 from softhand.fem.newton_steps import add_pair, bfgs_direction
 from softhand.fem.solid import Solid
 
