@@ -41,7 +41,8 @@ def configure(parser) -> None:
 
 def run(args) -> int:
     from softhand.studies.cli.checks import check_writable
-    from softhand.studies.design.task import LOWER, UPPER, load_task
+    from softhand.studies.design.task import load_task
+    from softhand.studies.design.task_values import LOWER, UPPER
     from softhand.studies.design.workflow import OUTPUT_FILES, OUTPUT_FOLDERS, DesignRun, run_task
     from softhand.studies.io.files import check_output_tree, check_owned
 
