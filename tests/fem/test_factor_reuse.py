@@ -139,7 +139,7 @@ def test_the_mkl_runtime_found_without_a_search_is_the_one_pypardiso_finds(monke
     own search of the environment loads, or nothing."""
     import pypardiso
 
-    from softhand.fem.linsolve_backends import _wheel_mkl_rt
+    from softhand.fem.linsolve_pardiso import _wheel_mkl_rt
 
     monkeypatch.delenv("PYPARDISO_MKL_RT", raising=False)
     found = _wheel_mkl_rt()
