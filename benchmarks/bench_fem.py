@@ -34,7 +34,8 @@ from softhand.fem.hand.finger_sweep import SWEEP_NEWTON
 from softhand.fem.linsolve import make_solver
 from softhand.fem.loads import dead_load
 from softhand.fem.materials import CompressibleNeoHookean
-from softhand.fem.newton import NewtonOptions, PathOptions, solve_path
+from softhand.fem.newton import NewtonOptions
+from softhand.fem.newton_path import PathOptions, solve_path
 from softhand.fem.solid import Solid
 from softhand.meshes.tube import Tube, tube_mesh
 

@@ -14,7 +14,8 @@ import time
 from dataclasses import replace
 
 from softhand.fem.hand.finger import FingerOptions
-from softhand.fem.hand.hold import HoldOptions, solve_hold
+from softhand.fem.hand.hold import solve_hold
+from softhand.fem.hand.hold_options import HoldOptions
 from softhand.reduced.vocabulary.design import HandDesign
 from softhand.reduced.holding.objects import parse_object
 

@@ -10,7 +10,7 @@ import sys
 
 import numpy as np
 
-from softhand.studies.calibration.finger_table import leave_one_out
+from softhand.studies.calibration.finger_check import leave_one_out
 
 
 def main() -> None:

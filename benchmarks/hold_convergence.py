@@ -15,7 +15,9 @@ import time
 from dataclasses import replace
 
 from softhand.fem.hand.finger import FingerModel, FingerOptions
-from softhand.fem.hand.hold import HoldModel, HoldOptions, run_hold, solve_hold
+from softhand.fem.hand.hold import run_hold, solve_hold
+from softhand.fem.hand.hold_model import HoldModel
+from softhand.fem.hand.hold_options import HoldOptions
 from softhand.fem.hand.hold_body import Body
 from softhand.fem.hand.hold_contact import ContactOptions
 from softhand.fem.hand.hold_geometry import FingerFrame

@@ -16,7 +16,8 @@ from dataclasses import replace
 from pathlib import Path
 
 from softhand.fem.hand.finger import FingerOptions
-from softhand.fem.hand.hold import HoldOptions, solve_hold
+from softhand.fem.hand.hold import solve_hold
+from softhand.fem.hand.hold_options import HoldOptions
 from softhand.fem.newton import NotConverged
 from softhand.reduced.vocabulary.design import HandDesign
 from softhand.reduced.vocabulary.errors import InputError

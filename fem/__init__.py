@@ -1,7 +1,7 @@
 """Hyperelastic FEM on scikit-fem: materials, forms, loads, constraints, contact, Newton, I/O.
 
 Its public face, imported on first use: the building blocks of a model of one's own
-(:class:`~softhand.fem.materials.NeoHookean`, :class:`~softhand.fem.solid.Solid`, :class:`~softhand.fem.loads.FollowerPressure`, :func:`~softhand.fem.newton.solve_path`, ...) and
+(:class:`~softhand.fem.materials.NeoHookean`, :class:`~softhand.fem.solid.Solid`, :class:`~softhand.fem.loads.FollowerPressure`, :func:`~softhand.fem.newton_path.solve_path`, ...) and
 the hand's models built from them (:class:`~softhand.fem.hand.finger.FingerModel`, :class:`~softhand.fem.hand.grasp.GraspModel`,
 :class:`~softhand.fem.hand.reservoir.SheetModel`).
 """

@@ -7,5 +7,6 @@ from .hand.reservoir import SheetModel, inflate
 from .linsolve import make_solver
 from .loads import FollowerPressure
 from .materials import NeoHookean
-from .newton import NewtonOptions, PathOptions, solve_path
+from .newton import NewtonOptions
+from .newton_path import PathOptions, solve_path
 from .solid import MixedNewton, Solid

@@ -105,7 +105,7 @@ class ElementScatter:
     def block_matrix_data(self, Ke: np.ndarray) -> np.ndarray:
         """CSR data of the sum of ALL elements' matrices given in the block layout
         Ke[e, n, a, b, m] (row dof: node n, component a; column dof: node m, component b;
-        shape (nel, nloc, 3, 3, nloc), as :func:`softhand.fem.solid.element_matrices` writes them).
+        shape (nel, nloc, 3, 3, nloc), as :func:`softhand.fem.solid_kernels.element_matrices` writes them).
 
         One bincount over the whole mesh (a chunk-wise scatter re-reads the nnz-long data
         array once per chunk); the positions in that layout are computed once and kept as

@@ -14,16 +14,17 @@ with a minimum-degree ordering on A^T + A. On the finger FEM's 38k-unknown tange
 SuperLU's default COLAMD; the one python-mumps wheel does not import with NumPy 2. A
 fallback is announced once (a :class:`RuntimeWarning`) with its expected slowdown.
 
-The backends, their bookkeeping, the reuse of the symbolic analysis and PARDISO's mixed
-precision are in :mod:`softhand.fem.linsolve_backends`.
+The backends, their bookkeeping and the reuse of the symbolic analysis are in
+:mod:`softhand.fem.linsolve_backends`, PARDISO and its mixed precision in
+:mod:`softhand.fem.linsolve_pardiso`.
 """
 from __future__ import annotations
 
 import warnings
 
 from softhand.fem import threads
-from softhand.fem.linsolve_backends import (REFINE_MAX, REFINE_RTOL, LinearSolver, PardisoSolver,
-                                            QdldlSolver, SuperLUSolver, UmfpackSolver, pardiso_handle)
+from softhand.fem.linsolve_backends import LinearSolver, QdldlSolver, SuperLUSolver, UmfpackSolver
+from softhand.fem.linsolve_pardiso import REFINE_MAX, REFINE_RTOL, PardisoSolver, pardiso_handle
 
 __all__ = ["METHODS", "PRECISIONS", "available", "make_solver", "LinearSolver", "PardisoSolver",
            "UmfpackSolver", "QdldlSolver", "SuperLUSolver", "REFINE_RTOL", "REFINE_MAX"]

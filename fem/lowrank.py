@@ -25,7 +25,7 @@ one batched matrix product with an inner dimension of 2 per quadrature point (pl
 column per extra rank-one term: the mean-dilatation :math:`b_e b_e^T`, a fiber family's
 :math:`c_1 (f_a g_n)(f_b g_m)`), and one small product that adds the delta and epsilon
 parts. It replaces the general kernel's 81-component tangent per point and its two
-products (:func:`softhand.fem.solid.element_matrices`); tests/test_lowrank.py checks that both give the
+products (:func:`softhand.fem.solid_kernels.element_matrices`); tests/test_lowrank.py checks that both give the
 same matrices.
 """
 from __future__ import annotations
@@ -70,7 +70,7 @@ def neo_hookean_terms(F, G, W, mu: float, p_geo):
 
 def write_matrices(Ke, L, R, S=None, X=None, *, add: bool = False) -> None:
     """Ke[e, n, a, b, m] (=, or += with ``add``) sum_k L[e, (n a), k] R[e, k, (b m)]
-    + delta_ab S[e, n, m] + eps_abc X[e, c, n, m]; Ke in :func:`softhand.fem.solid.element_matrices`'s
+    + delta_ab S[e, n, m] + eps_abc X[e, c, n, m]; Ke in :func:`softhand.fem.solid_kernels.element_matrices`'s
     block layout (ne, nloc, 3, 3, nloc)."""
     ne, nloc = Ke.shape[:2]
     flat = Ke.reshape(ne, 3 * nloc, 3 * nloc)

@@ -18,7 +18,7 @@ finger curve (default mesh, 2 cores) took 19.8 s with them, 15.9 s with OpenBLAS
 thread (PARDISO's time 9.6 -> 6.8 s) and 15.0 s with MKL's threads also asleep right after
 a parallel region (``KMP_BLOCKTIME=0``: the tangent 133 -> 114 ms). :func:`quiet_blas`
 does the first when a FEM solver is made (:func:`softhand.fem.linsolve.make_solver`); the second is
-set before MKL is loaded (:mod:`softhand.fem.linsolve_backends`), unless the environment says otherwise.
+set before MKL is loaded (:mod:`softhand.fem.linsolve_pardiso`), unless the environment says otherwise.
 """
 from __future__ import annotations
 

@@ -12,7 +12,7 @@ itself is singular. Along the path :math:`dΠ/dV^* = p`, so :math:`\int p\,dV = 
 independent check of the residual, the tangent-free parts and the volume functional
 (``tests/fem/test_reservoir.py``).
 
-The path is the load path of :func:`softhand.fem.newton.solve_path` with the load t = V* [mm^3]:
+The path is the load path of :func:`softhand.fem.newton_path.solve_path` with the load t = V* [mm^3]:
 the same Newton iteration, line search, cut-back and step growth as every other FEM
 path, set up by :func:`volume_path_options`: Newton starts at the secant extrapolation
 of the last two states, takes its first step whole and halves later ones until the merit
@@ -34,7 +34,8 @@ import numpy as np
 from softhand.fem.assembly import Restriction
 from softhand.fem.linsolve import make_solver
 from softhand.fem.loads import volume_control
-from softhand.fem.newton import NewtonOptions, NotConverged, PathOptions, solve_path
+from softhand.fem.newton import NewtonOptions, NotConverged
+from softhand.fem.newton_path import PathOptions, solve_path
 
 __all__ = ["PathOptions", "PathState", "NotConverged", "VolumeNotConverged", "follow_volume",
            "volume_path_options"]
@@ -46,7 +47,7 @@ FLOOR = 1e-5
 
 def volume_path_options(*, first_step: float = 1.0, max_step: float = 200.0, atol: float = 0.0,
                         min_step: float = 1e-6, max_iter: int = 12) -> PathOptions:
-    """:class:`softhand.fem.newton.PathOptions` of a volume path: increments [mm^3] from ``first_step``
+    """:class:`softhand.fem.newton_path.PathOptions` of a volume path: increments [mm^3] from ``first_step``
     up to ``max_step``, grown 1.5x after a step of at most 5 iterations, halved down to
     ``min_step``; ``max_iter`` Newton iterations a step, from the secant predictor; ``atol``:
     force residual floor [N] (round-off of the stiff volumetric terms); the force residual

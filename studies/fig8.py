@@ -18,7 +18,8 @@ import numpy as np
 
 from softhand.reduced.equations import grasp
 from softhand.reduced.vocabulary import paper
-from softhand.studies.weights import WeightsCase, finger_options, reduced_F_v, state_row
+from softhand.studies.weights import WeightsCase, finger_options
+from softhand.studies.weights_rows import reduced_F_v, state_row
 
 
 @dataclass(frozen=True)

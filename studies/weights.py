@@ -8,6 +8,9 @@
   by interpolation checked against the FEM there (:class:`WeightsResult`: summary, plot, write).
 * The Fig. 8 analogue (F_v against theta at several pressures) is :mod:`softhand.studies.fig8`.
 
+The cache is :mod:`softhand.studies.weights_cache`; a state's reported numbers (eq. (25)'s
+F_v beside the FEM's) are in :mod:`softhand.studies.weights_rows`.
+
 ``softhand weights``, ``softhand grasp --diameter-mm``, the batch kind ``weights`` and the
 ``weights_fem`` section of ``softhand reproduce`` only choose the inputs.
 
@@ -26,13 +29,12 @@ from pathlib import Path
 
 import numpy as np
 
-from softhand.reduced.equations import grasp
 from softhand.reduced.vocabulary.design import HandDesign
 from softhand.reduced.vocabulary.errors import InputError
-from softhand.studies.io.files import json_text, jsonable, read_bounded, write_json
+from softhand.studies.io.files import jsonable, write_json
+from softhand.studies.weights_cache import CACHE_FORMAT, cache_dir, read_entry, write_entry
+from softhand.studies.weights_rows import rubber_stretches, state_row
 
-#: bump when the FEM or the result's fields change, to invalidate cached results
-CACHE_FORMAT = 6  # 6: the pressure named P_cavity_MPa, eq. (25)'s F_v_reduced_note; 5: entries {format, key, sha256, result}; 4: factorisations counted; 3: the finger's windings on their own degree-5 rule, mesh graded at the ring edges
 #: the default element size of the grasp FEM [mm] (docs/grasp.md: w's mesh sensitivity)
 MESH_SIZE = 6.0
 
@@ -61,52 +63,6 @@ def _package_version() -> str:
     from softhand.reduced.vocabulary.versions import package_version
 
     return package_version()
-
-
-def cache_dir():
-    """``$SOFTHAND_CACHE/weights`` (default ``~/.cache/softhand/weights``), next to the meshes."""
-    from softhand.meshes.cache import cache_dir as mesh_cache_dir
-
-    return mesh_cache_dir().parent / "weights"
-
-
-def reduced_F_v(P: float, theta: float, mass: float, w, design: HandDesign) -> float | None:
-    """Eq. (25) -> (29) at cavity pressure P [MPa], theta [rad]: F_v [N]; None if J_x w = 0."""
-    try:
-        return float(grasp.grasp_forces(P, theta, mass, w, design, reservoir=False).F_v)
-    except InputError:
-        return None
-
-
-#: eq. (25)'s F_v further than this from the FEM's, relative, is printed with why
-NOTE_RTOL = 0.1
-
-
-def reduced_note(F_v_red: float | None, F_v_fem: float, N, design: HandDesign) -> str | None:
-    """Why eq. (25)'s F_v [N] is not to be trusted where it is further than ``NOTE_RTOL`` from
-    the FEM's (N: each link's contact force [N]); None where it is close."""
-    if F_v_red is None or abs(F_v_red - F_v_fem) <= NOTE_RTOL * abs(F_v_fem):
-        return None
-    links = [k for k, n in enumerate(N) if n > 0]
-    where = f"touches link {', '.join(map(str, links))} of {design.n_s}" if links else "is not touched"
-    return (f"eq. (25) charges the pressure's work to a force at the fingertip, but the object {where}: "
-            f"its F_v is {F_v_red / F_v_fem:.3g} x the FEM's; use F_v_fem_N" if F_v_fem > 0 else
-            f"eq. (25) charges the pressure's work to a force at the fingertip, but the object {where}; "
-            "use F_v_fem_N")
-
-
-def state_row(state, w, mass: float, design: HandDesign) -> dict:
-    """The reported numbers of one converged contact state (forces physical, hand frame)."""
-    F_v_red = reduced_F_v(state.P, state.theta, mass, w, design)
-    return {"P_cavity_MPa": state.P, "theta_deg": math.degrees(state.theta),
-            "hinge_deg": np.degrees(state.q).tolist(), "contact_force_N": state.N.tolist(),
-            "F_x_fem_N": float(state.F[0]), "F_y_fem_N": float(state.F[1]),
-            "F_v_fem_N": state.F_v, "F_v_reduced_N": F_v_red,
-            "F_v_error_kgf": None if F_v_red is None else (F_v_red - state.F_v) / grasp.KGF,
-            "F_v_reduced_note": reduced_note(F_v_red, state.F_v, state.N, design),
-            "max_penetration_mm": float(np.max(-state.gap[state.N > 0], initial=0.0)),
-            "contact_updates": state.updates, "contact_penalty_N_per_mm": state.penalty,
-            "newton_iterations": state.iterations, "factorizations": state.factorizations}
 
 
 def failed_record(case: WeightsCase, states) -> dict:
@@ -152,13 +108,6 @@ def compute(case: WeightsCase, out=None, progress=None) -> dict:
             "mesh_size_mm": case.mesh_size_mm, "ndofs": r.ndofs, "wall_seconds": r.wall_seconds}
 
 
-def rubber_stretches(finger, state) -> dict:
-    """The tube's converged ``rubber_stretch`` and its corner peak ``max_principal_stretch``
-    (mesh-dependent) at a grasp state (:mod:`softhand.fem.rubber_stretch`)."""
-    fs = finger.state(state.y, state.P)
-    return {"rubber_stretch": fs.rubber_stretch, "max_principal_stretch": fs.max_principal_stretch}
-
-
 def write_vtk(out, model, states) -> None:
     """The contact states as the scene series grasp.pvd (see :mod:`softhand.fem.hand.scene`)."""
     from softhand.fem.io import SceneSeries
@@ -174,7 +123,7 @@ def weights(case: WeightsCase, *, cache: bool = True, out=None, progress=None) -
     which); ``out``: a folder for the VTK series grasp.pvd (always computes). The result is
     returned, not written: the caller decides where it goes.
 
-    A cache entry is used only if it is valid (:func:`read_entry`); an invalid one is
+    A cache entry is used only if it is valid (:func:`softhand.studies.weights_cache.read_entry`); an invalid one is
     recomputed and replaced, with a warning. A cache that cannot be written is a warning.
     """
     path = cache_dir() / f"{case.key()}.json"
@@ -247,49 +196,6 @@ def run_case(case: WeightsCase, *, cache: bool = True, out=None, progress=None) 
     ``progress``: called with each converged grasp state."""
     return CaseResult(case, weights(case, cache=cache, out=out, progress=progress),
                       () if out is None else ("grasp.pvd",))
-
-
-#: keys and types every cached result has
-_SCHEMA = {"w": list, "w_sum": float, "theta_deg": float, "F_v_fem_N": float,
-           "diameter_mm": float, "mesh_size_mm": float, "ndofs": int}
-
-
-def _checksum(result: dict) -> str:
-    return hashlib.sha256(json.dumps(result, sort_keys=True, default=jsonable).encode()).hexdigest()
-
-
-#: the largest cache entry read (one grasp's numbers: a few kB)
-MAX_ENTRY_BYTES = 1 << 20
-
-
-def read_entry(path: Path, key: str) -> dict | None:
-    """The cached result at ``path`` if it is there and valid (format, key, schema, checksum)."""
-    if not (path.exists() or path.is_symlink()):
-        return None
-    try:
-        entry = json.loads(read_bounded(path, MAX_ENTRY_BYTES))  # a FIFO: refused, not waited on
-        result = entry["result"]
-        valid = (entry["format"] == CACHE_FORMAT and entry["key"] == key
-                 and entry["sha256"] == _checksum(result)
-                 and all(isinstance(result.get(k), t if t is not float else (int, float))
-                         for k, t in _SCHEMA.items()))
-    except (OSError, ValueError, KeyError, TypeError, RecursionError):  # RecursionError: nested deep
-        valid = False
-    if valid:
-        return result
-    print(f"softhand: warning: invalid cache entry {path.name}; recomputing it", file=sys.stderr)
-    return None
-
-
-def write_entry(path: Path, key: str, result: dict) -> None:
-    """Cache ``result`` with its format, key and checksum; a failure to write is a warning."""
-    result = json.loads(json_text(result))  # as it reads back
-    try:
-        write_json(path, {"format": CACHE_FORMAT, "key": key, "sha256": _checksum(result),
-                          "result": result})
-    except OSError as exc:
-        print(f"softhand: warning: the result is not cached ({path.parent}: "
-              f"{exc.strerror or exc})", file=sys.stderr)
 
 
 def interpolate(diameters, ws, diameter: float) -> np.ndarray:

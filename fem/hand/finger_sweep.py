@@ -7,7 +7,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from softhand.fem.linsolve import make_solver
-from softhand.fem.newton import NewtonOptions, NotConverged, PathOptions, solve_path
+from softhand.fem.newton import NewtonOptions, NotConverged
+from softhand.fem.newton_path import PathOptions, solve_path
 
 #: quasi-Newton on the last factorisation (:func:`softhand.fem.newton.newton`, ``refactor="adaptive"``),
 #: re-factorised only when a step lowers the residual by less than half: on the default mesh,
@@ -39,7 +40,7 @@ def solve_pressures(model, pressures, *, link_load=None, y0=None, callback=None,
                     newton_options: NewtonOptions = SWEEP_NEWTON):
     """Follow increasing pressures [MPa] from the state y0 (default: unloaded, P = 0).
 
-    Each pressure is one load step of :func:`softhand.fem.newton.solve_path` from the last converged
+    Each pressure is one load step of :func:`softhand.fem.newton_path.solve_path` from the last converged
     state, cut back (halved) when Newton fails. Returns
     ([FingerState], SweepStats); raises :class:`softhand.fem.newton.NotConverged` with the last
     converged state when even the cut-back fails.
@@ -71,7 +72,7 @@ def _solve_one(model, P, history, link_load, solver, options, scale, totals):
     """The state at P from the last converged (P_i, y_i); updates totals in place.
 
     One load step from the last state with the tangent predictor of
-    :func:`softhand.fem.newton.solve_path` (a secant predictor from the last two states made the
+    :func:`softhand.fem.newton_path.solve_path` (a secant predictor from the last two states made the
     chattering tension-only fibers fail more often than it saved iterations).
     """
     P1, y1 = history[-1]

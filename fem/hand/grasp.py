@@ -35,7 +35,8 @@ from softhand.fem.contact import Circle, Pads, contact_load, gaps
 from softhand.fem.hand.finger import FingerModel
 from softhand.fem.hand.frame import hand_frame, to_finger_frame
 from softhand.fem.linsolve import make_solver
-from softhand.fem.newton import NewtonOptions, NotConverged, PathOptions, solve_path
+from softhand.fem.newton import NewtonOptions, NotConverged
+from softhand.fem.newton_path import PathOptions, solve_path
 from softhand.reduced.vocabulary.design import HandDesign
 from softhand.reduced.vocabulary.errors import InputError
 

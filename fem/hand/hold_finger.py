@@ -12,7 +12,7 @@ with y = (u_free, q). The generalised force that holds the links at q,
 the inverse of the q-block of the reduced tangent's inverse (a Schur complement), taken
 from the factorisation the last Newton step left (five back-substitutions, no new
 factorisation). Loads move along a straight path from the last (P, Q) to the new one
-(:func:`softhand.fem.newton.solve_path`, tangent predictor, cut-back).
+(:func:`softhand.fem.newton_path.solve_path`, tangent predictor, cut-back).
 """
 from __future__ import annotations
 
@@ -20,7 +20,8 @@ import numpy as np
 
 from softhand.fem.hand.finger import FingerModel
 from softhand.fem.linsolve import make_solver
-from softhand.fem.newton import NewtonOptions, PathOptions, solve_path
+from softhand.fem.newton import NewtonOptions
+from softhand.fem.newton_path import PathOptions, solve_path
 
 
 class HeldFinger:

@@ -139,7 +139,7 @@ class Windings:
 
     def add_residual_tangent(self, u: np.ndarray, R: np.ndarray, Ke_all: np.ndarray) -> None:
         """R += the windings' internal force; Ke_all (element matrices of the whole mesh in the
-        block layout of :func:`softhand.fem.solid.element_matrices`) += their tangent. (The finger passes
+        block layout of :func:`softhand.fem.solid_kernels.element_matrices`) += their tangent. (The finger passes
         :meth:`terms` to the rubber's kernel instead, which adds them in its own product.)"""
         def kernels(c):  # in a thread: adds only to its own chunk of Ke_all
             re, L, Rw, S = self.terms(u, c)

@@ -33,7 +33,8 @@ def volume_rates(model, pressures=PRESSURES, dP: float = DP):
     """(theta_free (k,) [rad], A (k, n_s) [mm^3/rad]): the free bends and the locked hinges' A_j."""
     from softhand.fem.hand.finger import solve_pressures
     from softhand.fem.linsolve import make_solver
-    from softhand.fem.newton import NewtonOptions, PathOptions, solve_path
+    from softhand.fem.newton import NewtonOptions
+    from softhand.fem.newton_path import PathOptions, solve_path
 
     d = model.design
     n, scale = d.n_s, d.mu_sf * d.a ** 2 * d.l0

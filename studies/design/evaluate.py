@@ -4,7 +4,7 @@ For a design the task's object is placed as in the grasp FEM (:func:`softhand.re
 the finger closes with equal hinge angles until a pad touches (the **grasp angle** theta_g,
 :func:`softhand.reduced.equations.contact.contact_angle`), and the virtual displacement w is the rolling motion
 that keeps that pad on the object (:func:`softhand.reduced.equations.contact.rolling_weights`). Then
-:func:`grasp_relation`, the one place where a design's F_v is computed, gives
+:func:`softhand.studies.design.grasp_force.grasp_relation`, the one place where a design's F_v is computed, gives
 
 * ``P_grasp``: the pump pressure at which each finger presses with the required F_v;
 * ``P_contact``: the free hand's pump pressure at theta_g (eq. (27)), where the fingers touch;
@@ -21,15 +21,8 @@ it; else eq. (8), 1 + (d + a + b) theta / l0 (the outer fibre on the far side of
 plate), with its strain lambda - 1 scaled by the task's ``stretch_factor`` once an FEM proof
 has measured how far the FEM's stretch (at the tied rings and the end cap) lies above it.
 
-Constraints (each ``(name, value, limit, sense)``, normalised slack >= 0 when met): the tube
-fits its links (a + b < d), walls (b >= min wall, t > 0), the reservoir keeps oil at the grasp
-and sits below the first pressure maximum of its model p_r(V) (limit point), peak stretch,
-pump pressure (at most the pump's limit), the open hand passes the object and at rest (pump
-off) does not reach into the object's place (the free hand's pump pressure at the grasp angle,
-P_contact >= 0, so P_grasp >= 0 too: the pump pushes oil into the fingers), the sheet is thin
-enough for the membrane models of the reservoir (t/R <=
-:data:`softhand.reduced.equations.reservoir.MAX_THICKNESS_RATIO`), and the finger model's calibrated range when
-it has one. The whole model's P(theta) and theta(P) are those of
+The constraints the design is judged by (:func:`softhand.studies.design.constraints.design_constraints`)
+are listed in :mod:`softhand.studies.design.constraints`. The whole model's P(theta) and theta(P) are those of
 ``design.finger_model``/``design.reservoir_model`` through :mod:`softhand.reduced.equations.hand`, so another
 finger model changes the answer by a design key alone.
 """
@@ -37,48 +30,17 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, replace
-from functools import lru_cache
-from typing import NamedTuple
 
 import numpy as np
 
-from softhand.reduced.calibrated import finger_fem, grasp_hold, grasp_hold_solve, reservoir_fem
-from softhand.reduced.equations import contact, finger, grasp, hand, reservoir
+from softhand.reduced.calibrated import finger_fem, reservoir_fem
+from softhand.reduced.equations import contact, finger, hand, reservoir
 from softhand.reduced.vocabulary.design import HandDesign, hinges_for
 from softhand.reduced.vocabulary.design_files import design_from_dict
 from softhand.reduced.vocabulary.errors import InputError
+from softhand.studies.design.constraints import Constraint, design_constraints
+from softhand.studies.design.grasp_force import asks_force_at_limit, grasp_relation
 from softhand.studies.design.task import Task
-
-
-@dataclass(frozen=True)
-class Constraint:
-    name: str
-    value: float
-    limit: float
-    sense: str  #: "<=" or ">="
-    scale: float | None = None  #: of the normalised slack; None: ``|limit|``
-    #: a value with no number (inf): how far the design is from having one, in (0, 1] (None: no measure)
-    shortfall: float | None = None
-
-    @property
-    def slack(self) -> float:
-        """Normalised distance to the limit, >= 0 when met; -1 - shortfall for a value with no number
-        but a measure of how far it is from one, else -1e3."""
-        if not math.isfinite(self.value):
-            return -1.0 - self.shortfall if self.shortfall is not None else -1e3
-        if not math.isfinite(self.limit):  # no limit (e.g. no limit point): met, by far
-            return 1e3
-        gap = self.limit - self.value if self.sense == "<=" else self.value - self.limit
-        scale = self.scale if self.scale is not None else abs(self.limit)
-        return min(gap / max(scale, 1e-9), 1e3)
-
-    @property
-    def satisfied(self) -> bool:
-        return self.slack >= -1e-9
-
-    def as_dict(self) -> dict:
-        return {"name": self.name, "value": self.value, "limit": self.limit, "sense": self.sense,
-                "satisfied": self.satisfied}
 
 
 @dataclass(frozen=True)
@@ -208,15 +170,6 @@ def sheet_stretch(design: HandDesign) -> float:
     return float(reservoir.stretch(design.V0, design))
 
 
-@lru_cache(maxsize=4096)
-def limit_point_volume(design: HandDesign) -> float:
-    """Oil volume [mm^3] of the first pressure maximum of p_r(V) up to 4 V0 (inf: none)."""
-    V = np.linspace(0.01, 4.0, 201) * design.V0
-    p = reservoir.pressure(V, design)
-    falls = np.flatnonzero(np.diff(p) <= 0.0)
-    return float(V[falls[0]]) if falls.size else math.inf
-
-
 def evaluate(design: HandDesign, task: Task, *, exact: bool = True) -> Evaluation:
     """Grasp angle, pressures, forces, stretch and every constraint of ``design`` for ``task``
     (``exact=False``: the kinematics interpolated in l0, see :func:`grasp_geometry`); a hold task
@@ -245,36 +198,6 @@ def evaluate(design: HandDesign, task: Task, *, exact: bool = True) -> Evaluatio
                       tuple(cons), theta_hold, P_margin, edge, no_grasp)
 
 
-def design_constraints(design: HandDesign, task: Task, oil, stretch, sheet, P_grasp, P_contact, F_lim,
-                       P_open, grasp_shortfall: float | None = None) -> list:
-    """Every constraint of a design; how many depends on the task and the finger model alone.
-    ``grasp_shortfall``: the pump pressure's :attr:`Constraint.shortfall` (no P_grasp)."""
-    return [
-        Constraint("tube_fits_links (a + b < d) [mm]", design.a + design.b, design.d, "<="),
-        Constraint("tube_wall b [mm]", design.b, task.min_wall, ">="),
-        Constraint("sheet_thickness t [mm]", design.t, 0.0, ">=", 1.0),
-        Constraint("reservoir_oil the fingers take at the grasp [mm^3]", oil, design.V0, "<="),
-        Constraint("reservoir_below_limit_point V0 [mm^3]", design.V0, limit_point_volume(design), "<="),
-        Constraint("rubber_stretch of the tube", stretch, task.max_stretch, "<="),
-        Constraint("sheet_stretch at V0" + (" (FEM-calibrated rubber_stretch)" if design.reservoir_model == "fem"
-                                            and reservoir_fem.rubber_stretch(design.V0, design) is not None
-                                            else ", eq. (16)"), sheet, task.max_stretch, "<="),
-        Constraint("pump_pressure at the grasp [MPa]", P_grasp, task.max_pressure, "<=", shortfall=grasp_shortfall),
-        Constraint("contact: P(theta_g), the free hand's pump pressure where a pad touches the object "
-                   "[MPa] (the hand at rest must not reach into the object's place)", P_contact, 0.0, ">=",
-                   task.max_pressure),
-        *([Constraint("F_v at the pump limit [N]" if design.finger_model != "fem" else
-                      "F_v at the pump limit, or where one pad stops holding the object alone below it [N]",
-                      F_lim, task.required_F_v(), ">=")]
-          if asks_force_at_limit(design, task) else []),
-        Constraint("opening: P(theta_open), the free hand's pump pressure where the tips "
-                   f"span {task.opening_mm:g} mm [MPa]", P_open, 0.0, ">=", task.max_pressure),
-        Constraint("thin_sheet t/R (membrane models)", design.t / design.R,
-                   reservoir.MAX_THICKNESS_RATIO, "<="),
-        *calibrated_range(design),
-    ]
-
-
 def unanswered(task: Task) -> Evaluation:
     """The evaluation of free values the model has no answer for (the design rules refuse them,
     a + b >= d, t >= R, ...; the finger does not reach the object): the constraints of
@@ -284,91 +207,3 @@ def unanswered(task: Task) -> Evaluation:
     cons = design_constraints(base, task, nan, nan, nan, math.inf, nan, nan, nan)
     return Evaluation(base, nan, nan, -1, np.full(base.n_s, nan), math.inf, math.inf, task.required_F_v(),
                       nan, nan, nan, tuple(replace(c, value=nan) for c in cons), nan)
-
-
-class GraspRelation(NamedTuple):
-    P_grasp: float     #: pump pressure at which each finger presses with the required F_v [MPa]
-    P_contact: float   #: free hand's pump pressure at the grasp angle (27) [MPa]
-    P_open: float      #: free hand's pump pressure where the tips span the opening [MPa]; -inf: never
-    F_at_limit: float  #: F_v at the pump limit (or at P_margin, see edge) [N]; nan: not asked (see grasp_relation)
-    theta_hold: float  #: the finger's bend when it presses with the required F_v [rad]
-    P_margin: float    #: the pump pressure of F_at_limit: the limit, or where the FEM-informed grasp ends [MPa]
-    edge: str = ""     #: why P_margin is below the limit (:attr:`softhand.reduced.calibrated.grasp_hold_solve.Hold.edge`), or ""
-    no_grasp: str = ""  #: why P_grasp is inf (the required F_v not reached by the FEM-informed grasp), or ""
-    F_reached: float = math.nan  #: with no_grasp: F_v where the FEM-informed grasp ends (how far it comes) [N]
-
-
-def asks_force_at_limit(design: HandDesign, task: Task) -> bool:
-    """Whether F_v at the pump limit is a constraint: always for the paper's finger model, for
-    the FEM-informed grasp only with the "margin" objective. Decided by the task and the finger
-    model alone, never by an evaluation's outcome, so that every design of one optimisation has
-    the same constraints (the optimiser needs a constraint vector of fixed length)."""
-    return design.finger_model != "fem" or task.objective == "margin" or task.obj is not None
-
-
-def grasp_relation(design: HandDesign, task: Task, theta: float, w, theta_open: float) -> GraspRelation:
-    """The design's pump pressure <-> normal force F_v at the grasp angle theta [rad]: for
-    ``finger_model = "fem"`` the FEM-informed grasp (:mod:`softhand.reduced.calibrated.grasp_hold`), else eqs. (25),
-    (29) with the rolling w. The one place where the design's F_v is computed."""
-    if design.finger_model == "fem":
-        return _fem_relation(design, task, theta, theta_open)
-    F_req = task.required_F_v()
-    # eq. (25) is linear in F_v: one call for F_v = 0, 1 N, F_req and the free hand (27)
-    P0, P1, P_grasp, P_contact, P_open = (float(p) for p in grasp.pressure_to_hold(
-        np.array([task.mass, task.mass, task.mass, 0.0, 0.0]),
-        np.array([theta] * 4 + [theta_open if math.isfinite(theta_open) else 0.0]), w, design,
-        F_v=np.array([0.0, 1.0, F_req, 0.0, 0.0])))
-    F_lim = (task.max_pressure - P0) / (P1 - P0)  # [N]: F_v at P0 is 0, at P1 1 N
-    return GraspRelation(P_grasp, P_contact, P_open if math.isfinite(theta_open) else -math.inf, F_lim,
-                         theta, task.max_pressure)
-
-
-def _fem_relation(design: HandDesign, task: Task, theta: float, theta_open: float) -> GraspRelation:
-    """The FEM-informed grasp: P_grasp from the equilibrium with F_v = F_req; F_v at the pump
-    limit only for the "margin" objective (for "pressure" the pump-pressure constraint on
-    P_grasp is the same condition, F_v growing with the pump pressure: nan). Where the
-    FEM-informed grasp ends below the pump limit (a second pad touches the object, the finger
-    reaches its largest bend: :func:`softhand.reduced.calibrated.grasp_hold.at_pump`) F_v is the one there, at the
-    highest pump pressure the model answers for, and ``edge`` says why."""
-    P_contact = float(hand.pressure(theta, design))
-    P_open = float(hand.pressure(theta_open, design)) if math.isfinite(theta_open) else -math.inf
-    F_req = task.required_F_v()
-    # F_v = 0 (a massless object, no margin): the fingers only touch it, at the contact pressure
-    no_grasp, F_reached = "", math.nan
-    try:
-        held = grasp_hold.hold(design, task.diameter, task.mass, "F_v", F_req) if F_req > 0.0 else \
-            grasp_hold_solve.Hold(math.nan, P_contact, 0.0, theta, -1, True)
-    except grasp_hold.NotReached as refused:  # F_req beyond what the finger gives: no P_grasp, the rest stands
-        held, no_grasp = grasp_hold_solve.Hold(math.nan, math.inf, math.nan, theta, -1, False), refused.allowed
-        F_reached = refused.reached.F_v
-    F_lim, P_margin, edge = math.nan, task.max_pressure, ""
-    if asks_force_at_limit(design, task):
-        at = grasp_hold_solve.Hold(math.nan, task.max_pressure, 0.0, theta, -1, True) \
-            if task.max_pressure <= P_contact else \
-            grasp_hold.at_pump(design, task.diameter, task.mass, task.max_pressure)
-        F_lim, P_margin, edge = at.F_v, at.P_pump, at.edge
-    return GraspRelation(held.P_pump, P_contact, P_open, F_lim, held.theta, P_margin, edge, no_grasp, F_reached)
-
-
-def calibrated_range(design: HandDesign) -> list[Constraint]:
-    """The FEM-calibrated finger model's space (its table's group ranges) as constraints;
-    none for the paper's model."""
-    if getattr(design, "finger_model", "paper") == "paper":
-        return []
-    from softhand.reduced.calibrated import finger_fem
-
-    table = _finger_table(design.finger_table or str(finger_fem.TABLE_FILE))
-    groups = finger_fem.groups_of(design)
-    out = []
-    for g in finger_fem.GROUPS:
-        lo, hi = table.ranges[g]
-        label = f"calibrated range of {finger_fem.LABELS[g]}"
-        out += [Constraint(label, groups[g], lo, ">="), Constraint(label, groups[g], hi, "<=")]
-    return out
-
-
-@lru_cache(maxsize=4)
-def _finger_table(path: str):
-    from softhand.reduced.calibrated import finger_fem
-
-    return finger_fem.read_table(path)

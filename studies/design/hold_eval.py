@@ -7,7 +7,7 @@ reaches the margin (``P_grasp``; bisection on the cavity pressure between the fi
 the pump's limit, to :data:`PRESSURE_TOL`), the holding limit at the pump's limit
 (``F_v_at_limit``; its requirement is ``F_v``), the free hand's pump pressure where a pad first
 touches (``P_contact``), and the tube's stretch and the oil at the least pressure. The
-constraints are the design's (:func:`softhand.studies.design.evaluate.design_constraints`); the opening
+constraints are the design's (:func:`softhand.studies.design.constraints.design_constraints`); the opening
 is met by construction (the placement refuses an object the open fingers do not clear, and the
 evaluation then has no answer). Units: mm, N, MPa.
 """
@@ -22,7 +22,8 @@ from softhand.reduced.holding import hold, hold_closing, hold_fast
 from softhand.reduced.vocabulary.design import HandDesign
 from softhand.reduced.vocabulary.errors import InputError
 from softhand.reduced.holding.hand_layout import place_object
-from softhand.studies.design.evaluate import Evaluation, design_constraints, peak_stretch, unanswered
+from softhand.studies.design.constraints import design_constraints
+from softhand.studies.design.evaluate import Evaluation, peak_stretch, unanswered
 from softhand.studies.design.task import Task
 
 #: the least pressure's bisection tolerance [MPa]

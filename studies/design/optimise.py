@@ -24,7 +24,8 @@ import numpy as np
 from scipy.optimize import NonlinearConstraint, differential_evolution, minimize
 
 from softhand.reduced.vocabulary.errors import InputError
-from softhand.studies.design.evaluate import Constraint, Evaluation, design_at, unanswered
+from softhand.studies.design.constraints import Constraint
+from softhand.studies.design.evaluate import Evaluation, design_at, unanswered
 from softhand.studies.design.evaluate import evaluate as grasp_evaluate
 from softhand.studies.design.hold_eval import evaluate_hold
 from softhand.studies.design.task import Task

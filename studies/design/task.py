@@ -37,29 +37,30 @@ holding limit along the pull reaches the margin, the holding limit at the pump's
 A task designs on the FEM-calibrated models (``finger_model = "fem"``, ``reservoir_model =
 "fem"``, :data:`~softhand.studies.design.task.MODELS`) unless its ``[design]`` table names others: those are the models the
 FEM proof checks. With the packaged finger table, the free bounds are clipped to the box the
-table was calibrated on (:data:`CALIBRATED_SPACE`, its ``[space]``); the table's group ranges
-are the optimiser's constraints (:func:`softhand.studies.design.evaluate.calibrated_range`).
+table was calibrated on (:data:`softhand.studies.design.task_values.CALIBRATED_SPACE`, its
+``[space]``); the table's group ranges are the optimiser's constraints
+(:func:`softhand.studies.design.constraints.calibrated_range`). The values' checks are in
+:mod:`softhand.studies.design.task_values`.
 Every mistake is one :class:`~softhand.reduced.vocabulary.errors.InputError` naming the key.
 """
 from __future__ import annotations
 
-import math
 import os
 
 import numpy as np
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from softhand.reduced.vocabulary.design import BOUNDS, PAPER_DESIGN_FILE, PUBLIC_KEYS, HandDesign
+from softhand.reduced.vocabulary.design import HandDesign
 
-from softhand.reduced.vocabulary.design_files import design_from_dict, load_design
+from softhand.reduced.vocabulary.design_files import design_from_dict
 
 from softhand.reduced.vocabulary.inputfiles import read_toml
 from softhand.reduced.vocabulary.errors import InputError
 from softhand.reduced.holding.objects import GraspObject
+from softhand.studies.design.task_values import (UPPER, base_design, calibrated_bounds,
+                                                 check_free_bounds_keep_the_rules, checked_number, free_bounds)
 
-#: design keys the optimiser may vary; "l0_mm" scales the hinge positions with the tube
-FREE_KEYS = ("a_mm", "b_mm", "d_mm", "l0_mm", "R_mm", "t_mm", "V0_mm3", "tie_width_mm")
 OBJECTIVES = ("pressure", "margin")
 _SECTIONS = {
     "object": {"diameter_mm", "mass_kg", "shape", "length_mm", "size_mm", "file", "offset_mm", "rotation_deg",
@@ -73,24 +74,7 @@ _SECTIONS = {
 }
 #: the reduced models a task designs with unless its [design] table says otherwise
 MODELS = {"finger_model": "fem", "reservoir_model": "fem"}
-#: the design space the packaged finger table was calibrated on (its [space] box)
-CALIBRATED_SPACE = PAPER_DESIGN_FILE.parents[1] / "finger_space.toml"
-#: highest value of each number of a task (the lowest: > 0, or >= 0 where zero makes sense)
-UPPER = {"diameter_mm": 500.0, "mass_kg": 20.0, "max_pressure_MPa": 5.0, "force_factor": 100.0,
-         "margin_N": 1000.0, "opening_mm": 1000.0, "rubber_stretch": 10.0, "min_wall_mm": 50.0,
-         "mesh_size_mm": 12.0, "edge_ratio": 1.0, "dP_MPa": 0.5}
-#: lowest value of the FEM proof's mesh and step (a finer one is refused, not run for hours), of the
-#: force factor (below 1 the fingers would not carry the object's weight) and of the pump limit
-#: (10 kPa: far below the contact pressure of any finger in the calibrated space, ~0.1-0.5 MPa)
-LOWER = {"mesh_size_mm": 0.5, "edge_ratio": 0.05, "dP_MPa": 0.001, "force_factor": 1.0,
-         "max_pressure_MPa": 0.01}
-#: least non-zero mass [kg] and margin [N]: 0 is a massless object or no margin (the fingers
-#: press with m g / n, or just touch), a positive value below it asks for a force the grasp
-#: model does not resolve (a root at 1e-300 N ran for minutes)
-LEAST_NONZERO = {"mass_kg": 1e-3, "margin_N": 1e-3}
 _TOP = {"base_design", "object", "grasp", "pump", "limits", "material", "design", "free", "fem", "hold"}
-UPPER.update({"margin": 100.0, "pull_N": 1e5})
-LOWER.update({"margin": 1.0})
 
 
 @dataclass(frozen=True)
@@ -168,14 +152,14 @@ def task_from_dict(data: dict, *, folder: Path = Path("."), name: str = "task") 
         if key in tables["material"]:
             raise InputError(f"design.{key}", tables["design"][key],
                              "is also in [material]; give it in one of them")
-    base = _base_design(data.get("base_design"), folder)
+    base = base_design(data.get("base_design"), folder)
     fixed = dict(tables["design"])
     table = fixed.get("finger_table")
     if isinstance(table, str) and table and not Path(table).is_absolute():
         fixed["finger_table"] = os.path.abspath(folder / table)  # next to the task, as a design file's
     base = design_from_dict({**MODELS, **fixed, **tables["material"]}, base, source="design")
-    free, clipped = _calibrated(_free(tables["free"], base), base)
-    _some_design_keeps_the_rules(free, base)
+    free, clipped = calibrated_bounds(free_bounds(tables["free"], base), base)
+    check_free_bounds_keep_the_rules(free, base)
     obj, grasp, pump, limits, fem = (tables[s] for s in ("object", "grasp", "pump", "limits", "fem"))
     if "force_factor" in grasp and "margin_N" in grasp:
         raise InputError("grasp.margin_N", grasp["margin_N"], "give force_factor or margin_N, not both")
@@ -183,27 +167,27 @@ def task_from_dict(data: dict, *, folder: Path = Path("."), name: str = "task") 
     if objective not in OBJECTIVES:
         raise InputError("grasp.objective", objective, f"must be one of {', '.join(OBJECTIVES)}")
     held = _hold_object(obj, tables["hold"], folder)
-    diameter = held[1] if held[0] is not None else _number(obj, "object", "diameter_mm", required=True)
-    opening = _number(grasp, "grasp", "opening_mm", default=None)
+    diameter = held[1] if held[0] is not None else checked_number(obj, "object", "diameter_mm", required=True)
+    opening = checked_number(grasp, "grasp", "opening_mm", default=None)
     if opening is not None and opening < diameter:
         raise InputError("grasp.opening_mm", grasp["opening_mm"], f"must be >= the object's diameter_mm "
                          f"= {diameter:g} (the open hand must pass the object) and <= {UPPER['opening_mm']:g}")
     return Task(
         base=base, name=name, source=data,
         diameter=diameter,
-        mass=_number(obj, "object", "mass_kg", required=True, positive=False),
+        mass=checked_number(obj, "object", "mass_kg", required=True, positive=False),
         obj=held[0], **held[2],
         free=free, clipped=clipped,
-        max_pressure=_number(pump, "pump", "max_pressure_MPa", required=True),
-        force_factor=_number(grasp, "grasp", "force_factor", default=2.0),
-        margin=_number(grasp, "grasp", "margin_N", default=None, positive=False),
+        max_pressure=checked_number(pump, "pump", "max_pressure_MPa", required=True),
+        force_factor=checked_number(grasp, "grasp", "force_factor", default=2.0),
+        margin=checked_number(grasp, "grasp", "margin_N", default=None, positive=False),
         objective=objective,
         opening=opening,
-        max_stretch=_number(limits, "limits", "rubber_stretch", default=1.5, above=1.0),
-        min_wall=_number(limits, "limits", "min_wall_mm", default=1.0),
-        mesh_size=_number(fem, "fem", "mesh_size_mm", default=6.0),
-        edge_ratio=_number(fem, "fem", "edge_ratio", default=0.5),
-        dP=_number(fem, "fem", "dP_MPa", default=0.05))
+        max_stretch=checked_number(limits, "limits", "rubber_stretch", default=1.5, above=1.0),
+        min_wall=checked_number(limits, "limits", "min_wall_mm", default=1.0),
+        mesh_size=checked_number(fem, "fem", "mesh_size_mm", default=6.0),
+        edge_ratio=checked_number(fem, "fem", "edge_ratio", default=0.5),
+        dP=checked_number(fem, "fem", "dP_MPa", default=0.05))
 
 
 def _hold_object(obj: dict, hold: dict, folder: Path):
@@ -221,8 +205,8 @@ def _hold_object(obj: dict, hold: dict, folder: Path):
     span = 2.0 * float(np.max(np.hypot(pts[:, 0], pts[:, 2])))
     if "margin" in hold and "pull_N" in hold:
         raise InputError("hold.pull_N", hold["pull_N"], "give margin or pull_N, not both")
-    fields = {"hold_margin": _number(hold, "hold", "margin", default=2.0),
-              "hold_pull_N": _number(hold, "hold", "pull_N", default=None, positive=False)}
+    fields = {"hold_margin": checked_number(hold, "hold", "margin", default=2.0),
+              "hold_pull_N": checked_number(hold, "hold", "pull_N", default=None, positive=False)}
     if "pull" in hold:
         from softhand.reduced.holding.hold import pull_unit
 
@@ -235,92 +219,3 @@ def _table(data: dict, section: str) -> dict:
     if not isinstance(value, dict):
         raise InputError(section, value, "must be a table ([" + section + "])")
     return value
-
-
-def _base_design(value, folder: Path) -> HandDesign:
-    if value is None:
-        return load_design(None)
-    if not isinstance(value, str):
-        raise InputError("base_design", value, "must be a file name (string)")
-    for candidate in (Path(value), folder / value, PAPER_DESIGN_FILE.parents[2] / value):
-        if candidate.is_file():
-            return load_design(candidate)
-    raise InputError("base_design", value, "no such design file (looked as given, next to the "
-                                           "task file and in the package)")
-
-
-def _number(table: dict, section: str, key: str, *, required: bool = False, default=None,
-            positive: bool = True, above: float | None = None):
-    if key not in table:
-        if required:
-            raise InputError(f"{section}.{key}", None, "is required")
-        return default
-    value = table[key]
-    ok = isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
-    limit, upper = above if above is not None else 0.0, UPPER[key]
-    if not ok or (value <= limit if positive or above is not None else value < 0) or value > upper \
-            or value < LOWER.get(key, -math.inf) or 0 < value < LEAST_NONZERO.get(key, 0.0):
-        what = f"> {limit:g}" if positive or above is not None else ">= 0"
-        what = f">= {LOWER[key]:g}" if key in LOWER else what
-        what = f"0 or a number >= {LEAST_NONZERO[key]:g}" if key in LEAST_NONZERO else f"a number {what}"
-        raise InputError(f"{section}.{key}", value, f"must be {what} and <= {upper:g}")
-    return float(value)
-
-
-def _free(table: dict, base: HandDesign) -> tuple[tuple[str, float, float], ...]:
-    if not table:
-        raise InputError("free", table, f"must name at least one design key with [lower, upper] "
-                                        f"bounds; allowed: {', '.join(FREE_KEYS)}")
-    out = []
-    for key, bounds in table.items():
-        if key not in FREE_KEYS or key not in PUBLIC_KEYS:
-            allowed = [k for k in FREE_KEYS if k in PUBLIC_KEYS]
-            raise InputError(f"free.{key}", bounds, f"not a free design key; allowed: {', '.join(allowed)}")
-        if not (isinstance(bounds, list) and len(bounds) == 2
-                and all(isinstance(b, (int, float)) and not isinstance(b, bool) and math.isfinite(b)
-                        for b in bounds) and 0 < bounds[0] < bounds[1]):
-            raise InputError(f"free.{key}", bounds, "must be [lower, upper] with 0 < lower < upper")
-        lo, hi = BOUNDS[key]
-        if bounds[0] < lo or bounds[1] > hi:
-            raise InputError(f"free.{key}", bounds, f"must lie within [{lo:g}, {hi:g}]")
-        out.append((key, float(bounds[0]), float(bounds[1])))
-    return tuple(out)
-
-
-#: free keys whose smaller values the design rules favour (a + b < d, t < R, ties shorter than
-#: the links); the others' larger values (V0 is in no rule)
-_RULES_FAVOUR_LOW = ("a_mm", "b_mm", "t_mm", "tie_width_mm")
-
-
-def _some_design_keeps_the_rules(free, base: HandDesign) -> None:
-    """InputError if no design within the free bounds passes the design rules: each rule is
-    monotone in each key, so the box's most favourable corner decides (before any search)."""
-    corner = {key: lo if key in _RULES_FAVOUR_LOW else hi for key, lo, hi in free}
-    try:
-        design_from_dict(corner, base, source="free")
-    except InputError as exc:
-        raise InputError("free", {key: [lo, hi] for key, lo, hi in free},
-                         f"no design within these bounds keeps the design rules; at their most "
-                         f"favourable corner, {exc}") from None
-
-
-def _calibrated(free, base: HandDesign):
-    """(free bounds clipped to the packaged finger table's box, the bounds that were clipped)."""
-    if base.finger_model != "fem" or base.finger_table:
-        return free, ()
-    from softhand.studies.calibration.space import load_space
-
-    box = load_space(CALIBRATED_SPACE).box
-    out, clipped = [], []
-    for key, lo, hi in free:
-        if key not in box:
-            out.append((key, lo, hi))
-            continue
-        c_lo, c_hi = max(lo, box[key][0]), min(hi, box[key][1])
-        if not c_lo < c_hi:
-            raise InputError(f"free.{key}", [lo, hi], f'must overlap [{box[key][0]:g}, {box[key][1]:g}], '
-                             'the calibrated space of finger_model "fem"')
-        out.append((key, c_lo, c_hi))
-        if (c_lo, c_hi) != (lo, hi):
-            clipped.append((key, lo, hi))
-    return tuple(out), tuple(clipped)

@@ -13,7 +13,7 @@ import numpy as np
 
 from softhand.reduced.vocabulary.errors import MeshRejected, MeshTooLarge
 from softhand.studies.design import optimise as design_opt
-from softhand.studies.design import evaluate, proof
+from softhand.studies.design import evaluate, proof, proof_sizes, proof_steps
 from softhand.studies.io.files import kept_if_unwritable, write_atomic, write_json
 from softhand.studies.io.outputs import replaced_outputs
 
@@ -154,7 +154,7 @@ def prove_knee(pareto: dict, task, run: DesignRun, dirs, say) -> dict | None:
 def prove_on_meshes(ev, task, mesh_size_mm: float | None, out, say, *, show_progress: bool = False) -> dict:
     """The FEM proof of the evaluated design on the finger mesh ``mesh_size_mm`` (None: the
     task's), a mesh that fails retried on the next finer one
-    (:func:`~softhand.studies.design.proof.proof_meshes`), which is said as information; with
+    (:func:`~softhand.studies.design.proof_sizes.proof_meshes`), which is said as information; with
     ``show_progress`` a bar of its phases (free bend, sheet, grasp states) on stderr. The
     proof's record, or its error and the meshes that failed."""
     import sys
@@ -164,7 +164,7 @@ def prove_on_meshes(ev, task, mesh_size_mm: float | None, out, say, *, show_prog
     from softhand.fem.newton import NotConverged
 
     failed = []
-    sizes = proof.proof_meshes(ev.design, mesh_size_mm if mesh_size_mm is not None else task.mesh_size)
+    sizes = proof_sizes.proof_meshes(ev.design, mesh_size_mm if mesh_size_mm is not None else task.mesh_size)
     with tqdm(desc="FEM proof", unit="phase", file=sys.stderr, leave=False, disable=not show_progress) as bar:
         def phase(text):  # each line the proof says starts a phase
             with bar.external_write_mode(file=sys.stderr):
@@ -174,7 +174,7 @@ def prove_on_meshes(ev, task, mesh_size_mm: float | None, out, say, *, show_prog
 
         for k, size in enumerate(sizes):
             try:
-                options = proof.ProofOptions(mesh_size_mm=size, dP_mpa=task.dP, edge_ratio=task.edge_ratio)
+                options = proof_steps.ProofOptions(mesh_size_mm=size, dP_mpa=task.dP, edge_ratio=task.edge_ratio)
                 fem = proof.prove(ev, task, options, out=out, progress=phase,
                                   tick=lambda text: bar.set_postfix_str(text))
                 return {**fem, "failed_meshes": failed} if failed else fem

@@ -3,7 +3,7 @@ locking, a fiber-wound tube, convergence rates): closed form vs FEM.
 
 All cases use the mean-dilatation P2-P0 solid of :mod:`softhand.fem.solid` on quadratic
 (isoparametric) tetrahedra, the follower pressure of :mod:`softhand.fem.loads` and Newton with
-load stepping of :mod:`softhand.fem.newton`. The tube has the finger's radii R_i = 4, R_o = 9 mm and
+load stepping of :mod:`softhand.fem.newton_path`. The tube has the finger's radii R_i = 4, R_o = 9 mm and
 μ = 1.15 MPa. Plane strain is a quarter-annulus slice with u_z = 0 on both faces and
 symmetry planes x = 0, y = 0 (exact for the plane-strain solution, which has u_z = 0 and
 no hoop displacement). Closed forms: :mod:`softhand.studies.verification.closed_forms`.
@@ -39,7 +39,8 @@ from scipy.optimize import brentq
 from softhand.fem.linsolve import make_solver
 from softhand.fem.loads import FollowerPressure
 from softhand.fem.materials import Fibers, NeoHookean
-from softhand.fem.newton import NewtonOptions, PathOptions, solve_path
+from softhand.fem.newton import NewtonOptions
+from softhand.fem.newton_path import PathOptions, solve_path
 from softhand.fem.solid import MixedNewton, Solid
 from softhand.meshes.tube import Tube, tube_mesh
 from softhand.studies.verification import closed_forms as cf

@@ -12,7 +12,8 @@ from softhand.fem.assembly import Restriction
 from softhand.fem.linsolve import make_solver
 from softhand.fem.loads import FollowerPressure
 from softhand.fem.materials import NeoHookean
-from softhand.fem.newton import NewtonOptions, PathOptions, solve_path
+from softhand.fem.newton import NewtonOptions
+from softhand.fem.newton_path import PathOptions, solve_path
 from softhand.fem.newton_steps import add_pair, bfgs_direction
 from softhand.fem.solid import Solid
 
@@ -138,7 +139,7 @@ def test_the_mkl_runtime_found_without_a_search_is_the_one_pypardiso_finds(monke
     own search of the environment loads, or nothing."""
     import pypardiso
 
-    from softhand.fem.linsolve_backends import _wheel_mkl_rt
+    from softhand.fem.linsolve_pardiso import _wheel_mkl_rt
 
     monkeypatch.delenv("PYPARDISO_MKL_RT", raising=False)
     found = _wheel_mkl_rt()

@@ -10,7 +10,9 @@ import pytest
 
 from softhand.fem.hand.finger import FingerModel, FingerOptions
 from softhand.fem.hand.grasp import GraspModel, GraspOptions, weight_vector
-from softhand.fem.hand.hold import HoldModel, HoldOptions, NoEquilibrium, run_hold
+from softhand.fem.hand.hold import run_hold
+from softhand.fem.hand.hold_model import HoldModel, NoEquilibrium
+from softhand.fem.hand.hold_options import HoldOptions
 from softhand.fem.hand.hold_body import Body
 from softhand.fem.hand.hold_contact import ContactOptions
 from softhand.fem.hand.hold_geometry import FingerFrame, Pose, pad_contacts
@@ -152,7 +154,7 @@ def test_pad_contact_of_a_sphere_off_the_bending_plane():
 
 
 def test_symmetry_orbits_follow_the_object():
-    from softhand.fem.hand.hold import symmetry_orbits
+    from softhand.fem.hand.hold_options import symmetry_orbits
     from softhand.fem.hand.hold_geometry import default_layout
 
     frames = default_layout(4)

@@ -1,5 +1,5 @@
 """The low-rank element kernel of the Neo-Hookean solid (fem.lowrank) against the general
-kernel (the 81-component tangent and fem.solid.element_matrices) and against finite
+kernel (the 81-component tangent and fem.solid_kernels.element_matrices) and against finite
 differences of the residual."""
 import numpy as np
 import pytest

@@ -9,7 +9,8 @@ from softhand.fem.assembly import Restriction
 from softhand.fem.linsolve import available, make_solver
 from softhand.fem.loads import FollowerPressure
 from softhand.fem.materials import NeoHookean
-from softhand.fem.newton import NewtonOptions, NotConverged, PathOptions, newton, solve_path
+from softhand.fem.newton import NewtonOptions, NotConverged, newton
+from softhand.fem.newton_path import PathOptions, solve_path
 from softhand.fem.solid import Solid
 
 

@@ -202,7 +202,7 @@ def test_cli_reports_newton_failure_in_one_line(monkeypatch, capsys, tmp_path):
 
 
 def test_volume_steps_follow_the_path_options():
-    """The volume path is fem.newton.solve_path with t = V*: its first increment, its largest
+    """The volume path is fem.newton_path.solve_path with t = V*: its first increment, its largest
     one and the stops it lands on are those of the one PathOptions (coarse 6 x 1 sheet)."""
     model = SheetModel(n_radial=6, n_thick=1)
     solid, volume, fixed = model.build()

@@ -13,7 +13,8 @@ from softhand.fem.assembly import Restriction
 from softhand.fem.linsolve import make_solver
 from softhand.fem.loads import FollowerPressure
 from softhand.fem.materials import CompressibleNeoHookean, Fibers, NeoHookean
-from softhand.fem.newton import NewtonOptions, PathOptions, solve_path
+from softhand.fem.newton import NewtonOptions
+from softhand.fem.newton_path import PathOptions, solve_path
 from softhand.fem.solid import MixedNewton, Solid
 
 RNG = np.random.default_rng(3)

@@ -176,7 +176,7 @@ def test_each_design_of_the_package_table_is_predicted_without_it():
     design): measured theta 1.33 % rms, 6.4 % at worst (the corner b/a 0.5, d/a 3.33, link/a 3.33,
     tie/link 0.75: extrapolation), dQ 0.87 % rms, 4.5 % at worst (b/a 1.17 at that link and tie). The least-squares fit linear in
     the features had twice the interpolant's leave-one-out error in y on the earlier 31-design table."""
-    from softhand.studies.calibration.finger_table import leave_one_out
+    from softhand.studies.calibration.finger_check import leave_one_out
 
     rows = leave_one_out()
     theta = np.array([r["theta_err_pct"] for r in rows])
@@ -260,7 +260,7 @@ def test_the_held_out_whole_hand_error_is_the_fingers_for_the_models_own_reservo
     1 %: the reservoir parts cancel (the shipped sheet table reproduces the sheet FEM at the
     paper's sheet, measured to 1e-8 MPa), so the whole hand's error is the finger's alone,
     -0.01 P; a point where the fingers would take more oil than V0 is nan."""
-    from softhand.studies.calibration.finger_table import _whole_hand_errors
+    from softhand.studies.calibration.finger_check import _whole_hand_errors
 
     d = HandDesign(tie_width=10.0)
     model = d.replace(finger_model="fem")
@@ -277,7 +277,7 @@ def test_heldout_60_deg_row_is_the_fem_point_there_when_one_lies_at_60_deg():
     """The held-out check interpolates the FEM's pressure and oil to 60 deg monotonically, so
     with an FEM point at exactly 60 deg its 60-degree row repeats that point: the same pressure
     and the same whole-hand error (FEM points here: the calibrated model's own curve)."""
-    from softhand.studies.calibration.finger_table import heldout_rows
+    from softhand.studies.calibration.finger_check import heldout_rows
 
     design = HandDesign()
     model = design.replace(finger_model="fem")

@@ -9,7 +9,8 @@ import pytest
 from softhand.reduced.calibrated import finger_fem
 from softhand.reduced.vocabulary.design import HandDesign
 from softhand.reduced.calibrated.finger_fem import STRETCH, TABLE_FILE, read_table, stretch_prior
-from softhand.studies.calibration.finger_table import leave_one_out, table_rows
+from softhand.studies.calibration.finger_table import table_rows
+from softhand.studies.calibration.finger_check import leave_one_out
 
 
 def known_z(b_a, theta):

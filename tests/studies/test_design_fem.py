@@ -9,7 +9,8 @@ import pytest
 from softhand.reduced.calibrated import grasp_hold
 from softhand.reduced.equations import hand
 from softhand.studies.design import optimise as design_opt
-from softhand.studies.design.proof import ProofOptions, prove
+from softhand.studies.design.proof import prove
+from softhand.studies.design.proof_steps import ProofOptions
 from softhand.studies.design.task import load_task, task_from_dict
 
 TASK_DICT = {

@@ -29,7 +29,7 @@ def test_the_proof_flags_a_fem_stretch_above_the_limit():
 
 
 def test_the_proof_mesh_follows_the_wall():
-    from softhand.studies.design.proof import proof_mesh
+    from softhand.studies.design.proof_sizes import proof_mesh
 
     task = task_from_dict(CI_TASK)
     assert proof_mesh(task.base.replace(b=4.5), 10.0) == 10.0
@@ -110,18 +110,18 @@ def test_the_proof_mesh_is_bounded_on_the_boxs_thinnest_shortest_tube(monkeypatc
     try: the bound of a uniform gmsh tube of that size."""
     from softhand.fem.hand import finger_options as fo
     from softhand.reduced.vocabulary.errors import MeshTooLarge
-    from softhand.studies.design import proof
+    from softhand.studies.design import proof_sizes
 
     seen = []
     monkeypatch.setattr(fo, "check_unknowns", lambda least, mesh, memory=None: seen.append((least, mesh)))
     task = task_from_dict({**CI_TASK, "design": {"a_mm": 5.0, "b_mm": 5.0},
                            "free": {"d_mm": [10.0, 18.0], "l0_mm": [150.0, 200.0]}})
-    proof.check_proof_size(task, 10.0)
+    proof_sizes.check_proof_size(task, 10.0)
     assert seen == [(int(4 * fo.gmsh_least_tets(5.0, 5.0, 150.0, 5.0, 4.0)), "gmsh mesh_size=4 (the proof's)")]
     monkeypatch.undo()
     monkeypatch.setattr(fo, "memory_bytes", lambda: 24 * 2 ** 30)
     with pytest.raises(MeshTooLarge, match="at least 2,8"):  # ~2.9 million unknowns
-        proof.check_proof_size(task, 0.5)
+        proof_sizes.check_proof_size(task, 0.5)
 
 
 def test_a_fem_stretch_above_the_limit_reoptimises_with_the_fems_factor(tmp_path, monkeypatch, capsys):
@@ -274,7 +274,7 @@ def test_the_margin_state_is_the_pump_pressure_asked():
     from types import SimpleNamespace
 
     import numpy as np
-    from softhand.studies.design.proof import ProofOptions, margin
+    from softhand.studies.design.proof_steps import ProofOptions, margin
 
     model, options = _LinearGrasp(), ProofOptions(pump_tol_mpa=1e-9)
     sheet = SimpleNamespace(path_volume=np.array([0.0, 30000.0]), path_pressure=np.array([0.0, 0.3]))
@@ -308,7 +308,7 @@ def test_a_margin_the_grasp_fem_does_not_reach_is_reported_not_raised(capsys):
 
     def print_margin(fem, task):  # what softhand design prints
         print(*margin_lines(fem, task), sep="\n")
-    from softhand.studies.design.proof import ProofOptions, margin
+    from softhand.studies.design.proof_steps import ProofOptions, margin
 
     sheet = SimpleNamespace(path_volume=np.array([0.0, 30000.0]), path_pressure=np.array([0.0, 0.3]))
     task = SimpleNamespace(required_F_v=lambda: 10.0, max_pressure=1.5)

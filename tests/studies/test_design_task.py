@@ -418,7 +418,7 @@ def test_free_values_the_design_rules_refuse_are_infeasible_points_not_errors():
 
 def test_all_eight_free_keys_at_their_full_bounds():
     from softhand.reduced.vocabulary.design import BOUNDS
-    from softhand.studies.design.task import FREE_KEYS
+    from softhand.studies.design.task_values import FREE_KEYS
 
     free = {k: list(BOUNDS[k]) for k in FREE_KEYS}
     task = task_from_dict({**CI_TASK, "free": free, "design": {"finger_model": "paper", "reservoir_model": "ellipse"}})

@@ -428,7 +428,7 @@ def test_a_read_only_finished_study_is_one_warning(quick_study, tmp_path, monkey
 
 
 def test_a_weights_cache_entry_that_is_a_fifo_or_nested_deep_is_recomputed(tmp_path, capsys):
-    from softhand.studies.weights import read_entry
+    from softhand.studies.weights_cache import read_entry
 
     fifo, deep = tmp_path / "fifo.json", tmp_path / "deep.json"
     os.mkfifo(fifo)

@@ -151,7 +151,8 @@ def test_weights_sweep_result_is_what_the_verb_prints_and_interpolates_exactly(f
 def _fig8_result():
     """Rows of two pressures at two angles each, the reduced values by eq. (25) at their (P, theta)."""
     from softhand.studies.fig8 import Fig8Result, paper_w_F_v
-    from softhand.studies.weights import WeightsCase, reduced_F_v
+    from softhand.studies.weights import WeightsCase
+    from softhand.studies.weights_rows import reduced_F_v
 
     case = WeightsCase(diameter_mm=180.0, mass_kg=2.0)
     rows = []

@@ -24,7 +24,7 @@ from softhand.studies.cli.main import main
 
 def test_eq25_far_from_the_fem_is_printed_with_why():
     """Within 10 % of the FEM's F_v: no note; beyond it, the ratio and the touching link."""
-    from softhand.studies.weights import NOTE_RTOL, reduced_note
+    from softhand.studies.weights_rows import NOTE_RTOL, reduced_note
 
     d = HandDesign()
     N = np.array([0.0, 0.0, 3.2, 0.0, 0.0, 0.0])  # the object on link 2 of 5
@@ -72,7 +72,7 @@ def test_replace_takes_the_design_files_names_with_its_rules():
 
 
 def test_a_proof_mesh_retried_on_a_finer_one_is_a_note(monkeypatch, capsys):
-    from softhand.studies.design import proof, workflow
+    from softhand.studies.design import proof, proof_sizes, workflow
 
     calls = []
 
@@ -84,7 +84,7 @@ def test_a_proof_mesh_retried_on_a_finer_one_is_a_note(monkeypatch, capsys):
         return {"ok": True}
 
     monkeypatch.setattr(proof, "prove", prove)
-    monkeypatch.setattr(proof, "proof_meshes", lambda design, size: [10.0, 6.0])
+    monkeypatch.setattr(proof_sizes, "proof_meshes", lambda design, size: [10.0, 6.0])
     task = Namespace(mesh_size=10.0, dP=0.05, edge_ratio=1.0)
     said = []
     fem = workflow.prove_on_meshes(Namespace(design=None), task, None, None, said.append)
@@ -119,7 +119,7 @@ def test_weights_prints_eq25s_force_under_its_caveat(monkeypatch, capsys):
     from types import SimpleNamespace
 
     from softhand.studies import weights
-    from softhand.studies.weights import reduced_note
+    from softhand.studies.weights_rows import reduced_note
 
     N = [0.0, 0.0, 3.2, 0.0, 0.0, 0.0]
     row = {"diameter_mm": 240.0, "F_v_fem_N": 4.751, "F_v_reduced_N": 87.21, "contact_force_N": N,

@@ -159,7 +159,7 @@ def _load_space(path):
 
 def _check(space, args) -> int:
     from softhand.reduced.vocabulary.errors import InputError
-    from softhand.studies.calibration.finger_table import heldout_rows
+    from softhand.studies.calibration.finger_check import heldout_rows
 
     results = _run(space, args)
     if results is None:

@@ -41,7 +41,8 @@ def configure(parser) -> None:
 
 def run(args) -> int:
     from softhand.studies.cli.checks import check_writable
-    from softhand.studies.design.task import LOWER, UPPER, load_task
+    from softhand.studies.design.task import load_task
+    from softhand.studies.design.task_values import LOWER, UPPER
     from softhand.studies.design.workflow import OUTPUT_FILES, OUTPUT_FOLDERS, DesignRun, run_task
     from softhand.studies.io.outputs import check_output_tree, check_owned
 
@@ -88,7 +89,7 @@ def _default_out(task, path) -> Path:
 
 def _check_proof_size(task, args) -> None:
     """A proof mesh too large for this machine: one line now, not after the optimiser's minutes."""
-    from softhand.studies.design.proof import check_proof_size
+    from softhand.studies.design.proof_sizes import check_proof_size
 
     given = args.mesh_size_mm is not None
     size = args.mesh_size_mm if given else task.mesh_size

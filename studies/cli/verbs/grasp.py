@@ -72,7 +72,8 @@ def _scalar(text: str, field: str) -> float:
 def _fem_weights(diameter: float, mass: float, design) -> tuple[np.ndarray, str, list[str]]:
     """w from the grasp FEM (studies.weights, cached) at its default pressure and mesh, where it
     came from, and the caveat on eq. (25) with it where the FEM's own F_v says it is off."""
-    from softhand.studies.weights import WeightsCase, reduced_note, weights
+    from softhand.studies.weights import WeightsCase, weights
+    from softhand.studies.weights_rows import reduced_note
 
     if not diameter > 0:
         raise InputError("diameter_mm", diameter, "must be a positive number")

@@ -22,23 +22,16 @@ model finds for the pump pressure given. Both print the same ``--json`` keys.
 """
 from __future__ import annotations
 
-from contextlib import contextmanager
-
 import sys
-from pathlib import Path
-
 
 from softhand.reduced.vocabulary.errors import InputError
 from softhand.studies.cli.args import add_design_option, add_json_option, add_progress_option, \
     design_from_args, parse_values, print_json
+from softhand.studies.cli.verbs.hold_io import (OUTPUT_NAMES, PULLS, checked_option, object_from_args,
+                                                 progress_bar, pull_direction, staged, write_output)
 
 HELP = "does the hand hold an object: held or not, holding limit, least pump pressure, hold map"
 MODELS = ("reduced", "fem")
-#: named pull directions (hand frame: y down, x outward through finger 0, z = x cross y)
-PULLS = {"down": (0, 1, 0), "up": (0, -1, 0), "x": (1, 0, 0), "-x": (-1, 0, 0), "z": (0, 0, 1), "-z": (0, 0, -1)}
-#: option -> (lowest, highest)
-LIMITS = {"--pressure-mpa": (-1.0, 5.0), "--cavity-pressure-mpa": (0.0, 5.0), "--mass-kg": (0.0, 100.0),
-          "--friction": (0.0, 10.0), "--margin": (1.0, 100.0), "--pull-n": (0.0, 1e5), "--max-pump-mpa": (0.01, 5.0)}
 
 
 def configure(parser) -> None:
@@ -73,57 +66,13 @@ def configure(parser) -> None:
     add_progress_option(parser)
 
 
-def _checked(args, option: str):
-    value = getattr(args, option[2:].replace("-", "_"))
-    if value is None:
-        return None
-    lo, hi = LIMITS[option]
-    if not lo <= value <= hi:
-        raise InputError(option, value, f"must be a number in [{lo:g}, {hi:g}]")
-    return float(value)
-
-
-def _pull(text: str):
-    from softhand.reduced.holding.hold import pull_unit
-
-    if text in PULLS:
-        return pull_unit(PULLS[text])
-    values = parse_values(text, "--pull", 3, "x,y,z")
-    if len(values) != 3:
-        raise InputError("--pull", text, f"must be three numbers x,y,z or one of {', '.join(PULLS)}")
-    return pull_unit(values, "--pull")
-
-
-def _object(args):
-    from dataclasses import replace
-
-    from softhand.reduced.holding.objects import parse_object
-
-    obj = parse_object(args.object)
-    changes = {k: v for k, v in (("mass_kg", _checked(args, "--mass-kg")), ("friction", _checked(args, "--friction")))
-               if v is not None}
-    return replace(obj, **changes) if changes else obj
-
-
-def _bar(show: bool, desc: str):
-    from tqdm import tqdm
-
-    bar = tqdm(desc=desc, unit="point", file=sys.stderr, leave=False, disable=not show)
-
-    def update(done, total):
-        bar.total = total
-        bar.n = done
-        bar.refresh()
-    return bar, update
-
-
 def run(args) -> int:
     from softhand.reduced.holding import hold
 
     design = design_from_args(args)
-    obj = _object(args)
-    pull = _pull(args.pull)
-    max_pump = _checked(args, "--max-pump-mpa")
+    obj = object_from_args(args)
+    pull = pull_direction(args.pull)
+    max_pump = checked_option(args, "--max-pump-mpa")
     if args.out:  # a file or folder of the user's where an output goes: refused before any work
         from softhand.studies.io.outputs import check_owned
 
@@ -132,7 +81,7 @@ def run(args) -> int:
         return _run_map(args, design, obj, pull, max_pump)
     if args.check:
         raise InputError("--check", True, "runs the FEM at points of a map; give --map too")
-    P_pump, P_cav = _checked(args, "--pressure-mpa"), _checked(args, "--cavity-pressure-mpa")
+    P_pump, P_cav = checked_option(args, "--pressure-mpa"), checked_option(args, "--cavity-pressure-mpa")
     if P_pump is None and P_cav is None:
         return _run_least(args, design, obj, pull, max_pump)
     if args.margin is not None or args.pull_n is not None:
@@ -149,7 +98,7 @@ def run(args) -> int:
     else:
         result = hold.solve_hold(design, obj, P_cavity_MPa=P_cav, pull_direction=pull, finger_model=args.finger,
                                  placed=placed)
-        _write(args, result.to_json(), "result.json")
+        write_output(args, result.to_json(), "result.json")
     if args.json:
         print_json(result.to_json())
     else:
@@ -167,7 +116,8 @@ def _fem_hold(args, design, obj, P_cav, P_pump, pull):
 
     from softhand.fem.newton import NotConverged
 
-    from softhand.fem.hand.hold import check_hold, solve_hold
+    from softhand.fem.hand.hold import solve_hold
+    from softhand.fem.hand.hold_options import check_hold
 
     check_hold(design, obj, tuple(pull))  # what the FEM hold refuses: one line, before its bar
     bar = tqdm(desc="hold (FEM)", unit="step", file=sys.stderr, leave=False,
@@ -188,36 +138,9 @@ def _fem_hold(args, design, obj, P_cav, P_pump, pull):
     if args.out:
         from softhand.fem.hand.hold_output import write_hold
 
-        with _staged(args) as stage:
+        with staged(args) as stage:
             write_hold(path, result, stage)
     return result
-
-
-#: what ``hold --out DIR`` writes (its manifest: an earlier run's are replaced whole, nothing else)
-OUTPUT_NAMES = ("result.json", "hold.pvd", "hold", "hold_map.csv", "hold_map.png")
-
-
-@contextmanager
-def _staged(args):
-    """The run's outputs staged and renamed into --out when whole (the project's output rule)."""
-    from softhand.studies.io.files import UNWRITTEN, kept_if_unwritable
-    from softhand.studies.io.outputs import replaced_outputs
-
-    refused = len(UNWRITTEN)
-    with replaced_outputs(args.out, OUTPUT_NAMES, verb="hold") as stage, \
-            kept_if_unwritable(Path(args.out), "hold"):
-        yield stage
-    if len(UNWRITTEN) == refused:
-        print(f"softhand hold: wrote {args.out}", file=sys.stderr)
-
-
-def _write(args, data: dict, name: str) -> None:
-    if not args.out:
-        return
-    from softhand.studies.io.files import write_json
-
-    with _staged(args) as stage:
-        write_json(stage / name, data)
 
 
 def _print(r) -> None:
@@ -238,9 +161,9 @@ def _run_least(args, design, obj, pull, max_pump) -> int:
     if args.model == "fem":
         raise InputError("--model", "fem", "the least pressure is searched with the fast model; give "
                                            "--pressure-mpa to run the FEM at one pressure")
-    margin = _checked(args, "--margin")
-    pull_n = _checked(args, "--pull-n")
-    bar, update = _bar(not args.no_progress, "hold: least pressure")
+    margin = checked_option(args, "--margin")
+    pull_n = checked_option(args, "--pull-n")
+    bar, update = progress_bar(not args.no_progress, "hold: least pressure")
     try:
         least = hold.least_pressure(design, obj, max_pump_MPa=max_pump, margin=margin or 1.0, pull_N=pull_n,
                                     pull_direction=pull, finger_model=args.finger, progress=update)
@@ -249,7 +172,7 @@ def _run_least(args, design, obj, pull, max_pump) -> int:
     data = {**least.result.to_json(), "least_P_pump_MPa": least.P_pump_MPa,
             "least_P_cavity_MPa": least.P_cavity_MPa, "required_holding_limit_N": least.required_N,
             "max_pump_MPa": max_pump}
-    _write(args, data, "result.json")
+    write_output(args, data, "result.json")
     if args.json:
         print_json(data)
     else:
@@ -272,23 +195,23 @@ def _run_map(args, design, obj, pull, max_pump) -> int:
     from softhand.studies.hold import HoldMap, run_map, write_map
 
     x, y = (_axis(t) for t in args.map)
-    pressure = _checked(args, "--pressure-mpa")
+    pressure = checked_option(args, "--pressure-mpa")
     if pressure is None and "pressure" not in (x[0], y[0]):
         raise InputError("--pressure-mpa", None, "is required when pressure is not an axis of the map")
     m = HoldMap(design, obj, x, y, pressure_MPa=pressure if pressure is not None else 0.0, pull=tuple(pull),
                 max_pump_MPa=max_pump, finger_model=args.finger)
     if args.check:  # what the FEM hold refuses, before the map, not after it
-        from softhand.fem.hand.hold import check_hold
+        from softhand.fem.hand.hold_options import check_hold
 
         check_hold(design, obj, tuple(pull))
-    bar, update = _bar(not args.no_progress, "hold map")
+    bar, update = progress_bar(not args.no_progress, "hold map")
     try:
         rows = run_map(m, progress=update)
     finally:
         bar.close()
     checks = _map_checks(m, rows, design) if args.check else []
     if args.out:
-        with _staged(args) as stage:
+        with staged(args) as stage:
             write_map(m, rows, stage)
     if args.json:
         print_json({"rows": rows, "checks": checks, "max_pump_MPa": max_pump})

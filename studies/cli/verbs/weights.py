@@ -19,7 +19,7 @@ from softhand.reduced.vocabulary.errors import InputError
 from softhand.reduced.vocabulary.paper import FIG8
 from softhand.studies.cli.args import MOST_FEM_POINTS, add_design_option, add_json_option, \
     add_max_cases_option, add_progress_option, design_from_args, max_cases, parse_values, print_json, print_table
-from softhand.studies.design.task import UPPER
+from softhand.studies.design.task_values import UPPER
 from softhand.studies.io.files import kept_if_unwritable
 from softhand.studies.io.outputs import replaced_outputs
 
