@@ -136,3 +136,15 @@ def test_the_private_name_check_sees_one(tmp_path):
     path.write_text("from softhand.reduced.vocabulary.errors import (\n    InputError,\n    _hidden,\n)\n\n"
                     "def f():\n    from softhand.fem.newton import _step, __all__\n")
     assert private_imports(path) == ["softhand.reduced.vocabulary.errors._hidden", "softhand.fem.newton._step"]
+
+
+#: a module a reader takes in whole: past this many lines, it holds more than one concern
+MAX_LINES = 300
+
+
+def test_every_module_is_one_concern_a_reader_takes_in_whole():
+    """Rooms cut by concern keep modules short; a module past the mark is due a split (by
+    concern, not by size), not a higher mark."""
+    long = {name: n for name, path in ALL.items()
+            if (n := len(path.read_text().splitlines())) > MAX_LINES}
+    assert not long, f"modules over {MAX_LINES} lines: {long}"
