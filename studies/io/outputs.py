@@ -106,7 +106,7 @@ def replaced_outputs(folder: str | Path | None, names, *, verb: str = "softhand"
     outputs (those its manifest names, nothing else) are removed: the folder holds one run's
     whole result, a reader never sees a half-written one. If the block does not finish (an
     error, Ctrl-C, SIGTERM) the staging folder is removed and the earlier result stays as it
-    was. If some output could not be written (:func:`kept_if_unwritable`: disk full, file-size
+    was. If some output could not be written (:func:`softhand.studies.io.files.kept_if_unwritable`: disk full, file-size
     limit), the pieces written go to ``folder/incomplete/`` and the earlier result stays too.
     An output of the user's of the same name is refused (:func:`check_owned`). Two runs into
     one folder: each stages its own; the last to finish replaces the other's result whole (a
