@@ -9,4 +9,5 @@ from .loads import FollowerPressure
 from .materials import NeoHookean
 from .newton import NewtonOptions
 from .newton_path import PathOptions, solve_path
-from .solid import MixedNewton, Solid
+from .mixed import MixedNewton
+from .solid import Solid

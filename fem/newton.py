@@ -46,7 +46,7 @@ class NewtonOptions:
     max_iter: int = 25  #: Newton iterations per solve
     line_search: bool = True  #: adjust the step length (see ``merit``)
     #: "slope": R(x + s dx).dx -> 0 (energy); "residual": Armijo on ||R||; "finite": full
-    #: steps, halved only where R is not finite (the mixed (u, p) iteration, see fem.solid.MixedNewton)
+    #: steps, halved only where R is not finite (the mixed (u, p) iteration, see fem.mixed.MixedNewton)
     #: "decrease": the first step whole, then halving until ``newton``'s ``merit`` decreases
     merit: str = "slope"
     eta: float = 0.5  #: "slope": accept when ``|R(x + s dx).dx|`` <= eta ``|R(x).dx|``

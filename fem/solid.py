@@ -53,10 +53,10 @@ from skfem import Basis, ElementTetP2
 from softhand.fem import kinematics as kin
 from softhand.fem import threads
 from softhand.fem.assembly import ElementScatter, Restriction
-from softhand.fem.mixed import MixedNewton, PressureAnchor
+from softhand.fem.mixed import PressureAnchor
 from softhand.fem.solid_kernels import ElementKernels
 
-__all__ = ["FORMULATIONS", "Solid", "MixedNewton", "PressureAnchor"]
+__all__ = ["FORMULATIONS", "Solid"]
 
 FORMULATIONS = ("mean_dilatation", "displacement")
 

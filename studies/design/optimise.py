@@ -30,7 +30,7 @@ from softhand.studies.design.evaluate import evaluate as grasp_evaluate
 from softhand.studies.design.hold_eval import evaluate_hold
 from softhand.studies.design.task import Task
 
-__all__ = ["Constraint", "Evaluation", "design_at", "evaluate", "objective", "Problem", "OptimiserOptions",
+__all__ = ["design_at", "evaluate", "objective", "Problem", "OptimiserOptions",
            "Optimum", "Stall", "optimise", "on_bounds", "polish", "binding", "infeasible_report", "open_span"]
 
 

@@ -42,7 +42,7 @@ from dataclasses import replace
 import numpy as np
 
 from softhand.reduced.equations import reservoir
-from softhand.studies.design.optimise import Evaluation
+from softhand.studies.design.evaluate import Evaluation
 from softhand.studies.design.proof_steps import ProofOptions, free_bend, grasp_secant, margin, sheet_pressure
 from softhand.studies.design.task import Task
 

@@ -13,7 +13,7 @@ import numpy as np
 from scipy.interpolate import PchipInterpolator
 
 from softhand.reduced.equations import hand, reservoir
-from softhand.studies.design.optimise import Evaluation
+from softhand.studies.design.evaluate import Evaluation
 from softhand.studies.design.task import Task
 
 

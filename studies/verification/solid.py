@@ -41,7 +41,8 @@ from softhand.fem.loads import FollowerPressure
 from softhand.fem.materials import Fibers, NeoHookean
 from softhand.fem.newton import NewtonOptions
 from softhand.fem.newton_path import PathOptions, solve_path
-from softhand.fem.solid import MixedNewton, Solid
+from softhand.fem.mixed import MixedNewton
+from softhand.fem.solid import Solid
 from softhand.meshes.tube import Tube, tube_mesh
 from softhand.studies.verification import closed_forms as cf
 from softhand.studies.verification.registry import Check

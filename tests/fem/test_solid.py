@@ -15,7 +15,8 @@ from softhand.fem.loads import FollowerPressure
 from softhand.fem.materials import CompressibleNeoHookean, Fibers, NeoHookean
 from softhand.fem.newton import NewtonOptions
 from softhand.fem.newton_path import PathOptions, solve_path
-from softhand.fem.solid import MixedNewton, Solid
+from softhand.fem.mixed import MixedNewton
+from softhand.fem.solid import Solid
 
 RNG = np.random.default_rng(3)
 
