@@ -32,7 +32,7 @@ from softhand.reduced.vocabulary import paper
 from softhand.reduced.vocabulary.design import HandDesign
 from softhand.reduced.vocabulary.errors import InputError
 from softhand.studies.io.files import write_atomic, write_csv
-from softhand.studies.io.outputs import check_owned, record_outputs
+from softhand.studies.io.outputs import MANIFEST, check_owned, record_outputs
 from softhand.studies.reproduce.section import Context, Section
 from softhand.studies.batch.runner import FAILED, RESULT, code_version, commit, execute_case, outcome_record
 
@@ -119,6 +119,7 @@ def reproduce(out: str | Path = "results/reproduce", *, quick: bool = False,
     ctx = Context(design=design or HandDesign(), quick=quick, progress=progress)
     _SHOW["progress"] = progress
     todo = section_list if section_list is not None else sections()
+    _adopt_earlier(out, todo)
     check_owned(out, [*REPORT_FILES, *(s.key for s in todo)], "--out")
     _ACTIVE.clear()
     _ACTIVE.update((s.key, s) for s in todo)
@@ -136,6 +137,28 @@ def reproduce(out: str | Path = "results/reproduce", *, quick: bool = False,
                                            or Outcome(s, "not run", "interrupted")
                                            for s in todo[len(outcomes):]])
     return outcomes
+
+
+def _adopt_earlier(out: Path, todo: list[Section]) -> None:
+    """Record in the manifest the sections a run of an earlier softhand, which kept no
+    manifest, left in ``out``: a plain folder whose own record names that section."""
+    if not out.is_dir() or (out / MANIFEST).exists():
+        return
+    earlier = [s.key for s in todo if (out / s.key).is_dir() and not (out / s.key).is_symlink()
+               and any((_read(out / s.key / name) or {}).get("section") == s.key for name in (RESULT, FAILED))]
+    heads = {"report.md": "# softhand reproduce", "summary.csv": "section,status,name,value"}
+    earlier += [name for name, head in heads.items() if earlier and _starts_with(out / name, head)]
+    if earlier:
+        record_outputs(out, earlier, verb="reproduce")
+
+
+def _starts_with(path: Path, head: str) -> bool:
+    from softhand.studies.io.files import read_bounded
+
+    try:
+        return path.is_file() and not path.is_symlink() and read_bounded(path, 1 << 24).startswith(head)
+    except (OSError, ValueError):
+        return False
 
 
 def _not_built(section: Section, ctx: Context, only) -> Outcome | None:

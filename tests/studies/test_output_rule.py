@@ -151,6 +151,21 @@ def test_reproduce_refuses_an_output_name_the_user_holds_and_resumes_its_own(tmp
     assert [o.status for o in reproduce(out, quick=True, only=only, progress=False)][0] == "reused"
 
 
+def test_reproduce_resumes_sections_an_earlier_version_left_without_a_manifest(tmp_path):
+    from softhand.studies.reproduce.core import reproduce
+
+    out = tmp_path / "out"
+    only = ("fig7_reduced",)
+    reproduce(out, quick=True, only=only, progress=False)
+    (out / MANIFEST).unlink()  # as an earlier softhand left it
+    assert [o.status for o in reproduce(out, quick=True, only=only, progress=False)][0] == "reused"
+    (out / MANIFEST).unlink()
+    (out / "fig7_reduced" / "result.json").write_text('{"section": "table2_reduced"}')  # not this section's
+    with pytest.raises(InputError, match="not written by an earlier softhand run"):
+        reproduce(out, quick=True, only=only, progress=False)
+    assert not (out / MANIFEST).exists()
+
+
 def test_a_killed_runs_staging_folder_is_removed_by_the_next_run(tmp_path):
     out = tmp_path / "out"
     out.mkdir()
