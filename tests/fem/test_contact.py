@@ -4,6 +4,7 @@ The convergence tests use the rigid chain alone with hinge springs standing in f
 (a 5-unknown problem solved by Newton here), so they run in milliseconds.
 """
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -145,3 +146,37 @@ def test_augmented_lagrangian_reaches_the_rigid_limit_for_any_penalty():
     np.testing.assert_allclose(L1.N, L2.N, rtol=1e-6, atol=1e-8)  # gap tolerance 1e-10 mm
     np.testing.assert_allclose(q1, q2, atol=1e-9)
     assert n2 <= n1  # a stiffer penalty needs fewer updates
+
+
+def test_an_off_axis_release_converges_on_the_slipping_pads_own_tangent():
+    """A contact problem replayed from the FEM hold: tests/fem/data/off_axis_release.npz is the
+    condensed hold of a 180 mm sphere 1.5 mm off the palm axis (2 kg, mu 0.8, 0.9 MPa, CI mesh,
+    every finger and all six pose components solved) with half its weight let go. With every
+    kept pad stuck in the Newton tangent, Newton stalled at a constant residual: the sphere
+    turning in pads that slip kept the stick stiffness. The slipping pads' own tangent (the
+    return map's derivative) converges; the answer is checked as an equilibrium, not a number."""
+    from softhand.fem.constraints import PlanarChain
+    from softhand.fem.hand.hold_body import Body
+    from softhand.fem.hand.hold_contact import ContactHistory, ContactOptions, Fingers, Problem, solve_contact
+    from softhand.fem.hand.hold_geometry import FingerFrame, PadSet
+    from softhand.reduced.vocabulary.design import HandDesign
+
+    d = np.load(Path(__file__).parent / "data" / "off_axis_release.npz")
+    body = Body("sphere", tuple(d["body_centre"]), tuple(d["body_size"]), tuple(d["body_axis"]),
+                mass_kg=float(d["body_mass_kg"]), friction=float(d["body_friction"]))
+    pads = PadSet(PlanarChain(d["hinges"]), tuple(d["ends"]), float(d["pad_y"]), float(d["pad_width"]), HandDesign())
+    n = len(d["azimuths"])
+    fingers = Fingers([FingerFrame(float(a)) for a in d["azimuths"]], [pads] * n, d["mult"], list(d["q0"]),
+                      list(d["Q0"]), list(d["S"]))
+    hist = ContactHistory(*(d[f"hist_{k}"] for k in ("lam_N", "lam_T", "X", "zeta", "Xo", "xp0", "xo0")))
+    problem = Problem(body, fingers, d["pose0"], d["free"], d["load"], hist, float(d["scale"]))
+    options = ContactOptions()
+    x, cs, _, _, R = solve_contact(problem, d["x0"], options)
+    touching = cs.N > 0
+    assert np.linalg.norm(R) <= options.rtol * problem.scale  # hinges of every finger and the object in equilibrium
+    assert np.max(-cs.g[touching]) <= options.gap_tol  # no pad in the sphere
+    assert np.max(np.linalg.norm(cs.slip[cs.stick], axis=1), initial=0.0) <= options.slip_tol
+    assert np.all(np.linalg.norm(cs.T, axis=1) <= body.friction * cs.N * (1 + 1e-12) + 1e-12)  # Coulomb's cone
+    assert touching.sum() == n and (~cs.stick[touching]).any()  # every finger touches; some pads slip
+    # the object's force balance, summed over the pads: they carry its weight's share let go
+    assert np.allclose(cs.wrench[:3], -d["load"][:3], atol=1e-6 * np.abs(d["load"]).max())
