@@ -33,7 +33,7 @@ from pathlib import Path
 import numpy as np
 
 from softhand.reduced.vocabulary.errors import InputError
-from softhand.reduced.holding.object_mesh import MeshData, mesh_sdf, read_mesh, self_intersection
+from softhand.reduced.holding.object_mesh import read_mesh
 
 __all__ = ["SHAPES", "KEYS", "GraspObject", "check_object", "object_from_table", "object_from_short",
            "load_object", "parse_object", "rotation_matrix"]

@@ -40,7 +40,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from softhand.reduced.materials.rubber_base import MODES, InvariantRubber, Rubber, invariants, stretches
+from softhand.reduced.materials.rubber_base import MODES, InvariantRubber, Rubber, stretches
 
 __all__ = ["drucker_check", "NeoHookean", "MooneyRivlin", "Yeoh", "Gent", "Ogden", "MODELS"]
 
