@@ -1,6 +1,7 @@
 """Leave-one-out check of the finger calibration table: each FEM design predicted by the
 table without it (fit redone, ranges kept), no FEM run. Prints theta and dQ errors per
-design (worst over its FEM points) and the rms / worst over all points.
+design (worst over its FEM points), and the rubber's converged stretch where the table holds
+it, and the rms / worst over all points.
 
 Run: ``python benchmarks/finger_loo.py [TABLE.csv]`` (default: the shipped table).
 """
@@ -15,13 +16,16 @@ from softhand.studies.calibration.finger_check import leave_one_out
 
 def main() -> None:
     rows = leave_one_out(sys.argv[1] if len(sys.argv) > 1 else None)
-    print("design  b/a    d/a    link/a  tie/link  |theta err| max [%]  |dQ err| max [%]")
+    keys = ["theta_err_pct", "dQ_err_pct"] + (["rubber_stretch_err_pct"] if "rubber_stretch_err_pct" in rows[0] else [])
+    print("design  b/a    d/a    link/a  tie/link  |theta err| max [%]  |dQ err| max [%]"
+          + ("  |stretch err| max [%]" if len(keys) > 2 else ""))
     for i in sorted({r["design"] for r in rows}):
         mine = [r for r in rows if r["design"] == i]
         g = mine[0]
+        worst = [max(abs(r[k]) for r in mine) for k in keys]
         print(f"{i:6d}  {g['b_a']:5.3f}  {g['d_a']:5.3f}  {g['link_a']:6.3f}  {g['tie_link']:8.3f}  "
-              f"{max(abs(r['theta_err_pct']) for r in mine):19.2f}  {max(abs(r['dQ_err_pct']) for r in mine):16.2f}")
-    for key in ("theta_err_pct", "dQ_err_pct"):
+              f"{worst[0]:19.2f}  {worst[1]:16.2f}" + (f"  {worst[2]:21.2f}" if len(keys) > 2 else ""))
+    for key in keys:
         e = np.array([r[key] for r in rows])
         print(f"{key}: rms {np.sqrt(np.mean(e**2)):.2f} %, worst {np.abs(e).max():.2f} % over {e.size} FEM points")
 

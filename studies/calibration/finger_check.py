@@ -25,7 +25,11 @@ def heldout_rows(results: list[tuple[HandDesign, dict]], table: str | None = Non
     the design's reservoir), error [MPa] (nan where the fingers take more oil than V0); per
     design with an FEM bend >= 60 deg, the model's bend at the FEM's pressure of 60 deg and the
     whole hand's error there (the FEM's pressure and oil at 60 deg by monotone cubic
-    interpolation of its points). Returns (rows, worst ``|error|`` per column)."""
+    interpolation of its points). Where the table has the rubber's converged stretch and the
+    case recorded it, also that stretch by FEM and by the model, error [%] of the stretch.
+    Returns (rows, worst ``|error|`` per column)."""
+    from softhand.reduced.calibrated.finger_fem import rubber_stretch
+
     rows = []
     for design, record in results:
         model = design.replace(finger_model="fem", finger_table=str(table or ""))
@@ -33,6 +37,8 @@ def heldout_rows(results: list[tuple[HandDesign, dict]], table: str | None = Non
         P, th, dQ = (np.array(v, float) for v in (cavity_pressures(n), n["theta_deg"], n["dQ_mm3"]))
         keep = P > 0
         P, th, dQ = P[keep], th[keep], dQ[keep]
+        lam_m = rubber_stretch(np.radians(th), model) if "rubber_stretch" in n else None
+        lam = None if lam_m is None else np.array(n["rubber_stretch"], float)[keep]
         at60 = th.max() >= 60.0
         if at60:
             P60, dQ60 = (float(PchipInterpolator(np.r_[0.0, th], np.r_[0.0, v])(60.0)) for v in (P, dQ))
@@ -47,14 +53,19 @@ def heldout_rows(results: list[tuple[HandDesign, dict]], table: str | None = Non
             rows.append({"design": point, "P_cavity_MPa": P[k], "theta_fem_deg": th[k], "theta_model_deg": th_m[k],
                          "theta_err_pct": 100 * (th_m[k] / th[k] - 1), "dQ_fem_mm3": dQ[k],
                          "dQ_model_mm3": dQ_m[k], "dQ_err_pct": 100 * (dQ_m[k] / dQ[k] - 1),
-                         "P_hand_err_MPa": hand_err[k]})
+                         "P_hand_err_MPa": hand_err[k],
+                         **({} if lam is None else {"rubber_stretch_fem": lam[k], "rubber_stretch_model": lam_m[k],
+                                                    "rubber_stretch_err_pct": 100 * (lam_m[k] / lam[k] - 1)})})
         if at60:
             t60 = float(np.degrees(hand.bend_angle(P60, model, reservoir=False)))
             rows.append({"design": point, "P_cavity_MPa": P60, "theta_fem_deg": 60.0, "theta_model_deg": t60,
                          "theta_err_pct": 100 * (t60 / 60.0 - 1), "dQ_fem_mm3": math.nan,
-                         "dQ_model_mm3": math.nan, "dQ_err_pct": math.nan, "P_hand_err_MPa": hand_err[-1]})
-    worst = {k: float(np.nanmax([abs(r[k]) for r in rows]))
-             for k in ("theta_err_pct", "dQ_err_pct", "P_hand_err_MPa")}
+                         "dQ_model_mm3": math.nan, "dQ_err_pct": math.nan, "P_hand_err_MPa": hand_err[-1],
+                         **({} if lam is None else {"rubber_stretch_fem": math.nan, "rubber_stretch_model": math.nan,
+                                                    "rubber_stretch_err_pct": math.nan})})
+    columns = ("theta_err_pct", "dQ_err_pct", "P_hand_err_MPa", "rubber_stretch_err_pct")
+    worst = {k: float(np.nanmax([abs(r.get(k, math.nan)) for r in rows]))
+             for k in columns if any(k in r for r in rows)}
     return rows, worst
 
 
