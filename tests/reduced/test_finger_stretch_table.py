@@ -32,8 +32,17 @@ def stretch_table(tmp_path):
     return path
 
 
-def test_a_table_without_the_column_predicts_no_stretch():
-    assert finger_fem.rubber_stretch(0.5, HandDesign(finger_model="fem")) is None
+def test_a_table_without_the_column_predicts_no_stretch(tmp_path):
+    """A table written before the column (the shipped one's P and dQ alone) predicts no stretch;
+    the shipped table has it."""
+    table = read_table(TABLE_FILE)
+    r = table.rows
+    text = "\n".join(table.header) + "\n" + ",".join(finger_fem.COLUMNS) + "\n"
+    text += "".join(",".join(f"{r[c][k]:.12g}" for c in finger_fem.COLUMNS) + "\n" for k in range(r["theta"].size))
+    path = tmp_path / "without_stretch.csv"
+    path.write_text(text)
+    assert finger_fem.rubber_stretch(0.5, HandDesign(finger_model="fem", finger_table=str(path))) is None
+    assert finger_fem.rubber_stretch(0.5, HandDesign(finger_model="fem")) > 1.0
 
 
 def test_the_fit_reproduces_a_stretch_it_can_represent(tmp_path):
@@ -74,7 +83,8 @@ def test_the_calibration_rows_carry_the_converged_stretch():
 
 def test_the_optimiser_judges_the_tube_by_the_calibrated_stretch(tmp_path):
     """With such a table, a design's evaluated tube stretch is the table's prediction at the bend
-    that holds the object (not eq. (8) x a factor)."""
+    the free finger reaches under the grasp's cavity pressure (not eq. (8) x a factor)."""
+    from softhand.reduced.equations import hand
     from softhand.studies.design import evaluate
     from softhand.studies.design.task import task_from_dict
 
@@ -82,5 +92,9 @@ def test_the_optimiser_judges_the_tube_by_the_calibrated_stretch(tmp_path):
                            "design": {"finger_table": str(stretch_table(tmp_path))},
                            "free": {"d_mm": [10.0, 20.0]}})
     ev = evaluate.evaluate(task.base, task)
-    assert ev.stretch == pytest.approx(float(finger_fem.rubber_stretch(ev.theta_hold, task.base)), rel=1e-12)
+    th, design = ev.theta_hold, task.base
+    p_r = float(hand.pressure(th, design, reservoir=False) - hand.pressure(th, design))
+    free = float(hand.bend_angle(ev.P_grasp + p_r, design, reservoir=False))
+    assert free > th
+    assert ev.stretch == pytest.approx(float(finger_fem.rubber_stretch(free, design)), rel=1e-12)
     assert ev.stretch != pytest.approx(evaluate.peak_stretch(ev.theta_hold, task.base), rel=1e-3)
