@@ -28,6 +28,18 @@ def test_the_proof_flags_a_fem_stretch_above_the_limit():
     assert "rubber_stretch (FEM, verified grasp) = 1.54 above the limit 1.5" in text and "\n" not in text
 
 
+def test_the_fem_meets_a_limit_to_its_tolerance():
+    """A design the optimiser put on its binding limit is confirmed by an FEM value at that limit
+    to FEM_TOLERANCE of it (1.50002 against 1.5, the paper task's sheet), not beyond."""
+    from softhand.studies.design.proof import FEM_TOLERANCE, fem_constraints
+
+    task = task_from_dict(CI_TASK)  # stretch limit 1.5, pump 2 MPa
+    at = {"rubber_stretch": 1.2, "sheet_rubber_stretch": 1.50002, "P_grasp_MPa": 0.7}
+    assert all(c["satisfied"] and c["tolerance"] == FEM_TOLERANCE for c in fem_constraints(at, task))
+    beyond = {**at, "sheet_rubber_stretch": 1.5 * (1 + 1.01 * FEM_TOLERANCE)}
+    assert [c["satisfied"] for c in fem_constraints(beyond, task)] == [True, False, True]
+
+
 def test_the_proof_mesh_follows_the_wall():
     from softhand.studies.design.proof_sizes import proof_mesh
 
@@ -124,11 +136,17 @@ def test_the_proof_mesh_is_bounded_on_the_boxs_thinnest_shortest_tube(monkeypatc
         proof_sizes.check_proof_size(task, 0.5)
 
 
+#: the task's finger on the paper's model: its tube stretch is eq. (8)'s, which the FEM corrects
+PAPER_FINGER = '[design]\nfinger_model = "paper"\n'
+
+
 def test_a_fem_stretch_above_the_limit_reoptimises_with_the_fems_factor(tmp_path, monkeypatch, capsys):
-    """The proof's rubber stretch 1.51 breaks the limit 1.5: the verb optimises again with eq. (8)'s
+    """On the paper's finger model the proof's rubber stretch 1.51 breaks the limit 1.5: the verb
+    optimises again with eq. (8)'s
     strain scaled by (1.51 - 1) / (lambda_pred - 1), proves that design (here: the FEM stand-in
-    gives its scaled prediction), keeps the first under "rejected" and exits 0. At 1.55 no design
-    meets the scaled limit if l0 is fixed: one paragraph naming it and the nearest design, exit 1."""
+    gives its scaled prediction), keeps the first under "rejected" and exits 0. At 2.5 no design
+    meets the scaled limit if l0 is fixed (at 1.7 one still does): one paragraph naming it and the
+    nearest design, exit 1."""
     from softhand.studies.cli.main import main
     from softhand.studies.design import proof
     from softhand.studies.design import evaluate
@@ -143,7 +161,7 @@ def test_a_fem_stretch_above_the_limit_reoptimises_with_the_fems_factor(tmp_path
         return {**fem, "constraints": fem_constraints(fem, task)}
 
     monkeypatch.setattr(proof, "prove", prove)
-    task = _write(tmp_path, CI_TASK_TOML + "l0_mm = [150.0, 200.0]\n")  # a longer finger stretches less
+    task = _write(tmp_path, CI_TASK_TOML + "l0_mm = [150.0, 200.0]\n" + PAPER_FINGER)  # a longer finger stretches less
     first = 1.51
     assert main(["design", "--task", str(task), "--json", "--out", str(tmp_path / "out"), "--seed", "3"]) == 0
     result = json.loads(capsys.readouterr().out)
@@ -158,8 +176,8 @@ def test_a_fem_stretch_above_the_limit_reoptimises_with_the_fems_factor(tmp_path
     assert result["rejected"]["fem"]["rubber_stretch"] == 1.51 and "fem_report" not in result
     assert load_design(result["design_file"]).to_dict() == result["design"] == ev2.design.to_dict()
     assert load_design(result["rejected"]["design_file"]).to_dict() == ev1.design.to_dict()
-    seen.clear()  # with l0 fixed the bend at the grasp, so eq. (8), hardly moves: 1.55 cannot be met
-    first, fixed_l0 = 1.55, _write(tmp_path, CI_TASK_TOML, "fixed_l0.toml")
+    seen.clear()  # with l0 fixed the bend at the grasp, so eq. (8), hardly moves: 2.5 cannot be met
+    first, fixed_l0 = 2.5, _write(tmp_path, CI_TASK_TOML + PAPER_FINGER, "fixed_l0.toml")
     assert main(["design", "--task", str(fixed_l0), "--json", "--out", str(tmp_path / "o1"), "--seed", "3"]) == 1
     result = json.loads(capsys.readouterr().out)
     assert len(seen) == 1 and result["report"].startswith("The task cannot be met")
@@ -169,6 +187,31 @@ def test_a_fem_stretch_above_the_limit_reoptimises_with_the_fems_factor(tmp_path
     assert main(["design", "--task", str(task), "--json", "--out", str(tmp_path / "o2"), "--seed", "3",
                  "--no-correct"]) == 1
     assert len(seen) == 1 and "rejected" not in json.loads(capsys.readouterr().out)
+
+
+def test_a_calibrated_tube_stretch_is_not_corrected_by_the_proof(tmp_path, monkeypatch, capsys):
+    """On the FEM-calibrated finger (the task's default models, the packaged table holding the
+    converged stretch) the tube's stretch is the table's prediction of the FEM's: a proof that
+    finds 1.51 above the limit 1.5 is reported (exit 1), not turned into a factor and a second
+    optimisation."""
+    from softhand.studies.cli.main import main
+    from softhand.studies.design import proof
+    from softhand.studies.design.proof import fem_constraints
+
+    seen = []
+
+    def prove(ev, task, options, out=None, progress=None, tick=None):
+        seen.append(ev)
+        fem = {"rubber_stretch": 1.51, "sheet_rubber_stretch": 1.0, "P_grasp_MPa": ev.P_grasp, "F_v_N": ev.F_v}
+        return {**fem, "constraints": fem_constraints(fem, task)}
+
+    monkeypatch.setattr(proof, "prove", prove)
+    task = _write(tmp_path, CI_TASK_TOML + "l0_mm = [150.0, 200.0]\n")
+    assert main(["design", "--task", str(task), "--json", "--out", str(tmp_path / "out"), "--seed", "3"]) == 1
+    result = json.loads(capsys.readouterr().out)
+    assert result["models"]["tube_stretch"] == "FEM-calibrated rubber_stretch"
+    assert len(seen) == 1 and "rejected" not in result and "stretch_factor" not in result
+    assert "rubber_stretch (FEM, verified grasp) = 1.51 above the limit 1.5" in result["fem_report"]
 
 
 def test_the_pareto_knee_goes_through_the_fem_too(tmp_path, monkeypatch, capsys):
