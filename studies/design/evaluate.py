@@ -145,11 +145,14 @@ def tube_stretch(theta, design: HandDesign, task: Task, P_pump: float = math.nan
     same pressure is the larger, so the prediction stays on the safe side (+4 to +6 % over the
     proofs' FEM on the 10 mm mesh, which reads a few per cent low; docs/finger.md)."""
     if design.finger_model == "fem":
-        try:
-            free = theta
-            if math.isfinite(P_pump):
+        free = theta
+        if math.isfinite(P_pump):
+            try:
                 p_r = float(hand.pressure(theta, design, reservoir=False) - hand.pressure(theta, design))
                 free = max(theta, float(hand.bend_angle(P_pump + p_r, design, reservoir=False)))
+            except InputError:  # no free bend at that pressure (e.g. the reservoir runs dry): the held one
+                free = theta
+        try:
             calibrated = finger_fem.rubber_stretch(free, design)
         except InputError:  # outside the calibrated range: eq. (8), the range constraint says so
             calibrated = None
