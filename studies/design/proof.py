@@ -93,9 +93,9 @@ def fem_report(fem: dict, ev: Evaluation) -> str | None:
         return None
     names = "; ".join(f"{c['name']} = {c['value']:.4g} above the limit {c['limit']:.4g}" for c in broken)
     if calibrated_tube(ev.design):
-        return (f"The FEM proof does not confirm the design: {names}. The FEM-calibrated finger predicted "
-                f"a tube stretch of {ev.stretch:.4g} (the calibrated table's fit of the FEM's converged "
-                f"stretch, which this design's FEM exceeds).")
+        return (f"The FEM proof does not confirm the design: {names}. The calibrated models predicted a "
+                f"rubber stretch of {ev.stretch:.4g} for the tube and {ev.sheet_stretch:.4g} for the sheet "
+                f"(their fits of the FEM's converged stretch) and a pump pressure of {ev.P_grasp:.4g} MPa.")
     return (f"The FEM proof does not confirm the design: {names}. The reduced model's estimate of the "
             f"rubber stretch (eq. (8), the wall's bending strain) is {ev.stretch:.4g}; the FEM's sits "
             f"at the tied rings and the end cap, which the reduced model does not see.")
