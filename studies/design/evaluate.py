@@ -131,9 +131,9 @@ def peak_stretch(theta, design: HandDesign) -> float:
     return 1.0 + (design.d + design.a + design.b) * theta / design.l0
 
 
-def tube_stretch(theta, design: HandDesign, task: Task, P_pump: float = math.nan) -> float:
-    """The tube's rubber stretch in the grasp at bend theta [rad] and pump pressure ``P_pump``
-    [MPa]: the calibrated finger table's (finger_model "fem" with a table that holds the FEM's
+def tube_stretch(theta, design: HandDesign, task: Task, P_cavity: float = math.nan) -> float:
+    """The tube's rubber stretch in the grasp at bend theta [rad] and cavity pressure ``P_cavity``
+    [MPa] (nan: unknown, the bend alone): the calibrated finger table's (finger_model "fem" with a table that holds the FEM's
     converged stretch, reduced.finger_fem.rubber_stretch) at the bend the free finger reaches at
     the grasp's cavity pressure, else eq. (8) at theta with its strain x the task's stretch_factor.
 
@@ -146,11 +146,10 @@ def tube_stretch(theta, design: HandDesign, task: Task, P_pump: float = math.nan
     proofs' FEM on the 10 mm mesh, which reads a few per cent low; docs/finger.md)."""
     if design.finger_model == "fem":
         free = theta
-        if math.isfinite(P_pump):
+        if math.isfinite(P_cavity):
             try:
-                p_r = float(hand.pressure(theta, design, reservoir=False) - hand.pressure(theta, design))
-                free = max(theta, float(hand.bend_angle(P_pump + p_r, design, reservoir=False)))
-            except InputError:  # no free bend at that pressure (e.g. the reservoir runs dry): the held one
+                free = max(theta, float(hand.bend_angle(P_cavity, design, reservoir=False)))
+            except InputError:  # no free bend at that pressure: the held one
                 free = theta
         try:
             calibrated = finger_fem.rubber_stretch(free, design)
@@ -199,9 +198,9 @@ def evaluate(design: HandDesign, task: Task, *, exact: bool = True) -> Evaluatio
     (:func:`softhand.studies.design.optimise.evaluate` chooses)."""
     depth, theta, link, w, theta_open = grasp_geometry(design, task, exact=exact)
     F_req = task.required_F_v()
-    P_margin, edge, no_grasp, F_reached = task.max_pressure, "", "", math.nan
+    P_margin, edge, no_grasp, F_reached, P_cavity = task.max_pressure, "", "", math.nan, math.nan
     try:
-        P_grasp, P_contact, P_open, F_lim, theta_hold, P_margin, edge, no_grasp, F_reached = \
+        P_grasp, P_contact, P_open, F_lim, theta_hold, P_margin, edge, no_grasp, F_reached, P_cavity = \
             grasp_relation(design, task, theta, w, theta_open)
     except InputError:  # e.g. V0 too small for the oil, a design outside the calibrated range
         F_lim = -math.inf if asks_force_at_limit(design, task) else math.nan
@@ -211,7 +210,7 @@ def evaluate(design: HandDesign, task: Task, *, exact: bool = True) -> Evaluatio
         oil = design.n * float(finger.oil_taken(theta_hold, design))
     except InputError:
         oil = math.inf
-    stretch = tube_stretch(theta_hold, design, task, P_grasp)
+    stretch = tube_stretch(theta_hold, design, task, P_cavity)
     sheet = sheet_stretch(design)
     # no P_grasp: how far short of F_req the finger comes (for the optimiser)
     shortfall = min(1.0, 1.0 - max(F_reached, 0.0) / F_req) if no_grasp and F_reached < F_req else None

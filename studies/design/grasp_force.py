@@ -26,6 +26,7 @@ class GraspRelation(NamedTuple):
     edge: str = ""     #: why P_margin is below the limit (:attr:`softhand.reduced.calibrated.grasp_hold_solve.Hold.edge`), or ""
     no_grasp: str = ""  #: why P_grasp is inf (the required F_v not reached by the FEM-informed grasp), or ""
     F_reached: float = math.nan  #: with no_grasp: F_v where the FEM-informed grasp ends (how far it comes) [N]
+    P_cavity: float = math.nan  #: the FEM-informed grasp's cavity pressure at P_grasp [MPa]; nan: eq. (25)
 
 
 def asks_force_at_limit(design: HandDesign, task: Task) -> bool:
@@ -77,4 +78,5 @@ def _fem_relation(design: HandDesign, task: Task, theta: float, theta_open: floa
             if task.max_pressure <= P_contact else \
             grasp_hold.at_pump(design, task.diameter, task.mass, task.max_pressure)
         F_lim, P_margin, edge = at.F_v, at.P_pump, at.edge
-    return GraspRelation(held.P_pump, P_contact, P_open, F_lim, held.theta, P_margin, edge, no_grasp, F_reached)
+    return GraspRelation(held.P_pump, P_contact, P_open, F_lim, held.theta, P_margin, edge, no_grasp, F_reached,
+                         held.P_cavity)
