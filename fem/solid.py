@@ -46,6 +46,8 @@ one pass (the kernels: :mod:`softhand.fem.solid_kernels`). Elements are processe
 """
 from __future__ import annotations
 
+import copy
+
 import numpy as np
 import scipy.sparse as sp
 from skfem import Basis, ElementTetP2
@@ -53,6 +55,7 @@ from skfem import Basis, ElementTetP2
 from softhand.fem import kinematics as kin
 from softhand.fem import threads
 from softhand.fem.assembly import ElementScatter, Restriction
+from softhand.fem.materials import Volumetric
 from softhand.fem.mixed import PressureAnchor
 from softhand.fem.solid_kernels import ElementKernels
 
@@ -90,6 +93,17 @@ class Solid(ElementKernels):
         nel = self.G.shape[0]
         self._chunks = [slice(i, min(i + chunk, nel)) for i in range(0, nel, chunk)]
         self._ke = None  # the element matrix buffer, allocated at the first tangent
+
+    def with_bulk_modulus(self, kappa: float) -> "Solid":
+        """The same body (mesh, quadrature, scatter shared) with its mean-dilatation volume energy
+        U(J) = kappa/2 (J - 1)^2 at another bulk modulus [MPa], e.g. a softer rubber to follow a
+        load path in full Newton steps (:mod:`softhand.fem.hand.finger_sweep`)."""
+        if self._vol is None:
+            raise ValueError("with_bulk_modulus needs the mean-dilatation formulation")
+        soft = copy.copy(self)
+        soft._vol, soft._ke = Volumetric(float(kappa)), None
+        soft.law = None  # no single law: the deviatoric part's and this volume energy
+        return soft
 
     # -- dofs ---------------------------------------------------------------------------
     def dofs(self, facets=None, components=(0, 1, 2)) -> np.ndarray:

@@ -181,6 +181,26 @@ def test_mixed_precision_sweeps_give_double_precisions_answer(model, sweep_run, 
         assert a.theta == pytest.approx(b.theta, rel=1e-7) and a.dQ == pytest.approx(b.dQ, rel=1e-7)
 
 
+@pytest.mark.slow
+def test_a_compliant_finger_reaches_the_direct_paths_answer_through_a_softer_rubber(monkeypatch):
+    """A compliant design bent over 30 deg by one pressure: the sweep predicts more than BEND_STEP of
+    bend, follows the path on a rubber 10x less stiff in bulk and corrects at the real one, with
+    no cut-back; theta and dQ are the direct path's (the cut-back sweep) to the Newton tolerance."""
+    from softhand.fem.hand import finger_sweep
+
+    compliant = FingerModel(DESIGN.replace(a=6.0, b=3.0, d=10.14, l0=180.0), FingerOptions(axial_size=5.0))
+    corrections = []  # the correction at the real rubber is the sweep's only plain newton call
+    newton = finger_sweep.newton
+    monkeypatch.setattr(finger_sweep, "newton", lambda *a, **kw: corrections.append(newton(*a, **kw)) or corrections[-1])
+    continued, stats = solve_pressures(compliant, [0.4])
+    assert len(corrections) == 1 and stats.cutbacks == 0
+    direct, direct_stats = solve_pressures(compliant, [0.4], continuation=False)
+    assert direct_stats.factorizations > stats.factorizations
+    assert math.degrees(continued[0].theta) > 30.0
+    assert continued[0].theta == pytest.approx(direct[0].theta, rel=1e-7)
+    assert continued[0].dQ == pytest.approx(direct[0].dQ, rel=1e-7)
+
+
 def test_hand_frame_matches_the_reduced_kinematics(model):
     q = np.radians([5.0, 10.0, 15.0, 20.0, 25.0])
     ours = to_hand_frame(model.chain.hinge_positions(q), DESIGN)

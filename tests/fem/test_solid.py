@@ -43,6 +43,27 @@ def test_residual_and_tangent_are_derivatives(formulation):
     np.testing.assert_allclose(solid.residual(u), R)
 
 
+def test_a_solid_with_another_bulk_modulus_is_that_solid_built_anew():
+    """with_bulk_modulus shares the mesh and quadrature and changes only the volume energy: its
+    energy, residual and tangent are those of the solid built from scratch with that kappa,
+    and the original keeps its own."""
+    mesh = box()
+    fibers = Fibers(30.0, RNG.standard_normal((3, mesh.t.shape[1])))
+    stiff = Solid(mesh, NeoHookean(1.0, 1000.0) + fibers, chunk=17)
+    u = 0.05 * stiff.dof_locations.T.ravel() + 0.005 * RNG.standard_normal(stiff.ndofs)
+    before = stiff.residual_tangent(u)
+    soft, fresh = stiff.with_bulk_modulus(40.0), Solid(mesh, NeoHookean(1.0, 40.0) + fibers, chunk=17)
+    (R, K), (R0, K0) = soft.residual_tangent(u), fresh.residual_tangent(u)
+    np.testing.assert_allclose(R, R0, rtol=1e-12, atol=1e-12 * np.abs(R0).max())
+    assert abs(K - K0).max() <= 1e-12 * abs(K0).max()
+    assert soft.energy(u) == pytest.approx(fresh.energy(u), rel=1e-13)
+    R1, K1 = stiff.residual_tangent(u)
+    np.testing.assert_array_equal(R1, before[0])
+    assert abs(K1 - before[1]).max() == 0.0
+    with pytest.raises(ValueError, match="mean-dilatation"):
+        Solid(mesh, NeoHookean(1.0, 40.0), formulation="displacement").with_bulk_modulus(10.0)
+
+
 def test_tangent_at_rest_is_scikit_fem_linear_elasticity():
     """An independent assembly (scikit-fem BilinearForm, COO -> CSR) of the same operator."""
     mesh = box((2, 3, 2))

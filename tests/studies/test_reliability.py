@@ -229,7 +229,7 @@ def test_a_failed_load_step_names_the_pressures_reached(monkeypatch):
 
     monkeypatch.setattr(ff, "solve_path", failing)
     with pytest.raises(NotConverged) as err:
-        ff._solve_one(None, 0.7, [(0.5, y)], None, None, None, 1.0, np.zeros(4))
+        ff._solve_one(None, None, 0.7, [(0.5, y)], None, None, None, 1.0, np.zeros(4))  # no softened model
     assert err.value.pressure == pytest.approx(0.55)  # 0.5 + 0.25 (0.7 - 0.5)
     assert "above P = 0.55 MPa on the way to 0.7 MPa" in str(err.value)
     assert err.value.last_converged[0] == pytest.approx(0.55) and list(err.value.last_converged[1]) == [0, 2, 4]
