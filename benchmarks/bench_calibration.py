@@ -10,11 +10,18 @@ the whole table's time estimated from them, wall x (designs in the space) / K: a
 rate, as good as the sample is typical of the space (its designs differ in cost: use K of at
 least the workers, and more for a better estimate). The whole table is
 ``softhand calibrate finger --space FILE.toml --out T.csv --workers N [--scheduler ...]``.
+
+``--from-results DIR [--workers N ...]``: no FEM; the whole table's time for N workers from the
+measured case times of a finished run of the whole space (its ``--results`` folder): the case
+list dealt out in order, each case to the worker that frees first (as the process pool and
+Dask's scheduler do), each case as long as it took in that run (workers as fast as the ones that
+ran it; on one 2-core machine two workers each run a case ~1.3x slower than one alone).
 """
 from __future__ import annotations
 
 import argparse
 import dataclasses
+import heapq
 import os
 import tempfile
 import time
@@ -36,6 +43,37 @@ def sample(space, k: int):
     return dataclasses.replace(study, case_list=tuple(study.case_list[i] for i in picks)), n
 
 
+def list_schedule(times, workers: int) -> float:
+    """Wall time when the cases (times, in order) go each to the worker that frees first."""
+    free = [0.0] * workers
+    for t in times:
+        heapq.heappush(free, heapq.heappop(free) + t)
+    return max(free)
+
+
+def case_times(space, results: Path) -> list[float]:
+    """The measured wall times [s] of the space's cases in a finished run's results folder, in the
+    order the runner deals them out."""
+    study = as_study(space)
+    sdir = study_dir(study, results)
+    times = []
+    for case in plan(study):
+        record = read_case(sdir, case)
+        if record is None or record.get("status") != "done":
+            raise SystemExit(f"case {case} is not finished in {sdir}: run the whole space first")
+        times.append(record["provenance"]["solver"]["wall_time_s"])
+    return times
+
+
+def from_results(space, results: Path, workers) -> None:
+    times = case_times(space, results)
+    print(f"# {len(times)} cases measured in {results}: {sum(times) / 60:.1f} min of case time, "
+          f"the longest {max(times):.0f} s")
+    print("workers  table_estimate_min")
+    for n in workers:
+        print(f"{n:7d}  {list_schedule(times, n) / 60:18.1f}")
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--space", default=str(ROOT / "studies" / "finger_space.toml"),
@@ -43,7 +81,11 @@ def main() -> None:
     parser.add_argument("--designs", type=int, default=2, help="designs in the sample (default 2)")
     parser.add_argument("--workers", type=int, nargs="+", default=[1, 2], help="worker counts (default 1 2)")
     parser.add_argument("--scheduler", default=None, help="a Dask scheduler address, or 'local'")
+    parser.add_argument("--from-results", type=Path, default=None, metavar="DIR",
+                        help="no FEM: estimate from a finished run's case times (its --results folder)")
     args = parser.parse_args()
+    if args.from_results is not None:
+        return from_results(load_space(args.space), args.from_results, args.workers)
     study, n_space = sample(load_space(args.space), args.designs)
     k = len(study.case_list)
     where = "process pool" if args.scheduler is None else f"Dask at {args.scheduler}"

@@ -26,17 +26,16 @@ from softhand.fem.newton_steps import factored_size
 SWEEP_NEWTON = NewtonOptions(rtol=1e-9, max_iter=40, refactor="adaptive", contraction=0.5, memory=20)
 
 #: the rubber's bulk modulus over its shear modulus on the way to a pressure the direct load step
-#: fails to reach: the step runs on the finger with this softer rubber, then one (quasi-)Newton
-#: solve at the rubber's own bulk modulus (1000 mu) lands on the same equilibrium (to the Newton
-#: tolerance). Not the first try: where the direct step converges (the paper's finger, 0-0.8
-#: MPa) the correction from 100 to 1000 mu costs as many factorisations as the step. The nearly
-#: incompressible rubber's volume energy along an accurate predictor rises a hundredfold and
-#: more in a few elements of the end cap, so the line search cuts Newton's steps to a few per
-#: cent on compliant designs; at 100 mu the same steps are taken whole, and the correction from
-#: 100 to 1000 mu is small (a dilatation of about 1e-3 of the strain). On the compliant design
-#: of ``benchmarks/bench_newton_compliant.py`` (a 6, b 3, d 10.14, l0 180 mm, 0.6 MPa), direct:
-#: 162 factorisations, 7 cut-backs; continued: 44, none. 10 mu is too soft (the correction then
-#: needs cut-backs itself), 300 mu still cuts back
+#: would bend too far (:data:`BEND_STEP`) or fails to reach: the step runs on the finger with this
+#: softer rubber, then one (quasi-)Newton solve at the rubber's own bulk modulus (1000 mu) lands
+#: on the same equilibrium (to the Newton tolerance). Not every step's way: where the direct
+#: step converges (the paper's finger, 0-0.8 MPa) the correction from 100 to 1000 mu costs as
+#: many factorisations as the step. The nearly incompressible rubber's volume energy along an
+#: accurate predictor rises a hundredfold and more in a few elements of the end cap, so the line
+#: search cuts Newton's steps to a few per cent on compliant designs; at 100 mu the same steps
+#: are taken whole. On the compliant design of ``benchmarks/bench_newton_compliant.py`` (a 6,
+#: b 3, d 10.14, l0 180 mm, 0.6 MPa), direct: 88-162 factorisations, 4-7 cut-backs; this way:
+#: 46, none. 10 mu is too soft (the correction then needs cut-backs itself), 300 mu still cuts back
 PATH_KAPPA_RATIO = 100.0
 #: the largest bend [rad] the tangent predictor may add in one load step of the finger itself;
 #: above it the step runs on the softer rubber, in steps of about this predicted bend (then cut

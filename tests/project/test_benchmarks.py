@@ -23,3 +23,16 @@ def test_the_bad_input_replay_refuses_every_hold_case():
     run = subprocess.run([sys.executable, str(ROOT / "benchmarks" / "bad_input_replay.py"), "--only", "hold"],
                          capture_output=True, text=True, timeout=600, cwd=ROOT)
     assert run.returncode == 0 and run.stdout.strip().endswith("0 failed"), run.stdout[-2000:] + run.stderr[-2000:]
+
+
+def test_the_calibration_estimate_deals_cases_to_the_worker_that_frees_first():
+    """bench_calibration's table time for N workers from measured case times: the list schedule
+    worked by hand (2 workers: 3 | 3, then 2 to each, then the last 2 to the first: 7)."""
+    import runpy
+
+    bench = runpy.run_path(str(ROOT / "benchmarks" / "bench_calibration.py"), run_name="imported")
+    schedule = bench["list_schedule"]
+    assert schedule([3.0, 3.0, 2.0, 2.0, 2.0], 2) == 7.0
+    assert schedule([3.0, 3.0, 2.0, 2.0, 2.0], 1) == 12.0
+    assert schedule([3.0, 3.0, 2.0, 2.0, 2.0], 8) == 3.0  # more workers than cases: the longest
+    assert schedule([1.0, 1.0, 1.0, 5.0], 2) == 6.0  # in order, not longest first (that would give 5)
