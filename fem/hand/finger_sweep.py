@@ -38,13 +38,17 @@ SWEEP_NEWTON = NewtonOptions(rtol=1e-9, max_iter=40, refactor="adaptive", contra
 #: 46, none. 10 mu is too soft (the correction then needs cut-backs itself), 300 mu still cuts back
 PATH_KAPPA_RATIO = 100.0
 #: the largest bend [rad] the tangent predictor may add in one load step of the finger itself;
-#: above it the step runs on the softer rubber, in steps of about this predicted bend (then cut
-#: back or grown as :func:`softhand.fem.newton_path.solve_path` does). The bend, not the
-#: pressure, limits a Newton step; the predictor, tangent at the start, under-predicts a
-#: softening finger's bend about threefold (that design, 0-0.6 MPa: 27 deg predicted, 70 reached).
-#: There at 100 mu: 1, 2, 3, 4, 6 steps took 65, 64, 48, 52, 42 factorisations (3, 2, 1, 1, 0
-#: cut-backs). The paper's finger, 0-0.8 MPa in 0.1 MPa steps, predicts at most ~4 deg a step
-BEND_STEP = math.radians(5.0)
+#: above it the step runs on the softer rubber. The bend, not the pressure, limits a Newton
+#: step, and the softer rubber's path plus the correction costs more than a direct step that
+#: converges: the paper's finger on the CI mesh, 0-0.8 MPa in 0.2 MPa steps (~5 deg each), took
+#: 70 factorisations with a 5 deg threshold against 43 direct
+BEND_STEP = math.radians(10.0)
+#: the predicted bend [rad] of one load step on the softer rubber (its steps then cut back or
+#: grow as :func:`softhand.fem.newton_path.solve_path` does). The predictor, tangent at the
+#: start, under-predicts a softening finger's bend about threefold (the compliant design, 0-0.6
+#: MPa: 27 deg predicted, 70 reached); there at 100 mu 1, 2, 3, 4, 6 steps took 65, 64, 48, 52,
+#: 42 factorisations (3, 2, 1, 1, 0 cut-backs)
+SOFT_BEND = math.radians(5.0)
 #: the softer rubber's load steps where the predictor failed (a singular tangent)
 SOFT_STEPS = 6
 
@@ -135,7 +139,7 @@ def _solve_one(model, soft, P, history, link_load, solver, options, scale, total
     made the chattering tension-only fibers fail more often than it saved iterations). With a
     softened model (:func:`softened`), where the predictor bends the finger by more than
     :data:`BEND_STEP`, or where the direct step fails: the softer rubber's path from y_i to P in
-    steps of about that bend (cut back when one fails), then one (quasi-)Newton solve of the
+    steps of about :data:`SOFT_BEND` (cut back when one fails), then one (quasi-)Newton solve of the
     model itself from there; where that fails too, or without one, the direct step cut back
     (halved) until Newton converges.
     """
@@ -160,7 +164,7 @@ def _solve_one(model, soft, P, history, link_load, solver, options, scale, total
             except NotConverged:
                 failed()
         try:
-            path = step(soft, max(2, math.ceil(bend / BEND_STEP)) if np.isfinite(bend) else SOFT_STEPS)
+            path = step(soft, max(2, math.ceil(bend / SOFT_BEND)) if np.isfinite(bend) else SOFT_STEPS)
             last = newton(lambda y: model.residual_tangent(y, P, link_load), path.x[-1], options, solver=solver,
                           scale=scale, residual=lambda y: model.residual(y, P, link_load))
         except NotConverged:
