@@ -71,10 +71,10 @@ def solve_pressures(model, pressures, *, link_load=None, y0=None, callback=None,
     """Follow increasing pressures [MPa] from the state y0 (default: unloaded, P = 0).
 
     Each pressure is one load step of :func:`softhand.fem.newton_path.solve_path` from the last converged
-    state; where it fails, the path of the finger with a softer rubber
-    (:data:`PATH_KAPPA_RATIO`) to that pressure, then a (quasi-)Newton solve of the finger
-    itself; where that fails too (or ``continuation=False``), the load step cut back (halved)
-    until Newton converges. Returns
+    state; where its predictor bends the finger by more than :data:`BEND_STEP`, or where it
+    fails, the path of the finger with a softer rubber (:data:`PATH_KAPPA_RATIO`) to that
+    pressure, then a (quasi-)Newton solve of the finger itself; where that fails too (or
+    ``continuation=False``), the load step cut back (halved) until Newton converges. Returns
     ([FingerState], SweepStats); raises :class:`softhand.fem.newton.NotConverged` with the last
     converged state when even the cut-back fails.
     """
