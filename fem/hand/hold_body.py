@@ -12,6 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from softhand.reduced.holding.object_geometry import support_point
 from softhand.reduced.vocabulary.errors import InputError
 
 SHAPES = ("sphere", "cylinder", "box")
@@ -57,6 +58,14 @@ class Body:
             return _cylinder(r, np.asarray(self.axis), 0.5 * self.size[0], 0.5 * self.size[1])
         return _box(r, 0.5 * np.asarray(self.size, dtype=float))
 
+    def support(self, u, ref):
+        """The body's points deepest along -u (m, 3), those nearest ref where that is an edge or
+        a face (:func:`softhand.reduced.holding.object_geometry.support_point`), placed pose."""
+        c = np.asarray(self.centre)
+        F = _cylinder_frame(np.asarray(self.axis)) if self.shape == "cylinder" else np.eye(3)
+        local = support_point(self.shape, self.size, np.asarray(u) @ F, (np.asarray(ref) - c) @ F)
+        return c + local @ F.T
+
     def surface(self, n: int = 48):
         """(points (m, 3), triangles (k, 3)) of the surface in its placed pose."""
         if self.shape == "sphere":
@@ -65,6 +74,13 @@ class Body:
             return _cylinder_surface(np.asarray(self.centre), np.asarray(self.axis),
                                      0.5 * self.size[0], self.size[1], n)
         return _box_surface(np.asarray(self.centre), 0.5 * np.asarray(self.size, dtype=float))
+
+
+def _cylinder_frame(e):
+    """Columns: a unit vector normal to e, e, and their cross product (a cylinder's own frame, axis y)."""
+    u = np.cross(e, [1.0, 0.0, 0.0] if abs(e[0]) < 0.9 else [0.0, 1.0, 0.0])
+    u /= np.linalg.norm(u)
+    return np.column_stack([u, e, np.cross(u, e)])
 
 
 def _cylinder(r, e, R, h):
@@ -102,8 +118,7 @@ def _sphere_surface(c, R, n):
 
 
 def _cylinder_surface(c, e, R, length, n):
-    u = np.cross(e, [1.0, 0.0, 0.0] if abs(e[0]) < 0.9 else [0.0, 1.0, 0.0])
-    u /= np.linalg.norm(u)
+    u = _cylinder_frame(e)[:, 0]
     v = np.cross(e, u)
     p = np.linspace(0.0, 2 * math.pi, n, endpoint=False)
     ring = R * (np.cos(p)[:, None] * u + np.sin(p)[:, None] * v)
@@ -144,6 +159,10 @@ class PlacedBody:
     def signed_distance(self, x):
         x = np.atleast_2d(np.asarray(x, dtype=float))
         return self.placed.sdf(x), self.placed.normal(x)
+
+    def support(self, u, ref):
+        """As :meth:`Body.support`; None for a mesh."""
+        return self.placed.support(u, ref)
 
     def surface(self, n: int = 48):
         return self.placed.surface(resolution=n // 2)

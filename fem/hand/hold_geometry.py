@@ -20,7 +20,14 @@ Contact point of a pad: the pad point where the object's signed distance is smal
 clamped to the rectangle (exact for a sphere, and for a cylinder whose axis is normal to
 the bending plane -- the one-finger grasp's circle), then improved by projected gradient
 steps with backtracking on the signed distance (a convex object's signed distance is convex,
-so this finds the deepest point of a box or a tilted cylinder). A pad whose plane has the
+so this finds the deepest point of a box or a tilted cylinder). Where the object's point
+deepest through the pad's plane (its support point along the pad's normal, closed form for
+every primitive) lies over the pad, the contact is there instead: gap its height over the
+plane, normal the pad's. The two agree wherever the pad is clear of the object (the pad point
+nearest the object is that point's foot); they differ once a pad has sunk onto an edge or a
+corner, where the deepest pad point's nearest face switches across the edge's bisecting plane
+and its normal with it, while the support point's normal turns with the pad (the limit of a
+rounded edge as its radius goes to 0). A mesh keeps the deepest pad point. A pad whose plane has the
 object's centre behind it cannot touch: its gap is +inf (as in :mod:`softhand.fem.contact`).
 """
 from __future__ import annotations
@@ -175,6 +182,16 @@ def pad_contacts(body, pose: Pose, frames, padsets, qs, *, iterations: int = 40)
     x = point(sigma, zeta)
     facing = np.cross(e_n, AB)  # the pad's normal towards the closing side (finger frame +y)
     facing /= np.linalg.norm(facing, axis=1)[:, None]
+    support = getattr(body, "support", None)
+    S = None if support is None else support(facing @ pose.R, pose.to_body(x))
+    if S is not None:  # the object's point deepest through the pad's plane, where it is over the pad
+        rel = pose.to_hand(S) - A
+        s_f, z_f = np.einsum("ki,ki->k", rel, AB) / L2, np.einsum("ki,ki->k", rel, e_n)
+        over = (s_f >= 0.0) & (s_f <= 1.0) & (np.abs(z_f) <= half)
+        sigma, zeta = np.where(over, s_f, sigma), np.where(over, z_f, zeta)
+        d = np.where(over, np.einsum("ki,ki->k", rel, facing), d)
+        n = np.where(over[:, None], -facing, n)
+        x = point(sigma, zeta)
     g = np.where(np.einsum("ki,ki->k", facing, c - x) > 0.0, d, np.inf)
     X = A0 + sigma[:, None] * (B0 - A0)
     return PadContacts(g, n, x, X, zeta)

@@ -40,6 +40,41 @@ def local_sdf(obj: GraspObject, p) -> np.ndarray:
     return grid_sdf(mesh, p)
 
 
+def support_point(shape: str, size, u, ref) -> np.ndarray | None:
+    """The object's point deepest along -u (the argmin of X . u over the body), rows (m, 3), in
+    its own frame (centre at the origin, a cylinder's or capsule's axis along y; ``size`` as
+    :func:`dimensions`); where that set is an edge or a face (u normal to it), its point nearest
+    ``ref`` (m, 3). None for a mesh (no closed form). A flat pad facing along u touches the object
+    there when that point lies over the pad: an edge or corner against the pad's face."""
+    u, ref = np.atleast_2d(np.asarray(u, float)), np.atleast_2d(np.asarray(ref, float))
+    tiny = 1e-12 * np.linalg.norm(u, axis=1)
+    if shape == "sphere":
+        return -0.5 * size[0] * u / np.linalg.norm(u, axis=1)[:, None]
+    if shape == "box":
+        h = 0.5 * np.asarray(size, float)
+        return np.where(np.abs(u) > tiny[:, None], -h * np.sign(u), np.clip(ref, -h, h))
+    if shape not in ("cylinder", "capsule"):
+        return None
+    r = 0.5 * size[0]
+    h = 0.5 * size[1] - (r if shape == "capsule" else 0.0)
+    end = np.where(np.abs(u[:, 1]) > tiny, -h * np.sign(u[:, 1]), np.clip(ref[:, 1], -h, h))
+    if shape == "capsule":  # the end sphere's centre on the axis, then the sphere's support
+        return end[:, None] * np.array([0.0, 1.0, 0.0]) - r * u / np.linalg.norm(u, axis=1)[:, None]
+    ur, rr = u * [1.0, 0.0, 1.0], ref * [1.0, 0.0, 1.0]
+    nu, nr = np.linalg.norm(ur, axis=1)[:, None], np.linalg.norm(rr, axis=1)[:, None]
+    radial = np.where(nu > tiny[:, None], -r * ur / np.where(nu > 0, nu, 1.0),
+                      rr * np.minimum(1.0, r / np.where(nr > 0, nr, 1.0)))
+    return radial + end[:, None] * np.array([0.0, 1.0, 0.0])
+
+
+def dimensions(obj: GraspObject) -> tuple:
+    """A primitive's sizes as :func:`support_point` takes them: sphere (D,), cylinder and capsule
+    (D, length), box (x, y, z edges) [mm]; () for a mesh."""
+    return {"sphere": (obj.diameter_mm,), "box": tuple(obj.size_mm or ()),
+            "cylinder": (obj.diameter_mm, obj.length_mm),
+            "capsule": (obj.diameter_mm, obj.length_mm)}.get(obj.shape, ())
+
+
 def local_extent(obj: GraspObject) -> tuple[np.ndarray, np.ndarray]:
     """(lowest, highest) corner (3,) of the object's bounding box in its own frame [mm]."""
     if obj.shape == "sphere":
@@ -155,6 +190,11 @@ class Placed:
             g = np.stack([local_sdf(self.obj, q + e[i]) - local_sdf(self.obj, q - e[i]) for i in range(3)], axis=-1)
         g = g @ self.R.T
         return g / np.maximum(np.linalg.norm(g, axis=-1, keepdims=True), 1e-300)
+
+    def support(self, u, ref) -> np.ndarray | None:
+        """:func:`support_point` in the hand frame: directions u and references ref (m, 3)."""
+        local = support_point(self.obj.shape, dimensions(self.obj), np.asarray(u) @ self.R, self.to_local(ref))
+        return None if local is None else self.centre + local @ self.R.T
 
     def features(self) -> np.ndarray:
         """:func:`feature_points` in the hand frame (m, 3) [mm]."""

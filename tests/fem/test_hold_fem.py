@@ -134,6 +134,33 @@ def test_frictionless_sphere_caged_below_its_equator_drops_when_the_fingers_open
     assert held_at[1] > centre[1] - 1e-9   # it had sunk (or stayed) while the fingers opened
 
 
+@pytest.mark.slow
+def test_four_fingers_close_on_an_upright_cylinders_rim_and_hold_it(finger):
+    """The paper's 180 mm object as an upright cylinder (2 kg, mu 0.8), cavity 0.9 MPa: the
+    first pads to touch meet its top rim, where a pad point's nearest face is ambiguous. The
+    hand closes on it and holds its weight, every step to the tolerances, each touching pad on
+    the rim (the contact point within the gap tolerance of the rim circle: closed form)."""
+    from softhand.reduced.holding.objects import parse_object
+    from softhand.fem.hand.hold_body import body_of
+    from dataclasses import replace
+
+    obj = replace(parse_object("cylinder:180x180"), mass_kg=2.0, friction=0.8)
+    body = body_of(obj, DESIGN)
+    model = HoldModel(DESIGN, body, finger_model=finger, options=HoldOptions())
+    assert model.symmetric and model.n_solved == 1
+    for k in range(1, 5):
+        _check_tolerances(model, model.step(0.9 * k / 4, gravity=0.0, pull=0.0, stage="close"))
+    record = model.step(0.9, gravity=1.0, pull=0.0, stage="release")
+    _check_tolerances(model, record)
+    c = Pose(body.centre, model.pose).centre
+    touching = [t for t in record.contacts if t["normal_N"] > 0]
+    assert touching and all(t["state"] == "stick" for t in touching)
+    for t in touching:
+        x = np.asarray(t["point_mm"]) - c
+        assert math.hypot(x[0], x[2]) == pytest.approx(90.0, abs=1e-5)   # on the rim's circle ...
+        assert x[1] == pytest.approx(-90.0, abs=1e-5)                      # ... of the top face
+
+
 def test_pad_contact_of_a_sphere_off_the_bending_plane():
     """A pad is a plate of the tube's width: a sphere beside the finger's plane touches its
     edge, at sqrt(in-plane distance^2 + (|z| - w/2)^2) - R (closed form), base link, q = 0."""
@@ -151,6 +178,38 @@ def test_pad_contact_of_a_sphere_off_the_bending_plane():
         expect = math.hypot(30.0, max(abs(z) - 9.0, 0.0)) - R
         assert pc.g[0] == pytest.approx(expect, abs=1e-9)
         np.testing.assert_allclose(pc.X[0], [15.0, d.d], atol=1e-9)
+
+
+def test_a_pad_sunk_onto_a_cylinders_rim_pushes_along_its_own_normal():
+    """An upright cylinder's top rim 1 mm through the middle of link 1's pad (straight finger):
+    the gap is -1 mm and the normal the pad's (closed form: the rim point deepest along the
+    pad's normal), and both turn smoothly with the pad: a 1e-7 rad hinge rotation moves them by
+    O(1e-7), where the pad point's nearest face would switch from the top to the side."""
+    from softhand.fem.constraints import PlanarChain
+    from softhand.fem.hand.hold_geometry import PadSet
+
+    d = DESIGN
+    chain = PlanarChain(np.c_[d.hinge_s, np.full(d.n_s, d.d)])
+    pads = PadSet(chain, (0.0, *d.hinge_s, d.l0), d.d, 18.0, d)
+    frame = FingerFrame(0.0)
+    mid = 0.5 * (d.hinge_s[0] + d.hinge_s[1])
+    P, Q = frame.to_hand(d, np.array([[mid, d.d], [mid + 1.0, d.d]]))
+    f = np.cross(frame.normal(), Q - P)
+    f /= np.linalg.norm(f)                           # the pad's normal, towards the closing side
+    R, h = 90.0, 90.0
+    fr = f * [1.0, 0.0, 1.0]
+    rim = -R * fr / np.linalg.norm(fr) - h * np.sign(f[1]) * np.array([0.0, 1.0, 0.0])
+    c = P - 1.0 * f - rim                            # the rim's deepest point 1 mm behind the pad
+    body = Body("cylinder", tuple(c), (2 * R, 2 * h), axis=(0.0, 1.0, 0.0))
+    q = np.zeros(d.n_s)
+    pc = pad_contacts(body, Pose(c), [frame], [pads], [q])
+    assert pc.g[1] == pytest.approx(-1.0, abs=1e-9)
+    np.testing.assert_allclose(pc.normal[1], -f, atol=1e-12)
+    np.testing.assert_allclose(pc.X[1], [mid, d.d], atol=1e-9)
+    for dq in (1e-7, -1e-7):
+        moved = pad_contacts(body, Pose(c), [frame], [pads], [q + np.r_[dq, np.zeros(d.n_s - 1)]])
+        assert np.linalg.norm(moved.normal[1] - pc.normal[1]) < 2e-7
+        assert abs(moved.g[1] - pc.g[1]) < 1e-7 * d.l0
 
 
 def test_symmetry_orbits_follow_the_object():

@@ -49,6 +49,31 @@ def test_primitive_distances_closed_form():
     assert np.allclose(object_geometry.local_sdf(cap, p), [-50, 50, 130 - 100, math.hypot(50, 70) - 50])
 
 
+def test_support_point_is_the_surfaces_extreme_point():
+    """The closed-form point deepest along -u of each primitive against a brute-force minimum
+    of X . u over its tessellated surface (exact for the box's corners, to the rim's sampling
+    for the cylinder), on the surface (distance 0); where that set is a face, the point of it
+    nearest the reference."""
+    rng = np.random.default_rng(3)
+    u = rng.normal(size=(40, 3))
+    ref = rng.normal(scale=30.0, size=(40, 3))
+    for obj in (objects.GraspObject(shape="box", size_mm=(80, 60, 100)),
+                objects.GraspObject(shape="cylinder", diameter_mm=100, length_mm=200),
+                objects.GraspObject(shape="capsule", diameter_mm=100, length_mm=200),
+                objects.GraspObject(shape="sphere", diameter_mm=90)):
+        S = object_geometry.support_point(obj.shape, object_geometry.dimensions(obj), u, ref)
+        pts, _ = object_geometry.surface(obj, resolution=2048)
+        brute = np.min(pts @ u.T, axis=0)
+        h = np.einsum("ki,ki->k", S, u)
+        assert np.all(h <= brute + 1e-9) and np.allclose(h, brute, rtol=0, atol=1e-4 * 100), obj.shape
+        assert np.allclose(object_geometry.local_sdf(obj, S), 0.0, atol=1e-9), obj.shape
+    face = object_geometry.support_point("box", (80, 60, 100), [[0.0, 1.0, 0.0]], [[10.0, 0.0, 70.0]])
+    assert np.allclose(face, [[10.0, -30.0, 50.0]])          # the -y face's point nearest the reference
+    cap = object_geometry.support_point("cylinder", (100, 200), [[0.0, -1.0, 0.0]], [[80.0, 0.0, 0.0]])
+    assert np.allclose(cap, [[50.0, 100.0, 0.0]])            # the +y end disc, clamped to its rim
+    assert object_geometry.support_point("mesh", (), u, ref) is None
+
+
 def test_rotation_and_normal():
     """A box turned 90 deg about z swaps its x and y edges; the normal is the face's."""
     box = objects.GraspObject(shape="box", size_mm=(80, 20, 20), rotation_deg=(0, 0, 90))
