@@ -202,12 +202,12 @@ def solve_contact(problem: Problem, x0, options: ContactOptions):
     tol = options.rtol * problem.scale
 
     for update in range(options.max_updates + 1):
-        def fun(x, tangent):
+        def fun(x, tangent, keep_gap=options.keep_gap):
             R, cs = problem.residual(x, eps_N, eps_T)
             # the tangent keeps pads within keep_gap of touching in contact (a generalised
             # Jacobian): a step that opens a softly held pad is pulled back, not lost
             with np.errstate(invalid="ignore"):
-                kept = np.isfinite(cs.g) & (problem.hist.lam_N - eps_N * cs.g > -eps_N * options.keep_gap)
+                kept = np.isfinite(cs.g) & (problem.hist.lam_N - eps_N * cs.g > -eps_N * keep_gap)
             # "stick": every kept pad sticks in the tangent (regular when every pad slips at the
             # start of a load reversal); "slip": a pad slipping at x has the return map's own
             # derivative (no stiffness along its slip), else a slipping mode, e.g. an off-axis
@@ -224,11 +224,14 @@ def solve_contact(problem: Problem, x0, options: ContactOptions):
 
         # full steps first (a softly held pad keeps its gap window); when they cycle between
         # contact states, again from the same start with Armijo backtracking on ||R||; then
-        # both again with the slipping pads' own tangent
-        attempts = [(t, m) for t in ("stick", "slip") for m in ("finite", "residual")]
-        for k, (tangent, merit) in enumerate(attempts):
+        # both again with the slipping pads' own tangent; last, the residual's own Jacobian
+        # (no pad kept: an open pad within keep_gap, kept, can turn the Newton direction
+        # into an ascent one, measured on a sphere off the hand's axis)
+        attempts = [(t, m, options.keep_gap) for t in ("stick", "slip") for m in ("finite", "residual")]
+        attempts.append(("slip", "residual", 0.0))
+        for k, (tangent, merit, keep_gap) in enumerate(attempts):
             try:
-                res = newton(lambda x: fun(x, tangent), x,
+                res = newton(lambda x: fun(x, tangent, keep_gap), x,
                              NewtonOptions(rtol=0.0, atol=tol, max_iter=options.max_iter, merit=merit,
                                            forcing=None, xtol=1e-14, max_backtracks=30),
                              solver=solver, residual=lambda x: problem.residual(x, eps_N, eps_T)[0])
