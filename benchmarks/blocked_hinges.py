@@ -1,0 +1,56 @@
+"""The blocked finger's hinge moments and volume rates: the finger FEM against the fast hold model's hinges.
+
+The fast hold model's finger (``finger_model = "fem"``) holds hinge j with
+M_j = -A_j(theta_j) (P - P_free(theta_j)), A_j from the hinge table measured on free, equally bent
+fingers. Here the finger FEM (default mesh) is held by generalised forces Q on its hinges, as an
+object's pad holds it, at cavity pressure P: its hinge angles q, the fast model's moments at
+those q (equal to Q where the fast model is exact), and the FEM's volume rates at fixed q,
+A = S dq/dP (S the condensed stiffness, dq the hinge angles' change under the same Q from P to
+P + dP), against the table's A_j(theta_j). Prints one block per Q; no assertions.
+
+    python benchmarks/blocked_hinges.py [--pressure-mpa 0.9] [--q=-600,-300,0,0,0 --q=...]
+"""
+from __future__ import annotations
+
+import argparse
+import math
+
+import numpy as np
+
+from softhand.fem.hand.finger import FingerModel, FingerOptions
+from softhand.fem.hand.hold_finger import HeldFinger
+from softhand.reduced.calibrated.grasp_fem import fem_finger, hinge_moments, volume_rate
+from softhand.reduced.vocabulary.design import HandDesign
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--pressure-mpa", type=float, default=0.9)
+    parser.add_argument("--dp-mpa", type=float, default=0.05)
+    parser.add_argument("--q", action="append", default=None,
+                        help="generalised hinge forces Q [N mm], comma-separated, base hinge first "
+                             "(--q=-600,-300,0,0,0; repeat for more)")
+    args = parser.parse_args()
+    args.q = args.q or ["-600,-300,0,0,0", "-900,-600,-300,0,0"]
+    design = HandDesign()
+    unit = design.a ** 2 * math.pi * design.d
+    finger = HeldFinger(FingerModel(design, FingerOptions()))
+    P, dP = args.pressure_mpa, args.dp_mpa
+    finger.solve(P, np.zeros(design.n_s), steps=4)
+    print(f"free finger at {P:g} MPa: q = {np.round(np.degrees(finger.q), 3)} deg; "
+          f"fast model's M there {np.round(hinge_moments(finger.q, P, design), 1)} N mm")
+    for text in args.q:
+        Q = np.array([float(v) for v in text.split(",")])
+        finger.solve(P, Q, steps=2)
+        q0, S0 = finger.q.copy(), finger.S.copy()
+        finger.solve(P + dP, Q)
+        A = 0.5 * (S0 + finger.S) @ (finger.q - q0) / dP
+        finger.solve(P, Q)
+        print(f"Q = {Q} N mm: q = {np.round(np.degrees(q0), 3)} deg")
+        print(f"  fast model's M(q)       {np.round(hinge_moments(q0, P, design), 1)} N mm")
+        print(f"  FEM A / (a^2 pi d)      {np.round(A / unit, 3)}")
+        print(f"  table A(theta_j) / ...  {np.round(volume_rate(design.n_s * q0, fem_finger(design)) / unit, 3)}")
+
+
+if __name__ == "__main__":
+    main()
