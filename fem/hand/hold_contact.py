@@ -189,6 +189,14 @@ class Problem:
         return np.concatenate(R), cs
 
 
+def _kept_open(problem: Problem, x, eps_N: float, eps_T: float, options: ContactOptions) -> bool:
+    """Whether a pad at x is open (no normal force) yet within keep_gap of touching."""
+    g = problem.residual(x, eps_N, eps_T)[1].g
+    with np.errstate(invalid="ignore"):
+        trial = problem.hist.lam_N - eps_N * g
+        return bool(np.any(np.isfinite(g) & (trial <= 0.0) & (trial > -eps_N * options.keep_gap)))
+
+
 def solve_contact(problem: Problem, x0, options: ContactOptions):
     """Newton + Uzawa on the condensed hold from x0; returns (x, ContactState, updates, iterations,
     residual at x); raises NotConverged when no equilibrium is found."""
@@ -224,9 +232,9 @@ def solve_contact(problem: Problem, x0, options: ContactOptions):
 
         # full steps first (a softly held pad keeps its gap window); when they cycle between
         # contact states, again from the same start with Armijo backtracking on ||R||; then
-        # both again with the slipping pads' own tangent; last, the residual's own Jacobian
-        # (no pad kept: an open pad within keep_gap, kept, can turn the Newton direction
-        # into an ascent one, measured on a sphere off the hand's axis)
+        # both again with the slipping pads' own tangent; last, where the failed iterate has an
+        # open pad within keep_gap, the residual's own Jacobian (no pad kept: such a pad, kept,
+        # can turn the Newton direction into an ascent one, measured on a sphere off the axis)
         attempts = [(t, m, options.keep_gap) for t in ("stick", "slip") for m in ("finite", "residual")]
         attempts.append(("slip", "residual", 0.0))
         for k, (tangent, merit, keep_gap) in enumerate(attempts):
@@ -236,8 +244,8 @@ def solve_contact(problem: Problem, x0, options: ContactOptions):
                                            forcing=None, xtol=1e-14, max_backtracks=30),
                              solver=solver, residual=lambda x: problem.residual(x, eps_N, eps_T)[0])
                 break
-            except NotConverged:
-                if k == len(attempts) - 1:
+            except NotConverged as err:
+                if k == len(attempts) - 1 or (k == len(attempts) - 2 and not _kept_open(problem, err.x, eps_N, eps_T, options)):
                     raise
         x, its = res.x, its + res.iterations
         cs = problem.residual(x, eps_N, eps_T)[1]
