@@ -45,7 +45,6 @@ def main() -> None:
         q0, S0 = finger.q.copy(), finger.S.copy()
         finger.solve(P + dP, Q)
         A = 0.5 * (S0 + finger.S) @ (finger.q - q0) / dP
-        finger.solve(P, Q)
         print(f"Q = {Q} N mm: q = {np.round(np.degrees(q0), 3)} deg")
         print(f"  fast model's M(q)       {np.round(hinge_moments(q0, P, design), 1)} N mm")
         print(f"  FEM A / (a^2 pi d)      {np.round(A / unit, 3)}")

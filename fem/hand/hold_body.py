@@ -3,7 +3,9 @@ placed pose, its centre of mass, mass, friction and surface triangles.
 
 :class:`Body` wraps the analytic primitives here (sphere, cylinder of any axis, box); any
 object with the same methods (``signed_distance(points) -> (d, normals)``, ``centre``,
-``mass_kg``, ``friction``, ``surface() -> (points, triangles)``) can be held.
+``mass_kg``, ``friction``, ``surface() -> (points, triangles)``) can be held; one that also has
+``support(directions, references) -> points`` (or None) meets pads with its edges and corners
+through the pads' own normal (:func:`softhand.fem.hand.hold_geometry.pad_contacts`).
 """
 from __future__ import annotations
 
