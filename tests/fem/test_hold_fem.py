@@ -59,7 +59,9 @@ def test_frictionless_circle_is_the_one_finger_grasp(finger):
     b = grasp.solve(P + DP, start=a)
     body = Body("cylinder", (0.0, grasp.depth, 0.0), (180.0, 400.0), axis=(0.0, 0.0, 1.0))
     hold = HoldModel(DESIGN, body, layout=[FingerFrame(0.0)], finger_model=finger,
-                     options=HoldOptions(symmetry=False, q_tol=1e-10, contact=ContactOptions(gap_tol=1e-9)))
+                     # q_tol 1e-9 rad: the finger FEM's own Newton (rtol 1e-9) leaves q noise near
+                     # 1e-10 (once, in a full-suite run, the stagger stalled at 3.9e-10 with 1e-10)
+                     options=HoldOptions(symmetry=False, q_tol=1e-9, contact=ContactOptions(gap_tol=1e-9)))
     for P_k in (0.5 * P, P):
         _check_tolerances(hold, hold.step(P_k, gravity=0.0, pull=0.0, stage="close"))
     qa, Fa = hold.fingers[0].q, _F_v(hold)
