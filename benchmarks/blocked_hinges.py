@@ -1,12 +1,14 @@
 """The blocked finger's hinge moments and volume rates: the finger FEM against the fast hold model's hinges.
 
 The fast hold model's finger (``finger_model = "fem"``) holds hinge j with
-M_j = -A_j(theta_j) (P - P_free(theta_j)), A_j from the hinge table measured on free, equally bent
-fingers. Here the finger FEM (default mesh) is held by generalised forces Q on its hinges, as an
-object's pad holds it, at cavity pressure P: its hinge angles q, the fast model's moments at
-those q (equal to Q where the fast model is exact), and the FEM's volume rates at fixed q,
-A = S dq/dP (S the condensed stiffness, dq the hinge angles' change under the same Q from P to
-P + dP), against the table's A_j(theta_j). Prints one block per Q; no assertions.
+M_j = -int A_j(theta_j, p) dp from P_free(theta_j) to P, A_j from the hinge table measured on
+equally bent fingers locked at their free bends while the pressure rises. Here the finger FEM
+(default mesh) is held by generalised forces Q on its hinges, as an object's pad holds it, at
+cavity pressure P: its hinge angles q, the fast model's moments at those q (equal to Q where the
+fast model is exact), and the FEM's volume rates at fixed q, A = S dq/dP (S the condensed
+stiffness, dq the hinge angles' change under the same Q from P to P + dP), against the table's
+A_j(theta_j, P); and S itself (its diagonal and the coupling of neighbouring hinges) against the
+fast model's dM_j/dq_j. Prints one block per Q; no assertions.
 
     python benchmarks/blocked_hinges.py [--pressure-mpa 0.9] [--q=-600,-300,0,0,0 --q=...]
 """
@@ -48,7 +50,13 @@ def main() -> None:
         print(f"Q = {Q} N mm: q = {np.round(np.degrees(q0), 3)} deg")
         print(f"  fast model's M(q)       {np.round(hinge_moments(q0, P, design), 1)} N mm")
         print(f"  FEM A / (a^2 pi d)      {np.round(A / unit, 3)}")
-        print(f"  table A(theta_j) / ...  {np.round(volume_rate(design.n_s * q0, fem_finger(design)) / unit, 3)}")
+        print(f"  table A(theta_j, P) / ...{np.round(volume_rate(design.n_s * q0, P, fem_finger(design)) / unit, 3)}")
+        h = 1e-6
+        K = [(hinge_moments(q0 + h * e, P, design) - hinge_moments(q0 - h * e, P, design))[j] / (2 * h)
+             for j, e in enumerate(np.eye(design.n_s))]
+        print(f"  FEM stiffness S diagonal {np.round(np.diag(S0), 0)} N mm/rad, next to it "
+              f"{np.round(np.diag(S0, 1), 0)} (the fast model's hinges are uncoupled)")
+        print(f"  fast model's dM_j/dq_j   {np.round(K, 0)} N mm/rad")
 
 
 if __name__ == "__main__":

@@ -9,22 +9,23 @@ and drops the tip assumption:
   (no coupling between hinges, E = sum E_j). At fixed hinge angles dE/dP = -V, the oil
   inside, so the moment holding hinge j, M_j = dE/d theta_hat_j, changes with P by
   dM_j/dP = -A_j, A_j = dV/d theta_hat_j the oil the hinge draws per radian *at fixed P*.
-  With A_j a function of the hinge's bend theta_j = n_s theta_hat_j alone, and M_j = 0 on
-  the free curve P_free(theta) of the calibrated finger (``finger_model = "fem"``,
+  With A_j a function of the hinge's bend theta_j = n_s theta_hat_j and the pressure, and
+  M_j = 0 on the free curve P_free(theta) of the calibrated finger (``finger_model = "fem"``,
   :mod:`softhand.reduced.calibrated.finger_fem`; it bends its equal hinges equally),
 
-  .. math:: M_j = -A_j(\theta_j)\,\big(P - P_{free}(\theta_j)\big), \qquad
+  .. math:: M_j = -\int_{P_{free}(\theta_j)}^{P} A_j(\theta_j, p)\,dp, \qquad
             E_j = \int_0^{\hat\theta_j} M_j .
 
-  A_j is measured by the finger FEM with its hinges locked by springs
-  (``reduced/calibrated/data/grasp_hinges.csv``, written by ``python -m
-  softhand.studies.calibration.hinges``): 1.77 a^2 pi d for a straight hinge, 1.17 a^2 pi d
-  from a bend of 4.8 deg on (hinges 1-4; the tip hinge 1.31 and 1.10), against dQ/dtheta =
-  1.86 a^2 pi d of the free finger, which includes the tube's swelling with P. Piecewise
-  linear in theta between the table's bends, extended linearly beyond them; the table is
-  the paper's design (Table I): other designs reuse its A_j / (a^2 pi d) with their own
-  free curve. Without this, the free finger's W_f and Q split equally over the hinges, the
-  contact force of a finger held by the object low on it comes out 50 % too large.
+  A_j is measured by the finger FEM with its hinges locked by springs at free bends and the
+  pressure raised (:mod:`softhand.reduced.calibrated.hinge_table`,
+  ``reduced/calibrated/data/grasp_hinges.csv``, written by ``python -m
+  softhand.studies.calibration.hinges``): about 1.8 a^2 pi d for a straight hinge and 1.2 a^2 pi d
+  for a bent one at its free pressure, growing with the pressure above it (a locked tube
+  swells), against dQ/dtheta = 1.86 a^2 pi d of the free finger, which includes the tube's
+  swelling with P along the free curve. The table is the paper's design (Table I): other
+  designs reuse its A_j / (a^2 pi d) with their own free curve. Without this, the free
+  finger's W_f and Q split equally over the hinges, the contact force of a finger held by
+  the object low on it comes out 50 % too large.
 * **The contact where it is** (:mod:`softhand.reduced.equations.contact`, the grasp FEM's geometry): the
   object's force on pad k at its closest point x*, F = -N nu + T t_k (normal force N along
   the outward normal -nu, the weight share T = m g / n along the link, as in the grasp FEM).
@@ -53,14 +54,14 @@ from typing import NamedTuple
 import numpy as np
 from scipy.optimize import brentq, root
 
+from softhand.reduced.calibrated import hinge_table
 from softhand.reduced.equations import contact, hand, kinematics
 from softhand.reduced.vocabulary.design import HandDesign
 from softhand.reduced.vocabulary.errors import InputError
-from softhand.reduced.vocabulary.inputfiles import read_number_table
 
 #: a pad other than the touching one penetrating by more than this [mm] moves the contact there
 PENETRATION = 1e-6
-#: the finger FEM's locked-hinge volume rates A_j(theta) (written by ``python -m softhand.studies.calibration.hinges``)
+#: the finger FEM's locked-hinge volume rates A_j(theta, P) (written by ``python -m softhand.studies.calibration.hinges``)
 HINGE_TABLE = Path(__file__).resolve().parent / "data" / "grasp_hinges.csv"
 #: the equilibrium's tolerance (scipy hybr, relative on the unknowns)
 _XTOL = 1e-10
@@ -88,42 +89,26 @@ def fem_finger(design: HandDesign) -> HandDesign:
     return design if design.finger_model == "fem" else replace(design, finger_model="fem")
 
 
-class HingeTable(NamedTuple):
-    """The finger FEM's held-hinge volume rates (:data:`HINGE_TABLE`)."""
-
-    theta: np.ndarray   #: hinge bend n_s theta_hat_j of the nodes, increasing, from 0 [rad]
-    a: np.ndarray       #: A_j / (a^2 pi d) at the nodes, (nodes, n_s)
-
-
-@lru_cache(maxsize=4)
-def read_hinge_table(path: str) -> HingeTable:
-    """The CSV written by ``python -m softhand.studies.calibration.hinges`` (columns theta, a_1..a_n)."""
-    _, columns, data = read_number_table(path, "hinge_table", "the hinge CSV of softhand.studies.calibration.hinges")
-    if columns[0] != "theta" or columns[1:] != tuple(f"a_{j}" for j in range(1, len(columns))) \
-            or len(columns) < 2 or np.any(np.diff(data[:, 0]) <= 0):
-        raise InputError("hinge_table", path, "needs the header theta,a_1,...,a_n and increasing theta")
-    return HingeTable(data[:, 0], data[:, 1:])
-
-
-def volume_rate(theta, design: HandDesign) -> np.ndarray:
-    """A_j [mm^3/rad] (n_s,): oil hinge j draws per radian at fixed pressure, at hinge bends theta
-    = n_s theta_hat (n_s,) [rad]; piecewise linear in theta, extended linearly beyond the nodes."""
-    t = read_hinge_table(str(HINGE_TABLE))
-    if t.a.shape[1] != design.n_s:
-        raise InputError("n_s", design.n_s, f"the hinge table has {t.a.shape[1]} hinges")
-    theta = np.asarray(theta, float)
-    i = np.minimum(np.maximum(np.searchsorted(t.theta, theta) - 1, 0), len(t.theta) - 2)
-    j = np.arange(design.n_s)
-    slope = (t.a[i + 1, j] - t.a[i, j]) / (t.theta[i + 1] - t.theta[i])
-    return (t.a[i, j] + slope * (theta - t.theta[i])) * design.a ** 2 * math.pi * design.d
+def volume_rate(theta, P, design: HandDesign) -> np.ndarray:
+    """A_j [mm^3/rad] (..., n_s): oil hinge j draws per radian at fixed pressure, at hinge bends theta
+    = n_s theta_hat (..., n_s) [rad] and cavity pressure P [MPa] (:mod:`softhand.reduced.calibrated.hinge_table`)."""
+    return hinge_table.volume_rate(_table(design), theta, P) * design.a ** 2 * math.pi * design.d
 
 
 def hinge_moments(q, P: float, design: HandDesign) -> np.ndarray:
-    """M_j = dE/d theta_hat_j = -A_j(theta_j) (P - P_free(theta_j)) [N mm/rad] (n_s,) at hinge
-    angles q (n_s,) [rad] and cavity pressure P [MPa], theta_j = n_s q_j; P_free of finger_model "fem"."""
+    """M_j = dE/d theta_hat_j = -int_{P_free(theta_j)}^P A_j(theta_j, p) dp [N mm/rad] (..., n_s) at hinge
+    angles q (..., n_s) [rad] and cavity pressure P [MPa], theta_j = n_s q_j; P_free of finger_model "fem"."""
     design = fem_finger(design)
     theta = design.n_s * np.asarray(q, float)
-    return -volume_rate(theta, design) * (P - hand.finger_pressure(theta, design))
+    M = hinge_table.moment(_table(design), theta, P, hand.finger_pressure(theta, design))
+    return M * design.a ** 2 * math.pi * design.d
+
+
+def _table(design: HandDesign) -> hinge_table.HingeTable:
+    t = hinge_table.read(str(HINGE_TABLE))
+    if t.a.shape[-1] != design.n_s:
+        raise InputError("n_s", design.n_s, f"the hinge table has {t.a.shape[-1]} hinges")
+    return t
 
 
 #: Gauss-Legendre rule on [0, 1] for E, per piece between the table's nodes
@@ -133,8 +118,8 @@ _GX, _GW = 0.5 * (_GX + 1.0), 0.5 * _GW
 
 def hinge_energy(q, P: float, design: HandDesign) -> float:
     """E = sum_j int_0^q_j M_j [N mm] at hinge angles q (n_s,) [rad] (12-point Gauss on every
-    piece between the table's nodes: M is smooth there)."""
-    nodes = read_hinge_table(str(HINGE_TABLE)).theta / design.n_s
+    piece between the table's bends and the free bends of its pressures: M is smooth there)."""
+    nodes = _energy_cuts(fem_finger(design))
     total = 0.0
     for j, qj in enumerate(np.asarray(q, float)):  # n_s hinges
         inside = np.sort(nodes[(nodes > min(qj, 0.0)) & (nodes < max(qj, 0.0))])
@@ -145,6 +130,17 @@ def hinge_energy(q, P: float, design: HandDesign) -> float:
         M = hinge_moments(Q, P, design)[..., j]
         total += float(np.sum(M * _GW * np.diff(cuts)[:, None]))
     return total
+
+
+@lru_cache(maxsize=16)
+def _energy_cuts(design: HandDesign) -> np.ndarray:
+    """Hinge angles theta_hat where M_j's second derivative may jump: the table's bends, and the
+    free bends at its pressures (where P_free(theta) crosses a kink of A_j in p)."""
+    t = _table(design)
+    lo, hi = hand.pressure_span(design, reservoir=False)
+    p = t.p[(t.p > lo) & (t.p < hi)]
+    free = np.asarray(hand.bend_angle(p, design, reservoir=False), float) if len(p) else np.zeros(0)
+    return np.unique(np.r_[t.theta, free]) / design.n_s
 
 
 def _load(q, centre, link: int, weight: float, design: HandDesign, corner: bool = False):
@@ -179,7 +175,10 @@ def _solve_link(P, depth, radius, link, weight, q0, design, corner=False):
     _, grad, Tq, *_ = _load(q0, centre, k, weight, design, corner)
     M = (hinge_moments(q0, P, design) - Tq)[:k]
     N0 = max(float(M @ grad[:k]) / max(float(grad[:k] @ grad[:k]), 1e-12), 0.0)
-    sol = root(residual, np.concatenate([q0[:k], [N0]]), method="hybr", options={"xtol": _XTOL})
+    x0 = np.concatenate([q0[:k], [N0]])
+    sol = root(residual, x0, method="hybr", options={"xtol": _XTOL})
+    if not sol.success:  # hybr stalls where the table's kinks meet a poor start: Levenberg-Marquardt
+        sol = root(residual, x0, method="lm", options={"xtol": _XTOL, "ftol": _XTOL})
     if not sol.success or np.max(np.abs(residual(sol.x)) / [*np.maximum(np.abs(M), 1.0), 1.0]) > 1e-7:
         raise InputError("pressure_MPa", P, f"no equilibrium with pad {k} on the object "
                                             f"(depth {depth:.4g} mm): {sol.message}")

@@ -1,0 +1,98 @@
+r"""The finger FEM's blocked-hinge table: the oil each hinge draws per radian at fixed pressure,
+A_j(theta, P) = dV/d theta_hat_j, and the moment that holds a hinge off its free bend,
+
+.. math:: M_j(\theta, P) = -\int_{P_{free}(\theta)}^{P} A_j(\theta, p)\,dp ,
+
+zero on the free curve P_free(theta) of the calibrated finger and falling (the hinge pushes
+closed harder) as the pressure rises above it at a fixed bend: dM_j/dP = -A_j, a Maxwell
+relation of the finger's potential E(q, P) (dE/dP = -V).
+
+The table (``data/grasp_hinges.csv``, written by ``python -m softhand.studies.calibration.hinges``)
+holds a_j = A_j / (a^2 pi d) at the free bends theta_i of a few pressures P0_i, measured with
+the hinges locked there while the pressure rises, at the middle P of each step: so A_j grows
+with P at a fixed bend as the locked tube swells (1.20 to 1.35 a^2 pi d at a 7.4 deg hinge bend
+from 0.35 to 0.95 MPa). Between the steps A_j is linear in P; below a node's first step (P < P0_i,
+the hinge bent beyond its free bend) and above its last it keeps its end value; between the
+nodes it is linear in theta, extended linearly beyond them. M_j is the exact integral of that
+function (piecewise quadratic in P). Units: rad, MPa, mm^3/rad, N mm/rad.
+"""
+from __future__ import annotations
+
+from functools import lru_cache
+from typing import NamedTuple
+
+import numpy as np
+
+from softhand.reduced.vocabulary.errors import InputError
+from softhand.reduced.vocabulary.inputfiles import read_number_table
+
+
+class HingeTable(NamedTuple):
+    """a_j(theta_i, p_k) on a grid: nodes theta_i (increasing), pressures p_k (equally spaced)."""
+
+    theta: np.ndarray   #: (nodes,) hinge bend n_s theta_hat of each node [rad], increasing from 0
+    p: np.ndarray       #: (K,) pressures [MPa], equally spaced
+    a: np.ndarray       #: (nodes, K, n_s) A_j / (a^2 pi d)
+    cum: np.ndarray     #: (nodes, K, n_s) int_{p_0}^{p_k} a_j dp
+
+
+@lru_cache(maxsize=4)
+def read(path: str) -> HingeTable:
+    """The CSV (columns theta, P, a_1..a_n; rows of one node together, P rising)."""
+    what = "the hinge CSV of softhand.studies.calibration.hinges"
+    _, columns, data = read_number_table(path, "hinge_table", what)
+    n = len(columns) - 2
+    if n < 1 or columns != ("theta", "P", *(f"a_{j}" for j in range(1, n + 1))):
+        raise InputError("hinge_table", path, "needs the header theta,P,a_1,...,a_n")
+    theta = np.unique(data[:, 0])
+    p = np.unique(np.round(data[:, 1], 9))
+    step = np.diff(p)
+    if len(theta) < 2 or len(p) < 2 or np.ptp(step) > 1e-6 * step[0]:
+        raise InputError("hinge_table", path, "needs two bends or more and equally spaced pressures")
+    a = np.full((len(theta), len(p), n), np.nan)
+    a[np.searchsorted(theta, data[:, 0]), np.searchsorted(p, np.round(data[:, 1], 9))] = data[:, 2:]
+    for i in range(len(theta)):   # below a node's first step its first value, above its last its last
+        rows = np.flatnonzero(np.isfinite(a[i, :, 0]))
+        if not len(rows) or np.any(np.diff(rows) != 1):
+            raise InputError("hinge_table", path, f"needs the pressures of bend {theta[i]:.6g} in one run")
+        a[i, :rows[0]], a[i, rows[-1] + 1:] = a[i, rows[0]], a[i, rows[-1]]
+    cum = np.concatenate([np.zeros((len(theta), 1, n)),
+                          np.cumsum(0.5 * (a[:, 1:] + a[:, :-1]) * step[0], axis=1)], axis=1)
+    return HingeTable(theta, p, a, cum)
+
+
+def _node_values(t: HingeTable, i, P):
+    """(A, integral from p_0) of node i's a_j(p) at pressures P, both shaped like i (..., n_s)."""
+    h, K = t.p[1] - t.p[0], len(t.p)
+    j = np.broadcast_to(np.arange(i.shape[-1]), i.shape)
+    x = (np.asarray(P, float) - t.p[0]) / h
+    k = np.clip(np.floor(x).astype(int), 0, K - 2)
+    s = np.clip(x - k, 0.0, 1.0) * h                       # within cell k
+    a0, a1 = t.a[i, k, j], t.a[i, k + 1, j]
+    A = a0 + (a1 - a0) * s / h
+    F = t.cum[i, k, j] + a0 * s + 0.5 * (a1 - a0) * s * s / h
+    below, above = x < 0, x > K - 1                          # constant ends
+    A = np.where(below, t.a[i, 0, j], np.where(above, t.a[i, -1, j], A))
+    F = F + np.where(below, x * h * t.a[i, 0, j], 0.0) + np.where(above, (x - K + 1) * h * t.a[i, -1, j], 0.0)
+    return A, F
+
+
+def _interpolate(t: HingeTable, theta, P):
+    """(a_j, int_{p_0}^{P} a_j dp) at hinge bends theta (..., n_s) and pressures P (broadcast)."""
+    theta = np.asarray(theta, float)
+    P = np.broadcast_to(np.asarray(P, float), theta.shape)
+    i = np.clip(np.searchsorted(t.theta, theta) - 1, 0, len(t.theta) - 2)
+    w = (theta - t.theta[i]) / (t.theta[i + 1] - t.theta[i])
+    (A0, F0), (A1, F1) = _node_values(t, i, P), _node_values(t, i + 1, P)
+    return A0 + w * (A1 - A0), F0 + w * (F1 - F0)
+
+
+def volume_rate(t: HingeTable, theta, P) -> np.ndarray:
+    """a_j = A_j / (a^2 pi d) at hinge bends theta (..., n_s) [rad] and cavity pressure P [MPa]."""
+    return _interpolate(t, theta, P)[0]
+
+
+def moment(t: HingeTable, theta, P, P_free) -> np.ndarray:
+    """M_j / (a^2 pi d) = -int_{P_free}^{P} a_j(theta, p) dp (module doc) at bends theta (..., n_s),
+    cavity pressure P and the free curve's pressure P_free at those bends."""
+    return -(_interpolate(t, theta, P)[1] - _interpolate(t, theta, P_free)[1])

@@ -1,0 +1,76 @@
+"""softhand.reduced.calibrated.hinge_table: the moment is the exact integral of the table's volume
+rate over the pressure (closed forms for rates constant and linear in P), its pressure
+derivative is the rate (the Maxwell relation it rests on), and bad tables are refused."""
+import numpy as np
+import pytest
+
+from softhand.reduced.calibrated import grasp_fem, hinge_table
+from softhand.reduced.vocabulary.design import HandDesign
+from softhand.reduced.vocabulary.errors import InputError
+
+THETA = (0.0, 0.1, 0.25)
+P = np.round(0.05 + 0.1 * np.arange(20), 9)
+
+
+def write(tmp_path, rate, first=(0.0, 0.2, 0.4), name="t.csv"):
+    """A table of two hinges, a_j = rate(theta, P, j), node i measured from P >= first[i]."""
+    rows = ["# test", "theta,P,a_1,a_2"]
+    for t, p0 in zip(THETA, first):
+        rows += [f"{t},{p},{float(rate(t, p, 0))!r},{float(rate(t, p, 1))!r}" for p in P if p >= p0]
+    path = tmp_path / name
+    path.write_text("\n".join(rows) + "\n")
+    hinge_table.read.cache_clear()
+    return hinge_table.read(str(path))
+
+
+def test_a_rate_independent_of_the_pressure_gives_the_linear_law(tmp_path):
+    """a_j(theta) alone: M_j = -a_j(theta) (P - P_free), the same below, inside and beyond the nodes."""
+    rate = lambda t, p, j: 1.8 - 2.0 * t + 0.1 * j  # noqa: E731
+    t = write(tmp_path, rate)
+    theta = np.array([[-0.05, 0.02], [0.13, 0.3], [0.24, 0.5]])
+    for Pc, Pf in [(0.9, 0.3), (2.6, -0.2), (0.0, 0.5)]:
+        want = -np.array([[rate(x, 0, j) for j, x in enumerate(r)] for r in theta]) * (Pc - Pf)
+        np.testing.assert_allclose(hinge_table.moment(t, theta, Pc, Pf), want, rtol=1e-12, atol=1e-12)
+
+
+def test_a_rate_linear_in_the_pressure_is_integrated_exactly(tmp_path):
+    """a = alpha(theta) + beta p on every node: M = -(alpha (P - Pf) + beta (P^2 - Pf^2) / 2) inside
+    the measured pressures (the first node's whole range: it starts at 0)."""
+    rate = lambda t, p, j: 1.2 + 0.5 * t + (0.3 + j * 0.1) * p  # noqa: E731
+    t = write(tmp_path, rate, first=(0.0, 0.0, 0.0))
+    theta = np.array([0.05, 0.2])
+    for Pc, Pf in [(0.9, 0.3), (1.95, 0.05), (0.61, 0.6)]:
+        want = [-((1.2 + 0.5 * x) * (Pc - Pf) + (0.3 + j * 0.1) * 0.5 * (Pc ** 2 - Pf ** 2))
+                for j, x in enumerate(theta)]
+        np.testing.assert_allclose(hinge_table.moment(t, theta, Pc, Pf), want, rtol=1e-12)
+
+
+def test_the_moments_pressure_rate_is_minus_the_volume_rate():
+    """dM_j/dP = -A_j at fixed hinge angles, by differences, on the finger's own table."""
+    design = grasp_fem.fem_finger(HandDesign())
+    q, h = np.radians([0.3, 1.2, 2.5, 4.0, 9.0]), 1e-6
+    for P in (0.37, 0.9, 1.4):
+        fd = (grasp_fem.hinge_moments(q, P + h, design) - grasp_fem.hinge_moments(q, P - h, design)) / (2 * h)
+        np.testing.assert_allclose(fd, -grasp_fem.volume_rate(design.n_s * q, P, design), rtol=1e-6)
+
+
+def test_the_finger_tables_rate_grows_with_the_pressure_at_a_locked_bend():
+    """The measured table itself: at a locked bend the tube swells and draws more oil per radian
+    as the pressure rises above the free one (the reason the table has P)."""
+    design = grasp_fem.fem_finger(HandDesign())
+    theta = np.full(design.n_s, 0.12)
+    low, high = (grasp_fem.volume_rate(theta, P, design) for P in (0.5, 1.5))
+    assert np.all(high[:4] > 1.05 * low[:4])
+
+
+@pytest.mark.parametrize("header, rows, says", [
+    ("theta,a_1,a_2", ["0,1,1", "0.1,1,1"], "theta,P,a_1"),
+    ("theta,P,a_1", ["0,0.1,1", "0,0.2,1", "0,0.4,1", "0.1,0.1,1", "0.1,0.2,1", "0.1,0.4,1"], "equally spaced"),
+    ("theta,P,a_1", ["0,0.1,1", "0,0.2,1", "0,0.3,1", "0.1,0.1,1", "0.1,0.3,1"], "in one run"),
+])
+def test_a_bad_table_is_one_line(tmp_path, header, rows, says):
+    path = tmp_path / "bad.csv"
+    path.write_text("\n".join([header, *rows]) + "\n")
+    with pytest.raises(InputError, match=says) as e:
+        hinge_table.read(str(path))
+    assert "\n" not in str(e.value) and "hinge_table" in str(e.value)
