@@ -121,9 +121,13 @@ def pad_distance(placed: Placed, p: Pads) -> PadDistance:
     """Gap of every pad to the object: exact for a sphere (the pad rectangle's point nearest the
     centre); otherwise the least distance on a :data:`PAD_SAMPLES` grid of the pad refined by a
     parabola through the least sample and its neighbours, along then across (exact for a flat
-    face; error O(h^3) on a curved one, h = 1/16 of the link); and an object's edges and corners
-    (:func:`softhand.reduced.holding.object_geometry.feature_points`) over the pad's face, by their height above it, where
-    the distance is not smooth (a box's corner on a pad: then the contact normal is the pad's)."""
+    face; error O(h^3) on a curved one, h = 1/16 of the link). Then, as the FEM hold does
+    (:func:`softhand.fem.hand.hold_geometry.pad_contacts`), where the object's point deepest through
+    the pad's plane (:meth:`~softhand.reduced.holding.object_geometry.Placed.support`, closed form) lies over the pad, the
+    contact is there: gap its height above the pad, normal the pad's (an edge or corner against
+    the pad's face; on a line of ties, the point nearest the one found). A mesh, which has no
+    closed form, takes its edges and corners (:func:`softhand.reduced.holding.object_geometry.feature_points`) over the
+    pad's face by their height above it instead."""
     if placed.obj.shape == "sphere":
         d = placed.centre - p.centre
         s = np.clip(np.einsum("fki,fki->fk", d, p.along), -p.half[:, 0], p.half[:, 0])
@@ -135,6 +139,19 @@ def pad_distance(placed: Placed, p: Pads) -> PadDistance:
     n = placed.normal(x)
     facing = np.einsum("fki,fki->fk", n, p.normal) < 0.0
     gap = np.where(facing, gap, np.inf)
+    d = placed.centre - p.centre  # ties: nearest the pad's point nearest the centre, as the FEM's start
+    ref = p.centre + np.clip(np.einsum("fki,fki->fk", d, p.along), -p.half[:, 0], p.half[:, 0])[..., None] * p.along \
+        + np.clip(np.einsum("fki,fki->fk", d, p.across), -p.half[:, 1], p.half[:, 1])[..., None] * p.across
+    S = placed.support(p.normal.reshape(-1, 3), ref.reshape(-1, 3))
+    if S is not None:  # the object's point deepest through the pad's plane, where it is over the pad
+        rel = S.reshape(x.shape) - p.centre
+        s, w = np.einsum("fki,fki->fk", rel, p.along), np.einsum("fki,fki->fk", rel, p.across)
+        over = (np.abs(s) <= p.half[:, 0]) & (np.abs(w) <= p.half[:, 1])
+        x = np.where(over[..., None], p.centre + s[..., None] * p.along + w[..., None] * p.across, x)
+        n = np.where(over[..., None], -p.normal, n)
+        towards = np.einsum("fki,fki->fk", placed.centre - x, p.normal) > 0.0
+        gap = np.where(over, np.where(towards, np.einsum("fki,fki->fk", rel, p.normal), np.inf), gap)
+        return PadDistance(gap, x, n)
     F = placed.features()
     if len(F):  # only those within a pad's half width of some finger's plane can be over a pad
         F = F[np.any(np.abs(F @ p.across[:, 0, :].T) <= float(np.max(p.half[:, 1])), axis=1)]

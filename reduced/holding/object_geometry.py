@@ -40,6 +40,10 @@ def local_sdf(obj: GraspObject, p) -> np.ndarray:
     return grid_sdf(mesh, p)
 
 
+#: depth differences below this [mm] are ties in :func:`support_point`
+TIE_MM = 1e-7
+
+
 def support_point(shape: str, size, u, ref) -> np.ndarray | None:
     """The object's point deepest along -u (the argmin of X . u over the body), rows (m, 3), in
     its own frame (centre at the origin, a cylinder's or capsule's axis along y; ``size`` as
@@ -47,7 +51,9 @@ def support_point(shape: str, size, u, ref) -> np.ndarray | None:
     ``ref`` (m, 3). None for a mesh (no closed form). A flat pad facing along u touches the object
     there when that point lies over the pad: an edge or corner against the pad's face."""
     u, ref = np.atleast_2d(np.asarray(u, float)), np.atleast_2d(np.asarray(ref, float))
-    tiny = 1e-12 * np.linalg.norm(u, axis=1)
+    # a component of u is taken as 0 where moving across the whole object along it changes the
+    # depth by less than TIE_MM: a tie (a direction's round-off must not pick a far corner)
+    tiny = TIE_MM * np.linalg.norm(u, axis=1) / (float(np.max(size)) if len(size) else 1.0)
     if shape == "sphere":
         return -0.5 * size[0] * u / np.linalg.norm(u, axis=1)[:, None]
     if shape == "box":

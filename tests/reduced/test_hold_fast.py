@@ -152,6 +152,33 @@ def test_box_corner_contact_does_not_depend_on_the_pad_sampling(monkeypatch):
     assert limits[0] == pytest.approx(limits[1], rel=1e-8)
 
 
+@pytest.mark.parametrize("text", ["box:180x180x180", "cylinder:180x180"])
+def test_pads_on_a_top_edge_touch_it_in_their_own_planes_as_the_fem_does(text):
+    """The 180 mm cube's top edges and the upright cylinder's rim under the four fingers: each
+    finger's pad meets the edge at the object's point deepest through the pad (the FEM hold's
+    rule): in the finger's own plane, on the edge, and the four contacts the quarter turns of
+    one another. (A sampled contact sat 8.4 mm across the pad on the cube, and 2.2 mm on two
+    of the cylinder's four, twisting the object the LP then had to hold.)"""
+    from softhand.reduced.holding import hand_layout
+
+    d = hold_fast.finger_design(HandDesign())
+    placed = place_object(objects.parse_object(text), d)
+    cs = hold.contact_set(hold_fast.close_hand(0.9, placed, d), d)
+    assert len(cs.finger) == 4 and sorted(cs.finger) == [0, 1, 2, 3]
+    frames = hand_layout.finger_frames(d)
+    rel = cs.point - placed.centre
+    for c, i in enumerate(cs.finger):
+        across = np.cross(frames.e_out[i], frames.e_down[i])
+        assert abs(rel[c] @ across) < 1e-9                                   # in the finger's plane
+        assert rel[c] @ frames.e_out[i] == pytest.approx(90.0, abs=1e-9)      # on the side's plane
+        assert rel[c][1] == pytest.approx(-90.0, abs=1e-6)                    # at the top
+    turn = np.array([[0.0, 0.0, -1.0], [0.0, 1.0, 0.0], [1.0, 0.0, 0.0]])  # a quarter turn about y
+    order = np.argsort(cs.finger)
+    for a, b in zip(order[:-1], order[1:]):
+        assert np.allclose(np.abs(rel[b]), np.abs(rel[a] @ turn.T), atol=1e-6)
+        assert cs.closing_N[b] == pytest.approx(cs.closing_N[a], rel=1e-9)
+
+
 def test_mesh_object_holds_as_the_sphere_it_approximates(tmp_path):
     """A triangulated sphere (icosphere, 2562 vertices, r = 90 mm) read from STL against the 180 mm
     sphere: the holding limit within 3 % (the facets lie up to 0.05 mm inside the sphere, the
