@@ -1,0 +1,69 @@
+"""The fast hold model beside whole-hand FEM holds: the same object, mass, friction, pull and cavity pressure.
+
+Give it the JSON that ``softhand hold --model fem --json`` printed (one file per case, or
+``result.json`` from its ``--out`` directory); for each it runs the fast model (``--model
+reduced``, calibrated finger) on the case the FEM ran and prints one row: held or not, the
+holding limit and one pad's normal force in each, and the relative differences. The FEM's rows
+take minutes each (make them first, e.g. with nice in the background); this takes a second.
+
+    python benchmarks/hold_fast_vs_fem.py RESULT.json [RESULT.json ...] [--markdown]
+"""
+from __future__ import annotations
+
+import argparse
+import json
+
+from softhand.reduced.holding.hold import solve_hold
+from softhand.reduced.holding.objects import object_from_table
+from softhand.reduced.vocabulary.design import HandDesign
+
+
+def describe(obj: dict) -> str:
+    shape = obj["shape"]
+    if shape == "sphere":
+        return f"sphere {obj['diameter_mm']:g} mm"
+    if shape == "box":
+        return "box " + " x ".join(f"{v:g}" for v in obj["size_mm"]) + " mm"
+    if shape in ("cylinder", "capsule"):
+        return f"{shape} {obj['diameter_mm']:g} x {obj['length_mm']:g} mm"
+    return shape
+
+
+def pad_N(result: dict) -> float:
+    """The largest normal force on one pad in the state reported [N]."""
+    return max((c["normal_N"] for c in result["contacts"]), default=0.0)
+
+
+def row(fem: dict) -> dict:
+    table = {k: v for k, v in fem["object"].items() if v is not None}
+    obj = object_from_table(table, source="FEM result")
+    fast = solve_hold(HandDesign(), obj, P_cavity_MPa=fem["P_cavity_MPa"], pull_direction=fem["pull_direction"]).to_json()
+    return {"object": describe(fem["object"]), "mass_kg": fem["mass_kg"], "friction": fem["friction"],
+            "P_cavity_MPa": fem["P_cavity_MPa"], "fem_held": fem["held"], "fem_limit_N": fem["holding_limit_N"],
+            "fem_pad_N": pad_N(fem), "fast_held": fast["held"], "fast_limit_N": fast["holding_limit_N"],
+            "fast_pad_N": pad_N(fast)}
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("results", nargs="+", help="FEM hold JSON files (softhand hold --model fem --json)")
+    parser.add_argument("--markdown", action="store_true", help="print a Markdown table")
+    args = parser.parse_args()
+    rows = [row(json.loads(open(path, encoding="utf-8").read())) for path in args.results]
+    pct = lambda a, b: f"{100.0 * (a / b - 1.0):+.1f} %" if b else "—"  # noqa: E731
+    head = ["object", "mass kg", "mu", "P_cavity MPa", "FEM held, limit N", "fast held, limit N", "limit",
+            "FEM N/pad", "fast N/pad", "N"]
+    if args.markdown:
+        print("| " + " | ".join(head) + " |")
+        print("|" + "---|" * len(head))
+    for r in rows:
+        cells = [r["object"], f"{r['mass_kg']:g}", f"{r['friction']:g}", f"{r['P_cavity_MPa']:g}",
+                 f"{'yes' if r['fem_held'] else 'no'}, {r['fem_limit_N']:.2f}",
+                 f"{'yes' if r['fast_held'] else 'no'}, {r['fast_limit_N']:.2f}",
+                 pct(r["fast_limit_N"], r["fem_limit_N"]) if r["fem_held"] and r["fast_held"] else "",
+                 f"{r['fem_pad_N']:.2f}", f"{r['fast_pad_N']:.2f}", pct(r["fast_pad_N"], r["fem_pad_N"])]
+        print("| " + " | ".join(cells) + " |" if args.markdown else "  ".join(cells))
+
+
+if __name__ == "__main__":
+    main()
