@@ -40,6 +40,7 @@ from scipy.spatial.transform import Rotation
 
 from softhand.fem.constraints import PlanarChain
 from softhand.fem.hand.frame import hand_frame
+from softhand.reduced.holding.object_geometry import over_pad
 
 
 def rot_y(psi: float) -> np.ndarray:
@@ -185,11 +186,10 @@ def pad_contacts(body, pose: Pose, frames, padsets, qs, *, iterations: int = 40)
     support = getattr(body, "support", None)
     S = None if support is None else support(facing @ pose.R, pose.to_body(x))
     if S is not None:  # the object's point deepest through the pad's plane, where it is over the pad
-        rel = pose.to_hand(S) - A
-        s_f, z_f = np.einsum("ki,ki->k", rel, AB) / L2, np.einsum("ki,ki->k", rel, e_n)
-        over = (s_f >= 0.0) & (s_f <= 1.0) & (np.abs(z_f) <= half)
-        sigma, zeta = np.where(over, s_f, sigma), np.where(over, z_f, zeta)
-        d = np.where(over, np.einsum("ki,ki->k", rel, facing), d)
+        L = np.sqrt(L2)
+        over, s_f, z_f, h = over_pad(pose.to_hand(S), A + 0.5 * AB, AB / L[:, None], e_n, facing, 0.5 * L, half)
+        sigma, zeta = np.where(over, 0.5 + s_f / L, sigma), np.where(over, z_f, zeta)
+        d = np.where(over, h, d)
         n = np.where(over[:, None], -facing, n)
         x = point(sigma, zeta)
     g = np.where(np.einsum("ki,ki->k", facing, c - x) > 0.0, d, np.inf)

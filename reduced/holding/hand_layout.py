@@ -32,7 +32,7 @@ from scipy.optimize import brentq
 from softhand.reduced.equations import contact, kinematics
 from softhand.reduced.vocabulary.design import HandDesign
 from softhand.reduced.vocabulary.errors import InputError
-from softhand.reduced.holding.object_geometry import Placed, place
+from softhand.reduced.holding.object_geometry import Placed, over_pad, place
 from softhand.reduced.holding.objects import CLEARANCE, PALM_GAP, GraspObject
 
 #: an object's edge or corner more than half this far behind a pad's face is not in front of it [mm]
@@ -121,13 +121,14 @@ def pad_distance(placed: Placed, p: Pads) -> PadDistance:
     """Gap of every pad to the object: exact for a sphere (the pad rectangle's point nearest the
     centre); otherwise the least distance on a :data:`PAD_SAMPLES` grid of the pad refined by a
     parabola through the least sample and its neighbours, along then across (exact for a flat
-    face; error O(h^3) on a curved one, h = 1/16 of the link). Then, as the FEM hold does
-    (:func:`softhand.fem.hand.hold_geometry.pad_contacts`), where the object's point deepest through
-    the pad's plane (:meth:`~softhand.reduced.holding.object_geometry.Placed.support`, closed form) lies over the pad, the
-    contact is there: gap its height above the pad, normal the pad's (an edge or corner against
-    the pad's face; on a line of ties, the point nearest the one found). A mesh, which has no
-    closed form, takes its edges and corners (:func:`softhand.reduced.holding.object_geometry.feature_points`) over the
-    pad's face by their height above it instead."""
+    face; error O(h^3) on a curved one, h = 1/16 of the link). Then, by the FEM hold's own rule
+    (:func:`softhand.reduced.holding.object_geometry.over_pad`), where the object's point deepest
+    through the pad's plane (:meth:`~softhand.reduced.holding.object_geometry.Placed.support`,
+    closed form) lies over the pad, the contact is there: gap its height above the pad, normal
+    the pad's (an edge or corner against the pad's face; on a line of ties, the point nearest the
+    pad's point nearest the centre). A mesh, which has no closed form, takes its edges and corners
+    (:func:`softhand.reduced.holding.object_geometry.feature_points`) over the pad's face by their
+    height above it instead."""
     if placed.obj.shape == "sphere":
         d = placed.centre - p.centre
         s = np.clip(np.einsum("fki,fki->fk", d, p.along), -p.half[:, 0], p.half[:, 0])
@@ -144,13 +145,12 @@ def pad_distance(placed: Placed, p: Pads) -> PadDistance:
         + np.clip(np.einsum("fki,fki->fk", d, p.across), -p.half[:, 1], p.half[:, 1])[..., None] * p.across
     S = placed.support(p.normal.reshape(-1, 3), ref.reshape(-1, 3))
     if S is not None:  # the object's point deepest through the pad's plane, where it is over the pad
-        rel = S.reshape(x.shape) - p.centre
-        s, w = np.einsum("fki,fki->fk", rel, p.along), np.einsum("fki,fki->fk", rel, p.across)
-        over = (np.abs(s) <= p.half[:, 0]) & (np.abs(w) <= p.half[:, 1])
+        over, s, w, h = over_pad(S.reshape(x.shape), p.centre, p.along, p.across, p.normal,
+                                 p.half[:, 0], p.half[:, 1])
         x = np.where(over[..., None], p.centre + s[..., None] * p.along + w[..., None] * p.across, x)
         n = np.where(over[..., None], -p.normal, n)
         towards = np.einsum("fki,fki->fk", placed.centre - x, p.normal) > 0.0
-        gap = np.where(over, np.where(towards, np.einsum("fki,fki->fk", rel, p.normal), np.inf), gap)
+        gap = np.where(over, np.where(towards, h, np.inf), gap)
         return PadDistance(gap, x, n)
     F = placed.features()
     if len(F):  # only those within a pad's half width of some finger's plane can be over a pad

@@ -73,6 +73,19 @@ def support_point(shape: str, size, u, ref) -> np.ndarray | None:
     return radial + end[:, None] * np.array([0.0, 1.0, 0.0])
 
 
+def over_pad(S, centre, along, across, normal, half_along, half_across):
+    """Where the object's support points S (..., 3) against flat pads lie over them: the pads are
+    rectangles (centres, unit axes along and across, unit normals towards the object, half sizes;
+    all broadcast to S's leading shape). Returns (over, s, w, height): whether S is over its pad,
+    its coordinates along and across from the centre, and its height along the normal (the
+    pad's gap to the object there). The one rule by which a pad meets an edge or corner, in the
+    fast hold and the FEM hold alike."""
+    rel = np.asarray(S, float) - centre
+    s, w = np.einsum("...i,...i->...", rel, along), np.einsum("...i,...i->...", rel, across)
+    over = (np.abs(s) <= half_along) & (np.abs(w) <= half_across)
+    return over, s, w, np.einsum("...i,...i->...", rel, normal)
+
+
 def dimensions(obj: GraspObject) -> tuple:
     """A primitive's sizes as :func:`support_point` takes them: sphere (D,), cylinder and capsule
     (D, length), box (x, y, z edges) [mm]; () for a mesh."""
