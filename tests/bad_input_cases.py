@@ -293,8 +293,8 @@ EXTRA_FILES.update({
 
 
 def hold_cases() -> list[tuple[str, list[str]]]:
-    """The whole-hand hold's inputs: objects (tables, short forms, mesh files), pulls, maps, the
-    FEM off the hand's symmetry; each refused before any computation."""
+    """The whole-hand hold's inputs: objects (tables, short forms, mesh files), pulls, maps; each
+    refused before any computation."""
     at = ["--pressure-mpa", "1.2", "--no-progress"]
     cases = [["hold", "--object", f, *at] for f in (
         "obj_open.toml", "obj_missing_file.toml", "obj_negative_mu.toml", "obj_unknown_key.toml",
@@ -307,7 +307,6 @@ def hold_cases() -> list[tuple[str, list[str]]]:
               ["hold", "--object", "sphere:150", "--map", "pressure=0:2:0.001", "mass=0:5:0.001"],
               ["hold", "--object", "sphere:150", "--map", "pressure=0.5:1:0.5", "colour=1,2"],
               ["hold", "--object", "sphere:150", "--check"],
-              ["hold", "--object", "sphere:150", "--model", "fem", "--pull", "x", *at],
               ["hold", "--object", "sphere:150", "--model", "fem", "--margin", "2", "--no-progress"],
               ["design", "--task", "task_open_mesh.toml", "--no-fem", "--no-progress"]]
     return [("hold", c) for c in cases]

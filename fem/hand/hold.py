@@ -63,16 +63,21 @@ def run_hold(model: HoldModel, P: float, *, progress=None) -> HoldPath:
             if dP < P / (16 * o.close_steps):
                 raise
     model.released = Pose(model.body.centre, model.pose).t.copy()
-    share, d_share = 0.0, 1.0  # of the weight: let go at once, in smaller parts if that fails
+    # of the weight: let go at once; where the hand is symmetric, in smaller parts if that fails
+    # (the largest share held is reported); else the release was followed as a path
+    share, d_share = 0.0, 1.0
     while share < 1.0:
         try:
             steps.append(model.step(P, gravity=min(share + d_share, 1.0), pull=0.0, stage="release"))
             tick(steps[-1])
             share = min(share + d_share, 1.0)
         except (NotConverged, NoEquilibrium) as err:
+            why = str(err).split("; residual history")[0]
+            if not model.symmetric:  # the release was followed as a path (HoldModel._relax)
+                return HoldPath(model, steps, False, 0.0, True, f"not held when let go of {share + d_share:.0%} "
+                                f"of its weight ({why})", time.perf_counter() - t0)
             d_share *= 0.5
             if d_share < o.min_weight_step:
-                why = str(err).split("; residual history")[0]
                 return HoldPath(model, steps, False, 0.0, True, f"held {share:.0%} of its weight at "
                                 f"most ({why})", time.perf_counter() - t0)
     F, failure = 0.0, ""
@@ -91,15 +96,17 @@ def run_hold(model: HoldModel, P: float, *, progress=None) -> HoldPath:
 
 def solve_hold(design: HandDesign, obj, *, P_cavity_MPa: float, pull_direction=(0.0, 1.0, 0.0),
                options: HoldOptions = HoldOptions(), progress=None, keep_path: bool = False,
-               P_pump_MPa: float = math.nan):
+               P_pump_MPa: float = math.nan, path_progress=None):
     """The FEM hold of ``obj`` (a :class:`softhand.reduced.holding.objects.GraspObject`, placed by its table) at
     cavity pressure P_cavity_MPa: the common :class:`softhand.reduced.holding.hold_result.HoldResult` (P_pump_MPa
-    only reported); ``progress(record)`` after every converged load step; with ``keep_path``
+    only reported); ``progress(record)`` after every converged load step, ``path_progress(k, support_N)``
+    after every step of a followed path (:meth:`HoldModel._relax`); with ``keep_path``
     also the :class:`HoldPath` (for :func:`softhand.fem.hand.hold_output.write_hold`)."""
     from softhand.fem.hand.hold_output import to_result
 
     body, layout = check_hold(design, obj, pull_direction, options)
     model = HoldModel(design, body, options=options, layout=layout, pull_direction=pull_direction)
+    model.on_path_step = path_progress
     path = run_hold(model, float(P_cavity_MPa), progress=progress)
     result = replace(to_result(path, obj=obj), P_pump_MPa=float(P_pump_MPa))
     return (result, path) if keep_path else result

@@ -37,7 +37,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 import scipy.sparse as sp
 
-from softhand.fem.hand.hold_geometry import Pose, pad_contacts
+from softhand.fem.hand.hold_geometry import Pose, pad_contacts, pad_points
 from softhand.fem.linsolve import make_solver
 from softhand.fem.newton import NewtonOptions, NotConverged, newton
 
@@ -109,17 +109,9 @@ class ContactState:
     stick: np.ndarray      #: (m,) bool
     Q: list = field(default_factory=list)  #: generalised force on each finger [N mm]
     wrench: np.ndarray = None  #: (6,) force and moment of the pads on the object (one of each finger) [N, N mm]
-
-
-def anchors_now(fingers: Fingers, qs, pose: Pose, hist: ContactHistory):
-    """Current hand-frame positions (pad anchors, object anchors)."""
-    xp, i = [], 0
-    for frame, pads, q in zip(fingers.frames, fingers.padsets, qs):
-        m = pads.n_links
-        xy = pads.chain.point_map(q, np.arange(m), hist.X[i:i + m], order=0)[0]
-        xp.append(frame.to_hand(pads.design, xy, hist.zeta[i:i + m]))
-        i += m
-    return np.concatenate(xp), pose.to_hand(hist.Xo)
+    parts: np.ndarray = None   #: (fingers, 6) each solved finger's share of the wrench [N, N mm]
+    attempt: int = 0           #: the Newton tangent that converged (:func:`solve_contact`)
+    penalty: tuple = (0.0, 0.0)  #: the penalties (eps_N, eps_T) it converged with [N/mm]
 
 
 def evaluate(body, fingers: Fingers, qs, pose: Pose, hist: ContactHistory, eps_N: float,
@@ -134,7 +126,7 @@ def evaluate(body, fingers: Fingers, qs, pose: Pose, hist: ContactHistory, eps_N
         N = np.where(np.isfinite(pc.g), np.maximum(trial, 0.0), 0.0)
         if keep is not None:
             N = np.where(keep & np.isfinite(pc.g), trial, N)
-    xp, xo = anchors_now(fingers, qs, pose, hist)
+    xp, xo = pad_points(fingers.frames, fingers.padsets, qs, hist.X, hist.zeta), pose.to_hand(hist.Xo)
     s = (xp - hist.xp0) - (xo - hist.xo0)
     proj = lambda v: v - np.einsum("ki,ki->k", v, n)[:, None] * n  # noqa: E731
     s_T = proj(s)
@@ -156,10 +148,10 @@ def evaluate(body, fingers: Fingers, qs, pose: Pose, hist: ContactHistory, eps_N
         Q.append(np.einsum("maj,ma->j", J, f2))
         i += m
     mult = np.repeat(fingers.mult, [p.n_links for p in fingers.padsets])
-    force = -(mult[:, None] * F).sum(axis=0)
-    moment = -(mult[:, None] * np.cross(pc.x - pose.centre, F)).sum(axis=0)
+    per_pad = -mult[:, None] * np.hstack([F, np.cross(pc.x - pose.centre, F)])
+    parts = np.add.reduceat(per_pad, np.cumsum([0] + [p.n_links for p in fingers.padsets[:-1]]), axis=0)
     return ContactState(pc.g, N, T, n, pc.x, pc.X, pc.zeta, s_T, stick & (N > 0), Q,
-                        np.r_[force, moment])
+                        parts.sum(axis=0), parts=parts)
 
 
 @dataclass
@@ -173,6 +165,9 @@ class Problem:
     load: np.ndarray       #: (6,) external wrench on the object about its centre [N, N mm]
     hist: ContactHistory
     scale: float           #: force scale for the tolerance [N mm]
+    #: (6,) viscous support on the object's pose, c (p - pose0) [N/mm, N mm/rad]: a relaxation
+    #: step (:meth:`softhand.fem.hand.hold_model.HoldModel.step`); None: none
+    damping: np.ndarray | None = None
 
     def unpack(self, x):
         n = len(self.fingers.frames) * self.fingers.n_s
@@ -185,7 +180,10 @@ class Problem:
         cs = evaluate(self.body, self.fingers, qs, pose, self.hist, eps_N, eps_T, keep, stuck)
         f = self.fingers
         R = [Q0 + S @ (q - q0) - Qc for Q0, S, q, q0, Qc in zip(f.Q0, f.S, qs, f.q0, cs.Q)]
-        R.append((cs.wrench + self.load)[self.free])
+        F = cs.wrench + self.load
+        if self.damping is not None:
+            F = F - self.damping * (np.r_[pose.t, pose.r] - self.pose0)
+        R.append(F[self.free])
         return np.concatenate(R), cs
 
 
@@ -197,11 +195,44 @@ def _kept_open(problem: Problem, x, eps_N: float, eps_T: float, options: Contact
         return bool(np.any(np.isfinite(g) & (trial <= 0.0) & (trial > -eps_N * options.keep_gap)))
 
 
-def solve_contact(problem: Problem, x0, options: ContactOptions):
+def _jacobian(problem: Problem, x, steps, eps_N, eps_T, kept, stuck) -> np.ndarray:
+    """The residual's Jacobian by central differences, with the tangent's kept and stuck pads.
+    A finger's hinge angles move only its own pads: the j-th hinge of every finger is
+    perturbed at once (a colouring), its columns taken from each finger's own rows and its
+    share of the object's wrench -- 2 (n_s + free) evaluations instead of 2 (fingers n_s + free)."""
+    fingers = problem.fingers
+    n_f, n_s = len(fingers.frames), fingers.n_s
+    n_q = n_f * n_s
+    K = np.zeros((len(x), len(x)))
+    for j in range(n_s):
+        cols = np.arange(n_f) * n_s + j
+        e = np.zeros(len(x))
+        e[cols] = steps[cols]
+        Rp, cp = problem.residual(x + e, eps_N, eps_T, kept, stuck)
+        Rm, cm = problem.residual(x - e, eps_N, eps_T, kept, stuck)
+        for f, col in enumerate(cols):
+            rows = slice(f * n_s, (f + 1) * n_s)
+            K[rows, col] = (Rp[rows] - Rm[rows]) / (2 * steps[col])
+            K[n_q:, col] = (cp.parts[f] - cm.parts[f])[problem.free] / (2 * steps[col])
+    for col in range(n_q, len(x)):
+        e = np.zeros(len(x))
+        e[col] = steps[col]
+        K[:, col] = (problem.residual(x + e, eps_N, eps_T, kept, stuck)[0]
+                     - problem.residual(x - e, eps_N, eps_T, kept, stuck)[0]) / (2 * steps[col])
+    return K
+
+
+def solve_contact(problem: Problem, x0, options: ContactOptions, warm=None):
     """Newton + Uzawa on the condensed hold from x0; returns (x, ContactState, updates, iterations,
-    residual at x); raises NotConverged when no equilibrium is found."""
+    residual at x); raises NotConverged when no equilibrium is found. ``warm``: the ContactState
+    of a solve of the same step (the fingers' linearisation since renewed): Uzawa goes on from
+    its multipliers and penalties, Newton first tries the tangent that converged there."""
     eps_N, eps_T = options.penalty, options.tangent_penalty
     hist = replace(problem.hist)
+    first = 0
+    if warm is not None:
+        hist.lam_N, hist.lam_T = warm.N.copy(), warm.T.copy()
+        (eps_N, eps_T), first = warm.penalty, warm.attempt
     problem = replace(problem, hist=hist)
     x, its, last = np.array(x0, dtype=float), 0, np.inf
     n_q = len(problem.fingers.frames) * problem.fingers.n_s
@@ -221,12 +252,7 @@ def solve_contact(problem: Problem, x0, options: ContactOptions):
             # derivative (no stiffness along its slip), else a slipping mode, e.g. an off-axis
             # sphere turning in its pads, keeps the stick stiffness and Newton stalls
             stuck = kept if tangent == "stick" else kept & ~((cs.N > 0) & ~cs.stick)
-            K = np.empty((len(x), len(x)))
-            for j, h in enumerate(steps):
-                e = np.zeros(len(x))
-                e[j] = h
-                K[:, j] = (problem.residual(x + e, eps_N, eps_T, kept, stuck)[0]
-                           - problem.residual(x - e, eps_N, eps_T, kept, stuck)[0]) / (2 * h)
+            K = _jacobian(problem, x, steps, eps_N, eps_T, kept, stuck)
             K[n_q:, n_q:] += 1e-9 * problem.scale * np.eye(len(x) - n_q)  # a free rotation of a frictionless sphere
             return R, sp.csr_matrix(K)
 
@@ -237,22 +263,32 @@ def solve_contact(problem: Problem, x0, options: ContactOptions):
         # can turn the Newton direction into an ascent one, measured on a sphere off the axis)
         attempts = [(t, m, options.keep_gap) for t in ("stick", "slip") for m in ("finite", "residual")]
         attempts.append(("slip", "residual", 0.0))
-        for k, (tangent, merit, keep_gap) in enumerate(attempts):
+        # the one that converged last goes first (the slipping pads' tangent, once an off-axis
+        # object turns in its pads, converges in 2-5 iterations where the stick tangent fails in 40)
+        order = [first] + [k for k in range(len(attempts)) if k != first]
+        error = None
+        for k in order:
+            tangent, merit, keep_gap = attempts[k]
+            if keep_gap == 0.0 and error is not None and not _kept_open(problem, error.x, eps_N, eps_T, options):
+                continue
             try:
                 res = newton(lambda x: fun(x, tangent, keep_gap), x,
                              NewtonOptions(rtol=0.0, atol=tol, max_iter=options.max_iter, merit=merit,
                                            forcing=None, xtol=1e-14, max_backtracks=30),
                              solver=solver, residual=lambda x: problem.residual(x, eps_N, eps_T)[0])
+                first, error = k, None
                 break
             except NotConverged as err:
-                if k == len(attempts) - 1 or (k == len(attempts) - 2 and not _kept_open(problem, err.x, eps_N, eps_T, options)):
-                    raise
+                error = err
+        if error is not None:
+            raise error
         x, its = res.x, its + res.iterations
         cs = problem.residual(x, eps_N, eps_T)[1]
         touching = cs.N > 0
         penetration = float(np.max(-cs.g[touching], initial=0.0))
         slip = float(np.max(np.linalg.norm(cs.slip[cs.stick], axis=1), initial=0.0))
         if penetration <= options.gap_tol and slip <= options.slip_tol:
+            cs.attempt, cs.penalty = first, (eps_N, eps_T)
             return x, cs, update, its, problem.residual(x, eps_N, eps_T)[0]
         measure = max(penetration / options.gap_tol, slip / options.slip_tol)
         if measure > 0.25 * last:  # slow Uzawa (near-dependent contacts): stiffen

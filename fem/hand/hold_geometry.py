@@ -134,6 +134,18 @@ class PadContacts:
     zeta: np.ndarray   #: (m,) its distance from the bending plane [mm]
 
 
+def pad_points(frames, padsets, qs, X, zeta) -> np.ndarray:
+    """(m, 3) hand-frame positions of pad material points: finger-frame references X (m, 2) at
+    distances zeta (m,) from the bending planes, one per link of every finger in turn."""
+    xp, i = [], 0
+    for frame, pads, q in zip(frames, padsets, qs):
+        m = pads.n_links
+        xy = pads.chain.point_map(q, np.arange(m), X[i:i + m], order=0)[0]
+        xp.append(frame.to_hand(pads.design, xy, zeta[i:i + m]))
+        i += m
+    return np.concatenate(xp)
+
+
 def pad_corners(pads: PadSet, q):
     """Start A and end B (n_links, 2) of every pad line, finger frame, current, and their references."""
     links = np.arange(pads.n_links)

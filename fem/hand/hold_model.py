@@ -17,6 +17,16 @@ condensed stiffness (:mod:`softhand.fem.hand.hold_finger`). A load step:
    problem's to ``q_tol`` -- then the contact forces, the object's equilibrium and every
    finger's FEM equilibrium hold together (a Newton iteration on the fingers' responses:
    it converges quadratically).
+
+Letting go (stage "release") of an object placed without the hand's symmetry can need the
+object to slide far from where its support held it: closed on an object held off the palm
+axis, one finger pushes harder than its opposite, and the unbalanced push must be taken up
+by pads that slip. No equilibrium is then near the last state, and one load step's Newton
+does not find one (its corrections grow to millimetres along the slipping pads' zero
+stiffness). Such a step is followed as a path (:meth:`HoldModel._relax`): the object moves
+against a viscous support that fades from step to step, each step anchoring friction where
+the last ended, until the support carries less than ``relax_force`` of the load and the
+step without it converges -- or the object slides farther than the slide limit: it slipped out.
 """
 from __future__ import annotations
 
@@ -57,6 +67,7 @@ class StepRecord:
     fem_residual: float   #: max finger FEM residual norm [N mm]
     iterations: int       #: contact/FEM (stagger) iterations
     states: list = field(repr=False, default_factory=list)  #: the solved fingers' FEM states y
+    relaxed: int = 0      #: relaxation steps the object slid through to this state (0: none needed)
 
 
 class HoldModel:
@@ -89,6 +100,8 @@ class HoldModel:
         self.scale = scale
         self.cs = None
         self.weight = body.mass_kg * design.g
+        #: called after each step of a followed path (:meth:`_relax`) with (step, support force [N])
+        self.on_path_step = None
         self._check_open()
 
     @property
@@ -127,16 +140,64 @@ class HoldModel:
     def step(self, P: float, *, gravity: bool, pull: float, stage: str) -> StepRecord:
         """One load step to (P, gravity, pull); the state is kept only if it converges
         (NotConverged or :class:`NoEquilibrium` leave the last state)."""
-        saved = ([f.copy_state() for f in self.fingers], self.pose.copy(), self.P, self.cs)
+        saved = self._save()
         try:
             return self._step(P, gravity, pull, stage)
+        except (NotConverged, NoEquilibrium, np.linalg.LinAlgError) as err:
+            self._restore(saved)
+            if stage != "release" or self.symmetric or not self.options.relax_steps \
+                    or isinstance(err, NoEquilibrium):
+                raise
+        try:
+            return self._relax(P, gravity, pull, stage)
         except (NotConverged, NoEquilibrium, np.linalg.LinAlgError):
-            states, self.pose, self.P, self.cs = saved
-            for f, s in zip(self.fingers, states):
-                f.restore(s)
+            self._restore(saved)
             raise
 
-    def _step(self, P, gravity, pull, stage) -> StepRecord:
+    def _save(self):
+        return [f.copy_state() for f in self.fingers], self.pose.copy(), self.P, self.cs
+
+    def _restore(self, saved) -> None:
+        states, pose, self.P, self.cs = saved
+        self.pose = pose.copy()
+        for f, s in zip(self.fingers, states):
+            f.restore(s)
+
+    def _relax(self, P, gravity, pull, stage) -> StepRecord:
+        """The load step as a path where it finds no equilibrium near the last state: the object
+        moves against a viscous support c (p - p_last) that fades step by step, each step
+        anchoring friction where the last ended (the slide followed in increments), until the
+        support's force is below ``relax_force`` of the load and the step without it converges.
+        NoEquilibrium where the object slides farther than the slide limit: it slipped out.
+        While the support's force decays (to below half its last), c halves and the step
+        without it is tried; while it does not (the object sliding on), c quarters."""
+        r = self.body.radius
+        load = np.linalg.norm(self.weight * gravity * np.array([0.0, 1.0, 0.0]) + pull * self.pull_direction)
+        c = 2.0 * self.weight * np.r_[1.0, 1.0, 1.0, r * r, r * r, r * r]  # [N/mm, N mm/rad]
+        last = np.inf
+        for k in range(self.options.relax_steps):
+            p0 = self.pose.copy()
+            try:
+                self._step(P, gravity, pull, stage, damping=c)
+            except (NotConverged, np.linalg.LinAlgError):
+                c = 4.0 * c
+                continue
+            support = float(np.linalg.norm(c[:3] * (self.pose - p0)[:3]))
+            if self.on_path_step is not None:
+                self.on_path_step(k, support)
+            settling, last = support < 0.5 * last, support
+            if settling and support <= self.options.relax_force * load:
+                saved = self._save()
+                try:
+                    record = self._step(P, gravity, pull, stage)
+                    record.relaxed = k + 1
+                    return record
+                except (NotConverged, np.linalg.LinAlgError):
+                    self._restore(saved)
+            c = (0.5 if settling else 0.25) * c
+        raise NotConverged(f"no equilibrium after {self.options.relax_steps} relaxation steps", [], self.pose)
+
+    def _step(self, P, gravity, pull, stage, damping=None) -> StepRecord:
         o = self.options
         hist = self.history()
         steps = 1 if self.cs is not None or P == self.P else 2
@@ -149,9 +210,11 @@ class HoldModel:
         if len(free):
             self._settle(load, hist)
         x = np.concatenate([f.q for f in self.fingers] + [self.pose[free]])
+        cs = None
         for it in range(1, o.max_stagger + 1):
-            problem = Problem(self.body, self._fingers_view(), self.pose.copy(), free, load, hist, self.scale)
-            x, cs, updates, its, R = solve_contact(problem, x, o.contact)
+            problem = Problem(self.body, self._fingers_view(), self.pose.copy(), free, load, hist, self.scale,
+                              damping)
+            x, cs, updates, its, R = solve_contact(problem, x, o.contact, warm=cs if it > 1 else None)
             qs, pose = problem.unpack(x)
             if self._slid(pose):
                 raise NoEquilibrium(f"the object slid more than {self._slide_limit():.3g} mm: slipped out")

@@ -36,10 +36,10 @@ class HoldOptions:
     q_tol: float = 1e-8              #: FEM vs contact hinge angles at convergence [rad]
     max_stagger: int = 30            #: contact/FEM iterations per load step
     symmetry: bool = True            #: solve one finger per symmetry orbit where the case allows
-    #: solve a placement without the hand's symmetry (all six pose components free). Not yet
-    #: validated: a 180 mm sphere 1.5 mm off the palm axis came out not held where the centred
-    #: one holds, so :func:`softhand.fem.hand.hold.solve_hold` refuses such a placement unless this is set
-    asymmetric: bool = False
+    #: relaxation steps when a load step finds no equilibrium near the last one: the object moves
+    #: against a viscous support that fades (:meth:`softhand.fem.hand.hold_model.HoldModel.step`); 0: none
+    relax_steps: int = 24
+    relax_force: float = 0.05        #: the step without the viscous support is tried below this share of the load
     min_weight_step: float = 1 / 16  #: not held when letting go of this share of the weight fails
     pull_floor: float = 0.1          #: the holding limit's resolution is at least this [N]
 
@@ -90,15 +90,8 @@ def check_hold(design: HandDesign, obj, pull_direction=(0.0, 1.0, 0.0), options:
 
 
 def check_placement(body, layout, pull_direction, options: HoldOptions, obj) -> None:
-    """InputError unless the placed object and the pull are symmetric to the hand's fingers
-    (or ``options.asymmetric``): the FEM hold is validated there only. Cheap: no FEM model."""
+    """InputError for a pull direction of zero length. Cheap: no FEM model. (Any placement and
+    pull are solved: with the hand's symmetry one finger per orbit, else every finger.)"""
     e = np.asarray(pull_direction, dtype=float)
     if e.shape != (3,) or not np.linalg.norm(e) > 0:
         raise InputError("pull_direction", pull_direction, "must be a nonzero 3-vector")
-    symmetric = len(symmetry_orbits(body, layout, e / np.linalg.norm(e))) < len(layout)
-    if not symmetric and not options.asymmetric:
-        raise InputError("object", f"{obj.shape} at offset_mm {list(obj.offset_mm)}, rotation_deg "
-                         f"{list(obj.rotation_deg)}, pull {[float(v) for v in pull_direction]}",
-                         "the whole-hand FEM hold is validated where the object and the pull are "
-                         "symmetric to the hand's fingers (centred on the palm axis, pulled along it); "
-                         "for this placement use --model reduced")

@@ -37,7 +37,8 @@ def _step_row(record) -> LoadStep:
                     {"gravity": record.gravity, "object_residual": record.residual_N,
                      "friction_cone": record.cone, "penetration_mm": record.penetration_mm,
                      "stick_slip_mm": record.stick_slip_mm, "q_mismatch_rad": record.q_mismatch,
-                     "finger_residual_Nmm": record.fem_residual, "iterations": record.iterations})
+                     "finger_residual_Nmm": record.fem_residual, "iterations": record.iterations,
+                     "path_steps": record.relaxed})
 
 
 def to_result(path, *, obj=None) -> HoldResult:

@@ -119,8 +119,7 @@ def prove_hold(ev: Evaluation, task: Task, say=print) -> dict:
     (``softhand.fem.hand.hold.solve_hold``) at the cavity pressure of the fast model's least pump
     pressure; proven when the FEM holds the object and its holding limit is the fast model's
     within :data:`PROOF_RTOL`. ``{"report": why}`` when it is not, or when the FEM hold does not
-    answer (a placement off the hand's symmetry, where it is not validated; a closing that does
-    not converge)."""
+    answer (a closing that does not converge)."""
     d = ev.design
     placed = place_object(task.obj, d)
     P_cavity = hold.cavity_pressure(ev.P_grasp, placed, d)

@@ -109,6 +109,35 @@ def test_two_pads_pinching_a_box_hold_two_mu_N(finger, tmp_path):
 
 
 @pytest.mark.slow
+def test_an_off_axis_box_pinched_by_two_pads_centres_itself_and_holds_two_mu_N(finger):
+    """The pinch above with the box 2 mm nearer finger 0: no symmetry, both fingers and all six
+    pose components solved. Closed with the box held, finger 0 pushes harder; let go, the box
+    moves away from it until the pads' normal forces (along x) are equal -- to the friction's x
+    part, the box tilting by about 1e-4 rad --, and the limit is again 2 mu N."""
+    mu = 0.5
+    box = Body("box", (2.0, 130.0, 0.0), (150.0, 140.0, 40.0), mass_kg=0.005, friction=mu)
+    model = HoldModel(DESIGN, box, layout=[FingerFrame(0.0), FingerFrame(math.pi)], finger_model=finger,
+                      options=HoldOptions(close_steps=3, pull_step=0.02, pull_floor=0.002))
+    assert not model.symmetric and model.n_solved == 2 and len(model.free) == 6
+    path = run_hold(model, 1.2)
+    assert path.held and path.limit_reached
+    for record in path.steps:
+        _check_tolerances(model, record)
+    closed = [s for s in path.steps if s.stage == "close"][-1]
+    N_closed = [sum(c["normal_N"] for c in closed.contacts if c["finger"] == f) for f in (0, 1)]
+    assert N_closed[0] > 1.05 * N_closed[1]
+    release = [s for s in path.steps if s.stage == "release"][-1]
+    assert release.pose[0] < -0.1                               # away from finger 0
+    last = path.steps[-1]
+    N = [sum(c["normal_N"] for c in last.contacts if c["finger"] == f) for f in (0, 1)]
+    assert np.linalg.norm(last.pose[3:]) < 1e-3
+    assert N[0] == pytest.approx(N[1], rel=1e-3)                 # measured 3e-4
+    load = model.weight + path.holding_limit_N
+    assert load <= mu * sum(N) * (1 + 1e-9)
+    assert load >= mu * sum(N) - max(0.02 * path.holding_limit_N, 0.002) - 1e-9
+
+
+@pytest.mark.slow
 def test_frictionless_sphere_caged_below_its_equator_drops_when_the_fingers_open(finger):
     """mu = 0: only the normals' upward parts can carry the weight, so the sphere is held only
     while pads touch it below its centre; opening the fingers (lower pressure) drops it."""
@@ -225,3 +254,47 @@ def test_symmetry_orbits_follow_the_object():
     assert symmetry_orbits(lying, frames, down) == [(0, [0, 2]), (1, [1, 3])]
     assert len(symmetry_orbits(Body("sphere", (2, 150, 0), (180,)), frames, down)) == 4   # off-axis
     assert len(symmetry_orbits(Body("sphere", (0, 150, 0), (180,)), frames, (1, 0, 0))) == 4  # pulled sideways
+
+
+def test_the_contact_jacobian_by_colouring_is_the_column_by_column_one():
+    """Four fingers around an off-axis sphere, every pad pressed (normal multipliers) and rubbing
+    (tangential multipliers, anchors moved): the Jacobian that perturbs the j-th hinge of every
+    finger at once equals central differences one column at a time, to round-off."""
+    from softhand.fem.constraints import PlanarChain
+    from softhand.fem.hand.hold_contact import ContactHistory, Fingers, Problem, _jacobian
+    from softhand.fem.hand.hold_geometry import PadSet, default_layout
+
+    d, rng = DESIGN, np.random.default_rng(7)
+    chain = PlanarChain(np.c_[d.hinge_s, np.full(d.n_s, d.d)])
+    pads = PadSet(chain, (0.0, *d.hinge_s, d.l0), d.d, 18.0, d)
+    frames = list(default_layout(4))
+    qs = [np.full(d.n_s, -0.25) + 0.02 * rng.standard_normal(d.n_s) for _ in frames]
+    body = Body("sphere", (3.0, 120.0, -2.0), (180.0,), friction=0.5)
+    pose = Pose(body.centre)
+    pc = pad_contacts(body, pose, frames, [pads] * 4, qs)
+    assert np.all(np.isfinite(pc.g))
+    m = len(pc.g)
+    xo = pc.x - pc.g[:, None] * pc.normal
+    lam_T = rng.standard_normal((m, 3))
+    lam_T -= np.einsum("ki,ki->k", lam_T, pc.normal)[:, None] * pc.normal
+    lam_T *= (100.0 * rng.uniform(0.3, 1.7, m) / np.linalg.norm(lam_T, axis=1))[:, None]  # mu N ~ 100 N
+    hist = ContactHistory(np.full(m, 200.0), lam_T, pc.X, pc.zeta, pose.to_body(xo), pc.x, xo)
+    S = [(lambda A: A @ A.T)(rng.standard_normal((d.n_s, d.n_s))) for _ in frames]
+    fingers = Fingers(frames, [pads] * 4, np.ones(4), qs, [np.zeros(d.n_s)] * 4, S)
+    problem = Problem(body, fingers, np.zeros(6), np.arange(6), np.r_[0.0, 19.6, 0.0, 0.0, 0.0, 0.0],
+                      hist, 1.0, damping=np.full(6, 3.0))
+    x = np.concatenate(qs + [np.r_[0.2, -0.3, 0.1, 1e-3, -2e-3, 1e-3]]) + 1e-3 * rng.standard_normal(26)
+    steps = np.r_[np.full(20, 1e-7), np.full(3, 1e-5), np.full(3, 1e-7)]
+    cs = problem.residual(x, 1.0, 1.0)[1]
+    assert np.any(cs.stick) and np.any((cs.N > 0) & ~cs.stick)     # both branches of the return map
+    keep = np.ones(m, dtype=bool)
+    for stuck in (keep, cs.stick):
+        K = _jacobian(problem, x, steps, 1.0, 1.0, keep, stuck)
+        ref = np.empty_like(K)
+        for j, h in enumerate(steps):
+            e = np.zeros(len(x))
+            e[j] = h
+            ref[:, j] = (problem.residual(x + e, 1.0, 1.0, keep, stuck)[0]
+                         - problem.residual(x - e, 1.0, 1.0, keep, stuck)[0]) / (2 * h)
+        assert np.max(np.abs(K - ref)) <= 1e-9 * np.max(np.abs(ref))  # central differences round-off at h = 1e-7
+        assert np.max(np.abs(K[:20, :20] - np.kron(np.eye(4), np.ones((5, 5))) * K[:20, :20])) == 0.0

@@ -126,9 +126,13 @@ def _fem_hold(args, design, obj, P_cav, P_pump, pull):
     def tick(record):
         bar.update(1)
         bar.set_postfix_str(f"{record.stage} P={record.P:.3g} MPa pull={record.pull_N:.3g} N")
+
+    def path_tick(k, support_N):  # letting go off the hand's symmetry, followed as a path
+        bar.set_postfix_str(f"letting go: path step {k + 1}, support {support_N:.3g} N")
     try:
         result, path = solve_hold(design, obj, P_cavity_MPa=P_cav, pull_direction=tuple(pull), progress=tick,
-                                  keep_path=True, P_pump_MPa=math.nan if P_pump is None else P_pump)
+                                  path_progress=path_tick, keep_path=True,
+                                  P_pump_MPa=math.nan if P_pump is None else P_pump)
     except NotConverged as exc:
         print(f"softhand hold: error: the FEM did not converge while the fingers closed: "
               f"{str(exc).split(';')[0]}", file=sys.stderr)
