@@ -100,7 +100,7 @@ def solve_hold(design: HandDesign, obj, *, P_cavity_MPa: float, pull_direction=(
     """The FEM hold of ``obj`` (a :class:`softhand.reduced.holding.objects.GraspObject`, placed by its table) at
     cavity pressure P_cavity_MPa: the common :class:`softhand.reduced.holding.hold_result.HoldResult` (P_pump_MPa
     only reported); ``progress(record)`` after every converged load step, ``path_progress(k, support_N)``
-    after every step of a followed path (:meth:`HoldModel._relax`); with ``keep_path``
+    after every step of a followed path (``HoldModel._relax``); with ``keep_path``
     also the :class:`HoldPath` (for :func:`softhand.fem.hand.hold_output.write_hold`)."""
     from softhand.fem.hand.hold_output import to_result
 

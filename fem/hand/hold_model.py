@@ -23,7 +23,7 @@ object to slide far from where its support held it: closed on an object held off
 axis, one finger pushes harder than its opposite, and the unbalanced push must be taken up
 by pads that slip. No equilibrium is then near the last state, and one load step's Newton
 does not find one (its corrections grow to millimetres along the slipping pads' zero
-stiffness). Such a step is followed as a path (:meth:`HoldModel._relax`): the object moves
+stiffness). Such a step is followed as a path (``HoldModel._relax``): the object moves
 against a viscous support that fades from step to step, each step anchoring friction where
 the last ended, until the support carries less than ``relax_force`` of the load and the
 step without it converges -- or the object slides farther than the slide limit: it slipped out.
@@ -100,7 +100,7 @@ class HoldModel:
         self.scale = scale
         self.cs = None
         self.weight = body.mass_kg * design.g
-        #: called after each step of a followed path (:meth:`_relax`) with (step, support force [N])
+        #: called after each step of a followed path (``HoldModel._relax``) with (step, support force [N])
         self.on_path_step = None
         self._check_open()
 
