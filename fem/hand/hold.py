@@ -104,7 +104,7 @@ def solve_hold(design: HandDesign, obj, *, P_cavity_MPa: float, pull_direction=(
     also the :class:`HoldPath` (for :func:`softhand.fem.hand.hold_output.write_hold`)."""
     from softhand.fem.hand.hold_output import to_result
 
-    body, layout = check_hold(design, obj, pull_direction, options)
+    body, layout = check_hold(design, obj, pull_direction)
     model = HoldModel(design, body, options=options, layout=layout, pull_direction=pull_direction)
     model.on_path_step = path_progress
     path = run_hold(model, float(P_cavity_MPa), progress=progress)

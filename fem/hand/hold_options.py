@@ -76,22 +76,17 @@ def symmetry_orbits(body, frames, pull_direction, tol: float = 1e-9):
     return orbits
 
 
-def check_hold(design: HandDesign, obj, pull_direction=(0.0, 1.0, 0.0), options: HoldOptions = HoldOptions()):
-    """(placed body, finger frames) of ``obj`` on the design's hand, after
-    :func:`check_placement`: what :func:`softhand.fem.hand.hold.solve_hold` refuses, found before any FEM model."""
+def check_hold(design: HandDesign, obj, pull_direction=(0.0, 1.0, 0.0)):
+    """(placed body, finger frames) of ``obj`` on the design's hand: what
+    :func:`softhand.fem.hand.hold.solve_hold` refuses (an object the open fingers overlap is
+    refused by the model), found before any FEM model. Any placement and pull are solved: with
+    the hand's symmetry one finger per orbit, else every finger."""
     from softhand.fem.hand.hold_body import body_of
     from softhand.fem.hand.hold_geometry import FingerFrame
     from softhand.reduced.holding.hand_layout import azimuths
 
-    body = body_of(obj, design)
-    layout = tuple(FingerFrame(float(a)) for a in azimuths(design))
-    check_placement(body, layout, pull_direction, options, obj)
-    return body, layout
-
-
-def check_placement(body, layout, pull_direction, options: HoldOptions, obj) -> None:
-    """InputError for a pull direction of zero length. Cheap: no FEM model. (Any placement and
-    pull are solved: with the hand's symmetry one finger per orbit, else every finger.)"""
     e = np.asarray(pull_direction, dtype=float)
     if e.shape != (3,) or not np.linalg.norm(e) > 0:
         raise InputError("pull_direction", pull_direction, "must be a nonzero 3-vector")
+    body = body_of(obj, design)
+    return body, tuple(FingerFrame(float(a)) for a in azimuths(design))
