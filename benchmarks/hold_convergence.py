@@ -24,7 +24,7 @@ from softhand.fem.hand.hold import run_hold, solve_hold
 from softhand.fem.hand.hold_model import HoldModel
 from softhand.fem.hand.hold_options import HoldOptions
 from softhand.fem.hand.hold_body import Body
-from softhand.fem.hand.hold_contact import ContactOptions
+from softhand.fem.hand.hold_options import ContactOptions
 from softhand.fem.hand.hold_geometry import FingerFrame
 from softhand.reduced.vocabulary.design import HandDesign
 from softhand.reduced.holding.objects import parse_object

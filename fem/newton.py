@@ -65,6 +65,10 @@ class NewtonOptions:
     #: (PETSc's SNES divergence tolerance, taken relative to the best iterate). Not the start's
     #: ||R||: a small load step starts tiny, and its first step may raise ||R|| 1e5-fold and converge
     diverge: float | None = None
+    #: give up once ||R|| has not fallen below 0.9 times its smallest value for this many
+    #: iterations (None: only after max_iter): a solve cycling between contact states, or
+    #: stuck on a plateau, costs a few iterations, not max_iter
+    stall: int | None = None
 
     def __post_init__(self):
         if self.merit not in MERITS:
@@ -75,6 +79,8 @@ class NewtonOptions:
             raise ValueError(f"contraction {self.contraction!r} not in (0, 1)")
         if self.diverge is not None and not self.diverge > 1:
             raise ValueError(f"diverge {self.diverge!r} must be None or > 1")
+        if self.stall is not None and not self.stall >= 1:
+            raise ValueError(f"stall {self.stall!r} must be None or >= 1")
 
 
 class NotConverged(RuntimeError):
@@ -150,6 +156,9 @@ def newton(fun, x0, options: NewtonOptions = NewtonOptions(), *, solver=None, sc
             raise NotConverged("residual is not finite", history, x)
         if options.diverge is not None and len(history) > 2 and norm > options.diverge * min(history[1:]):
             raise NotConverged(f"diverging (||R|| above {options.diverge:g} times its smallest)", history, x)
+        if options.stall is not None and stalled(history, options.stall):
+            raise NotConverged(f"stalled (||R|| not below 0.9 times its smallest in {options.stall} "
+                               "iterations)", history, x)
         if done(x, R, len(history) - 1):
             return NewtonResult(x, it, history, steps, t_asm, t_solve, factorizations)
         if it == options.max_iter:
@@ -218,3 +227,8 @@ def forcing_term(history, tol: float, largest: float, etas) -> float:
             eta = max(eta, 0.9 * etas[-1] ** 2)
     floor = 0.5 * tol / norm if norm > 0 else largest
     return float(min(largest, max(eta, floor)))
+
+
+def stalled(history, k: int, factor: float = 0.9) -> bool:
+    """Whether the last k residual norms all stayed above ``factor`` times the smallest before them."""
+    return len(history) > k and min(history[-k:]) >= factor * min(history[:-k])

@@ -57,7 +57,7 @@ class GraspOptions:
     #: a load step whose residual grows 100-fold is cut back at once, not after max_iter
     #: factorisations: at 1.2 MPa, 120-180 mm, the first step's two failed tries took 33-41
     #: of a solve's 88-104 factorisations (``softhand weights --diameter-mm D --pressure-mpa 1.2``)
-    newton: NewtonOptions = field(default_factory=lambda: NewtonOptions(rtol=1e-9, diverge=100.0))
+    newton: NewtonOptions = field(default_factory=lambda: NewtonOptions(rtol=1e-9, diverge=100.0, stall=8))
 
     def __post_init__(self):
         for name in ("penalty", "gap_tol", "share_tol"):

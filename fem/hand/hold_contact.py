@@ -38,27 +38,9 @@ import numpy as np
 import scipy.sparse as sp
 
 from softhand.fem.hand.hold_geometry import Pose, pad_contacts, pad_points
+from softhand.fem.hand.hold_options import ContactOptions
 from softhand.fem.linsolve import make_solver
 from softhand.fem.newton import NewtonOptions, NotConverged, newton
-
-
-@dataclass(frozen=True)
-class ContactOptions:
-    """Contact treatment and tolerances of the hold."""
-
-    #: normal penalty epsilon_N to start with [N/mm]: ~50 times a finger tip's stiffness on the
-    #: CI mesh (0.2 N/mm), so an Uzawa update cuts the gap ~50-fold while a soft contact (the
-    #: weight's share on a nearly vertical pad) keeps a gap window Newton's full steps do not jump
-    penalty: float = 10.0
-    tangent_penalty: float = 10.0  #: tangential penalty epsilon_T [N/mm]
-    max_penalty: float = 1e6      #: the penalties grow x10 while Uzawa stagnates, up to this [N/mm]
-    gap_tol: float = 1e-6         #: largest penetration of a touching pad at convergence [mm]
-    slip_tol: float = 1e-6        #: largest slip of a sticking pad within a step [mm]
-    max_updates: int = 40         #: Uzawa updates per solve
-    #: object and hinge equilibrium, relative to the force scale mu a^2 l0 of the finger [-]
-    rtol: float = 1e-10
-    max_iter: int = 40            #: Newton iterations per Uzawa update
-    keep_gap: float = 0.01        #: the Newton tangent keeps pads this near touching in contact [mm]
 
 
 @dataclass
@@ -239,6 +221,7 @@ def solve_contact(problem: Problem, x0, options: ContactOptions, warm=None):
     steps = np.r_[np.full(n_q, 1e-7), np.where(problem.free < 3, 1e-5, 1e-7)]
     solver = make_solver("superlu")
     tol = options.rtol * problem.scale
+    stall = options.stall if problem.damping is None else None
 
     for update in range(options.max_updates + 1):
         def fun(x, tangent, keep_gap=options.keep_gap):
@@ -274,7 +257,7 @@ def solve_contact(problem: Problem, x0, options: ContactOptions, warm=None):
             try:
                 res = newton(lambda x: fun(x, tangent, keep_gap), x,
                              NewtonOptions(rtol=0.0, atol=tol, max_iter=options.max_iter, merit=merit,
-                                           forcing=None, xtol=1e-14, max_backtracks=30),
+                                           forcing=None, xtol=1e-14, max_backtracks=30, stall=stall),
                              solver=solver, residual=lambda x: problem.residual(x, eps_N, eps_T)[0])
                 first, error = k, None
                 break

@@ -14,10 +14,33 @@ import numpy as np
 
 from softhand.fem.hand.finger_options import FingerOptions
 from softhand.fem.hand.grasp import GraspOptions
-from softhand.fem.hand.hold_contact import ContactOptions
 from softhand.fem.hand.hold_geometry import rot_y
 from softhand.reduced.vocabulary.design import HandDesign
 from softhand.reduced.vocabulary.errors import InputError
+
+
+@dataclass(frozen=True)
+class ContactOptions:
+    """Contact treatment and tolerances of the hold."""
+
+    #: normal penalty epsilon_N to start with [N/mm]: ~50 times a finger tip's stiffness on the
+    #: CI mesh (0.2 N/mm), so an Uzawa update cuts the gap ~50-fold while a soft contact (the
+    #: weight's share on a nearly vertical pad) keeps a gap window Newton's full steps do not jump
+    penalty: float = 10.0
+    tangent_penalty: float = 10.0  #: tangential penalty epsilon_T [N/mm]
+    max_penalty: float = 1e6      #: the penalties grow x10 while Uzawa stagnates, up to this [N/mm]
+    gap_tol: float = 1e-6         #: largest penetration of a touching pad at convergence [mm]
+    slip_tol: float = 1e-6        #: largest slip of a sticking pad within a step [mm]
+    max_updates: int = 40         #: Uzawa updates per solve
+    #: object and hinge equilibrium, relative to the force scale mu a^2 l0 of the finger [-]
+    rtol: float = 1e-10
+    max_iter: int = 40            #: Newton iterations per Uzawa update
+    #: give a Newton attempt up after this many iterations without a 10 % fall of its smallest
+    #: residual (not on a path step's supported solve, which can creep and then converge). The
+    #: converged solves without support stalled at most 1 iteration (sphere on and off the
+    #: axis, CI mesh); a failed one ran all 40 (75 % of a hold's time, in the pulls past its limit)
+    stall: int | None = 8
+    keep_gap: float = 0.01        #: the Newton tangent keeps pads this near touching in contact [mm]
 
 
 @dataclass(frozen=True)

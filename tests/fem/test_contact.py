@@ -157,7 +157,8 @@ def test_an_off_axis_release_converges_on_the_slipping_pads_own_tangent():
     return map's derivative) converges; the answer is checked as an equilibrium, not a number."""
     from softhand.fem.constraints import PlanarChain
     from softhand.fem.hand.hold_body import Body
-    from softhand.fem.hand.hold_contact import ContactHistory, ContactOptions, Fingers, Problem, solve_contact
+    from softhand.fem.hand.hold_contact import ContactHistory, Fingers, Problem, solve_contact
+    from softhand.fem.hand.hold_options import ContactOptions
     from softhand.fem.hand.hold_geometry import FingerFrame, PadSet
     from softhand.reduced.vocabulary.design import HandDesign
 

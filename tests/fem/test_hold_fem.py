@@ -14,7 +14,7 @@ from softhand.fem.hand.hold import run_hold
 from softhand.fem.hand.hold_model import HoldModel, NoEquilibrium
 from softhand.fem.hand.hold_options import HoldOptions
 from softhand.fem.hand.hold_body import Body
-from softhand.fem.hand.hold_contact import ContactOptions
+from softhand.fem.hand.hold_options import ContactOptions
 from softhand.fem.hand.hold_geometry import FingerFrame, Pose, pad_contacts
 from softhand.fem.hand.hold_output import to_result, write_hold
 from softhand.fem.newton import NotConverged

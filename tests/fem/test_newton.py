@@ -1,5 +1,6 @@
 """Newton: quadratic convergence on a hyperelastic problem, line search where plain Newton
-diverges, cut-back and the last converged state on failure; the linear solvers."""
+diverges, a diverging or stalled solve given up, cut-back and the last converged state on
+failure; the linear solvers."""
 import numpy as np
 import pytest
 import scipy.sparse as sp
@@ -71,6 +72,26 @@ def test_a_diverging_solve_is_given_up_when_its_residual_grows_past_diverge():
     assert abs(r.x[0]) < 1e-20
     with pytest.raises(ValueError, match="diverge"):
         NewtonOptions(diverge=1.0)
+
+
+CYCLE = scalar_system(lambda x: x ** 3 - 2 * x + 2, lambda x: 3 * x ** 2 - 2)
+
+
+def test_a_cycling_solve_is_given_up_after_stall_iterations_without_progress():
+    # x^3 - 2x + 2 = 0 from x0 = 0: full Newton steps cycle 0, 1, 0, 1, ... (||R|| 2, 1, 2, 1, ...)
+    opts = NewtonOptions(line_search=False, max_iter=30)
+    with pytest.raises(NotConverged) as plain:
+        newton(CYCLE, [0.0], opts)
+    assert plain.value.history[:5] == [2.0, 1.0, 2.0, 1.0, 2.0] and len(plain.value.history) == 31
+    for k in (1, 3, 6):
+        with pytest.raises(NotConverged, match="stalled") as err:
+            newton(CYCLE, [0.0], NewtonOptions(line_search=False, max_iter=30, stall=k))
+        # the best ||R|| (1, after the first step) is not beaten by 10 % in the k iterations after it
+        assert len(err.value.history) == k + 2
+    r = newton(ATAN, [2.0], NewtonOptions(stall=1))  # a converging solve is not stopped
+    assert abs(r.x[0]) < 2e-8
+    with pytest.raises(ValueError, match="stall"):
+        NewtonOptions(stall=0)
 
 
 def test_cut_back_and_last_converged_state():
