@@ -395,7 +395,8 @@ def replay_cases() -> list[tuple[str, list[str]]]:
         ["--only", ""], ["--only", "x" * 5000], ["--out", "/proc/r"], ["--out", "a_file/r"],
         ["--design", "missing.toml"], ["--design", "/dev/zero"], ["--design", "d_sheet_thick.toml"],
         ["--design", "rep_small_reservoir.toml", "--only", "fig7_reduced"],
-        ["--design", "rep_three_hinges.toml", "--only", "table2_reduced"], ["--only", "verify", "--quick"])]
+        ["--design", "rep_three_hinges.toml", "--only", "table2_reduced"], ["--only", "verify", "--quick"],
+        ["--workers", "0"], ["--workers", "100000"], ["--workers", "two"])]
     cases += [("study", ["study", *s]) for s in (
         ["run", "good_study.toml", "--max-cases", "-1"], ["run", "good_study.toml", "--max-cases", "x"],
         ["run", "good_study.toml", "--max-cases", "1"], ["status", "good_study.toml", "--max-cases", "1"],

@@ -21,35 +21,22 @@ import hashlib
 import importlib
 import json
 import math
-import re
 import sys
-from dataclasses import dataclass
-from datetime import datetime, timezone
 from pathlib import Path
 
 from softhand.reduced.equations import finger
 from softhand.reduced.vocabulary import paper
 from softhand.reduced.vocabulary.design import HandDesign
 from softhand.reduced.vocabulary.errors import InputError
-from softhand.studies.io.files import write_atomic, write_csv
 from softhand.studies.io.outputs import MANIFEST, check_owned, record_outputs
-from softhand.studies.reproduce.section import Context, Section
+from softhand.studies.reproduce.report import REPORT_FILES, SECTION_MD, write_report
+from softhand.studies.reproduce.section import Context, Outcome, Section
 from softhand.studies.batch.runner import FAILED, RESULT, code_version, commit, execute_case, outcome_record
 
-SECTION_MD = "section.md"
 #: the largest bend the report's sections ask of the hand (Figs. 7 and 8: 0-90 deg)
 THETA_MAX_DEG = 90.0
 _ACTIVE: dict = {}  #: the sections of the current reproduce() call, by key
 _SHOW: dict = {"progress": True}  #: whether the current reproduce() call shows progress
-
-
-@dataclass
-class Outcome:
-    section: Section
-    status: str  #: 'done', 'reused', 'failed', 'not available', 'not selected', 'skipped'
-    detail: str = ""  #: error or missing module
-    wall_time_s: float = 0.0
-    numbers: dict | None = None
 
 
 def sections() -> list[Section]:
@@ -101,20 +88,18 @@ def check_design(design: HandDesign) -> None:
                                             f"use the paper's weight vectors w, one weight per hinge")
 
 
-#: the files a run writes beside the section folders
-REPORT_FILES = ("report.md", "summary.csv")
-
-
 def reproduce(out: str | Path = "results/reproduce", *, quick: bool = False,
               design: HandDesign | None = None, only: tuple[str, ...] | None = None,
               fresh: bool = False, progress: bool = True,
-              section_list: list[Section] | None = None) -> list[Outcome]:
+              section_list: list[Section] | None = None, workers: int = 1) -> list[Outcome]:
     """Build every section (or those in ``only``) and write ``<out>/report.md``.
 
     Each section's folder is renamed into ``out`` whole as it finishes and recorded in the
     folder's manifest (:func:`softhand.studies.io.outputs.record_outputs`): a rerun resumes
     from it, and a file or folder of the user's named like an output is refused before any
-    work (InputError), never replaced."""
+    work (InputError), never replaced. ``workers`` > 1: the sections to build run side by
+    side in that many processes (the batch runner's pool, each with its share of the cores'
+    threads), the costliest first; their own progress bars are then not drawn."""
     out = Path(out)
     ctx = Context(design=design or HandDesign(), quick=quick, progress=progress)
     _SHOW["progress"] = progress
@@ -123,20 +108,54 @@ def reproduce(out: str | Path = "results/reproduce", *, quick: bool = False,
     check_owned(out, [*REPORT_FILES, *(s.key for s in todo)], "--out")
     _ACTIVE.clear()
     _ACTIVE.update((s.key, s) for s in todo)
-    outcomes = []
+    outcomes: dict[str, Outcome] = {}
     from tqdm import tqdm
 
-    bar = tqdm(todo, desc="reproduce", unit="section", file=sys.stderr, disable=not progress)
+    bar = tqdm(total=len(todo), desc="reproduce", unit="section", file=sys.stderr, disable=not progress)
     try:
-        for section in bar:
+        pending = []
+        for section in todo:
+            known = _known(section, ctx, out, only, fresh)
+            if known is None:
+                pending.append(section)
+            else:
+                outcomes[section.key] = known
+                bar.update()
+        if workers > 1 and len(pending) > 1:
+            _build_side_by_side(pending, ctx, out, workers, outcomes, bar)
+        for section in pending:  # one by one, in this process (each FEM path with its own bar)
             bar.set_postfix_str(section.key)
-            outcomes.append(_one(section, ctx, out, only, fresh))
+            outcomes[section.key] = _build(section, ctx, out)
+            bar.update()
     finally:
         bar.close()
-        write_report(out, ctx, outcomes + [_not_built(s, ctx, only) or _finished(s, ctx, out, fresh)
-                                           or Outcome(s, "not run", "interrupted")
-                                           for s in todo[len(outcomes):]])
-    return outcomes
+        write_report(out, ctx, [outcomes.get(s.key) or _not_built(s, ctx, only) or _finished(s, ctx, out, fresh)
+                                or Outcome(s, "not run", "interrupted") for s in todo])
+    return [outcomes[s.key] for s in todo]
+
+
+def _build_side_by_side(pending: list[Section], ctx: Context, out: Path, workers: int,
+                        outcomes: dict, bar) -> None:
+    """Build ``pending`` in a pool of ``workers`` processes, the costliest first; each section
+    is committed as it finishes (an interrupted run keeps those)."""
+    from types import SimpleNamespace
+
+    from softhand.studies.batch.cases import Case
+    from softhand.studies.batch.pool import pool_outcomes
+
+    cases = [Case(s.key, {}, {"section": s.key, "quick": ctx.quick}, ctx.design)
+             for s in sorted(pending, key=lambda s: -s.cost)]
+    show, _SHOW["progress"] = _SHOW["progress"], False  # the workers, forked now, draw no bars
+    bar.set_postfix_str(f"{len(pending)} sections in {min(workers, len(pending))} processes")
+    try:
+        for case, output in pool_outcomes(SimpleNamespace(kind=run_section), iter(cases), workers):
+            outcomes[case.key] = _commit(_ACTIVE[case.key], ctx, out, output)
+            bar.update()
+    finally:
+        _SHOW["progress"] = show
+    for section in pending:  # its worker died, and again in the pools that took it over
+        outcomes.setdefault(section.key, Outcome(section, "failed", "its worker process died"))
+    pending.clear()
 
 
 def _adopt_earlier(out: Path, todo: list[Section]) -> None:
@@ -170,7 +189,9 @@ def _not_built(section: Section, ctx: Context, only) -> Outcome | None:
     return None
 
 
-def _one(section: Section, ctx: Context, out: Path, only, fresh: bool) -> Outcome:
+def _known(section: Section, ctx: Context, out: Path, only, fresh: bool) -> Outcome | None:
+    """The section's outcome when this run does not build it (left out, not available, or
+    finished by an earlier run), else None."""
     chosen = _not_built(section, ctx, only)
     if chosen is not None:
         return chosen
@@ -180,14 +201,20 @@ def _one(section: Section, ctx: Context, out: Path, only, fresh: bool) -> Outcom
         return Outcome(section, "failed", f"{type(exc).__name__}: {exc}")
     if lack:
         return Outcome(section, "not available", lack)
-    reused = _finished(section, ctx, out, fresh)
-    if reused is not None:
-        return reused
-    folder, key = out / section.key, section_key(section, ctx)
+    return _finished(section, ctx, out, fresh)
+
+
+def _build(section: Section, ctx: Context, out: Path) -> Outcome:
+    """Build the section in this process and commit it."""
+    output = execute_case(run_section, {"section": section.key, "quick": ctx.quick}, ctx.design)
+    return _commit(section, ctx, out, output)
+
+
+def _commit(section: Section, ctx: Context, out: Path, output: dict) -> Outcome:
+    """Rename the built section's folder into ``out`` (its record with it); its outcome."""
     params = {"section": section.key, "quick": ctx.quick}
-    output = execute_case(run_section, params, ctx.design)
-    commit(folder, {"section": section.key, "case": key,
-                    **outcome_record(params, ctx.design, output)}, output.get("files", {}))
+    commit(out / section.key, {"section": section.key, "case": section_key(section, ctx),
+                               **outcome_record(params, ctx.design, output)}, output.get("files", {}))
     record_outputs(out, [section.key], verb="reproduce")
     if output["status"] != "done":
         return Outcome(section, "failed", output["error"], output["wall_time_s"])
@@ -211,64 +238,6 @@ def _read(path: Path) -> dict | None:
         return json.loads(read_bounded(path, 64 << 20))
     except (OSError, ValueError, RecursionError):
         return None
-
-
-# ---------------------------------------------------------------------- the report
-def write_report(out: Path, ctx: Context, outcomes: list[Outcome]) -> Path:
-    """``report.md`` (sections in order, with their figures) and ``summary.csv``."""
-    code = code_version()
-    lines = ["# softhand reproduce: the paper's results, recomputed", "",
-             f"- generated {datetime.now(timezone.utc).isoformat(timespec='seconds')}, "
-             f"softhand {code['softhand']} (sources {code['source_sha256']})",
-             f"- mode: {'quick (CI-sized meshes)' if ctx.quick else 'full'}; "
-             f"design hash `{ctx.design.hash()}`",
-             "- every number below was computed by this code for these inputs; a section "
-             "marked *reused* was computed by an earlier run of the identical code and inputs",
-             "", "| section | status | wall time [s] | note |", "|---|---|---|---|"]
-    lines += [f"| [{o.section.title}](#{_anchor(o.section.title)}) | {o.status} | "
-              f"{o.wall_time_s:.1f} | {_one_line(o.detail)} |" for o in outcomes]
-    for o in outcomes:
-        lines += ["", f"## {o.section.title}", ""] + _body(out, o)
-    out.mkdir(parents=True, exist_ok=True)
-    write_csv(out / "summary.csv", _summary_rows(outcomes), ["section", "status", "name", "value"])
-    report = write_atomic(out / "report.md", "\n".join(lines) + "\n")
-    record_outputs(out, REPORT_FILES, verb="reproduce")
-    return report
-
-
-def _body(out: Path, o: Outcome) -> list[str]:
-    if o.status in ("done", "reused"):
-        text = (out / o.section.key / SECTION_MD).read_text()
-        note = [f"*reused: computed {o.detail}*", ""] if o.status == "reused" else []
-        return note + [_relink(text, o.section.key)]
-    if o.status == "failed":
-        return [f"**failed**: `{_one_line(o.detail)}` (traceback in "
-                f"`{o.section.key}/{FAILED}`)"]
-    return [f"*{o.status}*" + (f": {o.detail}" if o.detail else "")]
-
-
-def _relink(markdown: str, folder: str) -> str:
-    """Make a section's relative links (images, files) relative to the report."""
-    return re.sub(r"\]\((?![a-z]+:|#|/)([^)]+)\)", rf"]({folder}/\1)", markdown)
-
-
-def _anchor(title: str) -> str:
-    return re.sub(r"[^a-z0-9 -]", "", title.lower()).replace(" ", "-")
-
-
-def _one_line(text: str) -> str:
-    return " ".join(str(text).split())[:200].replace("|", "/")
-
-
-def _summary_rows(outcomes: list[Outcome]) -> list[dict]:
-    rows = []
-    for o in outcomes:
-        for name, value in (o.numbers or {}).items():
-            rows.append({"section": o.section.key, "status": o.status, "name": name,
-                         "value": value})
-        if not o.numbers:
-            rows.append({"section": o.section.key, "status": o.status, "name": "", "value": ""})
-    return rows
 
 
 def exit_code(outcomes: list[Outcome]) -> int:

@@ -1,4 +1,4 @@
-"""What a section of ``softhand reproduce`` is: the context it receives, its record, and the
+"""What a section of ``softhand reproduce`` is: the context it receives, its outcome, and the
 Markdown table its text uses. The section builders (:mod:`softhand.studies.reproduce.sections`,
 :mod:`softhand.studies.reproduce.fem_sections`) and the report (:mod:`softhand.studies.reproduce.core`) import
 this module, never each other.
@@ -31,7 +31,19 @@ class Section:
     needs: tuple[str, ...]  #: "module" or "module:attribute" that must exist
     build: Callable  #: writes files into outdir; returns (markdown body, {name: number})
     in_quick: bool = True  #: False: skipped by --quick (reported as such)
+    #: rough cost (seconds with --quick on 2 cores): sections built side by side start costliest first
+    cost: float = 0.0
 
+
+@dataclass
+class Outcome:
+    """What became of a section in one run."""
+
+    section: Section
+    status: str  #: 'done', 'reused', 'failed', 'not available', 'not selected', 'skipped'
+    detail: str = ""  #: error or missing module
+    wall_time_s: float = 0.0
+    numbers: dict | None = None
 
 
 def md_table(rows: list[dict], columns: list[str] | None = None, *, digits: int = 4) -> str:

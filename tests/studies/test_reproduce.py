@@ -4,6 +4,7 @@ import json
 import re
 
 import numpy as np
+import pytest
 
 from softhand.studies.cli.main import main
 from softhand.studies.reproduce.core import Section, exit_code, reproduce, sections
@@ -47,13 +48,19 @@ def _boom(ctx, outdir):
     raise RuntimeError("solver exploded")
 
 
-def test_missing_and_failing_sections_are_reported_and_the_others_go_on(tmp_path):
+@pytest.mark.parametrize("workers", [1, 2])
+def test_missing_and_failing_sections_are_reported_and_the_others_go_on(tmp_path, workers):
+    """Also with the sections built side by side in two processes: the same outcomes, in order."""
     fake = [Section("missing", "Missing", ("no_such_module_softhand",), _ok),
             Section("attr", "Missing attribute", ("softhand.reduced.equations.hand:no_such_function",), _ok),
             Section("boom", "Boom", (), _boom),
-            Section("fine", "Fine", ("softhand.reduced.equations.hand",), _ok)]
-    outcomes = reproduce(tmp_path, section_list=fake, progress=False)
-    assert [o.status for o in outcomes] == ["not available", "not available", "failed", "done"]
+            Section("fine", "Fine", ("softhand.reduced.equations.hand",), _ok),
+            Section("costly", "Costly", (), _ok, cost=10.0)]
+    outcomes = reproduce(tmp_path, section_list=fake, progress=False, workers=workers)
+    assert [o.status for o in outcomes] == ["not available", "not available", "failed", "done", "done"]
+    assert (tmp_path / "costly" / "data.csv").is_file()
+    again = reproduce(tmp_path, section_list=fake, progress=False, workers=workers)
+    assert [o.status for o in again] == ["not available", "not available", "failed", "reused", "reused"]
     assert exit_code(outcomes) == 1
     failed = json.loads((tmp_path / "boom" / "failed.json").read_text())
     assert "solver exploded" in failed["error"]
