@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import argparse
 import json
+from pathlib import Path
 
 from softhand.reduced.holding.hold import solve_hold
 from softhand.reduced.holding.objects import object_from_table
@@ -19,14 +20,20 @@ from softhand.reduced.vocabulary.design import HandDesign
 
 
 def describe(obj: dict) -> str:
+    """The object in a few words: shape and size, and its rotation and offset where it has them."""
     shape = obj["shape"]
     if shape == "sphere":
-        return f"sphere {obj['diameter_mm']:g} mm"
-    if shape == "box":
-        return "box " + " x ".join(f"{v:g}" for v in obj["size_mm"]) + " mm"
-    if shape in ("cylinder", "capsule"):
-        return f"{shape} {obj['diameter_mm']:g} x {obj['length_mm']:g} mm"
-    return shape
+        text = f"sphere {obj['diameter_mm']:g} mm"
+    elif shape == "box":
+        text = "box " + " x ".join(f"{v:g}" for v in obj["size_mm"]) + " mm"
+    elif shape in ("cylinder", "capsule"):
+        text = f"{shape} {obj['diameter_mm']:g} x {obj['length_mm']:g} mm"
+    else:
+        text = f"mesh {Path(obj.get('file') or '').name}"
+    for key, unit in (("rotation_deg", "°"), ("offset_mm", " mm")):
+        if any(obj.get(key) or ()):
+            text += f", {key.split('_')[0]} (" + ", ".join(f"{v:g}" for v in obj[key]) + f"){unit}"
+    return text
 
 
 def pad_N(result: dict) -> float:
