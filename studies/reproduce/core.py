@@ -145,8 +145,9 @@ def _build_side_by_side(pending: list[Section], ctx: Context, out: Path, workers
 
     cases = [Case(s.key, {}, {"section": s.key, "quick": ctx.quick}, ctx.design)
              for s in sorted(pending, key=lambda s: -s.cost)]
+    workers = min(workers, len(pending))  # no idle process: each takes its share of the cores' threads
     show, _SHOW["progress"] = _SHOW["progress"], False  # the workers, forked now, draw no bars
-    bar.set_postfix_str(f"{len(pending)} sections in {min(workers, len(pending))} processes")
+    bar.set_postfix_str(f"{len(pending)} sections in {workers} processes")
     try:
         for case, output in pool_outcomes(SimpleNamespace(kind=run_section), iter(cases), workers):
             outcomes[case.key] = _commit(_ACTIVE[case.key], ctx, out, output)
