@@ -33,6 +33,17 @@ def max_cases(args, default: int, most: int) -> int:
     return n
 
 
+#: most worker processes of one run (``--workers``)
+MAX_WORKERS = 256
+
+
+def check_workers(workers: int | None) -> int | None:
+    """``--workers`` if absent (None) or a whole number in [1, MAX_WORKERS], else InputError."""
+    if workers is not None and not 1 <= workers <= MAX_WORKERS:
+        raise InputError("--workers", workers, f"must be a whole number in [1, {MAX_WORKERS}]")
+    return workers
+
+
 def check_range(field: str, value: float, lo: float, hi: float, unit: str = "") -> float:
     """``value`` if finite and in [lo, hi], else InputError naming ``field``."""
     if not (math.isfinite(value) and lo <= value <= hi):

@@ -123,10 +123,11 @@ def reproduce(out: str | Path = "results/reproduce", *, quick: bool = False,
                 bar.update()
         if workers > 1 and len(pending) > 1:
             _build_side_by_side(pending, ctx, out, workers, outcomes, bar)
-        for section in pending:  # one by one, in this process (each FEM path with its own bar)
-            bar.set_postfix_str(section.key)
-            outcomes[section.key] = _build(section, ctx, out)
-            bar.update()
+        else:
+            for section in pending:  # one by one, in this process (each FEM path with its own bar)
+                bar.set_postfix_str(section.key)
+                outcomes[section.key] = _build(section, ctx, out)
+                bar.update()
     finally:
         bar.close()
         write_report(out, ctx, [outcomes.get(s.key) or _not_built(s, ctx, only) or _finished(s, ctx, out, fresh)
@@ -156,7 +157,6 @@ def _build_side_by_side(pending: list[Section], ctx: Context, out: Path, workers
         _SHOW["progress"] = show
     for section in pending:  # its worker died, and again in the pools that took it over
         outcomes.setdefault(section.key, Outcome(section, "failed", "its worker process died"))
-    pending.clear()
 
 
 def _adopt_earlier(out: Path, todo: list[Section]) -> None:

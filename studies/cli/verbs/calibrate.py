@@ -50,10 +50,9 @@ def run(args) -> int:
     from softhand.studies.calibration import space as fc
     from softhand.studies.calibration.finger_table import write_design_with_table, write_table
 
-    from softhand.studies.cli.verbs.study import MAX_WORKERS
+    from softhand.studies.cli.args import check_workers
 
-    if not 1 <= args.workers <= MAX_WORKERS:
-        raise InputError("--workers", args.workers, f"must be a whole number in [1, {MAX_WORKERS}]")
+    check_workers(args.workers)
     if args.table is not None and args.check is None:
         raise InputError("--table", args.table, "is the table --check compares with the FEM; --space "
                                                 "and --design write one (--out)")

@@ -33,10 +33,9 @@ def run(args) -> int:
     from softhand.studies.io.outputs import check_output_tree
     from softhand.studies.reproduce.core import REPORT_FILES, check_design, exit_code, reproduce, sections
 
-    from softhand.studies.cli.verbs.study import MAX_WORKERS
+    from softhand.studies.cli.args import check_workers
 
-    if args.workers is not None and not 1 <= args.workers <= MAX_WORKERS:
-        raise InputError("--workers", args.workers, f"must be a whole number in [1, {MAX_WORKERS}]")
+    check_workers(args.workers)
     keys = [s.key for s in sections()]
     only = None
     if args.only is not None:

@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import sys
 
-from softhand.studies.cli.args import add_progress_option, print_json
+from softhand.studies.cli.args import add_progress_option, check_workers, print_json
 
 HELP = "run a batch study (TOML file) on a process pool or a Dask cluster; status; report"
 
@@ -31,18 +31,14 @@ def configure(parser) -> None:
                          help="allow a study of up to N cases (default 10000)")
 
 
-#: most worker processes of one run
-MAX_WORKERS = 256
-
-
 def run(args) -> int:
     from softhand.reduced.vocabulary.errors import InputError
     from softhand.studies.batch.studyfile import MAX_CASES, load_study
 
     if args.max_cases is not None and not 1 <= args.max_cases <= 10**7:
         raise InputError("--max-cases", args.max_cases, "must be a whole number in [1, 10000000]")
-    if args.action == "run" and args.workers is not None and not 1 <= args.workers <= MAX_WORKERS:
-        raise InputError("--workers", args.workers, f"must be a whole number in [1, {MAX_WORKERS}]")
+    if args.action == "run":
+        check_workers(args.workers)
     study = load_study(args.file, max_cases=args.max_cases or MAX_CASES)
     return {"run": _run, "status": _status, "report": _report}[args.action](study, args)
 
