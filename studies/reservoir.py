@@ -202,9 +202,10 @@ def write_calibration(study: ReservoirStudy, path) -> int:
     """FEM tables at the design's thickness t and at 2t (twice the layers: same element shape),
     written to ``path`` with their provenance; the number of rows."""
     if not study.design.reservoir_is_neo_hookean:
-        raise InputError("--write-calibration", str(path), "the calibration table of the 'fem' "
-                         "reservoir model is for a Neo-Hookean sheet; this design's sheet is "
-                         f"{study.design.reservoir_material.model}")
+        raise InputError("--write-calibration", str(path), "the 'fem' reservoir model's table holds a "
+                         "Neo-Hookean sheet (the model applies a design's own rubber on top of it); "
+                         f"write it from a design without [reservoir.material] (this one's is "
+                         f"{study.design.reservoir_material.model})")
     thin = study.model()
     thick = replace(thin, t=2 * thin.t, n_thick=2 * thin.n_thick)
     rows = calibration_rows(thin) + calibration_rows(thick)

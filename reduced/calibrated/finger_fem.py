@@ -29,6 +29,12 @@ squares in linear terms (older tables: polynomial degrees). So P(theta) = P_prio
 e^{y} and Delta Q = a^2 pi d theta + a^3 kappa P(theta) / mu_sf. Beyond the table's largest
 angle theta_max (and below -theta_max) y and ln kappa are held at their end values.
 
+Another rubber. The table's FEM runs are Neo-Hookean: P/mu_sf is the tube's geometry. A design
+with another rubber (``design.finger_material``) takes the rubber's pure-shear nominal stress,
+scaled to its initial modulus mu_sf, in the prior's integral (eq. (10) generalised, as in
+:func:`softhand.reduced.equations.finger.finger_force`); y, kappa and the stretch's z stay the
+geometry's. Measured against the FEM run with the rubber: docs/finger.md.
+
 Energy consistency. Per design, P(theta) and Delta Q(theta) are sampled at 0.5 deg and
 interpolated by cubic Hermite polynomials; dW_f/dtheta is defined as P dQ/dtheta (a quintic
 per piece) and W_f as its exact integral (3-point Gauss per piece, W_f(0) = 0), so
@@ -84,34 +90,51 @@ def lstsq_terms(groups: dict, theta, target, terms) -> np.ndarray:
 
 
 class _Tube(NamedTuple):
-    """The lengths of a tube [mm] that eq. (10) integrates over (a design's a, b, d, l0)."""
+    """A tube that eq. (10) integrates over: a design's lengths a, b, d, l0 [mm] and its rubber
+    (None: Neo-Hookean, mu = 1)."""
 
     a: float
     b: float
     d: float
     l0: float
+    finger_rubber: object = None
+
+    mu_sf = 1.0  # the groups' pressure is P / mu_sf
+
+    @property
+    def finger_is_neo_hookean(self) -> bool:
+        return self.finger_rubber is None
 
 
-def prior_pressure(theta, groups: dict, prior: str):
+def prior_pressure(theta, groups: dict, prior: str, rubber=None):
     """P / mu_sf [-] of the physics the fit corrects: eq. (28) ("paper"), or eq. (28) with the
     tube stretching over its untied length l0 - 6 w only ("rings": the tied rings cannot
-    stretch, the kinematic bound of the finger FEM)."""
+    stretch, the kinematic bound of the finger FEM). ``rubber``: the tube's rubber scaled to
+    an initial shear modulus of 1 (its pure-shear stress in eq. (10)'s integral); None:
+    Neo-Hookean, the paper's zeta_f."""
     L = groups["link_a"]
     l0 = N_LINKS * L * ((1.0 - groups["tie_link"]) if prior == "rings" else 1.0)
     # eq. (10) needs only the tube's lengths; any point of the groups' box, not only a design
-    free = _Tube(a=1.0, b=groups["b_a"], d=groups["d_a"], l0=l0)
+    free = _Tube(a=1.0, b=groups["b_a"], d=groups["d_a"], l0=l0, finger_rubber=rubber)
+
+    def force(t):
+        return finger.finger_force(t, free) / (math.pi * groups["d_a"])
 
     # bent backwards beyond the angle where the outermost fibre halves its length, P continues
     # linearly (C1): the short untied length of "rings" would otherwise compress it to nothing
     lo = -0.5 * l0 / (groups["d_a"] + 1.0 + groups["b_a"])
     theta = np.asarray(theta, float)
-    t = np.maximum(theta, lo)
-    P = finger.zeta_f(t, free) / (math.pi * groups["d_a"])
+    P = force(np.maximum(theta, lo))
     if np.any(theta < lo):
         h = 1e-6
-        slope = (finger.zeta_f(lo + h, free) - finger.zeta_f(lo - h, free)) / (2 * h * math.pi * groups["d_a"])
+        slope = (force(lo + h) - force(lo - h)) / (2 * h)
         P = np.where(theta < lo, P + slope * (theta - lo), P)
     return P
+
+
+def unit_rubber(design: HandDesign):
+    """The design's tube rubber scaled to an initial shear modulus of 1; None if Neo-Hookean."""
+    return None if design.finger_is_neo_hookean else design.finger_rubber.scaled(1.0 / design.mu_sf)
 
 
 def stretch_prior(theta, groups: dict):
@@ -231,7 +254,7 @@ def curves(design: HandDesign) -> Curves:
 
     def pressure_and_oil(t):
         y, ln_kappa = residuals(t, design)
-        P = design.mu_sf * prior_pressure(t, groups, table.prior) * np.exp(y)
+        P = design.mu_sf * prior_pressure(t, groups, table.prior, unit_rubber(design)) * np.exp(y)
         return P, design.a**2 * math.pi * design.d * t + design.a**3 * np.exp(ln_kappa) * P / design.mu_sf
 
     return energy_curves(pressure_and_oil, design.a**2 * math.pi * design.l0)

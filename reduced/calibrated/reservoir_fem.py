@@ -31,6 +31,7 @@ import numpy as np
 from softhand.reduced.vocabulary.design import HandDesign
 from softhand.reduced.vocabulary.errors import InputError
 from softhand.reduced.vocabulary.inputfiles import read_number_table
+from softhand.reduced.equations import reservoir as ellipse
 from softhand.reduced.equations.reservoir import register_model
 
 __all__ = ["TABLE_FILE", "table", "pressure", "strain_energy", "height", "rubber_stretch"]
@@ -91,15 +92,38 @@ def _W_tilde(V, design, tab):
 
 
 def pressure(V, design: HandDesign):
-    """Reservoir gauge pressure p_r(V) = dW/dV [MPa] of the FEM-calibrated sheet, V [mm^3]."""
+    """Reservoir gauge pressure p_r(V) = dW/dV [MPa] of the FEM-calibrated sheet, V [mm^3];
+    another rubber than Neo-Hookean times :func:`rubber_factor`."""
     p = sum(w * _p_tilde(V, design, tab) for tab, w in _weights(design))
-    return design.mu_sr * design.t / design.R * p
+    return design.mu_sr * design.t / design.R * p * rubber_factor(V, design)
+
+
+def rubber_factor(V, design: HandDesign):
+    """The design's sheet rubber over a Neo-Hookean one of its initial shear modulus mu_sr, in
+    the equi-biaxial stretch lambda_r(V) of the ellipse model (eq. (16)): the equibiaxial
+    nominal stress of the rubber over mu_sr (lambda - lambda^-5); 1 for Neo-Hookean."""
+    if design.reservoir_is_neo_hookean:
+        return 1.0
+    lam = np.maximum(ellipse.stretch(np.asarray(V, float), design), 1.0 + 1e-6)  # 0/0 at the flat sheet
+    return design.reservoir_rubber.nominal_stress("equibiaxial", lam) / (design.mu_sr * (lam - lam**-5))
 
 
 def strain_energy(V, design: HandDesign):
-    """Strain energy W(V) [N mm] of the FEM-calibrated sheet."""
+    """Strain energy W(V) [N mm] of the FEM-calibrated sheet; for another rubber than
+    Neo-Hookean the integral of :func:`pressure` from the flat sheet (composite Gauss)."""
+    if not design.reservoir_is_neo_hookean:
+        return _integral_of_pressure(np.asarray(V, float), design)
     W = sum(w * _W_tilde(V, design, tab) for tab, w in _weights(design))
     return design.mu_sr * design.t * design.R**2 * W
+
+
+def _integral_of_pressure(V, design: HandDesign, panels: int = 64):
+    """int_0^V p dV [N mm], 4-point Gauss on ``panels`` equal panels (p is C1: relative error
+    ~1e-8 at the table's spacing)."""
+    x, w = np.polynomial.legendre.leggauss(4)
+    s = (np.arange(panels)[:, None] + 0.5 * (x + 1.0)) / panels  # (panels, 4) in (0, 1)
+    weights = np.broadcast_to(0.5 * w / panels, s.shape).ravel()
+    return (pressure(np.multiply.outer(V, s.ravel()), design) @ weights) * V
 
 
 def height(V, design: HandDesign):

@@ -107,11 +107,8 @@ class HandDesign:
         check_layout(self)
         for check in CONSISTENCY:
             check(self)
-        check_model("reservoir_model", self.reservoir_model, RESERVOIR_MODELS,
-                     self.reservoir_is_neo_hookean, "reservoir", "sheet", self.reservoir_material,
-                     "ellipse")
-        check_model("finger_model", self.finger_model, FINGER_MODELS, self.finger_is_neo_hookean,
-                     "finger", "tube", self.finger_material, "paper")
+        check_model("reservoir_model", self.reservoir_model, RESERVOIR_MODELS)
+        check_model("finger_model", self.finger_model, FINGER_MODELS)
 
     # ------------------------------------------------------------------ derived
     @property

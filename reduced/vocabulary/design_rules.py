@@ -94,15 +94,10 @@ def check_layout(design: "HandDesign") -> None:
                                                            "(0: the tube's outer diameter)")
 
 
-def check_model(field: str, name: str, models, neo_hookean: bool, part: str, body: str,
-                 material, closed_form: str) -> None:
-    """A model name the registry knows; the FEM-calibrated table only for a Neo-Hookean part."""
+def check_model(field: str, name: str, models) -> None:
+    """A model name the registry knows (every model takes any rubber the project fits)."""
     if name not in models:
         raise InputError(field, name, f"must be one of {', '.join(models)}")
-    if name == "fem" and not neo_hookean:
-        raise InputError(field, "fem", f"the FEM-calibrated {part} table holds a Neo-Hookean "
-                         f"{body}, not {material.model}; use {field} = \"{closed_form}\" with this "
-                         f"[{part}.material]")
 
 
 def is_number(value) -> bool:

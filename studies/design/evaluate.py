@@ -175,6 +175,7 @@ def models(design: HandDesign, task: Task) -> dict:
     tube = calibrated_tube(design)
     sheet = design.reservoir_model == "fem" and reservoir_fem.rubber_stretch(design.V0, design) is not None
     return {"finger_model": design.finger_model, "reservoir_model": design.reservoir_model,
+            "tube_rubber": design.finger_rubber.model, "sheet_rubber": design.reservoir_rubber.model,
             "tube_stretch": "FEM-calibrated rubber_stretch" if tube else
             f"eq. (8), strain x {task.stretch_factor:.4g}",
             "sheet_stretch": "FEM-calibrated rubber_stretch" if sheet else "eq. (16)"}

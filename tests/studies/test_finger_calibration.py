@@ -176,3 +176,20 @@ def test_table_on_a_local_dask_cluster_is_the_process_pools(tmp_path):
                 assert a[key] == b[key]
                 continue
             assert y == pytest.approx(x, rel=1e-7, abs=1e-12), key
+
+
+def test_a_table_is_built_on_a_neo_hookean_tube_of_the_rubbers_initial_modulus(tmp_path, capsys):
+    """The table holds the tube's geometry: calibrating a design with its own rubber runs the
+    FEM on a Neo-Hookean tube of that rubber's mu0 (finger_model "fem" adds the rubber back),
+    and says so; the design file written beside the table keeps the rubber."""
+    from softhand.studies.calibration.space import single_design_space
+    from softhand.studies.cli.verbs.calibrate import neo_hookean
+
+    design = tmp_path / "own.toml"
+    design.write_text('[finger.material]\nmodel = "yeoh"\nC10_MPa = 0.44\nC20_MPa = -0.017\nC30_MPa = 0.0037\n')
+    space = single_design_space(design)
+    built = neo_hookean(space)
+    assert built.base.finger_is_neo_hookean and built.base.mu_sf == pytest.approx(0.88)
+    assert built.points == space.points and not space.base.finger_is_neo_hookean
+    assert "Neo-Hookean tube of the rubber's initial shear modulus mu_sf_MPa = 0.88" in capsys.readouterr().err
+    assert neo_hookean(built) is built

@@ -74,7 +74,8 @@ def run(args) -> int:
         from softhand.studies.calibration.finger_table import check_design_file
 
         check_design_file(args.out, (args.design,))
-    space = _load_space(args.space) if args.space else fc.single_design_space(args.design)
+    given_space = _load_space(args.space) if args.space else fc.single_design_space(args.design)
+    space = neo_hookean(given_space)
     results = _run(space, args)
     if results is None:
         return 1
@@ -92,9 +93,24 @@ def run(args) -> int:
         path = write_table(args.out, space, results, command)
         print(f"table: {path} ({len(space.points)} designs)")
         if args.design:
-            toml = write_design_with_table(space.designs()[0], path)
+            toml = write_design_with_table(given_space.designs()[0], path)
             print(f"design using it: {toml}")
     return 0
+
+
+def neo_hookean(space):
+    """The space with a Neo-Hookean tube of its rubber's initial shear modulus: a table holds
+    the tube's geometry; finger_model "fem" adds a design's own rubber through eq. (10)'s
+    pure-shear stress (:func:`softhand.reduced.calibrated.finger_fem.prior_pressure`)."""
+    import dataclasses
+
+    base = space.base
+    if base.finger_is_neo_hookean:
+        return space
+    print(f"note: the table is built with a Neo-Hookean tube of the rubber's initial shear modulus "
+          f"mu_sf_MPa = {base.mu_sf:.6g}; finger_model \"fem\" applies a design's own rubber "
+          f"({base.finger_material.model} here) on top of it", file=sys.stderr)
+    return dataclasses.replace(space, base=base.replace(finger_material=None))
 
 
 def _run(space, args):

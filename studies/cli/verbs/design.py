@@ -104,8 +104,9 @@ def _print(result: dict, task, opt) -> None:
     print(f"task {task.name}: {task.diameter:g} mm, {task.mass:g} kg, F_v >= {task.required_F_v():.4g} N "
           f"per finger, pump <= {task.max_pressure:g} MPa; objective: {task.objective}")
     m = result["models"]
-    print(f"models: finger {m['finger_model']!r}, reservoir {m['reservoir_model']!r}; rubber stretch of the "
-          f"tube: {m['tube_stretch']}, of the sheet: {m['sheet_stretch']}")
+    print(f"models: finger {m['finger_model']!r} ({m['tube_rubber']} tube), reservoir {m['reservoir_model']!r} "
+          f"({m['sheet_rubber']} sheet); rubber stretch of the tube: {m['tube_stretch']}, of the sheet: "
+          f"{m['sheet_stretch']}")
     print(f"optimum: {free}  ({opt.evaluations} model evaluations, {opt.seconds:.1f} s wall, "
           f"{opt.cpu_seconds:.1f} s CPU)")
     if not opt.evaluation.feasible:  # why the search ended where it did
