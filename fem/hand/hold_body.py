@@ -163,7 +163,7 @@ class PlacedBody:
         return self.placed.sdf(x), self.placed.normal(x)
 
     def support(self, u, ref):
-        """As :meth:`Body.support`; None for a mesh."""
+        """As :meth:`Body.support` (a mesh: its extreme vertex where that is an edge or corner, else NaN)."""
         return self.placed.support(u, ref)
 
     def surface(self, n: int = 48):

@@ -22,12 +22,15 @@ the bending plane -- the one-finger grasp's circle), then improved by projected 
 steps with backtracking on the signed distance (a convex object's signed distance is convex,
 so this finds the deepest point of a box or a tilted cylinder). Where the object's point
 deepest through the pad's plane (its support point along the pad's normal, closed form for
-every primitive) lies over the pad, the contact is there instead: gap its height over the
+every primitive, a mesh's extreme vertex) lies over the pad, the contact is there instead: gap its height over the
 plane, normal the pad's. The two agree wherever the pad is clear of the object (the pad point
 nearest the object is that point's foot); they differ once a pad has sunk onto an edge or a
 corner, where the deepest pad point's nearest face switches across the edge's bisecting plane
 and its normal with it, while the support point's normal turns with the pad (the limit of a
-rounded edge as its radius goes to 0). A mesh keeps the deepest pad point. A pad whose plane has the
+rounded edge as its radius goes to 0). A mesh's support point is its extreme vertex where that is
+one of its edges or corners (on ties the nearest point of the tied face or edge); on a smooth
+surface's facets the deepest pad point on the mesh's smooth (cubic B-spline) distance stays
+(:func:`softhand.reduced.holding.object_mesh.mesh_support`). A pad whose plane has the
 object's centre behind it cannot touch: its gap is +inf (as in :mod:`softhand.fem.contact`).
 """
 from __future__ import annotations

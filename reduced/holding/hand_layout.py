@@ -35,8 +35,6 @@ from softhand.reduced.vocabulary.errors import InputError
 from softhand.reduced.holding.object_geometry import Placed, over_pad, place
 from softhand.reduced.holding.objects import CLEARANCE, PALM_GAP, GraspObject
 
-#: an object's edge or corner more than half this far behind a pad's face is not in front of it [mm]
-_DEPTH = 20.0
 #: points sampled along and across a pad for a non-spherical object (then refined by parabolas)
 PAD_SAMPLES = (17, 3)
 
@@ -124,11 +122,9 @@ def pad_distance(placed: Placed, p: Pads) -> PadDistance:
     face; error O(h^3) on a curved one, h = 1/16 of the link). Then, by the FEM hold's own rule
     (:func:`softhand.reduced.holding.object_geometry.over_pad`), where the object's point deepest
     through the pad's plane (:meth:`~softhand.reduced.holding.object_geometry.Placed.support`,
-    closed form) lies over the pad, the contact is there: gap its height above the pad, normal
-    the pad's (an edge or corner against the pad's face; on a line of ties, the point nearest the
-    pad's point nearest the centre). A mesh, which has no closed form, takes its edges and corners
-    (:func:`softhand.reduced.holding.object_geometry.feature_points`) over the pad's face by their
-    height above it instead."""
+    closed form, a mesh's extreme vertex) lies over the pad, the contact is there: gap its height
+    above the pad, normal the pad's (an edge or corner against the pad's face; on a line of ties,
+    the point nearest the pad's point nearest the centre)."""
     if placed.obj.shape == "sphere":
         d = placed.centre - p.centre
         s = np.clip(np.einsum("fki,fki->fk", d, p.along), -p.half[:, 0], p.half[:, 0])
@@ -144,34 +140,12 @@ def pad_distance(placed: Placed, p: Pads) -> PadDistance:
     ref = p.centre + np.clip(np.einsum("fki,fki->fk", d, p.along), -p.half[:, 0], p.half[:, 0])[..., None] * p.along \
         + np.clip(np.einsum("fki,fki->fk", d, p.across), -p.half[:, 1], p.half[:, 1])[..., None] * p.across
     S = placed.support(p.normal.reshape(-1, 3), ref.reshape(-1, 3))
-    if S is not None:  # the object's point deepest through the pad's plane, where it is over the pad
-        over, s, w, h = over_pad(S.reshape(x.shape), p.centre, p.along, p.across, p.normal,
-                                 p.half[:, 0], p.half[:, 1])
-        x = np.where(over[..., None], p.centre + s[..., None] * p.along + w[..., None] * p.across, x)
-        n = np.where(over[..., None], -p.normal, n)
-        towards = np.einsum("fki,fki->fk", placed.centre - x, p.normal) > 0.0
-        gap = np.where(over, np.where(towards, h, np.inf), gap)
-        return PadDistance(gap, x, n)
-    F = placed.features()
-    if len(F):  # only those within a pad's half width of some finger's plane can be over a pad
-        F = F[np.any(np.abs(F @ p.across[:, 0, :].T) <= float(np.max(p.half[:, 1])), axis=1)]
-    if len(F):  # an edge or corner of the object against the pad's face: its height over the pad
-        rel = F[None, None] - p.centre[:, :, None, :]                    # (nf, k, m, 3)
-        s = np.einsum("fkmi,fki->fkm", rel, p.along)
-        w = np.einsum("fkmi,fki->fkm", rel, p.across)
-        h = np.einsum("fkmi,fki->fkm", rel, p.normal)
-        over = (np.abs(s) <= p.half[None, :, None, 0]) & (np.abs(w) <= p.half[None, :, None, 1]) \
-            & (h > -0.5 * _DEPTH)
-        h = np.where(over, h, np.inf)
-        j = np.argmin(h, axis=-1)
-        hf = np.take_along_axis(h, j[..., None], -1)[..., 0]
-        better = hf < gap
-        if np.any(better):
-            point = p.centre + np.take_along_axis(s, j[..., None], -1) * p.along \
-                + np.take_along_axis(w, j[..., None], -1) * p.across
-            x = np.where(better[..., None], point, x)
-            n = np.where(better[..., None], -p.normal, n)
-            gap = np.where(better, hf, gap)
+    # the object's point deepest through the pad's plane, where it is over the pad
+    over, s, w, h = over_pad(S.reshape(x.shape), p.centre, p.along, p.across, p.normal, p.half[:, 0], p.half[:, 1])
+    x = np.where(over[..., None], p.centre + s[..., None] * p.along + w[..., None] * p.across, x)
+    n = np.where(over[..., None], -p.normal, n)
+    towards = np.einsum("fki,fki->fk", placed.centre - x, p.normal) > 0.0
+    gap = np.where(over, np.where(towards, h, np.inf), gap)
     return PadDistance(gap, x, n)
 
 

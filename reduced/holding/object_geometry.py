@@ -3,9 +3,9 @@ object placed in the hand frame (:class:`softhand.reduced.holding.object_geometr
 
 Geometry queries are vectorised over points (..., 3) in the hand frame: :meth:`Placed.sdf`
 (signed distance, negative inside) and :meth:`Placed.normal` (outward unit normal, the
-distance's gradient). Primitives use their closed-form distance; a mesh, trilinear
-interpolation of its distance sampled once on a grid (:mod:`softhand.reduced.holding.object_mesh`, points on its longest
-edge; error ~ the grid step squared over the surface's radius of curvature). Units: mm, rad.
+distance's gradient). Primitives use their closed-form distance; a mesh, the cubic B-spline
+of its distance sampled once on a grid (:mod:`softhand.reduced.holding.object_mesh`, points on
+its longest edge) and its exact vertices at its edges and corners. Units: mm, rad.
 """
 from __future__ import annotations
 
@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from softhand.reduced.holding.object_mesh import grid_sdf, mesh_features, read_mesh
+from softhand.reduced.holding.object_mesh import grid_sdf, mesh_support, read_mesh
 from softhand.reduced.holding.objects import GraspObject
 
 
@@ -48,7 +48,8 @@ def support_point(shape: str, size, u, ref) -> np.ndarray | None:
     """The object's point deepest along -u (the argmin of X . u over the body), rows (m, 3), in
     its own frame (centre at the origin, a cylinder's or capsule's axis along y; ``size`` as
     :func:`dimensions`); where that set is an edge or a face (u normal to it), its point nearest
-    ``ref`` (m, 3). None for a mesh (no closed form). A flat pad facing along u touches the object
+    ``ref`` (m, 3). None for a mesh (:func:`~softhand.reduced.holding.object_mesh.mesh_support`, which
+    :meth:`Placed.support` calls). A flat pad facing along u touches the object
     there when that point lies over the pad: an edge or corner against the pad's face."""
     u, ref = np.atleast_2d(np.asarray(u, float)), np.atleast_2d(np.asarray(ref, float))
     # a component of u is taken as 0 where moving across the whole object along it changes the
@@ -151,36 +152,6 @@ def surface(obj: GraspObject, *, resolution: int = 32) -> tuple[np.ndarray, np.n
     return np.asarray(pts), np.asarray(tris)
 
 
-#: points along each box edge and around each cylinder rim among an object's features
-FEATURE_POINTS = 65
-
-
-def feature_points(obj: GraspObject) -> np.ndarray:
-    """Points (m, 3) of the object's edges and corners in its own frame [mm] (a box's edges, a
-    cylinder's rims, a mesh's vertices where its surface folds by more than 20 deg; none for the
-    smooth sphere and capsule): where a flat pad may touch it at a point its distance is not smooth."""
-    if obj.shape == "box":
-        h = 0.5 * np.asarray(obj.size_mm)
-        t = np.linspace(-1.0, 1.0, FEATURE_POINTS)
-        out = []
-        for axis in range(3):
-            others = [i for i in range(3) if i != axis]
-            for sa in (-1.0, 1.0):
-                for sb in (-1.0, 1.0):
-                    p = np.zeros((len(t), 3))
-                    p[:, axis] = t * h[axis]
-                    p[:, others[0]], p[:, others[1]] = sa * h[others[0]], sb * h[others[1]]
-                    out.append(p)
-        return np.vstack(out)
-    if obj.shape == "cylinder":
-        a = np.linspace(0.0, 2.0 * np.pi, 2 * FEATURE_POINTS, endpoint=False)
-        r, h = 0.5 * obj.diameter_mm, 0.5 * obj.length_mm
-        return np.vstack([np.stack([r * np.cos(a), np.full_like(a, y), r * np.sin(a)], -1) for y in (-h, h)])
-    if obj.shape == "mesh":
-        return mesh_features(obj.file)
-    return np.zeros((0, 3))
-
-
 @dataclass(frozen=True)
 class Placed:
     """An object at its pose in the hand frame: centre (3,) [mm] and rotation R (object -> hand)."""
@@ -211,13 +182,16 @@ class Placed:
         return g / np.maximum(np.linalg.norm(g, axis=-1, keepdims=True), 1e-300)
 
     def support(self, u, ref) -> np.ndarray | None:
-        """:func:`support_point` in the hand frame: directions u and references ref (m, 3)."""
-        local = support_point(self.obj.shape, dimensions(self.obj), np.asarray(u) @ self.R, self.to_local(ref))
+        """:func:`support_point` (a mesh's :func:`~softhand.reduced.holding.object_mesh.mesh_support`)
+        in the hand frame: directions u and references ref (m, 3)."""
+        u, ref = np.asarray(u) @ self.R, self.to_local(ref)
+        if self.obj.shape == "mesh":
+            mesh = read_mesh(self.obj.file)
+            tie = TIE_MM * np.linalg.norm(np.atleast_2d(u), axis=1)
+            local = mesh_support(mesh, u, ref, tie)
+        else:
+            local = support_point(self.obj.shape, dimensions(self.obj), u, ref)
         return None if local is None else self.centre + local @ self.R.T
-
-    def features(self) -> np.ndarray:
-        """:func:`feature_points` in the hand frame (m, 3) [mm]."""
-        return self.centre + feature_points(self.obj) @ self.R.T
 
     def surface(self, *, resolution: int = 32) -> tuple[np.ndarray, np.ndarray]:
         """The surface as (points (m, 3) in the hand frame [mm], triangles (k, 3))."""

@@ -5,7 +5,8 @@ read), refuses an open, inconsistently oriented, empty or self-intersecting mesh
 centres it at its centre of mass, and samples its signed distance (negative inside) on a grid of
 :data:`MESH_GRID` points along its longest edge (:func:`mesh_sdf`: exact point-triangle
 distances to the nearest triangles, signed by the closest face); :func:`grid_sdf` interpolates it
-trilinearly (error ~ the grid step squared over the surface's radius of curvature). Units: mm.
+by cubic B-splines (smooth normals; a smooth surface's distance to ~ the step^4, a sharp edge
+rounded over about a step, where :func:`mesh_support` meets pads with the exact vertices). Units: mm.
 """
 from __future__ import annotations
 
@@ -32,6 +33,8 @@ class MeshData:
     faces: np.ndarray      #: (nf, 3) vertex indices, outward winding
     grid: tuple            #: (x, y, z) grid axes [mm]
     distance: np.ndarray   #: signed distance at the grid points, negative inside [mm]
+    spline: np.ndarray     #: its cubic B-spline coefficients (scipy.ndimage.spline_filter)
+    folds: np.ndarray      #: (nv,) True at a vertex of an edge where the surface folds > FOLD_DEG
 
 
 @lru_cache(maxsize=8)
@@ -69,7 +72,32 @@ def read_mesh(path: str, field: str = "object.file") -> MeshData:
     axes = tuple(np.arange(lo[i] - 3 * step, hi[i] + 3.5 * step, step) for i in range(3))
     points = np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, 3)
     distance = mesh_sdf(vertices, faces, points).reshape(tuple(len(a) for a in axes))
-    return MeshData(vertices, faces, axes, distance)
+    from scipy.ndimage import spline_filter
+
+    return MeshData(vertices, faces, axes, distance, spline_filter(distance, order=3, mode="nearest"),
+                    fold_vertices(vertices, faces))
+
+
+#: an edge whose two faces' normals differ by more than this [deg] is an edge of the object (a
+#: box's), not a facet of a smooth surface
+FOLD_DEG = 20.0
+
+
+def fold_vertices(vertices, faces) -> np.ndarray:
+    """(nv,) True at the vertices of the edges where the closed surface folds by more than
+    :data:`FOLD_DEG`: the object's own edges and corners."""
+    V, F = np.asarray(vertices, float), np.asarray(faces, int)
+    n = np.cross(V[F[:, 1]] - V[F[:, 0]], V[F[:, 2]] - V[F[:, 0]])
+    n /= np.linalg.norm(n, axis=1, keepdims=True)
+    edges = np.sort(np.concatenate([F[:, [0, 1]], F[:, [1, 2]], F[:, [2, 0]]]), axis=1)
+    owner = np.tile(np.arange(len(F)), 3)
+    order = np.lexsort((edges[:, 1], edges[:, 0]))
+    e, o = edges[order], owner[order]
+    pair = np.all(e[:-1] == e[1:], axis=1)                  # closed mesh: each edge twice
+    fold = np.einsum("ij,ij->i", n[o[:-1][pair]], n[o[1:][pair]]) < np.cos(np.radians(FOLD_DEG))
+    out = np.zeros(len(V), dtype=bool)
+    out[e[:-1][pair][fold].ravel()] = True
+    return out
 
 
 #: triangles whose centroids are nearest a point, among which its closest triangle is sought
@@ -131,6 +159,37 @@ def closest_on_triangles(p, T) -> np.ndarray:
     return out
 
 
+def mesh_support(mesh: MeshData, u, ref, tie) -> np.ndarray:
+    """The mesh's point deepest along -u (argmin of X . u over the closed surface: a vertex), rows
+    (m, 3), object frame; where vertices tie within ``tie`` (m,) [mm] (a face or an edge normal
+    to u), the point of the tied faces and edges nearest ``ref`` (m, 3), as the primitives'
+    :func:`softhand.reduced.holding.object_geometry.support_point`. NaN where that point is a
+    single vertex that is no edge or corner of the object (:func:`fold_vertices`): there the
+    surface is a smooth one's facets, met by its smooth distance instead (:func:`grid_sdf`)."""
+    V, F = mesh.vertices, mesh.faces
+    u, ref = np.atleast_2d(np.asarray(u, float)), np.atleast_2d(np.asarray(ref, float))
+    depth = u @ V.T                                                     # (m, nv)
+    k = np.argmin(depth, axis=1)
+    out = V[k].copy()
+    tied = depth <= depth[np.arange(len(u)), k][:, None] + np.asarray(tie, float).reshape(-1, 1)
+    out[(tied.sum(axis=1) == 1) & ~mesh.folds[k]] = np.nan
+    for r in np.flatnonzero(tied.sum(axis=1) > 1):  # a face or an edge against the pad: rare rows
+        on = tied[r][F]                                                 # (nf, 3)
+        T = V[F[on.all(axis=1)]]                                        # tied faces
+        two = on.sum(axis=1) == 2                                       # tied edges of the others
+        E = V[F[two]][on[two]].reshape(-1, 2, 3)
+        cand = [V[tied[r]]]
+        if len(T):
+            cand.append(closest_on_triangles(ref[r], T))
+        if len(E):
+            d = E[:, 1] - E[:, 0]
+            t = np.clip(np.einsum("ki,ki->k", ref[r] - E[:, 0], d) / np.einsum("ki,ki->k", d, d), 0.0, 1.0)
+            cand.append(E[:, 0] + t[:, None] * d)
+        cand = np.concatenate(cand)
+        out[r] = cand[np.argmin(np.linalg.norm(cand - ref[r], axis=1))]
+    return out
+
+
 def self_intersection(vertices, faces):
     """A pair of triangles (i, j) that cross each other (sharing no vertex), or None: every edge
     tested (Moller-Trumbore) against the triangles whose centroid lies within reach of its
@@ -171,37 +230,17 @@ def self_intersection(vertices, faces):
 
 
 def grid_sdf(mesh: MeshData, p) -> np.ndarray:
-    """The mesh's grid distance at p (..., 3), trilinear; outside the grid, plus the distance to it."""
+    """The mesh's grid distance at p (..., 3): its cubic B-spline (C2: the normal turns smoothly
+    from cell to cell); outside the grid, plus the distance to it."""
+    from scipy.ndimage import map_coordinates
+
+    p = np.asarray(p, float)
     axes = mesh.grid
     lo = np.array([a[0] for a in axes])
     hi = np.array([a[-1] for a in axes])
     step = np.array([a[1] - a[0] for a in axes])
     inside = np.clip(p, lo, hi)
     outside = np.linalg.norm(p - inside, axis=-1)
-    x = (inside - lo) / step
-    shape = np.array(mesh.distance.shape)
-    i = np.minimum(np.floor(x).astype(int), shape - 2)
-    f = x - i
-    D = mesh.distance
-    out = np.zeros(p.shape[:-1])
-    for corner in np.ndindex(2, 2, 2):  # the cell's eight corners
-        c = np.asarray(corner)
-        w = np.prod(np.where(c, f, 1.0 - f), axis=-1)
-        out += w * D[i[..., 0] + c[0], i[..., 1] + c[1], i[..., 2] + c[2]]
-    return out + outside
-
-
-@lru_cache(maxsize=8)
-def mesh_features(path: str) -> np.ndarray:
-    """Vertices (m, 3) of the mesh file's edges where its surface folds by more than 20 deg."""
-    m = read_mesh(path)
-    V, F = m.vertices, m.faces
-    n = np.cross(V[F[:, 1]] - V[F[:, 0]], V[F[:, 2]] - V[F[:, 0]])
-    n /= np.linalg.norm(n, axis=1, keepdims=True)
-    edges = np.sort(np.concatenate([F[:, [0, 1]], F[:, [1, 2]], F[:, [2, 0]]]), axis=1)
-    owner = np.tile(np.arange(len(F)), 3)
-    order = np.lexsort((edges[:, 1], edges[:, 0]))
-    e, o = edges[order], owner[order]
-    pair = np.all(e[:-1] == e[1:], axis=1)                  # closed mesh: each edge twice
-    fold = np.einsum("ij,ij->i", n[o[:-1][pair]], n[o[1:][pair]]) < np.cos(np.radians(20.0))
-    return V[np.unique(e[:-1][pair][fold])]
+    x = ((inside - lo) / step).reshape(-1, 3).T
+    out = map_coordinates(mesh.spline, x, order=3, mode="nearest", prefilter=False)
+    return out.reshape(p.shape[:-1]) + outside

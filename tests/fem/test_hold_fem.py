@@ -211,6 +211,43 @@ def test_pad_contact_of_a_sphere_off_the_bending_plane():
         np.testing.assert_allclose(pc.X[0], [15.0, d.d], atol=1e-9)
 
 
+@pytest.mark.parametrize("shape", ["box", "sphere"])
+def test_pad_contacts_of_a_mesh_are_the_primitives(shape, tmp_path):
+    """Every pad of a bent finger against a box written as an STL, its faces, edges and corners
+    over the pads (its exact vertices: the primitive's gaps, points and normals to round-off;
+    where a pad's nearest point is off its end, the descent on the smooth distance, to 1 um),
+    and against an icosphere, two fingers (its smooth distance, the cubic B-spline of the grid:
+    gaps within the facets' sag, 0.05-0.1 mm on r = 90; normals within 0.3 deg; points within
+    sqrt(2 R sag) = 3 mm, the play of a flat pad on a sphere)."""
+    import trimesh
+
+    from softhand.fem.constraints import PlanarChain
+    from softhand.fem.hand.hold_body import PlacedBody
+    from softhand.fem.hand.hold_geometry import PadSet
+    from softhand.reduced.holding import object_geometry, objects
+
+    d = DESIGN
+    chain = PlanarChain(np.c_[d.hinge_s, np.full(d.n_s, d.d)])
+    pads = PadSet(chain, (0.0, *d.hinge_s, d.l0), d.d, 18.0, d)
+    centre = (-10.0, 100.0, 5.0)
+    if shape == "box":
+        trimesh.creation.box(extents=[150.0, 140.0, 150.0]).export(tmp_path / "m.stl")
+        # the pads meeting a face, an edge or a corner over them to round-off (measured 1e-13); the
+        # one whose nearest box point lies beyond its end, by descent on the smooth distance: 1 um
+        solid, frames, tol = Body("box", centre, (150.0, 140.0, 150.0)), [FingerFrame(0.0)], (2e-3, 1e-9, 1e-4)
+    else:
+        trimesh.creation.icosphere(subdivisions=4, radius=90.0).export(tmp_path / "m.stl")
+        solid, frames, tol = Body("sphere", centre, (180.0,)), [FingerFrame(0.0), FingerFrame(0.3)], (0.11, 3.0, 0.01)
+    qs = [np.radians([5.0, 8.0, 12.0, 15.0, 18.0])] * len(frames)
+    mesh = objects.object_from_table({"shape": "mesh", "file": "m.stl", "mass_kg": 1.0}, base_dir=tmp_path)
+    body = PlacedBody(object_geometry.place(mesh, centre), mass_kg=1.0, friction=0.5, radius=130.0)
+    a, b = (pad_contacts(x, Pose(centre), frames, [pads] * len(frames), qs) for x in (solid, body))
+    assert np.all(np.isfinite(a.g)) and np.all(np.abs(a.g) < 20.0) and np.any(np.abs(a.g) < 4.0)  # near it
+    np.testing.assert_allclose(b.g, a.g, atol=tol[0])
+    np.testing.assert_allclose(b.x, a.x, atol=tol[1])
+    np.testing.assert_allclose(b.normal, a.normal, atol=tol[2])
+
+
 def test_a_pad_sunk_onto_a_cylinders_rim_pushes_along_its_own_normal():
     """An upright cylinder's top rim 1 mm through the middle of link 1's pad (straight finger):
     the gap is -1 mm and the normal the pad's (closed form: the rim point deepest along the
