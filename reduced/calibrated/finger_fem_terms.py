@@ -96,12 +96,24 @@ def legacy_terms(kind: str, varying: dict, design_degree: int, theta_degree: int
 KERNEL_FEATURES = ("lb", "ld", "lL", "lt", "s2")
 
 
+#: per residual (y, ln kappa, the stretch's z) the variable its per-design line is in: theta for P
+#: and Delta Q; ln theta for z, so the stretch is a power law of the bend, rubber_stretch - 1 =
+#: eq. (8)'s strain x C theta^b (over the shipped table's designs left out one by one: rms 1.58 %,
+#: worst 6.7 % against a line in theta's 1.97 %, 13.5 %: docs/finger.md)
+LINE_IN = ("theta", "theta", "log theta")
+
+
+def _variable(name: str, theta):
+    """theta, or ln theta (the stretch's: only asked for at theta > 0; floored at 1e-9 rad)."""
+    return np.log(np.maximum(theta, 1e-9)) if name == "log theta" else theta
+
+
 class KernelFit:
     """Residuals (y and ln kappa; the rubber stretch's where the table has it) as a radial-basis
-    interpolant over the designs: per design, each residual's least-squares line in theta
-    (a + b theta); a, b interpolated over the design features (scaled to [0, 1] over the
-    table's designs) by SciPy's RBFInterpolator with a linear polynomial, exact at every
-    design of the table."""
+    interpolant over the designs: per design, each residual's least-squares line a + b x in its
+    variable x (:data:`LINE_IN`: theta, or ln theta for the stretch); a, b interpolated over the
+    design features (scaled to [0, 1] over the table's designs) by SciPy's RBFInterpolator with a
+    linear polynomial, exact at every design of the table."""
 
     def __init__(self, rows: dict, targets, kernel: str, features):
         from scipy.interpolate import RBFInterpolator
@@ -111,7 +123,8 @@ class KernelFit:
         for i in ids:
             at = rows["design"] == i
             th = rows["theta"][at]
-            line = [np.polyfit(th, v[at], 1) if np.ptp(th) > 0 else (0.0, v[at].mean()) for v in targets]
+            line = [np.polyfit(_variable(x, th), v[at], 1) if np.ptp(th) > 0 else (0.0, v[at].mean())
+                    for v, x in zip(targets, LINE_IN)]
             coef.append([c for slope, intercept in line for c in (intercept, slope)])
             g = {k: rows[k][at][0] for k in ("b_a", "d_a", "link_a", "tie_link")}
             X.append([float(BASE[f](g, 0.0)) for f in features])
@@ -127,4 +140,4 @@ class KernelFit:
         x = np.array([float(BASE[f](groups, 0.0)) for f in self.features])
         c = self.rbf(((x - self.lo) / self.span)[None, :])[0]
         theta = np.asarray(theta, float)
-        return tuple(c[k] + c[k + 1] * theta for k in range(0, c.size, 2))
+        return tuple(c[k] + c[k + 1] * _variable(x, theta) for k, x in zip(range(0, c.size, 2), LINE_IN))

@@ -15,8 +15,8 @@ from softhand.studies.calibration.finger_check import leave_one_out
 
 def known_z(b_a, theta):
     """A residual the kernel fit reproduces exactly: linear in its feature ln(b/a) and, per
-    design, a line in theta (the fit's own form)."""
-    return 1.2 + 0.3 * np.log(b_a) - 0.1 * theta
+    design, a line in ln theta (the fit's own form: a power law of the bend)."""
+    return 1.2 + 0.3 * np.log(b_a) - 0.1 * np.log(theta)
 
 
 def stretch_table(tmp_path):
