@@ -163,16 +163,20 @@ def mesh_support(mesh: MeshData, u, ref, tie) -> np.ndarray:
     """The mesh's point deepest along -u (argmin of X . u over the closed surface: a vertex), rows
     (m, 3), object frame; where vertices tie within ``tie`` (m,) [mm] (a face or an edge normal
     to u), the point of the tied faces and edges nearest ``ref`` (m, 3), as the primitives'
-    :func:`softhand.reduced.holding.object_geometry.support_point`. NaN where that point is a
-    single vertex that is no edge or corner of the object (:func:`fold_vertices`): there the
-    surface is a smooth one's facets, met by its smooth distance instead (:func:`grid_sdf`)."""
+    :func:`softhand.reduced.holding.object_geometry.support_point`. NaN where none of the deepest
+    vertices is on an edge or a corner of the object (:func:`fold_vertices`): there the surface is
+    a smooth one's facets, met by its smooth distance instead (:func:`grid_sdf`)."""
     V, F = mesh.vertices, mesh.faces
     u, ref = np.atleast_2d(np.asarray(u, float)), np.atleast_2d(np.asarray(ref, float))
+    if not mesh.folds.any():  # a smooth surface: no edge or corner to meet
+        return np.full((len(u), 3), np.nan)
     depth = u @ V.T                                                     # (m, nv)
     k = np.argmin(depth, axis=1)
     out = V[k].copy()
     tied = depth <= depth[np.arange(len(u)), k][:, None] + np.asarray(tie, float).reshape(-1, 1)
-    out[(tied.sum(axis=1) == 1) & ~mesh.folds[k]] = np.nan
+    smooth = ~np.any(tied & mesh.folds, axis=1)  # no edge or corner among the deepest: a smooth patch
+    out[smooth] = np.nan
+    tied[smooth] = False
     for r in np.flatnonzero(tied.sum(axis=1) > 1):  # a face or an edge against the pad: rare rows
         on = tied[r][F]                                                 # (nf, 3)
         T = V[F[on.all(axis=1)]]                                        # tied faces

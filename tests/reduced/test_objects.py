@@ -180,7 +180,7 @@ def test_a_mesh_support_point_is_its_extreme_vertex_and_a_box_mesh_the_box(tmp_p
     np.testing.assert_allclose(mesh.support(u, ref), solid.support(u, ref), atol=1e-9)
     ball = trimesh.creation.icosphere(subdivisions=3, radius=50.0)
     m = object_mesh.read_mesh(_write(ball, tmp_path / "ball.stl"))
-    u = rng.normal(size=(50, 3))
+    u = np.concatenate([rng.normal(size=(50, 3)), np.eye(3), -np.eye(3)])  # axes: ties on its facets
     assert not m.folds.any() and object_mesh.fold_vertices(box.vertices, box.faces).all()
     assert np.isnan(object_mesh.mesh_support(m, u, np.zeros_like(u), np.full(len(u), 1e-9))).all()
 
