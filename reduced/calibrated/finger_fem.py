@@ -22,8 +22,8 @@ over the features a free tube segment's physics names (ln b/a, ln d/a, ln L/a, t
 bonded at both ends cannot contract, so it stiffens as s^2; :mod:`.finger_fem_terms`), as
 the table's ``# fit:`` line says. A table of the design space (12 designs or more) is
 interpolated by radial basis functions (the table names them: cubic in the shipped one) with a
-linear polynomial, per design a line in theta (:class:`~.finger_fem_terms.KernelFit`, exact at
-the table's designs; chosen over polynomial least squares and the other kernels by
+linear polynomial, per design a line in theta (the stretch's z: in ln theta;
+:class:`~.finger_fem_terms.KernelFit`, exact at the table's designs; chosen over polynomial least squares and the other kernels by
 leave-one-design-out error); a table of a few designs is fitted by least
 squares in linear terms (older tables: polynomial degrees). So P(theta) = P_prior(theta)
 e^{y} and Delta Q = a^2 pi d theta + a^3 kappa P(theta) / mu_sf. Beyond the table's largest
