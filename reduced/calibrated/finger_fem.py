@@ -23,8 +23,9 @@ bonded at both ends cannot contract, so it stiffens as s^2; :mod:`.finger_fem_te
 the table's ``# fit:`` line says. A table of the design space (12 designs or more) is
 interpolated by radial basis functions (the table names them: cubic in the shipped one) with a
 linear polynomial, per design a line in theta (the stretch's z: in ln theta;
-:class:`~.finger_fem_terms.KernelFit`, exact at the table's designs; chosen over polynomial least squares and the other kernels by
-leave-one-design-out error); a table of a few designs is fitted by least
+:class:`~.finger_fem_terms.KernelFit`, exact at the table's designs; chosen over polynomial
+least squares and the other kernels by leave-one-design-out error); a table of a few designs
+is fitted by least
 squares in linear terms (older tables: polynomial degrees). So P(theta) = P_prior(theta)
 e^{y} and Delta Q = a^2 pi d theta + a^3 kappa P(theta) / mu_sf. Beyond the table's largest
 angle theta_max (and below -theta_max) y and ln kappa are held at their end values.
