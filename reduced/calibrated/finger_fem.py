@@ -25,8 +25,7 @@ interpolated by radial basis functions (the table names them: cubic in the shipp
 linear polynomial, per design a line in theta (the stretch's z: in ln theta;
 :class:`~.finger_fem_terms.KernelFit`, exact at the table's designs; chosen over polynomial
 least squares and the other kernels by leave-one-design-out error); a table of a few designs
-is fitted by least
-squares in linear terms (older tables: polynomial degrees). So P(theta) = P_prior(theta)
+is fitted by least squares in linear terms (older tables: polynomial degrees). So P(theta) = P_prior(theta)
 e^{y} and Delta Q = a^2 pi d theta + a^3 kappa P(theta) / mu_sf. Beyond the table's largest
 angle theta_max (and below -theta_max) y and ln kappa are held at their end values.
 
