@@ -32,8 +32,9 @@ class MeshData:
     vertices: np.ndarray   #: (nv, 3) [mm], centred at the centre of mass
     faces: np.ndarray      #: (nf, 3) vertex indices, outward winding
     grid: tuple            #: (x, y, z) grid axes [mm]
-    distance: np.ndarray   #: signed distance at the grid points, negative inside [mm]
-    spline: np.ndarray     #: its cubic B-spline coefficients (scipy.ndimage.spline_filter)
+    #: cubic B-spline coefficients (scipy.ndimage.spline_filter) of the signed distance sampled
+    #: at the grid points, negative inside [mm]
+    spline: np.ndarray
     folds: np.ndarray      #: (nv,) True at a vertex of an edge where the surface folds > FOLD_DEG
 
 
@@ -74,7 +75,7 @@ def read_mesh(path: str, field: str = "object.file") -> MeshData:
     distance = mesh_sdf(vertices, faces, points).reshape(tuple(len(a) for a in axes))
     from scipy.ndimage import spline_filter
 
-    return MeshData(vertices, faces, axes, distance, spline_filter(distance, order=3, mode="nearest"),
+    return MeshData(vertices, faces, axes, spline_filter(distance, order=3, mode="nearest"),
                     fold_vertices(vertices, faces))
 
 
