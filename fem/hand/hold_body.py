@@ -175,7 +175,7 @@ def body_of(obj, design):
     InputError if it overlaps the open fingers or the palm): analytic for a sphere, a cylinder
     and an unrotated box, else the object's own distance queries."""
     from softhand.reduced.holding.hand_layout import place_object
-    from softhand.reduced.holding.object_geometry import local_extent
+    from softhand.reduced.holding.object_geometry import size_radius
 
     placed = place_object(obj, design)
     centre = tuple(float(c) for c in placed.centre)
@@ -187,5 +187,4 @@ def body_of(obj, design):
                     axis=tuple(placed.R @ [0.0, 1.0, 0.0]), **common)
     if obj.shape == "box" and not any(obj.rotation_deg):
         return Body("box", centre, tuple(obj.size_mm), **common)
-    lo, hi = local_extent(obj)
-    return PlacedBody(placed, radius=0.5 * float(np.linalg.norm(hi - lo)), **common)
+    return PlacedBody(placed, radius=size_radius(obj), **common)

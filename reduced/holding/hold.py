@@ -4,9 +4,11 @@ much more can it take along a pull, and what pump pressure holds it with a margi
 :func:`solve_hold` runs the path of the FEM hold in the fast model: close at the cavity pressure
 (:func:`softhand.reduced.holding.hold_fast.close_hand`), let go (the object's weight: the admissible state nearest
 the closing forces, :func:`softhand.reduced.holding.hold_lp.weight_state`), pull along a direction until no
-admissible state is left (:func:`softhand.reduced.holding.hold_lp.holding_limit`). It returns the common
-:class:`softhand.reduced.holding.hold_result.HoldResult` (model ``"reduced"``). The rigid object does not move in
-this model (displacement and rotation 0; the FEM reports them).
+admissible state is left (:func:`softhand.reduced.holding.hold_lp.holding_limit`), the object sliding along the
+pull where the fingers closing on it there hold it more (:mod:`softhand.reduced.holding.hold_slide`: the
+holding limit is the first maximum along that slide). It returns the common
+:class:`softhand.reduced.holding.hold_result.HoldResult` (model ``"reduced"``); the object's displacement
+is its slide under its own weight, along the pull (it does not turn in this model).
 
 :func:`least_pressure` answers the inverse question: the least pump pressure (and its cavity
 pressure) at which the holding limit along the pull reaches the margin asked -- the object's
@@ -19,18 +21,19 @@ the reservoir's, which falls as the fingers take its oil). Units: N, mm, MPa, kg
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 from typing import NamedTuple
 
 import numpy as np
 from scipy.optimize import brentq
 
 from softhand.reduced.equations import hand
-from softhand.reduced.holding import hold_fast, hold_finger, hold_lp
+from softhand.reduced.holding import hold_fast, hold_finger, hold_lp, hold_slide
 from softhand.reduced.vocabulary.design import HandDesign
 from softhand.reduced.vocabulary.errors import InputError
 from softhand.reduced.holding.hand_layout import place_object
 from softhand.reduced.holding.hold_result import SLIP, STICK, Contact, HoldResult, LoadStep
-from softhand.reduced.holding.object_geometry import Placed
+from softhand.reduced.holding.object_geometry import Placed, size_radius
 from softhand.reduced.holding.objects import GraspObject
 
 #: the default pull: straight down (more weight)
@@ -90,17 +93,38 @@ def _contacts(cs: hold_lp.ContactSet, state: hold_lp.LimitState | None, held: bo
 
 def solve_hold(design: HandDesign, obj: GraspObject, *, P_cavity_MPa: float, pull_direction=DOWN,
                finger_model: str = "fem", reservoir: bool = True, placed: Placed | None = None,
-               closed: hold_fast.Closed | None = None) -> HoldResult:
-    """The hold at cavity pressure P [MPa] (module doc): close, let go, pull along the direction."""
+               closed: hold_fast.Closed | None = None, enough_N: float = math.inf) -> HoldResult:
+    """The hold at cavity pressure P [MPa] (module doc): close, let go, pull along the direction,
+    the object sliding along it as far as the pull takes it (:mod:`softhand.reduced.holding.hold_slide`);
+    the slide is followed only until the pull borne reaches ``enough_N`` (the limit is then at least that)."""
     d = hold_fast.finger_design(design, finger_model)
     pull = pull_unit(pull_direction, "pull_direction")
     placed = place_object(obj, d) if placed is None else placed
     closed = hold_fast.close_hand(float(P_cavity_MPa), placed, d, reservoir_on=reservoir) if closed is None else closed
-    cs = contact_set(closed, d)
     weight = obj.mass_kg * d.g
     size = float(np.max(np.ptp(placed.surface(resolution=8)[0], axis=0)))
-    rest = hold_lp.weight_state(cs, placed.centre, weight, obj.friction, size_mm=size)
-    limit = hold_lp.holding_limit(cs, placed.centre, weight, pull, obj.friction, size_mm=size)
+
+    hands = {}
+
+    def at(y, hand=None):
+        """(lam, (placed, closed, contact set, limit state)) with the object moved y [mm] along the pull."""
+        moved = placed if y == 0.0 else replace(placed, centre=placed.centre + y * pull)
+        near = hands[min(hands, key=lambda x: abs(x - y))] if hands else None
+        try:
+            hand = hand or hold_fast.close_hand(closed.P_cavity, moved, d, reservoir_on=reservoir, near=near)
+        except InputError:  # moved into the open fingers: they have let it through
+            return -math.inf, None
+        hands[y] = hand
+        cs = contact_set(hand, d)
+        lim = hold_lp.holding_limit(cs, moved.centre, weight, pull, obj.friction, size_mm=size)
+        return (lim.pull_N if lim is not None else -math.inf), (moved, hand, cs, lim)
+
+    first = at(0.0, closed)
+    path = hold_slide.follow(at, first, weight_N=weight, slip_out_mm=0.5 * size_radius(obj), enough_N=enough_N)
+    moved, closed_rest, cs, _ = path.rest if path.rest is not None else first[1]
+    _, _, cs_limit, limit = path.limit if path.limit is not None else first[1]
+    rest = hold_lp.weight_state(cs, moved.centre, weight, obj.friction, size_mm=size) \
+        if path.y_rest is not None else None
     held = rest is not None and limit is not None and limit.pull_N >= -1e-9 * max(weight, 1.0)
     holding = max(limit.pull_N, 0.0) if held else 0.0
     notes = []
@@ -108,26 +132,35 @@ def solve_hold(design: HandDesign, obj: GraspObject, *, P_cavity_MPa: float, pul
         notes.append("no pad touches the object at this pressure")
     elif not held:
         notes.append("the pads cannot carry the object's weight (friction and the fingers' hinge moments)")
+    if held and path.slipped_out:
+        notes.append(f"past this pull the object slides more than {0.5 * size_radius(obj):.3g} mm (a quarter of its "
+                     f"size) from where it rests: slipped out")
     if held and limit.pull_N >= hold_lp.MAX_PULL:
         notes.append(f"the pull is bounded only by the search's {hold_lp.MAX_PULL:g} N")
     residual = max(float(np.max([s.residual for s in closed.fingers])), 0.0)
+    y_rest = path.y_rest if held else 0.0
+    shift = lambda y: tuple((y * pull).tolist())  # noqa: E731
     steps = (LoadStep("close", closed.P_cavity, 0.0, bool(len(cs.finger)), contacts=len(cs.finger),
                       extra={"hinge_residual": residual}),
-             LoadStep("release", closed.P_cavity, 0.0, held, contacts=len(_contacts(cs, rest, held)) if held else 0,
+             LoadStep("release", closed.P_cavity, 0.0, held, displacement_mm=shift(y_rest),
+                      contacts=len(_contacts(cs, rest, held)) if held else 0,
                       extra={"equilibrium_residual": rest.residual if rest is not None else math.nan}),
-             LoadStep("pull", closed.P_cavity, holding, held,
-                      contacts=len(_contacts(cs, limit, held)) if held else 0,
+             LoadStep("pull", closed.P_cavity, holding, held, displacement_mm=shift(path.y_limit),
+                      contacts=len(_contacts(cs_limit, limit, held)) if held else 0,
                       extra={"equilibrium_residual": limit.residual if limit is not None else math.nan}))
     return HoldResult(
         model="reduced", held=held, holding_limit_N=float(holding), pull_direction=tuple(pull.tolist()),
         contacts=_contacts(cs, rest if held else None, held), P_cavity_MPa=float(closed.P_cavity),
-        P_pump_MPa=float(closed.P_pump), mass_kg=obj.mass_kg, friction=obj.friction, object=obj.to_dict(),
-        steps=steps, symmetric=closed.symmetric, notes=tuple(notes),
+        P_pump_MPa=float((closed_rest if held else closed).P_pump), mass_kg=obj.mass_kg, friction=obj.friction,
+        object=obj.to_dict(), steps=steps, symmetric=closed.symmetric, notes=tuple(notes),
+        displacement_mm=shift(y_rest),
         extra={"finger_model": d.finger_model, "hinge_residual": residual,
                "limit_contacts": [c._asdict() if hasattr(c, "_asdict") else c.__dict__
-                                  for c in _contacts(cs, limit, held)] if held else [],
+                                  for c in _contacts(cs_limit, limit, held)] if held else [],
                "friction_polygon": hold_lp.GENERATORS, "object_centre_mm": placed.centre.tolist(),
-               "limit_pull_N": float(limit.pull_N) if limit is not None else None})
+               "limit_pull_N": float(limit.pull_N) if limit is not None else None,
+               "first_slip_pull_N": float(first[0]) if math.isfinite(first[0]) else None,
+               "slide_mm": float(path.y_limit), "slide_evaluations": path.evaluations})
 
 
 def cavity_pressure(P_pump: float, placed: Placed, design: HandDesign, *, finger_model: str = "fem",

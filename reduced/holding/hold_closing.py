@@ -34,9 +34,15 @@ class FingerState(NamedTuple):
     residual: float       #: hinge equilibrium residual, max ``|M - dg^T N|`` / max ``|M|`` [-]
 
 
-def close_finger(i: int, P: float, placed: Placed, design: HandDesign) -> FingerState:
+def close_finger(i: int, P: float, placed: Placed, design: HandDesign, near: FingerState | None = None) -> FingerState:
     """Finger i closing at cavity pressure P [MPa] on the object held in place (module doc of
-    :mod:`softhand.reduced.holding.hold_fast`)."""
+    :mod:`softhand.reduced.holding.hold_fast`); ``near``: the finger closed on the object at a pose
+    nearby, whose hinge angles and touching pads start the contact equations (the object sliding)."""
+    touching = [] if near is None else [int(k) for k in np.flatnonzero(near.N > 0.0)]
+    if touching:
+        found = _active_set(i, near.q, P, placed, design, touching, {k: float(near.N[k]) for k in touching})
+        if found is not None:
+            return _state_of(i, found[0], found[2], P, placed, design)
     n_s = design.n_s
     theta_free = float(hand.bend_angle(P, design, reservoir=False))
     q_free = np.full(n_s, theta_free / n_s)
@@ -72,14 +78,14 @@ def _newton(fun, z0, scale, *, tol: float = 1e-11, max_iter: int = 30):
     """Newton on a batched fun (one call per iteration: the point and its forward-difference
     neighbours), steps halved while the residual grows; the root or None."""
     z, h = np.asarray(z0, float), 1e-7 * np.asarray(scale, float)
-    best = None
+    best, dz = None, np.zeros_like(z)
     for _ in range(max_iter):
         R = fun(np.vstack([z, z + np.diag(h)]))
         norm = float(np.linalg.norm(R[0]))
         if not np.isfinite(norm):
             return None
         if best is not None and norm >= best[1]:
-            dz = 0.5 * dz  # noqa: F821 -- set below on the first pass
+            dz = 0.5 * dz  # the last step halved (best is set, so dz is that step)
             z = best[0] + dz
             continue
         best = (z, norm)

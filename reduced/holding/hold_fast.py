@@ -67,15 +67,18 @@ class Closed(NamedTuple):
     symmetric: bool         #: one finger solved, turned to the others
 
 
-def close_hand(P_cavity: float, placed: Placed, design: HandDesign, *, reservoir_on: bool = True) -> Closed:
+def close_hand(P_cavity: float, placed: Placed, design: HandDesign, *, reservoir_on: bool = True,
+               near: Closed | None = None) -> Closed:
     """Every finger closed on the object at cavity pressure P [MPa] (``design`` with its finger
-    model, :func:`finger_design`); the pump pressure is P less the reservoir's at the oil taken."""
+    model, :func:`finger_design`); the pump pressure is P less the reservoir's at the oil taken.
+    ``near``: the hand closed on the object at a pose nearby (each finger's start)."""
     sym = hand_layout.symmetric(placed, design)
+    start = (lambda i: near.fingers[i]) if near is not None else (lambda i: None)  # noqa: E731
     if sym:
-        one = close_finger(0, P_cavity, placed, design)
+        one = close_finger(0, P_cavity, placed, design, start(0))
         states = tuple(_turned(one, i, placed, design) for i in range(design.n))
     else:
-        states = tuple(close_finger(i, P_cavity, placed, design) for i in range(design.n))
+        states = tuple(close_finger(i, P_cavity, placed, design, start(i)) for i in range(design.n))
     return Closed(P_cavity, pump_pressure(P_cavity, [s.q.sum() for s in states], design, reservoir_on),
                   states, sym)
 

@@ -95,6 +95,15 @@ def dimensions(obj: GraspObject) -> tuple:
             "capsule": (obj.diameter_mm, obj.length_mm)}.get(obj.shape, ())
 
 
+def size_radius(obj: GraspObject) -> float:
+    """The object's radius as the holds measure a slide by it [mm]: half the diameter of a sphere
+    or cylinder, else half the diagonal of its bounding box (a box's, a capsule's, a mesh's)."""
+    if obj.shape in ("sphere", "cylinder"):
+        return 0.5 * obj.diameter_mm
+    lo, hi = local_extent(obj)
+    return 0.5 * float(np.linalg.norm(hi - lo))
+
+
 def local_extent(obj: GraspObject) -> tuple[np.ndarray, np.ndarray]:
     """(lowest, highest) corner (3,) of the object's bounding box in its own frame [mm]."""
     if obj.shape == "sphere":

@@ -30,11 +30,12 @@ from softhand.studies.design.task import Task
 PRESSURE_TOL = 2e-3
 
 
-def _limit(d, task, placed, P_cavity):
-    """(holding limit along the pull, the raw LP pull (may be < 0), closed hand) at P_cavity."""
+def _limit(d, task, placed, P_cavity, enough_N=math.inf):
+    """(holding limit along the pull, the raw LP pull (may be < 0), closed hand) at P_cavity; the
+    object's slide followed until the limit reaches ``enough_N``."""
     closed = hold_fast.close_hand(P_cavity, placed, d)
     r = hold.solve_hold(d, task.obj, P_cavity_MPa=P_cavity, pull_direction=task.hold_pull, placed=placed,
-                        closed=closed)
+                        closed=closed, enough_N=enough_N)
     raw = r.extra.get("limit_pull_N")
     return (r.holding_limit_N if r.held else -math.inf), (raw if raw is not None else -math.inf), closed
 
@@ -60,7 +61,7 @@ def evaluate_hold(design: HandDesign, task: Task) -> Evaluation:
                 break
             mid = hi - f_hi * (hi - lo) / (f_hi - f_lo) if n % 3 != 2 else 0.5 * (lo + hi)
             mid = min(max(mid, lo + 0.1 * PRESSURE_TOL), hi - 0.1 * PRESSURE_TOL)
-            F_mid, raw_mid, c_mid = _limit(d, task, placed, mid)
+            F_mid, raw_mid, c_mid = _limit(d, task, placed, mid, required)
             f_mid = (F_mid if math.isfinite(F_mid) else raw_mid) - required
             if F_mid >= required:
                 hi, f_hi, best = mid, f_mid, c_mid
