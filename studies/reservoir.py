@@ -16,6 +16,7 @@ and a fully bent finger.
 from __future__ import annotations
 
 import math
+import sys
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
@@ -25,7 +26,6 @@ from softhand.fem.hand.reservoir import ReservoirResult, SheetModel, inflate
 from softhand.reduced.equations import finger
 from softhand.reduced.equations import reservoir as ellipse
 from softhand.reduced.vocabulary.design import HandDesign
-from softhand.reduced.vocabulary.errors import InputError
 from softhand.studies.calibration.tables import write_table, written_by
 
 __all__ = ["ReservoirStudy", "ReservoirStudyResult", "run", "stroke_volume", "COLUMNS"]
@@ -200,12 +200,15 @@ CALIBRATION_COLUMNS = ("tau", "v", "p_tilde", "W_tilde", "h_tilde", "s_tilde")
 
 def write_calibration(study: ReservoirStudy, path) -> int:
     """FEM tables at the design's thickness t and at 2t (twice the layers: same element shape),
-    written to ``path`` with their provenance; the number of rows."""
+    written to ``path`` with their provenance; the number of rows. A design with its own rubber
+    gets the tables of a Neo-Hookean sheet of the rubber's initial shear modulus (the tables are
+    dimensionless; the "fem" model applies the rubber on top of them), as ``calibrate finger``
+    does for the tube, and a note says so."""
     if not study.design.reservoir_is_neo_hookean:
-        raise InputError("--write-calibration", str(path), "the 'fem' reservoir model's table holds a "
-                         "Neo-Hookean sheet (the model applies a design's own rubber on top of it); "
-                         f"write it from a design without [reservoir.material] (this one's is "
-                         f"{study.design.reservoir_material.model})")
+        print(f"note: the tables are built with a Neo-Hookean sheet of the rubber's initial shear modulus "
+              f"mu_sr_MPa = {study.design.mu_sr:.6g}; reservoir_model \"fem\" applies a design's own rubber "
+              f"({study.design.reservoir_material.model} here) on top of them", file=sys.stderr)
+        study = replace(study, design=study.design.replace(reservoir_material=None))
     thin = study.model()
     thick = replace(thin, t=2 * thin.t, n_thick=2 * thin.n_thick)
     rows = calibration_rows(thin) + calibration_rows(thick)
