@@ -6,7 +6,9 @@ much more can it take along a pull, and what pump pressure holds it with a margi
 the closing forces, :func:`softhand.reduced.holding.hold_lp.weight_state`), pull along a direction until no
 admissible state is left (:func:`softhand.reduced.holding.hold_lp.holding_limit`), the object sliding along the
 pull where the fingers closing on it there hold it more (:mod:`softhand.reduced.holding.hold_slide`: the
-holding limit is the first maximum along that slide). It returns the common
+holding limit is the first maximum along that slide; a pull towards the palm is not followed: pushed
+into the hand, the object meets the palm, which is not a contact of this model, and fingers pushed
+open past straight, where the hinge tables do not reach). It returns the common
 :class:`softhand.reduced.holding.hold_result.HoldResult` (model ``"reduced"``); the object's displacement
 is its slide under its own weight, along the pull (it does not turn in this model).
 
@@ -108,6 +110,8 @@ def solve_hold(design: HandDesign, obj: GraspObject, *, P_cavity_MPa: float, pul
 
     def at(y, hand=None):
         """(lam, (placed, closed, contact set, limit state)) with the object moved y [mm] along the pull."""
+        if y > 0.0 and pull[1] < 0.0:  # pushed towards the palm: not followed (module doc)
+            return -math.inf, None
         moved = placed if y == 0.0 else replace(placed, centre=placed.centre + y * pull)
         near = hands[min(hands, key=lambda x: abs(x - y))] if hands else None
         try:
@@ -120,7 +124,8 @@ def solve_hold(design: HandDesign, obj: GraspObject, *, P_cavity_MPa: float, pul
         return (lim.pull_N if lim is not None else -math.inf), (moved, hand, cs, lim)
 
     first = at(0.0, closed)
-    path = hold_slide.follow(at, first, weight_N=weight, slip_out_mm=0.5 * size_radius(obj), enough_N=enough_N)
+    path = hold_slide.follow(at, first, weight_N=weight, slip_out_mm=0.5 * size_radius(obj), enough_N=enough_N,
+                             settle=bool(pull[1] >= 1.0 - 1e-12))  # settles under its weight along a pull down
     moved, closed_rest, cs, _ = path.rest if path.rest is not None else first[1]
     _, _, cs_limit, limit = path.limit if path.limit is not None else first[1]
     rest = hold_lp.weight_state(cs, moved.centre, weight, obj.friction, size_mm=size) \

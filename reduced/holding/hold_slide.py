@@ -61,13 +61,17 @@ class Slide(NamedTuple):
 
 
 def follow(at: Callable[[float], tuple], first, *, weight_N: float, slip_out_mm: float,
-           enough_N: float = math.inf) -> Slide:
+           enough_N: float = math.inf, settle: bool = True) -> Slide:
     """The slide of module doc: ``at(y)`` is (lam(y), evaluation) for the object moved y [mm] along
     the pull (lam = -inf where no pad holds it), ``first`` that pair at y = 0. An object that has
     slid ``slip_out_mm`` from where it rests has slipped out (the FEM hold's rule: a quarter of its
-    size); the walk also stops once the pull borne reaches ``enough_N`` (then a lower bound)."""
+    size); the walk also stops once the pull borne reaches ``enough_N`` (then a lower bound).
+    ``settle``: an object whose weight the pads do not bear at y = 0 slides along the walk to rest
+    (the pull is along gravity); else it falls."""
     scale = max(abs(weight_N), 1.0)
     seen = {0.0: first}
+    if not settle and not first[0] >= 0.0:
+        return Slide(0.0, first[1], None, None, 1, False)
 
     def raw(y):
         if y not in seen:

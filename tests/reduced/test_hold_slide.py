@@ -122,3 +122,18 @@ def test_a_ball_held_above_its_widest_section_does_not_slide(P):
     assert r.held and r.holding_limit_N == r.extra["first_slip_pull_N"]
     assert r.extra["slide_mm"] == 0.0 and r.displacement_mm == (0.0, 0.0, 0.0)
     assert r.extra["slide_evaluations"] == 2
+
+
+def test_a_pull_towards_the_palm_is_not_followed_and_only_a_pull_down_settles():
+    """Pushed up into the hand the object would meet the palm (not a contact) and push the fingers
+    open past straight: its limit is where the pads first slip. Under a sideways pull an object
+    whose weight the pads do not bear falls (it would settle downwards, not along the pull)."""
+    d = hold_fast.finger_design(HandDesign())
+    up = hold.solve_hold(d, objects.GraspObject(diameter_mm=180.0, mass_kg=0.5, friction=0.8), P_cavity_MPa=0.9,
+                         pull_direction=(0.0, -1.0, 0.0))
+    assert up.held and up.holding_limit_N == up.extra["first_slip_pull_N"] and up.extra["slide_mm"] == 0.0
+    ball = objects.GraspObject(diameter_mm=150.0, mass_kg=0.5, friction=0.8)
+    down = hold.solve_hold(d, ball, P_cavity_MPa=1.7)
+    side = hold.solve_hold(d, ball, P_cavity_MPa=1.7, pull_direction=(1.0, 0.0, 0.0))
+    assert down.held and down.displacement_mm[1] > 0.0
+    assert not side.held and side.extra["slide_evaluations"] == 1
