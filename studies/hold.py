@@ -5,7 +5,8 @@ friction and pull direction.
 holding margin, the load the hand bears along the pull over the object's weight ((m g + limit)
 / m g; >= 1: held), the holding limit [N], and both pressures. The closed hand depends only on
 the pressure and the object's geometry, so it is computed once per pressure and size and
-reused across masses, frictions and pulls (the map's cost is then mostly linear programs).
+reused across masses, frictions and pulls, and so are the hands closed along the object's slide
+(per pull; :mod:`softhand.reduced.holding.hold_slide`): the map's cost is then mostly linear programs.
 ``write`` makes ``hold_map.csv`` and ``hold_map.png`` (held region shaded, margin contours, the
 margin-1 line where it drops, the pump's limit drawn when pressure is an axis). Units: MPa, kg,
 mm, N, deg.
@@ -103,10 +104,11 @@ def run_map(m: HoldMap, progress=None) -> list[dict]:
             if key not in cache:
                 placed = place_object(obj, d)
                 Pc = hold.cavity_pressure(float(P_pump), placed, d)
-                cache[key] = (placed, hold_fast.close_hand(Pc, placed, d))
-            placed, closed = cache[key]
+                cache[key] = (placed, hold_fast.close_hand(Pc, placed, d), {})
+            placed, closed, slides = cache[key]
+            along = slides.setdefault(tuple(np.round(np.asarray(pull, float), 12)), {})  # by pull: the slide's poses
             r = hold.solve_hold(d, obj, P_cavity_MPa=closed.P_cavity, pull_direction=pull, placed=placed,
-                                closed=closed)
+                                closed=closed, slide_hands=along)
             weight = obj.mass_kg * d.g
             raw = r.extra.get("limit_pull_N")
             margin = math.inf if weight == 0 else (0.0 if raw is None else (weight + raw) / weight)

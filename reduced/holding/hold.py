@@ -95,10 +95,13 @@ def _contacts(cs: hold_lp.ContactSet, state: hold_lp.LimitState | None, held: bo
 
 def solve_hold(design: HandDesign, obj: GraspObject, *, P_cavity_MPa: float, pull_direction=DOWN,
                finger_model: str = "fem", reservoir: bool = True, placed: Placed | None = None,
-               closed: hold_fast.Closed | None = None, enough_N: float = math.inf) -> HoldResult:
+               closed: hold_fast.Closed | None = None, enough_N: float = math.inf,
+               slide_hands: dict | None = None) -> HoldResult:
     """The hold at cavity pressure P [MPa] (module doc): close, let go, pull along the direction,
     the object sliding along it as far as the pull takes it (:mod:`softhand.reduced.holding.hold_slide`);
-    the slide is followed only until the pull borne reaches ``enough_N`` (the limit is then at least that)."""
+    the slide is followed only until the pull borne reaches ``enough_N`` (the limit is then at least that).
+    ``slide_hands``: the hands closed along the slide, by slide [mm], kept between calls that share
+    the pressure, the object's shape and pose and the pull (a map over mass fills it once)."""
     d = hold_fast.finger_design(design, finger_model)
     pull = pull_unit(pull_direction, "pull_direction")
     placed = place_object(obj, d) if placed is None else placed
@@ -106,7 +109,7 @@ def solve_hold(design: HandDesign, obj: GraspObject, *, P_cavity_MPa: float, pul
     weight = obj.mass_kg * d.g
     size = float(np.max(np.ptp(placed.surface(resolution=8)[0], axis=0)))
 
-    hands = {}
+    hands = {} if slide_hands is None else slide_hands
 
     def at(y, hand=None):
         """(lam, (placed, closed, contact set, limit state)) with the object moved y [mm] along the pull."""
@@ -115,7 +118,8 @@ def solve_hold(design: HandDesign, obj: GraspObject, *, P_cavity_MPa: float, pul
         moved = placed if y == 0.0 else replace(placed, centre=placed.centre + y * pull)
         near = hands[min(hands, key=lambda x: abs(x - y))] if hands else None
         try:
-            hand = hand or hold_fast.close_hand(closed.P_cavity, moved, d, reservoir_on=reservoir, near=near)
+            hand = hand or hands.get(y) or hold_fast.close_hand(closed.P_cavity, moved, d, reservoir_on=reservoir,
+                                                                near=near)
         except InputError:  # moved into the open fingers: they have let it through
             return -math.inf, None
         hands[y] = hand
