@@ -9,6 +9,7 @@ import pytest
 from softhand.reduced.holding import hold, hold_fast, hold_lp, hold_slide, objects
 from softhand.reduced.holding.hand_layout import place_object
 from softhand.reduced.vocabulary.design import HandDesign
+from softhand.reduced.vocabulary.design_files import design_from_dict
 
 
 def _walk(curve, *, weight=5.0, slip_out=100.0, enough=math.inf):
@@ -137,3 +138,22 @@ def test_a_pull_towards_the_palm_is_not_followed_and_only_a_pull_down_settles():
     side = hold.solve_hold(d, ball, P_cavity_MPa=1.7, pull_direction=(1.0, 0.0, 0.0))
     assert down.held and down.displacement_mm[1] > 0.0
     assert not side.held and side.extra["slide_evaluations"] == 1
+
+
+def test_a_finger_pressing_with_two_pads_keeps_their_closing_shares():
+    """A 160 mm cube under fingers of a 16 mm plate (a 5, b 4, l0 160 mm): each finger presses a
+    top edge with link 2 and the face with its tip. At the holding limit, and under the weight,
+    every finger's two normal forces keep the ratio they closed with (the finger cannot squeeze
+    the cube between its pads: module doc of hold_lp)."""
+    d = hold_fast.finger_design(design_from_dict({"a_mm": 5.0, "b_mm": 4.0, "d_mm": 16.0, "l0_mm": 160.0,
+                                                  "tie_width_mm": 8.0}))
+    obj = objects.GraspObject(shape="box", size_mm=(160.0, 160.0, 160.0), mass_kg=0.5, friction=0.5)
+    closed = hold_fast.close_hand(1.2, place_object(obj, d), d)
+    N = closed.fingers[0].N
+    assert np.count_nonzero(N) == 2
+    ratio = N[N > 0][0] / N[N > 0][1]
+    r = hold.solve_hold(d, obj, P_cavity_MPa=1.2, closed=closed)
+    for contacts in (r.extra["limit_contacts"], [c.__dict__ for c in r.contacts]):
+        for f in range(4):
+            mine = sorted((c["link"], c["normal_N"]) for c in contacts if c["finger"] == f)
+            assert len(mine) == 2 and mine[0][1] / mine[1][1] == pytest.approx(ratio, rel=1e-6)
