@@ -155,6 +155,10 @@ def _print(r) -> None:
           f"{r.holding_limit_N:.4g} N ({r.holding_limit_kg:.4g} kg) beyond the weight {weight:.4g} N")
     for c in r.contacts:
         print(f"  finger {c.finger} pad {c.link}: normal {c.normal_N:.4g} N, friction {c.friction_N:.4g} N, {c.state}")
+    at_limit = r.steps[-1].displacement_mm if r.steps else r.displacement_mm
+    if max(abs(float(v)) for v in (*r.displacement_mm, *at_limit)) > 0.01:
+        mm = lambda v: [round(float(x), 2) for x in v]  # noqa: E731
+        print(f"  the object moved {mm(r.displacement_mm)} mm under its weight, {mm(at_limit)} mm at the holding limit")
     for note in r.notes:
         print(f"  note: {note}")
 
