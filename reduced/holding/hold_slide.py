@@ -108,8 +108,8 @@ def follow(at: Callable[[float], tuple], first, *, weight_N: float, slip_out_mm:
     slipped_out = y_best >= bound and y_rest is not None
     if slipped_out and bound - WEDGE_MM > y_rest:
         y_best = bound - WEDGE_MM  # the pull kept over the last WEDGE_MM before it slips out
-    if 0.0 < y_best < y and raw(y_best) < enough_N and not slipped_out:  # golden sections on [y_before, y] around y_best
-        a, b = y_before, y
+    if 0.0 < y_best < y and raw(y_best) < enough_N and not slipped_out:
+        a, b = y_before, y  # golden sections on [y_before, y] around y_best
         while b - a > Y_TOL:
             c = b - _G * (b - a) if y_best - a > b - y_best else a + _G * (b - a)
             left, right = (c, y_best) if c < y_best else (y_best, c)
