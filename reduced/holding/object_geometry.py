@@ -190,7 +190,7 @@ class Placed:
         g = g @ self.R.T
         return g / np.maximum(np.linalg.norm(g, axis=-1, keepdims=True), 1e-300)
 
-    def support(self, u, ref) -> np.ndarray | None:
+    def support(self, u, ref) -> np.ndarray:
         """:func:`support_point` (a mesh's :func:`~softhand.reduced.holding.object_mesh.mesh_support`)
         in the hand frame: directions u and references ref (m, 3)."""
         u, ref = np.asarray(u) @ self.R, self.to_local(ref)
@@ -200,7 +200,7 @@ class Placed:
             local = mesh_support(mesh, u, ref, tie)
         else:
             local = support_point(self.obj.shape, dimensions(self.obj), u, ref)
-        return None if local is None else self.centre + local @ self.R.T
+        return self.centre + local @ self.R.T
 
     def surface(self, *, resolution: int = 32) -> tuple[np.ndarray, np.ndarray]:
         """The surface as (points (m, 3) in the hand frame [mm], triangles (k, 3))."""
