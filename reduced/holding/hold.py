@@ -58,7 +58,7 @@ def pull_unit(pull, field: str = "--pull") -> np.ndarray:
 
 
 def contact_set(closed: hold_fast.Closed, design: HandDesign) -> hold_lp.ContactSet:
-    """The touching pads of the closed hand and its fingers' hinge capacities for the LP."""
+    """The touching pads of the closed hand and its fingers' hinges (moments, stiffness) for the LP."""
     rows = []
     for i, s in enumerate(closed.fingers):
         for k in np.flatnonzero((s.N > 0.0) | (s.geometry.gap <= hold_finger.TOUCH)):
@@ -69,13 +69,15 @@ def contact_set(closed: hold_fast.Closed, design: HandDesign) -> hold_lp.Contact
     J = np.zeros((design.n * n_s, C, 3))
     for c, (i, k) in enumerate(rows):
         J[i * n_s:(i + 1) * n_s, c] = closed.fingers[i].geometry.dx[k]
-    capacity = np.concatenate([np.maximum(-s.moments, 0.0) for s in closed.fingers])
+    q = np.array([s.q for s in closed.fingers])
     take = lambda f: np.array([f(closed.fingers[i], k) for i, k in rows], float).reshape(C, -1) if C \
         else np.zeros((0, 3))  # noqa: E731
     return hold_lp.ContactSet(
         finger=np.array([i for i, _ in rows], int), link=np.array([k for _, k in rows], int),
         point=take(lambda s, k: s.geometry.point[k]), normal=take(lambda s, k: s.geometry.normal[k]),
-        closing_N=take(lambda s, k: s.N[k])[:, 0] if C else np.zeros(0), J=J, capacity=capacity)
+        closing_N=take(lambda s, k: s.N[k])[:, 0] if C else np.zeros(0), J=J,
+        moment=np.concatenate([s.moments for s in closed.fingers]),
+        stiffness=hold_finger.hinge_stiffness(q, closed.P_cavity, design).ravel())
 
 
 def _contacts(cs: hold_lp.ContactSet, state: hold_lp.LimitState | None, held: bool) -> tuple:

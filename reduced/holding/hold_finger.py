@@ -30,6 +30,17 @@ def hinge_moments(q, P, design: HandDesign) -> np.ndarray:
     return -finger.volume_rate(theta, design) * (P - hand.finger_pressure(theta, design))
 
 
+#: step [rad] of the central difference of :func:`hinge_stiffness`
+_DQ = 1e-6
+
+
+def hinge_stiffness(q, P, design: HandDesign) -> np.ndarray:
+    """K_j = dM_j/d theta_hat_j [N mm/rad] (..., n_s) at hinge angles q (M_j depends on q_j alone: one
+    central difference of every hinge at once)."""
+    q = np.asarray(q, float)
+    return (hinge_moments(q + _DQ, P, design) - hinge_moments(q - _DQ, P, design)) / (2.0 * _DQ)
+
+
 def hinge_energy(q, P, design: HandDesign) -> float:
     """E = sum_j int_0^q_j M_j [N mm] (16-point Gauss along each hinge; M_j depends on q_j alone)."""
     q = np.asarray(q, float)

@@ -11,25 +11,29 @@ and its friction force F_c (in the tangent plane), and the pull lam beyond the w
 
    |F_c| \le \mu N_c \qquad \text{(Coulomb)}
 
-   -\sum_{c \in i} (N_c n_c - F_c)\cdot \partial x_c/\partial\hat\theta_j \le -M_j(\hat\theta^*, P)
+   M_j(\hat\theta^*, P) + K_j\,\delta\hat\theta_j = \sum_{c \in i} (N_c n_c - F_c)\cdot \partial x_c/\partial\hat\theta_j
    \qquad \text{(finger i, hinge j)}
 
-   N_c / N^*_c = N_{c'} / N^*_{c'} \qquad \text{(pads c, c' of one finger that pressed when it closed)}
+   \sum_j \partial g_c/\partial\hat\theta_j\,\delta\hat\theta_j = 0 \qquad \text{(pad c stays on the object; } \ge 0
+   \text{ for a pad that touched without force)}
 
-The last line is each finger's hinge equilibrium read as a capacity: the force of the object on
-the finger's pads may push hinge j open with at most the moment the pressure holds it with at
-the grasp state, -M_j >= 0 (:func:`softhand.reduced.holding.hold_finger.hinge_moments`; in the closed state it is
-met with equality by the closing forces). The fingers stay at their grasp configuration (small
-displacements: the object and the pads are rigid, the compliance is the hinges'), so the
-holding limit is the largest lam for which some set of contact forces satisfies all of the
-above: a statically admissible state, the lower bound of limit analysis. The last line keeps the
-share of each finger's pads in their closing ratio: a finger pressing with two pads (a box's top
-edge and its face, a ball in the crease between two links) is statically indeterminate, and
-limit analysis would let it squeeze the object between them as hard as its hinges' moments allow,
-as if the hinges gave way at those moments; they are elastic and stiffen as they open, so the
-share between the pads is the stiffness's, which the closing found (measured: a 160 mm cube held
-by a top edge and a fingertip, 39.9 N of holding limit with the squeeze against the FEM's 28.5 N,
-24.7 N without it). It is solved by HiGHS
+The last two lines are each finger's hinge equilibrium, elastic: the force of the object on the
+finger's pads bends its hinges by :math:`\delta\hat\theta` from the grasp state, each hinge
+answering with its stiffness :math:`K_j = \partial M_j/\partial\hat\theta_j` at the grasp
+(:func:`softhand.reduced.holding.hold_finger.hinge_stiffness`; at :math:`\delta\hat\theta = 0` the
+closing forces meet it exactly), while the pads that press stay on the object, held where the
+slide has brought it (small displacements: the object and the pads are rigid, the compliance is
+the hinges'; the object's large motion along the pull is :mod:`softhand.reduced.holding.hold_slide`'s).
+A finger's normal forces change with the friction on its pads as its hinges' compliance gives:
+a tip pad whose friction loads every hinge sheds or gains N by the compliance-weighted mean of
+the hinges' loads, a finger pressing with two pads shares them by its stiffness. The finger FEM
+does the same: the 180 mm sphere of 2 kg at 0.9 MPa, pulled in steps of 0.25 N, raises its pads'
+N by 0.024 N per newton of friction while they stick (12.538 -> 12.570 N); this model 0.0226.
+(Until 2026-12-06 each hinge was a capacity, the opening moment the pressure held at the grasp,
+and a finger's pads kept their closing ratio: the weakest hinge then bounded a tip pad's N, and
+the fast limit was 10-31 % below the FEM's on every tip contact and wedge; docs/grasp.md.)
+The holding limit is the largest lam for which some set of contact forces satisfies all of the
+above. It is solved by HiGHS
 (:func:`scipy.optimize.linprog`). The Coulomb cone is replaced by the inscribed polygon of
 :data:`GENERATORS` directions, one along the tangential part of the load's direction (so a pull
 along the pad is bounded exactly by mu N): elsewhere the friction the polygon allows is at most
@@ -37,7 +41,10 @@ along the pad is bounded exactly by mu N): elsewhere the friction the polygon al
 
 The state reported under the object's own weight (lam = 0) is the admissible one whose normal
 forces are closest (sum of ``|N_c - N*_c|``) to the closing forces N*_c, the friction shared as evenly
-as it can be (the largest ``|F_c|`` / (mu N*_c) least). Units: N, mm.
+as it can be (the largest ``|F_c|`` / (mu N*_c) least), the object free to move a little (its small
+translation and rotation enter the pads' gap rates): the elastic fingers fix each pad's N for a
+given friction, and a frictionless ball caged below its equator rests only once it has risen
+until their push balances its weight. Units: N, mm.
 """
 from __future__ import annotations
 
@@ -55,15 +62,16 @@ MAX_PULL = 1e6
 
 
 class ContactSet(NamedTuple):
-    """The touching pads after closing and the fingers' hinge capacities."""
+    """The touching pads after closing and the fingers' hinges at the grasp."""
 
     finger: np.ndarray       #: (C,) finger of each contact
     link: np.ndarray         #: (C,) pad of each contact
     point: np.ndarray        #: (C, 3) contact point [mm]
     normal: np.ndarray       #: (C, 3) the object's outward unit normal there
     closing_N: np.ndarray    #: (C,) normal force at the end of closing [N]
-    J: np.ndarray            #: (H, C, 3) d x_c / d theta_hat of each capacity row's hinge [mm/rad]
-    capacity: np.ndarray     #: (H,) -M_j >= 0, the opening moment each hinge holds [N mm]
+    J: np.ndarray            #: (H, C, 3) d x_c / d theta_hat_j of every finger's hinge j [mm/rad] (0: not on c's finger)
+    moment: np.ndarray       #: (H,) M_j at the grasp [N mm/rad] (negative: the pressure holds the hinge shut)
+    stiffness: np.ndarray    #: (H,) K_j = dM_j / d theta_hat_j at the grasp [N mm/rad]
 
 
 class LimitState(NamedTuple):
@@ -92,40 +100,50 @@ def tangent_generators(normal, direction, count: int = GENERATORS) -> np.ndarray
     return np.cos(a)[None, :, None] * t1[:, None, :] + np.sin(a)[None, :, None] * t2[:, None, :]
 
 
-def _system(cs: ContactSet, centre, weight_N: float, pull, mu: float, gens: np.ndarray):
-    """Equality (A_eq, b_eq) and inequality (A_ub, b_ub) of the LP in z = (N (C), beta (C G), lam)."""
+def _system(cs: ContactSet, centre, weight_N: float, pull, mu: float, gens: np.ndarray, moving: bool = False):
+    """Equality (A_eq, b_eq) and inequality (A_ub, b_ub) of the LP in z = (N (C), beta (C G), dq, m, lam),
+    and the count of (dq, m): dq the bends of the hinges some pad loads (the other hinges stay as they
+    closed), m the object's small translation and rotation where it is ``moving`` (else none)."""
     C, G = len(cs.finger), gens.shape[1]
+    loaded = np.flatnonzero(np.any(cs.J != 0.0, axis=(1, 2)))     # hinges some pad can turn
+    Q, M = len(loaded), (6 if moving else 0)
     r = cs.point - np.asarray(centre, float)
-    # force on the object per unit of each unknown: N -> -n, beta -> t, lam -> d
+    # force on the object per unit of each unknown: N -> -n, beta -> t, dq, m -> 0, lam -> d
     f_N = -cs.normal                                           # (C, 3)
     f_b = gens.reshape(C * G, 3)                               # (C G, 3)
-    cols_f = np.vstack([f_N, f_b, np.asarray(pull, float)[None]])        # (nz, 3)
-    arms = np.vstack([r, np.repeat(r, G, axis=0), np.zeros((1, 3))])
+    cols_f = np.vstack([f_N, f_b, np.zeros((Q + M, 3)), np.asarray(pull, float)[None]])   # (nz, 3)
+    arms = np.vstack([r, np.repeat(r, G, axis=0), np.zeros((Q + M + 1, 3))])
     A_eq = np.vstack([cols_f.T, np.cross(arms, cols_f).T])     # (6, nz)
     b_eq = np.concatenate([[0.0, -weight_N, 0.0], np.zeros(3)])
-    cone = np.zeros((C, C + C * G + 1))
+    nz = A_eq.shape[1]
+    cone = np.zeros((C, nz))
     cone[np.arange(C), np.arange(C)] = -mu
     cone[np.repeat(np.arange(C), G), C + np.arange(C * G)] = 1.0
-    # hinge rows: force on the finger = N n - beta t; row: -(that) . J <= capacity
-    H = len(cs.capacity)
-    hinge = np.zeros((H, C + C * G + 1))
-    if H:
-        hinge[:, :C] = -np.einsum("ci,hci->hc", cs.normal, cs.J)
-        hinge[:, C:C + C * G] = np.einsum("cgi,hci->hcg", gens, cs.J).reshape(H, C * G)
-    A_ub = np.vstack([cone, hinge])
-    b_ub = np.concatenate([np.zeros(C), cs.capacity])
-    share = [(a, b) for f in np.unique(cs.finger)
-             for a, b in _pairs(np.flatnonzero((cs.finger == f) & (cs.closing_N > 0.0)))]
-    if share:  # N_a N*_b - N_b N*_a = 0: a finger's pads keep their closing ratio
-        rows = np.zeros((len(share), A_eq.shape[1]))
-        for r, (a, b) in enumerate(share):
-            rows[r, a], rows[r, b] = cs.closing_N[b], -cs.closing_N[a]
-        A_eq, b_eq = np.vstack([A_eq, rows]), np.concatenate([b_eq, np.zeros(len(share))])
-    return A_eq, b_eq, A_ub, b_ub
+    # hinge j: K_j dq_j - (N n - beta t) . J = -M_j  (the force on the finger is N n - beta t)
+    J = cs.J[loaded]                                           # (Q, C, 3)
+    dg = np.einsum("ci,hci->hc", cs.normal, J)                 # (Q, C) gap rates
+    hinge = np.zeros((Q, nz))
+    hinge[:, :C] = -dg
+    hinge[:, C:C + C * G] = np.einsum("cgi,hci->hcg", gens, J).reshape(Q, C * G)
+    hinge[np.arange(Q), C + C * G + np.arange(Q)] = cs.stiffness[loaded]
+    # pads that pressed stay on the object (gap rate 0); those that touched without force may leave it.
+    # gap rate: dg . dq - n . (dx + dw x r) = dg . dq - n . dx - (r x n) . dw
+    stay = np.zeros((C, nz))
+    stay[:, C + C * G:C + C * G + Q] = dg.T
+    if moving:
+        stay[:, C + C * G + Q:C + C * G + Q + 3] = -cs.normal
+        stay[:, C + C * G + Q + 3:C + C * G + Q + 6] = -np.cross(r, cs.normal)
+    pressed = cs.closing_N > 0.0
+    A_eq = np.vstack([A_eq, hinge, stay[pressed]])
+    b_eq = np.concatenate([b_eq, -cs.moment[loaded], np.zeros(int(pressed.sum()))])
+    A_ub = np.vstack([cone, -stay[~pressed]])
+    b_ub = np.zeros(len(A_ub))
+    return A_eq, b_eq, A_ub, b_ub, Q + M
 
 
-def _pairs(index):
-    return zip(index[:-1], index[1:])
+def _bounds(C: int, G: int, free: int, lam: tuple) -> list:
+    """N, beta >= 0, dq and m free, lam within ``lam``."""
+    return [(0, None)] * (C + C * G) + [(None, None)] * free + [lam]
 
 
 def _state(z, cs: ContactSet, gens, mu, A_eq, b_eq, size: float) -> LimitState:
@@ -148,11 +166,10 @@ def holding_limit(cs: ContactSet, centre, weight_N: float, pull, mu: float, *,
         return None
     load = np.asarray(pull, float)
     gens = tangent_generators(cs.normal, load)
-    A_eq, b_eq, A_ub, b_ub = _system(cs, centre, weight_N, load, mu, gens)
-    nz = A_eq.shape[1]
-    c = np.zeros(nz)
+    A_eq, b_eq, A_ub, b_ub, Q = _system(cs, centre, weight_N, load, mu, gens)
+    c = np.zeros(A_eq.shape[1])
     c[-1] = -1.0
-    bounds = [(0, None)] * (nz - 1) + [(-weight_N - 1.0, MAX_PULL)]
+    bounds = _bounds(len(cs.finger), gens.shape[1], Q, (-weight_N - 1.0, MAX_PULL))
     sol = linprog(c, A_ub=A_ub, b_ub=b_ub, A_eq=A_eq, b_eq=b_eq, bounds=bounds, method="highs")
     if sol.status != 0:
         return None
@@ -168,7 +185,7 @@ def weight_state(cs: ContactSet, centre, weight_N: float, mu: float, *, pull_N: 
     load = np.asarray(pull, float)
     direction = np.asarray([0.0, 1.0, 0.0]) * weight_N + pull_N * load
     gens = tangent_generators(cs.normal, direction if np.linalg.norm(direction) > 0 else load)
-    A_eq, b_eq, A_ub, b_ub = _system(cs, centre, weight_N, load, mu, gens)
+    A_eq, b_eq, A_ub, b_ub, Q = _system(cs, centre, weight_N, load, mu, gens, moving=True)
     C, nz = len(cs.finger), A_eq.shape[1]
     G = gens.shape[1]
     # z' = (z, s (C), u): s_c >= |N_c - N*_c|, u >= each pad's friction over mu N*_c; minimise
@@ -182,7 +199,7 @@ def weight_state(cs: ContactSet, centre, weight_N: float, mu: float, *, pull_N: 
     b_ub2 = np.concatenate([b_ub, cs.closing_N, -cs.closing_N, np.zeros(C)])
     A_eq2 = np.hstack([A_eq, np.zeros((len(A_eq), C + 1))])
     c = np.concatenate([np.zeros(nz), np.ones(C), [1e-3 * max(float(np.sum(cs.closing_N)), 1e-9)]])
-    bounds = [(0, None)] * (nz - 1) + [(pull_N, pull_N)] + [(0, None)] * (C + 1)
+    bounds = _bounds(C, G, Q, (pull_N, pull_N)) + [(0, None)] * (C + 1)
     sol = linprog(c, A_ub=A_ub2, b_ub=b_ub2, A_eq=A_eq2, b_eq=b_eq, bounds=bounds, method="highs")
     if sol.status != 0:
         return None

@@ -29,15 +29,20 @@ def test_one_finger_grasp_is_the_special_case(diameter, P):
     assert closed.symmetric
 
 
-def _pinch(N_cap: float, mu: float):
-    """Two flat pads on opposite faces x = +-20 of a box centred at the origin; each pad's
-    one 'hinge' row bounds its normal force by N_cap (J = the pad's push direction)."""
+def _pinch(N_cap: float, mu: float, *, along=0.0, K=(1000.0,)):
+    """Two flat pads on opposite faces x = +-20 of a box centred at the origin, each on its own
+    finger, closed with N_cap. A finger's hinges (stiffness K) push its pad along -n (J = -n: the
+    gap rate -1); its last hinge also moves the pad by ``along`` along +y per radian, so the pad's
+    friction loads that hinge."""
     normal = np.array([[1.0, 0, 0], [-1.0, 0, 0]])     # the box's outward normals at the pads
     point = 20.0 * normal
-    J = np.zeros((2, 2, 3))
-    J[0, 0], J[1, 1] = -normal[0], -normal[1]           # -(N n).J = N <= capacity
-    return hold_lp.ContactSet(np.array([0, 1]), np.array([1, 1]), point, normal,
-                              np.array([N_cap, N_cap]), J, np.array([N_cap, N_cap]))
+    h = len(K)
+    J = np.zeros((2 * h, 2, 3))
+    for c in range(2):
+        J[c * h:(c + 1) * h, c] = -normal[c]
+        J[(c + 1) * h - 1, c, 1] = along
+    return hold_lp.ContactSet(np.array([0, 1]), np.array([1, 1]), point, normal, np.array([N_cap, N_cap]), J,
+                              np.full(2 * h, -N_cap), np.tile(np.asarray(K, float), 2))
 
 
 @pytest.mark.parametrize("mu", [0.0, 0.3, 0.8])
@@ -52,6 +57,21 @@ def test_two_flat_pads_pinching_a_box_hold_two_mu_N(mu):
     assert np.allclose(lim.normal_N, 10.0)
     assert lim.pull_N + W == pytest.approx(2.0 * mu * float(np.mean(lim.normal_N)), rel=1e-9)
     assert np.all(lim.slip)
+
+
+@pytest.mark.parametrize("along", [0.5, -0.5])
+def test_a_pads_friction_on_elastic_hinges_changes_its_normal_force_by_their_compliance(along):
+    """A finger of two hinges (K_a = 1000, K_b = 3000 N mm/rad) pressing one pad; the pad's friction
+    (mu N against the pull along +y) loads hinge b alone, by s = ``along`` per unit. The pad stays on
+    the box: K_a da = N* - N, K_b db = N* - N + s mu N, da + db = 0, so N = N* / (1 - s mu w) with
+    w = (1/K_b) / (1/K_a + 1/K_b) = 1/4, the compliance-weighted share of the hinge it loads (a rigid
+    hinge a would keep N*, a rigid b would let it go to N* / (1 - s mu)). The pull beyond W is 2 mu N - W."""
+    mu, W, N_star = 0.8, 1.0, 10.0
+    cs = _pinch(N_star, mu, along=along, K=(1000.0, 3000.0))
+    lim = hold_lp.holding_limit(cs, np.zeros(3), W, (0, 1, 0), mu)
+    N = N_star / (1.0 - along * mu * 0.25)
+    assert np.allclose(lim.normal_N, N, rtol=1e-9)
+    assert lim.pull_N == pytest.approx(2.0 * mu * N - W, rel=1e-9)
 
 
 def test_pinch_off_axis_pull_within_the_polygon_bound():
