@@ -17,7 +17,8 @@ touching pads. Solved by SLSQP from the pose where the finger, closing with equa
 touches; then the active pads' equations by Newton (scipy's hybrid method) to 1e-10.
 
 **Holding**: the touching pads, their normals and closing forces, and each finger's hinge
-capacities (-M_j at the closed state) go to the limit analysis of :mod:`softhand.reduced.holding.hold_lp`.
+moments M_j and stiffnesses dM_j/d theta_hat_j at the closed state go to the limit analysis of
+:mod:`softhand.reduced.holding.hold_lp` (elastic fingers).
 
 Finger models: ``"fem"`` (default), the calibrated finger of :mod:`softhand.reduced.calibrated.grasp_fem` (hinge by
 hinge, from the finger FEM); ``"paper"``, the paper's finger (W_f, Q of eqs. (2), (10)) with its
