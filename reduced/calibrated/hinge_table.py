@@ -65,9 +65,9 @@ def _node_values(t: HingeTable, i, P):
     """(A, integral from p_0) of node i's a_j(p) at pressures P, both shaped like i (..., n_s)."""
     h, K = t.p[1] - t.p[0], len(t.p)
     j = np.broadcast_to(np.arange(i.shape[-1]), i.shape)
-    x = (np.asarray(P, float) - t.p[0]) / h
-    k = np.clip(np.floor(x).astype(int), 0, K - 2)
-    s = np.clip(x - k, 0.0, 1.0) * h                       # within cell k
+    x = (P - t.p[0]) / h
+    k = np.minimum(np.maximum(np.floor(x).astype(int), 0), K - 2)
+    s = np.minimum(np.maximum(x - k, 0.0), 1.0) * h          # within cell k
     a0, a1 = t.a[i, k, j], t.a[i, k + 1, j]
     A = a0 + (a1 - a0) * s / h
     F = t.cum[i, k, j] + a0 * s + 0.5 * (a1 - a0) * s * s / h
@@ -78,13 +78,13 @@ def _node_values(t: HingeTable, i, P):
 
 
 def _interpolate(t: HingeTable, theta, P):
-    """(a_j, int_{p_0}^{P} a_j dp) at hinge bends theta (..., n_s) and pressures P (broadcast)."""
-    theta = np.asarray(theta, float)
-    P = np.broadcast_to(np.asarray(P, float), theta.shape)
-    i = np.clip(np.searchsorted(t.theta, theta) - 1, 0, len(t.theta) - 2)
+    """(a_j, int_{p_0}^{P} a_j dp) at hinge bends theta (..., n_s) and pressures P (broadcast
+    together); both nodes of every bend are read from the table in one gather."""
+    theta, P = np.broadcast_arrays(np.asarray(theta, float), np.asarray(P, float))
+    i = np.minimum(np.maximum(np.searchsorted(t.theta, theta) - 1, 0), len(t.theta) - 2)
     w = (theta - t.theta[i]) / (t.theta[i + 1] - t.theta[i])
-    (A0, F0), (A1, F1) = _node_values(t, i, P), _node_values(t, i + 1, P)
-    return A0 + w * (A1 - A0), F0 + w * (F1 - F0)
+    A, F = _node_values(t, np.stack([i, i + 1]), np.stack([P, P]))
+    return A[0] + w * (A[1] - A[0]), F[0] + w * (F[1] - F[0])
 
 
 def volume_rate(t: HingeTable, theta, P) -> np.ndarray:
@@ -95,4 +95,7 @@ def volume_rate(t: HingeTable, theta, P) -> np.ndarray:
 def moment(t: HingeTable, theta, P, P_free) -> np.ndarray:
     """M_j / (a^2 pi d) = -int_{P_free}^{P} a_j(theta, p) dp (module doc) at bends theta (..., n_s),
     cavity pressure P and the free curve's pressure P_free at those bends."""
-    return -(_interpolate(t, theta, P)[1] - _interpolate(t, theta, P_free)[1])
+    theta = np.asarray(theta, float)
+    F = _interpolate(t, theta, np.stack(np.broadcast_arrays(np.asarray(P, float), np.asarray(P_free, float),
+                                                            theta)[:2]))[1]
+    return -(F[0] - F[1])

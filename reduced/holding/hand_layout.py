@@ -125,20 +125,18 @@ def pad_distance(placed: Placed, p: Pads) -> PadDistance:
     closed form, a mesh's extreme vertex) lies over the pad, the contact is there: gap its height
     above the pad, normal the pad's (an edge or corner against the pad's face; on a line of ties,
     the point nearest the pad's point nearest the centre)."""
+    d = placed.centre - p.centre  # the pad's point nearest the centre: a sphere's contact, else ties' start
+    s = np.minimum(np.maximum(np.einsum("fki,fki->fk", d, p.along), -p.half[:, 0]), p.half[:, 0])
+    w = np.minimum(np.maximum(np.einsum("fki,fki->fk", d, p.across), -p.half[:, 1]), p.half[:, 1])
+    ref = p.centre + s[..., None] * p.along + w[..., None] * p.across
     if placed.obj.shape == "sphere":
-        d = placed.centre - p.centre
-        s = np.clip(np.einsum("fki,fki->fk", d, p.along), -p.half[:, 0], p.half[:, 0])
-        w = np.clip(np.einsum("fki,fki->fk", d, p.across), -p.half[:, 1], p.half[:, 1])
-        x = p.centre + s[..., None] * p.along + w[..., None] * p.across
+        x = ref
         gap = placed.sdf(x)
     else:
         x, gap = _sampled_closest(placed, p)
     n = placed.normal(x)
     facing = np.einsum("fki,fki->fk", n, p.normal) < 0.0
     gap = np.where(facing, gap, np.inf)
-    d = placed.centre - p.centre  # ties: nearest the pad's point nearest the centre, as the FEM's start
-    ref = p.centre + np.clip(np.einsum("fki,fki->fk", d, p.along), -p.half[:, 0], p.half[:, 0])[..., None] * p.along \
-        + np.clip(np.einsum("fki,fki->fk", d, p.across), -p.half[:, 1], p.half[:, 1])[..., None] * p.across
     S = placed.support(p.normal.reshape(-1, 3), ref.reshape(-1, 3))
     # the object's point deepest through the pad's plane, where it is over the pad
     over, s, w, h = over_pad(S.reshape(x.shape), p.centre, p.along, p.across, p.normal, p.half[:, 0], p.half[:, 1])

@@ -42,7 +42,7 @@ def close_finger(i: int, P: float, placed: Placed, design: HandDesign, near: Fin
     if touching:
         found = _active_set(i, near.q, P, placed, design, touching, {k: float(near.N[k]) for k in touching})
         if found is not None:
-            return _state_of(i, found[0], found[2], P, placed, design)
+            return _state_of(i, found[0], found[2], P, placed, design, found[3])
     n_s = design.n_s
     theta_free = float(hand.bend_angle(P, design, reservoir=False))
     q_free = np.full(n_s, theta_free / n_s)
@@ -54,13 +54,13 @@ def close_finger(i: int, P: float, placed: Placed, design: HandDesign, near: Fin
     found = _active_set(i, first, P, placed, design)
     if found is None:  # Newton from the first touch missed: follow the pressure up from the touch
         P_touch = float(hand.finger_pressure(float(np.sum(first)), design))
-        found = (first, None, None)
+        found = (first, None, None, None)
         for P_k in np.linspace(P_touch, P, 6)[1:]:
             found = _active_set(i, found[0], P_k, placed, design, found[1], found[2])
             if found is None:
                 break
     if found is not None:
-        return _state_of(i, found[0], found[2], P, placed, design)
+        return _state_of(i, found[0], found[2], P, placed, design, found[3])
     return _by_slsqp(i, first, P, placed, design)
 
 
@@ -101,8 +101,8 @@ def _newton(fun, z0, scale, *, tol: float = 1e-11, max_iter: int = 30):
 
 def _active_set(i, q0, P, placed, design, active=None, N=None):
     """Finger i's contact equations with a growing / shrinking set of touching pads, from q0 and
-    the pads ``active`` (default: the one nearest the object at q0) with forces N: (q, active, N)
-    or None if it does not settle."""
+    the pads ``active`` (default: the one nearest the object at q0) with forces N: (q, active, N,
+    the finger's geometry at q) or None if it does not settle."""
     n_s = design.n_s
     if not active:
         g0 = finger_geometry(q0, i, placed, design)
@@ -129,7 +129,7 @@ def _active_set(i, q0, P, placed, design, active=None, N=None):
         gaps[active] = np.inf
         k = int(np.argmin(gaps))
         if gaps[k] >= -TOUCH:
-            return q, active, N
+            return q, active, N, geo
         same = [a for a in active if np.linalg.norm(geo.point[a] - geo.point[k]) < 1e-6]
         if same:  # two pads meeting at their hinge touch at one point: one constraint, the new pad's
             active = sorted([a for a in active if a not in same] + [k])
@@ -138,8 +138,8 @@ def _active_set(i, q0, P, placed, design, active=None, N=None):
     return None
 
 
-def _state_of(i, q, N_of, P, placed, design) -> FingerState:
-    geo = finger_geometry(q, i, placed, design)
+def _state_of(i, q, N_of, P, placed, design, geo: FingerGeometry | None = None) -> FingerState:
+    geo = finger_geometry(q, i, placed, design) if geo is None else geo
     M = hinge_moments(q, P, design)
     N = np.zeros(design.n_s + 1)
     for k, v in N_of.items():

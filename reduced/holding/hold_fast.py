@@ -41,7 +41,7 @@ from softhand.reduced.calibrated import grasp_fem
 from softhand.reduced.equations import finger, reservoir
 from softhand.reduced.holding import hand_layout
 from softhand.reduced.holding.hold_closing import FingerState, close_finger
-from softhand.reduced.holding.hold_finger import finger_geometry
+from softhand.reduced.holding.hold_finger import FingerGeometry, finger_geometry
 from softhand.reduced.vocabulary.design import HandDesign
 from softhand.reduced.vocabulary.errors import InputError
 from softhand.reduced.holding.object_geometry import Placed
@@ -77,17 +77,20 @@ def close_hand(P_cavity: float, placed: Placed, design: HandDesign, *, reservoir
     start = (lambda i: near.fingers[i]) if near is not None else (lambda i: None)  # noqa: E731
     if sym:
         one = close_finger(0, P_cavity, placed, design, start(0))
-        states = tuple(_turned(one, i, placed, design) for i in range(design.n))
+        states = _turned(one, placed, design)
     else:
         states = tuple(close_finger(i, P_cavity, placed, design, start(i)) for i in range(design.n))
     return Closed(P_cavity, pump_pressure(P_cavity, [s.q.sum() for s in states], design, reservoir_on),
                   states, sym)
 
 
-def _turned(state: FingerState, i: int, placed: Placed, design: HandDesign) -> FingerState:
-    if i == 0:
-        return state
-    return FingerState(state.q, state.N, finger_geometry(state.q, i, placed, design), state.moments, state.residual)
+def _turned(state: FingerState, placed: Placed, design: HandDesign) -> tuple:
+    """Finger 0's state turned to every finger (the object symmetric): their geometry in one batch."""
+    if design.n == 1:
+        return (state,)
+    others = finger_geometry(np.tile(state.q, (design.n - 1, 1)), np.arange(1, design.n), placed, design)
+    return (state,) + tuple(FingerState(state.q, state.N, FingerGeometry(*(v[k] for v in others)),
+                                        state.moments, state.residual) for k in range(design.n - 1))
 
 
 def pump_pressure(P_cavity: float, thetas, design: HandDesign, reservoir_on: bool = True) -> float:

@@ -38,7 +38,8 @@ def hinge_stiffness(q, P, design: HandDesign) -> np.ndarray:
     """K_j = dM_j/d theta_hat_j [N mm/rad] (..., n_s) at hinge angles q (M_j depends on q_j alone: one
     central difference of every hinge at once)."""
     q = np.asarray(q, float)
-    return (hinge_moments(q + _DQ, P, design) - hinge_moments(q - _DQ, P, design)) / (2.0 * _DQ)
+    M = hinge_moments(np.stack([q + _DQ, q - _DQ]), P, design)
+    return (M[0] - M[1]) / (2.0 * _DQ)
 
 
 def hinge_energy(q, P, design: HandDesign) -> float:
@@ -58,19 +59,21 @@ class FingerGeometry(NamedTuple):
     dg: np.ndarray       #: (n_s+1, n_s) d gap_k / d theta_hat_j [mm/rad]
 
 
-def finger_geometry(q, i: int, placed: Placed, design: HandDesign) -> FingerGeometry:
+def finger_geometry(q, i, placed: Placed, design: HandDesign) -> FingerGeometry:
     """Finger i's pads at hinge angles q (n_s,) or a batch (B, n_s): gaps, closest points,
-    normals and their rates (a batch adds the leading axis B to every array)."""
+    normals and their rates (a batch adds the leading axis B to every array; ``i`` may then name
+    a finger per row)."""
     q = np.asarray(q, float)
     Q = q.reshape(-1, design.n_s)
-    p = hand_layout.pads(Q, design, fingers=[i] * len(Q))
+    fingers = np.broadcast_to(np.asarray(i, int), len(Q))
+    p = hand_layout.pads(Q, design, fingers=fingers)
     pd = hand_layout.pad_distance(placed, p)
     frames = hand_layout.finger_frames(design)
-    e_out, e_down = frames.e_out[i], frames.e_down[i]
+    e_out, e_down = frames.e_out[fingers], frames.e_down[fingers]      # (B, 3)
     x, hinges = pd.point, p.joints[:, 1:-1]                            # (B, k, 3), (B, n_s, 3)
     r = x[:, :, None, :] - hinges[:, None, :, :]                       # (B, k, j, 3)
-    rx, ry = r @ e_out, r @ e_down
-    dx = -ry[..., None] * e_out + rx[..., None] * e_down               # rotation about hinge j
+    rx, ry = np.einsum("bkji,bi->bkj", r, e_out), np.einsum("bkji,bi->bkj", r, e_down)
+    dx = -ry[..., None] * e_out[:, None, None] + rx[..., None] * e_down[:, None, None]  # rotation about hinge j
     turns = np.arange(1, design.n_s + 1)[None, :] <= np.arange(design.n_s + 1)[:, None]
     dx = np.where(turns[None, ..., None], dx, 0.0)
     dg = np.einsum("bkji,bki->bkj", dx, pd.normal)

@@ -141,9 +141,13 @@ def _system(cs: ContactSet, centre, weight_N: float, pull, mu: float, gens: np.n
     return A_eq, b_eq, A_ub, b_ub, Q + M
 
 
-def _bounds(C: int, G: int, free: int, lam: tuple) -> list:
-    """N, beta >= 0, dq and m free, lam within ``lam``."""
-    return [(0, None)] * (C + C * G) + [(None, None)] * free + [lam]
+def _bounds(C: int, G: int, free: int, lam: tuple, extra: int = 0) -> np.ndarray:
+    """(nz + extra, 2): N, beta >= 0, dq and m free, lam within ``lam``, ``extra`` more >= 0."""
+    b = np.zeros((C + C * G + free + 1 + extra, 2))
+    b[:, 1] = np.inf
+    b[C + C * G:C + C * G + free, 0] = -np.inf
+    b[C + C * G + free] = lam
+    return b
 
 
 def _state(z, cs: ContactSet, gens, mu, A_eq, b_eq, size: float) -> LimitState:
@@ -199,7 +203,7 @@ def weight_state(cs: ContactSet, centre, weight_N: float, mu: float, *, pull_N: 
     b_ub2 = np.concatenate([b_ub, cs.closing_N, -cs.closing_N, np.zeros(C)])
     A_eq2 = np.hstack([A_eq, np.zeros((len(A_eq), C + 1))])
     c = np.concatenate([np.zeros(nz), np.ones(C), [1e-3 * max(float(np.sum(cs.closing_N)), 1e-9)]])
-    bounds = _bounds(C, G, Q, (pull_N, pull_N)) + [(0, None)] * (C + 1)
+    bounds = _bounds(C, G, Q, (pull_N, pull_N), extra=C + 1)
     sol = linprog(c, A_ub=A_ub2, b_ub=b_ub2, A_eq=A_eq2, b_eq=b_eq, bounds=bounds, method="highs")
     if sol.status != 0:
         return None

@@ -145,20 +145,17 @@ def surface(obj: GraspObject, *, resolution: int = 32) -> tuple[np.ndarray, np.n
                [(r * math.cos(t), h + r * math.sin(t)) for t in arc[::-1][1:]] + [(r, h)]
         rows = sorted(set(rows), key=lambda x: x[1])
         caps = (-h - r, h + r)
-    pts = [[0.0, caps[0], 0.0]]
-    for rad, y in rows:
-        pts += [[rad * math.cos(a), y, rad * math.sin(a)] for a in phi]
-    pts.append([0.0, caps[1], 0.0])
-    tris, last = [], len(pts) - 1
-    for j in range(n):
-        k = (j + 1) % n
-        tris.append((0, 1 + k, 1 + j))
-        for row in range(len(rows) - 1):
-            a, b = 1 + row * n, 1 + (row + 1) * n
-            tris += [(a + j, a + k, b + k), (a + j, b + k, b + j)]
-        base = 1 + (len(rows) - 1) * n
-        tris.append((last, base + j, base + k))
-    return np.asarray(pts), np.asarray(tris)
+    rad, y = np.asarray(rows, float).T                                   # rings: radius, height
+    ring = np.stack([rad[:, None] * np.cos(phi), np.broadcast_to(y[:, None], (len(rows), n)),
+                     rad[:, None] * np.sin(phi)], axis=-1).reshape(-1, 3)
+    pts = np.vstack([[0.0, caps[0], 0.0], ring, [0.0, caps[1], 0.0]])
+    j = np.arange(n)[:, None]
+    k, a = (j + 1) % n, 1 + n * np.arange(len(rows) - 1)[None, :]         # a: each band's lower ring
+    band = np.stack([np.stack([a + j, a + k, a + n + k], -1), np.stack([a + j, a + n + k, a + n + j], -1)], axis=2)
+    last, base = len(pts) - 1, 1 + (len(rows) - 1) * n
+    tris = np.concatenate([np.stack([np.zeros_like(j), 1 + k, 1 + j], -1), band.reshape(n, -1, 3),
+                           np.stack([np.full_like(j, last), base + j, base + k], -1)], axis=1)
+    return pts, tris.reshape(-1, 3)
 
 
 @dataclass(frozen=True)
