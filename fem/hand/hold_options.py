@@ -53,7 +53,10 @@ class HoldOptions:
     pad_width: float | None = None   #: pad width across the finger [mm]; None: the design's
     close_steps: int = 4             #: pressure steps from 0 to the grasp pressure
     pull_step: float | None = None   #: first pull increment [N]; None: half the weight, at least 1 N
-    pull_resolution: float = 0.02    #: the holding limit's resolution, relative to it (>= 0.1 N)
+    #: the holding limit's resolution, relative to it (at least ``pull_floor``): the limit is the
+    #: largest pull converged, so it lies up to this far below the pull where equilibrium ends
+    #: (the paper's 180 mm sphere of 0.5 kg at 0.9 MPa: 19.47 N resolved to 2 %, 19.85 N to 0.5 %)
+    pull_resolution: float = 0.005
     max_pull: float = 2000.0         #: stop pulling there: held beyond it [N]
     max_slide: float | None = None   #: slipped out beyond this slide after release [mm]; None: D / 4
     q_tol: float = 1e-8              #: FEM vs contact hinge angles at convergence [rad]
@@ -64,7 +67,7 @@ class HoldOptions:
     relax_steps: int = 24
     relax_force: float = 0.05        #: the step without the viscous support is tried below this share of the load
     min_weight_step: float = 1 / 16  #: not held when letting go of this share of the weight fails
-    pull_floor: float = 0.1          #: the holding limit's resolution is at least this [N]
+    pull_floor: float = 0.02         #: the holding limit's resolution is at least this [N]
 
     def __post_init__(self):
         if not self.close_steps >= 1:

@@ -91,9 +91,9 @@ def test_two_pads_pinching_a_box_hold_two_mu_N(finger, tmp_path):
     assert all(abs(c["normal_force_N"][1]) < 1e-9 * c["normal_N"] for c in touching)  # horizontal
     N = sum(c["normal_N"] for c in touching)                 # both pads
     load = model.weight + path.holding_limit_N
-    # the limit is resolved to pull_resolution (2 %) of the pull, or pull_floor: within that of 2 mu N / 2
+    # the limit is resolved to pull_resolution (0.5 %) of the pull, or pull_floor: within that of 2 mu N / 2
     assert load <= mu * N * (1 + 1e-9)
-    assert load >= mu * N - max(0.02 * path.holding_limit_N, 0.002) - 1e-9
+    assert load >= mu * N - max(model.options.pull_resolution * path.holding_limit_N, 0.002) - 1e-9
     # the common result and its files: result.json with every step, one VTK scene per step
     result = to_result(path)
     write_hold(path, result, tmp_path)
@@ -134,7 +134,7 @@ def test_an_off_axis_box_pinched_by_two_pads_centres_itself_and_holds_two_mu_N(f
     assert N[0] == pytest.approx(N[1], rel=1e-3)                 # measured 3e-4
     load = model.weight + path.holding_limit_N
     assert load <= mu * sum(N) * (1 + 1e-9)
-    assert load >= mu * sum(N) - max(0.02 * path.holding_limit_N, 0.002) - 1e-9
+    assert load >= mu * sum(N) - max(model.options.pull_resolution * path.holding_limit_N, 0.002) - 1e-9
 
 
 @pytest.mark.slow
