@@ -110,6 +110,18 @@ class PlanarChain:
         H = -np.moveaxis(arm[:, jl, :], -1, 1) * (jl[None, None] < links[:, None, None, None])
         return x, J, H
 
+    def generalised_force(self, q, links, x, f) -> np.ndarray:
+        """Q = sum_m J_m^T f_m (n_s,) [N mm] of forces f (m, 2) at the current points x (m, 2) of
+        links (m,), without forming J: entry j is the moment about p_j of the forces on links
+        > j, sum (x_m - p_j) x f_m, a suffix sum over the links (as in :meth:`force_hessian`)."""
+        links = np.asarray(links, dtype=int)
+        n = self.n_s + 1
+        xf = np.bincount(links, weights=x[:, 0] * f[:, 1] - x[:, 1] * f[:, 0], minlength=n)
+        fs = np.stack([np.bincount(links, weights=f[:, a], minlength=n) for a in range(2)], axis=1)
+        beyond = lambda v: np.cumsum(v[::-1], axis=0)[::-1][1:]  # noqa: E731  sum over links > j
+        p, F = self.hinge_positions(q), beyond(fs)
+        return beyond(xf) - (p[:, 0] * F[:, 1] - p[:, 1] * F[:, 0])
+
     def force_hessian(self, q, links, x, f) -> np.ndarray:
         """sum_m f_m . d2x_m/dq2 (n_s, n_s) for forces f (m, 2) at the current points x (m, 2)
         of links (m,), without forming d2x/dq2: entry (j, l) is -sum over the points of
@@ -225,14 +237,16 @@ class ChainConstraint:
         and with it the direct solver's symbolic analysis, never changes (a sparse
         triple product drops entries that happen to be zero).
         """
+        if K is None:  # the residual alone: J^T R as moments about the hinges, J not formed
+            x, _, _ = self.chain.point_map(self.q(y), self.links, self.X, order=0)
+            return np.concatenate((R[self.free], self.chain.generalised_force(
+                self.q(y), self.links, x, R[self.nodes[:, :2]])))
         x, J, _ = self.chain.point_map(self.q(y), self.links, self.X, order=1)
         moving = self.links > 0                       # link-0 nodes have J = 0
         n_s = self.chain.n_s
         rows_m = self.nodes[moving, :2].ravel()
         Jm = J[moving].reshape(-1, n_s)               # rows ordered like rows_m
         r = np.concatenate((R[self.free], R[rows_m] @ Jm))
-        if K is None:
-            return r
         K = K.tocsr()  # K.data below must be in CSR order
         pat = self._reduced_pattern(K, rows_m)
         KJ = pat["cols"](K.data) @ Jm                  # (n_dofs, n_s) = K J_m

@@ -72,10 +72,10 @@ class Averager:
     def operator(self) -> csr_matrix:
         """The average as a matrix: lambda_bar = operator @ lambda, (N, N), rows summing to 1."""
         pairs = cKDTree(self.points).sparse_distance_matrix(self.tree, self.radius, output_type="ndarray")
-        j = self.owner[pairs["j"]]
+        i, j = pairs["i"], self.owner[pairs["j"]]
         a = bell(pairs["v"], self.radius) * self.weights[j]
-        A = csr_matrix((a, (pairs["i"], j)), shape=(self.n, self.n))  # mirror images summed
-        return csr_matrix(A.multiply(1.0 / np.asarray(A.sum(axis=1))))
+        a /= np.bincount(i, weights=a, minlength=self.n)[i]  # rows summing to 1, before the matrix
+        return csr_matrix((a, (i, j)), shape=(self.n, self.n))  # mirror images summed
 
     def at(self, values, centres=None) -> np.ndarray:
         """lambda_bar at the points ``centres`` (indices; default all) of ``values`` (N,)."""

@@ -129,6 +129,20 @@ def test_force_hessian_equals_the_contraction_with_the_second_derivatives():
                                rtol=1e-12, atol=1e-12 * np.abs(x).max() * np.abs(f).max())
 
 
+def test_generalised_force_is_the_transposed_jacobian_times_the_forces():
+    x, J, _ = CHAIN.point_map(Q0, LINKS, POINTS)
+    f = RNG.normal(size=POINTS.shape)
+    np.testing.assert_allclose(CHAIN.generalised_force(Q0, LINKS, x, f), np.einsum("maj,ma->j", J, f),
+                               rtol=1e-12, atol=1e-12 * np.abs(x).max() * np.abs(f).max())
+
+
+def test_reduced_residual_alone_equals_the_one_with_the_tangent():
+    c = _random_constraint()
+    y, R = RNG.normal(size=c.n_reduced), RNG.normal(size=c.n_dofs)
+    K = sp.random(c.n_dofs, c.n_dofs, density=0.05, random_state=3, format="csr")
+    np.testing.assert_allclose(c.reduce(y, R), c.reduce(y, R, K)[0], rtol=1e-12, atol=1e-12)
+
+
 def test_reduced_tangent_is_the_triple_product_in_a_fixed_pattern_even_for_unsymmetric_K():
     """T'^T K T' + sum R . T'' against sparse products, with an unsymmetric K whose values
     vanish in places (a sparse product drops those entries; the reduced pattern must not)."""
