@@ -90,12 +90,15 @@ OWNER = "study.json"
 MAX_RECORD_BYTES = 64 << 20
 
 
-def own_study_dir(study: Study, results_root: str | Path = "results", *, write: bool) -> Path:
+def own_study_dir(study: Study, results_root: str | Path = "results", *, write: bool, outputs=()) -> Path:
     """The study's folder, after checking it holds no study of another kind under the same
-    name (whose index.csv and report this one would overwrite); ``write``: record this kind
-    there (a run, a report). InputError naming the study's name."""
+    name (whose index.csv and report this one would overwrite) and that every one of
+    ``outputs`` (names in it the caller writes) already there was written by an earlier softhand
+    run (:func:`~softhand.studies.io.outputs.check_owned`: never a file of the user's);
+    ``write``: record this kind there and ``outputs`` as softhand's (a run, a report).
+    InputError naming the study's name or the path."""
     from softhand.reduced.vocabulary.errors import InputError
-    from softhand.studies.io.outputs import check_output_tree
+    from softhand.studies.io.outputs import check_output_tree, check_owned, record_outputs
 
     sdir = study_dir(study, results_root)
     check_output_tree(sdir, "--results", files=(OWNER, "index.csv", "report.md"), folders=(".claims", "report"))
@@ -106,9 +109,12 @@ def own_study_dir(study: Study, results_root: str | Path = "results", *, write: 
     if held is not None and held != study.kind:
         raise InputError("name", study.name, f"{sdir} holds a {held!r} study of that name; this one "
                          f"is {study.kind!r}: rename it or give another --results")
-    if write and held is None:
+    check_owned(sdir, (OWNER, *outputs) if write else outputs, "--results")
+    if write:
         sdir.mkdir(parents=True, exist_ok=True)
-        write_json(sdir / OWNER, {"study": study.name, "kind": study.kind})
+        record_outputs(sdir, (OWNER, *outputs), verb="study")
+        if held is None:
+            write_json(sdir / OWNER, {"study": study.name, "kind": study.kind})
     return sdir
 
 

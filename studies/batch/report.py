@@ -16,7 +16,7 @@ MAX_LINES = 10  #: curves per plot; more combinations of the other axes are not 
 
 def write_report(study: Study, results_root: str | Path = "results") -> Path:
     """Write ``results/<study>/report.md`` and ``report/*.png``; return the Markdown path."""
-    sdir = own_study_dir(study, results_root, write=True)
+    sdir = own_study_dir(study, results_root, write=True, outputs=("index.csv", "report.md", "report"))
     rows = index_rows(study, results_root)
     write_index(study, results_root)
     axes = [name for name, _ in study.axes]

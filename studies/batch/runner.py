@@ -34,7 +34,7 @@ from contextlib import closing
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from softhand.studies.batch.cases import (FAILED, RESULT, Case, case_key, case_state, code_version,  # noqa: F401
+from softhand.studies.batch.cases import (FAILED, OWNER, RESULT, Case, case_key, case_state, code_version,  # noqa: F401
                                           commit, commit_case, execute_case, outcome_record,
                                           own_study_dir, package_versions, plan, read_case, study_dir,
                                           remove_leftovers)
@@ -62,6 +62,10 @@ class RunSummary:
 
 
 # ---------------------------------------------------------------------- the run
+#: the files a run writes into the study's folder beside the case folders and its claim locks
+STUDY_OUTPUTS = (OWNER, "index.csv")
+
+
 def run_study(study: Study, *, results_root: str | Path = "results", workers: int | None = None,
               scheduler: str | None = None, progress: bool = True,
               fresh: bool = False) -> RunSummary:
@@ -70,7 +74,7 @@ def run_study(study: Study, *, results_root: str | Path = "results", workers: in
     ``workers``: processes (default: the CPU count); 1 runs in this process.
     ``scheduler``: a Dask scheduler address, or 'local' for a LocalCluster.
     """
-    sdir = own_study_dir(study, results_root, write=False)
+    sdir = own_study_dir(study, results_root, write=False, outputs=STUDY_OUTPUTS)
     cases = plan(study)
     # a case folder that is a symbolic link is a damaged case: recomputed, the link replaced
     check_output_tree(sdir, "--results", folders=[c.key for c in cases if not (sdir / c.key).is_symlink()])
@@ -88,7 +92,7 @@ def run_study(study: Study, *, results_root: str | Path = "results", workers: in
         from softhand.studies.batch.cluster import open_cluster
 
         dask = open_cluster(scheduler, workers)  # reached before anything is written
-    own_study_dir(study, results_root, write=True)
+    own_study_dir(study, results_root, write=True, outputs=STUDY_OUTPUTS)
     bar = _progress_bar(study, summary, progress)
     claims = Claims(sdir)
     try:

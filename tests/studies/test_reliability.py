@@ -404,6 +404,32 @@ def test_damaged_claims_and_report_folders_are_one_line(quick_study, tmp_path, c
     assert list(outside.iterdir()) == []
 
 
+def test_a_users_files_in_a_study_folder_are_never_replaced(quick_study, tmp_path, capsys):
+    """A report.md, index.csv or study.json of the user's in the study's folder (a folder no
+    softhand run wrote them into): run and report refuse in one line, exit 2, the files as they
+    were; after the user moves them away both run, and run again over their own outputs."""
+    root = tmp_path / "res"
+    sdir = study_dir(load_study(quick_study), root)
+    sdir.mkdir(parents=True)
+    mine = {"report.md": "my notes\n", "index.csv": "a,b\n1,2\n", "study.json": '{"mine": 1}\n'}
+    for name, text in mine.items():
+        (sdir / name).write_text(text)
+    for action in ("report", "run", "report"):
+        argv = ["study", action, str(quick_study), "--results", str(root)] + (
+            ["--workers", "1", "--no-progress"] if action == "run" else [])
+        assert main(argv) == 2
+        err = capsys.readouterr().err.strip().splitlines()
+        assert len(err) == 1 and "was not written by an earlier softhand run" in err[0]
+        assert {n: (tmp_path / n if (tmp_path / n).exists() else sdir / n).read_text() for n in mine} == mine
+        name = next(n for n in mine if f"{sdir / n}'" in err[0])
+        (sdir / name).rename(tmp_path / name)  # moved away: the next refusal names another file
+    for action in ("run", "report", "run", "report"):
+        argv = ["study", action, str(quick_study), "--results", str(root)] + (
+            ["--workers", "1", "--no-progress"] if action == "run" else [])
+        assert main(argv) == 0
+    assert {n: (tmp_path / n).read_text() for n in mine} == mine
+
+
 def test_a_read_only_finished_study_is_one_warning(quick_study, tmp_path, monkeypatch, capsys):
     """run and report of a finished study whose folder refuses writes (tests run as root, for
     whom chmod refuses nothing: the refusal is simulated): tracebacks before; now the summary,
