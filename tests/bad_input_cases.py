@@ -287,6 +287,13 @@ EXTRA_FILES.update({
     "obj_cone.toml": '[object]\nshape = "cone"\ndiameter_mm = 150.0\n',
     "obj_no_table.toml": 'shape = "sphere"\ndiameter_mm = 150.0\n',
     "obj_binary.toml": b"\x00\xff\xfe\x89PNG\r\n",
+    "obj_task_tables.toml": '[object]\nshape = "sphere"\ndiameter_mm = 150.0\nmass_kg = 0.5\n[hold]\nmargin = 2.0\n',
+    "task_hold_in_palm.toml": TASK.replace("[object]\ndiameter_mm = 180.0\n",
+                                           '[object]\nshape = "sphere"\ndiameter_mm = 150.0\n'
+                                           'offset_mm = [0.0, -500.0, 0.0]\n'),
+    "task_hold_force_factor.toml": TASK.replace("[object]\ndiameter_mm = 180.0\n",
+                                                '[object]\nshape = "sphere"\ndiameter_mm = 150.0\n')
+    + "[grasp]\nforce_factor = 2.0\n",
     "task_open_mesh.toml": TASK.replace("[object]\ndiameter_mm = 180.0\n",
                                         '[object]\nshape = "mesh"\nfile = "obj_open.stl"\n'),
 })
@@ -299,6 +306,7 @@ def hold_cases() -> list[tuple[str, list[str]]]:
     cases = [["hold", "--object", f, *at] for f in (
         "obj_open.toml", "obj_missing_file.toml", "obj_negative_mu.toml", "obj_unknown_key.toml",
         "obj_in_palm.toml", "obj_cone.toml", "obj_no_table.toml", "obj_binary.toml", "obj_open.stl",
+        "obj_task_tables.toml",
         "missing.toml", "sphere:abc", "sphere:-150", "box:400x50x400", "cylinder:120")]
     cases += [["hold", "--object", "sphere:150", "--pull", "0,0,0", *at],
               ["hold", "--object", "sphere:150", "--pull", "sideways", *at],
@@ -308,7 +316,18 @@ def hold_cases() -> list[tuple[str, list[str]]]:
               ["hold", "--object", "sphere:150", "--map", "pressure=0.5:1:0.5", "colour=1,2"],
               ["hold", "--object", "sphere:150", "--check"],
               ["hold", "--object", "sphere:150", "--model", "fem", "--margin", "2", "--no-progress"],
-              ["design", "--task", "task_open_mesh.toml", "--no-fem", "--no-progress"]]
+              ["design", "--task", "task_open_mesh.toml", "--no-fem", "--no-progress"],
+              ["design", "--task", "task_hold_force_factor.toml", "--no-fem", "--no-progress"],
+              # the object fits no design: found by the optimiser's tries (seconds), then one line
+              ["design", "--task", "task_hold_in_palm.toml", "--no-fem", "--no-progress"]]
+    grid = ["--map", "pressure=0.5,1", "mass=0.5,1", "--no-progress"]  # what a map does not use: refused
+    cases += [["hold", "--object", "sphere:150", *grid, *extra] for extra in (
+        ["--model", "fem"], ["--margin", "3"], ["--pull-n", "2"], ["--pressure-mpa", "1"],
+        ["--cavity-pressure-mpa", "1"])]
+    cases += [["hold", "--object", "sphere:150", "--map", "pull=0,10", "mass=0.5,1", "--pressure-mpa", "1",
+               "--pull", "x", "--no-progress"],
+              ["hold", "--object", "sphere:150", "--map", "pull=0,1e300", "mass=0.5", "--pressure-mpa", "1"],
+              ["hold", "--object", "sphere:150", "--map", "pressure=-10,1", "mass=1,2"]]
     return [("hold", c) for c in cases]
 
 

@@ -51,10 +51,11 @@ def pull_unit(pull, field: str = "--pull") -> np.ndarray:
     v = np.asarray(pull, float).ravel() if not isinstance(pull, str) else None
     if v is None or v.shape != (3,) or not np.all(np.isfinite(v)):
         raise InputError(field, pull, "must be three numbers x,y,z (hand frame, y down)")
-    size = float(np.linalg.norm(v))
-    if not size > 1e-12:
+    top = float(np.abs(v).max())
+    if not top > 1e-12:
         raise InputError(field, [float(x) for x in v], "must not have zero length (a direction x,y,z; y down)")
-    return v / size
+    v = v / top  # (the length of 1e308,1e308,0 overflows)
+    return v / float(np.linalg.norm(v))
 
 
 def contact_set(closed: hold_fast.Closed, design: HandDesign) -> hold_lp.ContactSet:

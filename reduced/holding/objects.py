@@ -233,6 +233,10 @@ def load_object(path: str | Path, *, field: str = "--object") -> GraspObject:
     data = read_toml(path, field, "a TOML file with an [object] table")
     if "object" not in data:
         raise InputError(field, str(path), "has no [object] table")
+    other = sorted(k for k in data if k != "object")
+    if other:  # e.g. a design task's [hold]: not silently ignored
+        raise InputError(field, str(path), f"holds {', '.join(other)} besides [object]; an object file holds "
+                                           "the [object] table alone (a hold's margin and pull are options)")
     return object_from_table(data["object"], source=f"{path.name}: object", base_dir=path.parent)
 
 

@@ -23,7 +23,7 @@ from softhand.reduced.vocabulary.design import HandDesign
 from softhand.reduced.vocabulary.errors import InputError
 from softhand.reduced.holding.hand_layout import place_object
 from softhand.studies.design.constraints import design_constraints
-from softhand.studies.design.evaluate import Evaluation, peak_stretch, unanswered
+from softhand.studies.design.evaluate import Evaluation, peak_stretch
 from softhand.studies.design.task import Task
 
 #: the least pressure's bisection tolerance [MPa]
@@ -43,13 +43,10 @@ def _limit(d, task, placed, P_cavity, enough_N=math.inf):
 def evaluate_hold(design: HandDesign, task: Task) -> Evaluation:
     """The :class:`softhand.studies.design.evaluate.Evaluation` of ``design`` for a hold task (module doc)."""
     d = hold_fast.finger_design(design, "fem" if design.finger_model == "fem" else "paper")
-    try:
-        placed = place_object(task.obj, d)
-        Pc_top = hold.cavity_pressure(task.max_pressure, placed, d)
-        F_lim, raw, closed_top = _limit(d, task, placed, Pc_top)
-        theta_touch = _touch(d, placed)
-    except InputError:
-        return unanswered(task)
+    placed = place_object(task.obj, d)  # InputError: no answer for this design (the optimiser's refusal)
+    Pc_top = hold.cavity_pressure(task.max_pressure, placed, d)
+    F_lim, raw, closed_top = _limit(d, task, placed, Pc_top)
+    theta_touch = _touch(d, placed)
     required = task.required_hold_N()
     P_grasp, theta_hold, shortfall, link = math.inf, float(np.mean([s.q.sum() for s in closed_top.fingers])), None, -1
     if F_lim >= required:

@@ -183,8 +183,9 @@ def optimise(task: Task, options: OptimiserOptions = OptimiserOptions(), *, prog
     x = on_bounds(x, problem.bounds)
     try:
         ev = evaluate(design_at(task, x), task)  # exact kinematics
-    except InputError as exc:  # the point SLSQP ended at has none
-        raise _unanswerable(task, exc) from None
+    except InputError as exc:  # the point SLSQP ended at has none: every constraint violated
+        ev = unanswered(task)
+        problem.refusal = problem.refusal or exc
     return Optimum(x, ev, problem.evaluations, time.perf_counter() - t0, int(res.nit), message,
                    time.process_time() - cpu)
 

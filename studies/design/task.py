@@ -167,6 +167,10 @@ def task_from_dict(data: dict, *, folder: Path = Path("."), name: str = "task") 
     if objective not in OBJECTIVES:
         raise InputError("grasp.objective", objective, f"must be one of {', '.join(OBJECTIVES)}")
     held = _hold_object(obj, tables["hold"], folder)
+    for key in ("force_factor", "margin_N"):
+        if held[0] is not None and key in grasp:
+            raise InputError(f"grasp.{key}", grasp[key], "does not apply to a hold task (an [object] shape "
+                             "or a [hold] table): its margin is [hold] margin or pull_N")
     diameter = held[1] if held[0] is not None else checked_number(obj, "object", "diameter_mm", required=True)
     opening = checked_number(grasp, "grasp", "opening_mm", default=None)
     if opening is not None and opening < diameter:

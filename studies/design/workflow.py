@@ -11,7 +11,7 @@ from pathlib import Path
 
 import numpy as np
 
-from softhand.reduced.vocabulary.errors import MeshRejected, MeshTooLarge
+from softhand.reduced.vocabulary.errors import InputError, MeshRejected, MeshTooLarge
 from softhand.studies.design import optimise as design_opt
 from softhand.studies.design import evaluate, proof, proof_sizes, proof_steps
 from softhand.studies.io.files import kept_if_unwritable, write_atomic, write_json
@@ -45,7 +45,10 @@ def run_task(task, out, run: DesignRun = DesignRun(), say=print):
     options = design_opt.OptimiserOptions(seed=run.seed)
     opt = optimise_task(task, options, show_progress=run.show_progress)
     ev = opt.evaluation
-    base = design_opt.evaluate(task.base, task)
+    try:
+        base = design_opt.evaluate(task.base, task)
+    except InputError:  # the base design has no answer (the object does not fit it): as the optimiser's
+        base = evaluate.unanswered(task)
     if not ev.feasible:  # the documented outcome, before anything is written
         return {**result_record(task, opt, base, None, run.seed),
                 "report": design_opt.infeasible_report(task, opt)}, opt, False

@@ -22,11 +22,13 @@ _FORMS = "start:stop:step (step > 0, stop >= start) or a comma-separated list of
 ONE_NUMBER, NUMBER_LIST = "one finite number", "a comma-separated list of finite numbers"
 
 
-def parse_values(text: str, field: str, max_count: int = MAX_POINTS, forms: str | None = None) -> np.ndarray:
+def parse_values(text: str, field: str, max_count: int = MAX_POINTS, forms: str | None = None, *,
+                 more: str | None = "--max-cases N allows more") -> np.ndarray:
     """``'0:90:10'`` (start:stop:step, stop included) or ``'1,2.5,3'`` -> float array.
 
     Every value finite; at most ``max_count`` of them (InputError otherwise). ``forms``: what
-    the field takes, for the message (default: a range or list; one number if max_count is 1).
+    the field takes, for the message (default: a range or list; one number if max_count is 1);
+    ``more``: how the user may allow more values (None: they may not), for the message.
     """
     forms = forms or (ONE_NUMBER if max_count == 1 else _FORMS)
     if len(text) > MAX_TEXT:
@@ -43,19 +45,19 @@ def parse_values(text: str, field: str, max_count: int = MAX_POINTS, forms: str 
         start, stop, step = numbers
         count = (stop - start) / step + 1
         if not count <= max_count:
-            raise InputError(field, text, _too_many(_count(count), max_count))
+            raise InputError(field, text, _too_many(_count(count), max_count, more))
         values = start + step * np.arange(int(math.floor(count - 1 + 1e-9)) + 1)
     else:
         values = np.array(numbers, dtype=float)
         if values.size > max_count:
-            raise InputError(field, text, _too_many(values.size, max_count))
+            raise InputError(field, text, _too_many(values.size, max_count, more))
     if values.size == 0 or not np.all(np.isfinite(values)):
         raise InputError(field, text, f"must be {forms}")
     return values
 
 
-def _too_many(count, max_count: int) -> str:
-    more = "; --max-cases N allows more" if max_count > 1 else ""
+def _too_many(count, max_count: int, more: str | None) -> str:
+    more = f"; {more}" if more and max_count > 1 else ""
     return f"gives {count} values; at most {max_count} allowed{more}"
 
 

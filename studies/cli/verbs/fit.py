@@ -125,7 +125,7 @@ def _weights(args, design, data):
         except InputError as exc:
             raise exc.renamed("--diameter-mm") from None
     if args.weights is not None:
-        return parse_values(args.weights, "--weights", forms=NUMBER_LIST)
+        return parse_values(args.weights, "--weights", forms=NUMBER_LIST, more=None)
     return None
 
 

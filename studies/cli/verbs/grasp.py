@@ -99,7 +99,7 @@ def _weights(args, design, mass: float) -> tuple[np.ndarray, str, list[str]]:
         if ":" in args.weights:  # a range start:stop:step is no vector of hinge weights
             raise InputError("--weights", args.weights, f"must be {_WEIGHT_FORMS}: one weight per hinge, "
                                                         "not a range")
-        w, source = parse_values(args.weights, "--weights", forms=_WEIGHT_FORMS), "given"
+        w, source = parse_values(args.weights, "--weights", forms=_WEIGHT_FORMS, more=None), "given"
     else:
         w, source, caveat = _fem_weights(_scalar(args.diameter_mm, "--diameter-mm"), mass, design)
     with warnings.catch_warnings(record=True) as caught:
@@ -135,7 +135,7 @@ def run(args) -> int:
         try:
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore", grasp.WeightSumWarning)
-                grasp.check_weights(parse_values(args.weights, "--weights", 1000, _WEIGHT_FORMS), design)
+                grasp.check_weights(parse_values(args.weights, "--weights", 1000, _WEIGHT_FORMS, more=None), design)
         except InputError as exc:
             raise exc.renamed("--weights") from None
     try:

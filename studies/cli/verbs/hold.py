@@ -85,7 +85,8 @@ def run(args) -> int:
     if P_pump is None and P_cav is None:
         return _run_least(args, design, obj, pull, max_pump)
     if args.margin is not None or args.pull_n is not None:
-        raise InputError("--margin" if args.margin is not None else "--pull-n", args.margin or args.pull_n,
+        raise InputError("--margin" if args.margin is not None else "--pull-n",
+                         args.margin if args.margin is not None else args.pull_n,
                          "asks for the least pressure; give no --pressure-mpa with it")
     d = hold.hold_fast.finger_design(design, args.finger)
     placed = hold.place_object(obj, d)
@@ -196,13 +197,14 @@ def _axis(text: str):
     name, eq, values = text.partition("=")
     if not eq or name not in AXES:
         raise InputError("--map", text, f"must be NAME=RANGE with NAME one of {', '.join(AXES)}")
-    return name, tuple(float(v) for v in parse_values(values, f"--map {name}", 2500))
+    return name, tuple(float(v) for v in parse_values(values, f"--map {name}", 2500, more=None))
 
 
 def _run_map(args, design, obj, pull, max_pump) -> int:
     from softhand.studies.hold import HoldMap, run_map, write_map
 
     x, y = (_axis(t) for t in args.map)
+    _refuse_with_map(args, (x[0], y[0]))
     pressure = checked_option(args, "--pressure-mpa")
     if pressure is None and "pressure" not in (x[0], y[0]):
         raise InputError("--pressure-mpa", None, "is required when pressure is not an axis of the map")
@@ -230,6 +232,24 @@ def _run_map(args, design, obj, pull, max_pump) -> int:
         for c in checks:
             print(f"  check at {c['at']}: reduced {c['reduced_N']:.4g} N, fem {c['fem_N']:.4g} N")
     return 0
+
+
+def _refuse_with_map(args, axes) -> None:
+    """The options a map does not use (it would ignore them): one line each."""
+    given = [("--model", args.model, args.model == "fem", "a map runs the fast model; --check runs the "
+              "FEM at its corners and centre"),
+             ("--margin", args.margin, args.margin is not None, "asks for the least pressure, not a map "
+              "(the map's contours are the holding margin)"),
+             ("--pull-n", args.pull_n, args.pull_n is not None, "asks for the least pressure, not a map"),
+             ("--cavity-pressure-mpa", args.cavity_pressure_mpa, args.cavity_pressure_mpa is not None,
+              "a map is over the pump pressure; give --pressure-mpa"),
+             ("--pressure-mpa", args.pressure_mpa, args.pressure_mpa is not None and "pressure" in axes,
+              "pressure is an axis of the map"),
+             ("--pull", args.pull, args.pull != "down" and "pull" in axes, "pull is an axis of the map "
+              "(its angle from straight down towards finger 0)")]
+    for option, value, refused, why in given:
+        if refused:
+            raise InputError(option, value, f"is not used with --map: {why}")
 
 
 def _map_checks(m, rows, design) -> list[dict]:

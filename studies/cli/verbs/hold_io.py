@@ -35,7 +35,7 @@ def pull_direction(text: str):
 
     if text in PULLS:
         return pull_unit(PULLS[text])
-    values = parse_values(text, "--pull", 3, "x,y,z")
+    values = parse_values(text, "--pull", 3, "x,y,z", more=None)
     if len(values) != 3:
         raise InputError("--pull", text, f"must be three numbers x,y,z or one of {', '.join(PULLS)}")
     return pull_unit(values, "--pull")
