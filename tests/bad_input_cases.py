@@ -287,6 +287,9 @@ EXTRA_FILES.update({
     "obj_cone.toml": '[object]\nshape = "cone"\ndiameter_mm = 150.0\n',
     "obj_no_table.toml": 'shape = "sphere"\ndiameter_mm = 150.0\n',
     "obj_binary.toml": b"\x00\xff\xfe\x89PNG\r\n",
+    "m_kpa.csv": "mode,stretch,stress_MPa\n" + "".join(  # kPa under a stress_MPa header
+        f"uniaxial,{lam},{1000 * float(v):g}\n" for lam, v in (r.split(",")[1:] for r in GOOD_MATERIAL.split()[1:])),
+    "d_material_stiff.toml": '[finger.material]\nmodel = "neo-hookean"\nmu_MPa = 400.0\n',
     "obj_task_tables.toml": '[object]\nshape = "sphere"\ndiameter_mm = 150.0\nmass_kg = 0.5\n[hold]\nmargin = 2.0\n',
     "task_hold_in_palm.toml": TASK.replace("[object]\ndiameter_mm = 180.0\n",
                                            '[object]\nshape = "sphere"\ndiameter_mm = 150.0\n'
@@ -329,6 +332,21 @@ def hold_cases() -> list[tuple[str, list[str]]]:
               ["hold", "--object", "sphere:150", "--map", "pull=0,1e300", "mass=0.5", "--pressure-mpa", "1"],
               ["hold", "--object", "sphere:150", "--map", "pressure=-10,1", "mass=1,2"]]
     return [("hold", c) for c in cases]
+
+
+def mixed_cases() -> list[tuple[str, list[str]]]:
+    """Values that parse but mean nothing (units, reach, a sum near zero), options a mode ignores,
+    a file named under the option that gave it."""
+    cases = [["weights", "--diameter-mm", "180", "--depth-mm", d] for d in ("-1000", "5", "1000")]
+    cases += [["weights", "--diameter-mm", "180,180"], ["reservoir", "--volume-mm3", "17800,17800"]]
+    cases += [["reservoir", "--write-calibration", "cal.csv", *extra] for extra in (
+        ["--json"], ["--plot", "p.png"], ["--out", "rr"], ["--volume-mm3", "17800"])]
+    cases += [["grasp", "--pressure-mpa", "0.8", "--theta-deg", "45", "--mass-kg", "1",
+               "--weights=1,-1,0,0,1e-12", "--normalise"],
+              ["material", "fit", "--data", "m_kpa.csv", "--model", "neo-hookean", "--out", "kpa.toml"],
+              ["curve", "--theta-deg", "30", "--design", "d_material_stiff.toml"],
+              ["curve", "--theta-deg", "30", "--compare", "missing.toml"]]
+    return [("mixed", c) for c in cases]
 
 
 def outputs_cases() -> list[tuple[str, list[str]]]:
@@ -534,4 +552,5 @@ def replay_cases() -> list[tuple[str, list[str]]]:
     cases += [("files", f) for f in files]
     cases += outputs_cases()
     cases += hold_cases()
+    cases += mixed_cases()
     return [(f"{name}-{k}-{' '.join(argv[1:])[:40]}", argv) for k, (name, argv) in enumerate(cases)]

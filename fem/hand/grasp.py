@@ -83,6 +83,13 @@ def check_placement(design: HandDesign, diameter: float, depth: float,
     """InputError if the object (diameter [mm]) centred at depth [mm] overlaps the open
     finger's pads (default: those of the design's link chain as :class:`softhand.fem.hand.finger.FingerModel`
     builds it, no mesh, so it is checked before any meshing or FEM)."""
+    top, reach = depth - 0.5 * diameter, float(np.sum(design.link_lengths))
+    if top < 0.0:
+        raise InputError("depth_mm", depth, f"puts the object (diameter {diameter:g} mm) above the palm; its "
+                                            f"centre goes at least {0.5 * diameter:g} mm below it")
+    if top >= reach:
+        raise InputError("depth_mm", depth, f"puts the object's top {top:g} mm below the palm, beyond the "
+                                            f"finger's reach ({reach:g} mm, pointing straight down)")
     if pads is None:
         chain = PlanarChain(np.c_[design.hinge_s, np.full(design.n_s, design.d)])
         pads = pads_of(chain, design, options or GraspOptions())

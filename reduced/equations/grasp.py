@@ -83,8 +83,9 @@ def check_weights(w, design: HandDesign, normalise: bool = False) -> np.ndarray:
                          f"must be n_s = {design.n_s} numbers in [-{MAX_WEIGHT:g}, {MAX_WEIGHT:g}]")
     total = float(w.sum())
     if normalise:
-        if abs(total) < 1e-12:
-            raise InputError("weights", w.tolist(), "sum to 0; cannot normalise")
+        if abs(total) < 1e-12 or not np.all(np.abs(w / total) <= MAX_WEIGHT):
+            raise InputError("weights", w.tolist(), f"sum to {total:.3g}; normalised, each must still be in "
+                                                    f"[-{MAX_WEIGHT:g}, {MAX_WEIGHT:g}]")
         return w / total
     if abs(total - 1.0) > SUM_TOLERANCE:
         warnings.warn(f"weights sum to {total:.4g}, not 1 as eq. (23) requires; "

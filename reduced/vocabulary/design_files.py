@@ -35,7 +35,7 @@ from pathlib import Path
 from softhand.reduced.equations import finger
 from softhand.reduced.materials import rubber, rubber_parameters
 from softhand.reduced.vocabulary.design import KEY_OF, MODULUS_OF, PARTS, HandDesign, field_changes
-from softhand.reduced.vocabulary.design_rules import in_bounds, is_number
+from softhand.reduced.vocabulary.design_rules import BOUNDS, in_bounds, is_number
 from softhand.reduced.vocabulary.errors import InputError, Note
 from softhand.reduced.vocabulary.inputfiles import read_toml
 
@@ -52,6 +52,10 @@ def _material_changes(part: str, table, source: str, values: dict) -> dict:
                          f"must be one of {', '.join(rubber.MODELS)}")
     material = rubber_parameters.from_parameters(model, params, source=f"{source}: {part}.material")
     name = MODULUS_OF[part]
+    lo, hi = BOUNDS[KEY_OF[name]]
+    if not lo <= material.mu0 <= hi:  # named by the table the user wrote, not the key it becomes
+        raise InputError(f"{source}: {part}.material", f"{model}, mu0 = {material.mu0:.6g} MPa",
+                         f"its initial shear modulus must be in [{lo:g}, {hi:g}] MPa")
     given = values.get(KEY_OF[name])
     if given is not None:  # overridden, but still a value of the file: a bad one is bad input
         try:

@@ -63,3 +63,9 @@ def _too_many(count, max_count: int, more: str | None) -> str:
 
 def _count(count: float) -> str:
     return f"{math.floor(count + 1e-9):d}" if count < 1e15 else "too many"
+
+
+def check_distinct(values, text: str, option: str) -> None:
+    """Each value once (a repeated one would be one more FEM for the same answer)."""
+    if np.unique(values).size != np.asarray(values).size:
+        raise InputError(option, text, "gives a value twice; give each once")

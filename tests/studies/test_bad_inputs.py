@@ -394,6 +394,19 @@ def test_bad_input_is_one_line_exit_2_and_nothing_written(argv, scratch, capsys)
     assert _snapshot(scratch) == before  # nothing written, not even the cache or an output folder
 
 
+@pytest.mark.parametrize("argv, named", [
+    (["curve", "--theta-deg", "30", "--compare", "missing.toml"], "--compare = 'missing.toml'"),
+    (["curve", "--theta-deg", "30", "--design", "d_material_stiff.toml"], "finger.material"),
+    (["material", "fit", "--data", "m_kpa.csv", "--model", "neo-hookean"], "are the stresses in MPa?"),
+    (["hold", "--object", "sphere:150", "--pressure-mpa", "1", "--margin", "0"], "--margin = 0.0"),
+    (["hold", "--object", "sphere:150", "--map", "pressure=0:3000:1", "mass=1"], "at most 2500 allowed\n"),
+])
+def test_a_refusal_names_what_the_user_gave(argv, named, scratch, capsys):
+    """The option or table the user wrote, its value, no hint of an option the verb lacks."""
+    assert _run(argv) == 2
+    assert named in capsys.readouterr().err
+
+
 def test_every_number_of_a_design_has_bounds():
     """A new numeric design key needs a line in reduced.vocabulary.design.BOUNDS."""
     numeric = [k for k, v in HandDesign().to_dict().items()

@@ -65,8 +65,13 @@ def curves(args) -> list[tuple[str, HandDesign]]:
         models = tuple(m.strip() for m in args.model.split(","))
         check_choices("--model", models, FINGER_MODELS, "finger model", shown=args.model)
     out = []
-    for path in files:
-        design = design_from_args(Namespace(design=path))
+    for k, path in enumerate(files):
+        try:
+            design = design_from_args(Namespace(design=path))
+        except InputError as exc:
+            if exc.field == "--design" and k >= len(files) - len(args.compare or []):
+                raise exc.renamed("--compare") from None  # a file of --compare is named as one
+            raise
         for model in models or (design.finger_model,):
             label = f"{design_name(path)}, finger model {model}"
             if any(label == seen for seen, _ in out):

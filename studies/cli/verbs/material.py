@@ -16,6 +16,7 @@ import sys
 
 import numpy as np
 
+from softhand.reduced.vocabulary.design_rules import BOUNDS
 from softhand.reduced.vocabulary.errors import InputError
 from softhand.reduced.vocabulary.inputfiles import plain_float
 from softhand.studies.cli.args import add_json_option, print_json, print_table
@@ -51,6 +52,11 @@ def run(args) -> int:
     data = read_test_data(args.data)
     stretch_range = _stretch_range(args.stability_range, data)
     result = fit_material(data, args.model)
+    lo, hi = BOUNDS["mu_sf_MPa"]
+    if not lo <= result.material.mu0 <= hi:  # e.g. stresses in kPa under a stress_MPa header
+        raise InputError("--data", args.data, f"fits an initial shear modulus of {result.material.mu0:.4g} MPa, "
+                         f"outside the [{lo:g}, {hi:g}] MPa a design takes (a rubber's is about 0.1-10 MPa): "
+                         "are the stresses in MPa?")
     drucker = drucker_check(result.material, stretch_range)
     notes = list(result.warnings)
     if not drucker["stable"]:

@@ -15,6 +15,7 @@ from pathlib import Path
 from softhand.reduced.vocabulary.errors import InputError
 from softhand.studies.cli.args import MAX_FEM_POINTS, MOST_FEM_POINTS, add_design_option, add_json_option, \
     add_max_cases_option, add_progress_option, design_from_args, max_cases, parse_values, print_json, print_table
+from softhand.studies.io.values import check_distinct
 from softhand.studies.io.files import write_outputs
 from softhand.studies.io.outputs import replaced_outputs
 
@@ -49,6 +50,7 @@ def _study(args):
     volumes = ()
     if args.volume_mm3 is not None:
         volumes = tuple(parse_values(args.volume_mm3, "--volume-mm3", limit))
+        check_distinct(volumes, args.volume_mm3, "--volume-mm3")
         low, high = 1e-4 * design.V0, 100 * design.V0  # below 1e-4 V0 the sheet barely moves
         if min(volumes) < low or max(volumes) > high:
             raise InputError("--volume-mm3", args.volume_mm3,
@@ -65,6 +67,12 @@ OUTPUT_NAMES = ("result.json", "rows.csv", "sheet.pvd", "sheet", "sheet_V*_rz.vt
 
 
 def run(args) -> int:
+    if args.write_calibration:  # the table's own volumes and output: what it would ignore is refused
+        for option, given in (("--volume-mm3", args.volume_mm3), ("--plot", args.plot), ("--out", args.out),
+                              ("--json", args.json or None)):
+            if given is not None:
+                raise InputError(option, given, "is not used with --write-calibration (the table is "
+                                                "computed over its own volumes and written to its file)")
     study = _study(args)
     if args.out:
         from softhand.studies.io.outputs import check_owned

@@ -19,6 +19,7 @@ from softhand.reduced.vocabulary.errors import InputError
 from softhand.reduced.vocabulary.paper import FIG8
 from softhand.studies.cli.args import MOST_FEM_POINTS, add_design_option, add_json_option, \
     add_max_cases_option, add_progress_option, design_from_args, max_cases, parse_values, print_json, print_table
+from softhand.studies.io.values import check_distinct
 from softhand.studies.design.task_values import UPPER
 from softhand.studies.io.files import kept_if_unwritable
 from softhand.studies.io.outputs import replaced_outputs
@@ -119,12 +120,6 @@ def _failed(exc, out: Path) -> int:
         names=OUTPUT_NAMES)
 
 
-def _distinct(values, text: str, option: str) -> None:
-    """Each value once (a repeated one would be one more FEM for the same answer)."""
-    if np.unique(values).size != values.size:
-        raise InputError(option, text, "gives a value twice; give each once")
-
-
 def _run(args) -> int:
     from dataclasses import replace
 
@@ -141,7 +136,7 @@ def _run(args) -> int:
     if args.plot is not None and diameters.size == 1 and args.fig8 is None:
         raise InputError("--plot", args.plot, "draws w(D) of several diameters or the Fig. 8 analogue "
                          "(--fig8); one diameter's grasp is in --out's VTK (softhand inspect)")
-    _distinct(diameters, args.diameter_mm, "--diameter-mm")
+    check_distinct(diameters, args.diameter_mm, "--diameter-mm")
     if case.depth_mm is not None:  # an object placed into the open finger: before any FEM or message
         from softhand.fem.hand.grasp import check_placement
 
@@ -158,7 +153,7 @@ def _run(args) -> int:
                          "is of w interpolated at a diameter between them")
     if args.fig8 is not None:
         pressures = _values(args.fig8, "--fig8", max_cases(args, MAX_FIG8, MOST_FEM_POINTS))
-        _distinct(pressures, args.fig8, "--fig8")
+        check_distinct(pressures, args.fig8, "--fig8")
         return _fig8(args, replace(case, diameter_mm=float(diameters[0])), pressures)
     if diameters.size == 1:
         result = _one(replace(case, diameter_mm=float(diameters[0])), args)
