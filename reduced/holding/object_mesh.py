@@ -1,7 +1,8 @@
 """A closed triangle mesh as an object: read and checked (trimesh), its signed distance.
 
 :func:`read_mesh` reads STL, OBJ or PLY through trimesh (imported only here, only when a mesh is
-read), refuses an open, inconsistently oriented, empty or self-intersecting mesh in one line,
+read), refuses an open, inconsistently oriented, empty, self-intersecting or self-overlapping mesh, one
+of several bodies or one under :data:`MIN_EXTENT_MM` across in one line,
 centres it at its centre of mass, and samples its signed distance (negative inside) on a grid of
 :data:`MESH_GRID` points along its longest edge (:func:`mesh_sdf`: exact point-triangle
 distances to the nearest triangles, signed by the closest face); :func:`grid_sdf` interpolates it
@@ -22,6 +23,8 @@ from softhand.reduced.vocabulary.errors import InputError
 MESH_SUFFIXES = (".stl", ".obj", ".ply")
 #: grid points along a mesh's longest bounding-box edge for its distance field
 MESH_GRID = 40
+#: the smallest object a mesh may be [mm] (below it, most likely a mesh written in metres)
+MIN_EXTENT_MM = 1.0
 
 
 @dataclass(frozen=True)
@@ -40,7 +43,7 @@ class MeshData:
 
 @lru_cache(maxsize=8)
 def read_mesh(path: str, field: str = "object.file") -> MeshData:
-    """Read STL/OBJ/PLY with trimesh; InputError for a missing, open or self-intersecting mesh."""
+    """Read STL/OBJ/PLY with trimesh; InputError for a missing, open, self-intersecting or several-body mesh."""
     p = Path(path)
     if p.suffix.lower() not in MESH_SUFFIXES:
         raise InputError(field, path, f"must be a mesh file ending in {', '.join(MESH_SUFFIXES)}")
@@ -63,9 +66,15 @@ def read_mesh(path: str, field: str = "object.file") -> MeshData:
         mesh.invert()
     if not mesh.volume > 0:
         raise InputError(field, path, "encloses no volume")
+    extent = float(np.ptp(mesh.vertices, axis=0).max())
+    if extent < MIN_EXTENT_MM:
+        raise InputError(field, path, f"spans {extent:.3g} mm; a mesh is read in mm (was it written in m?)")
     pair = self_intersection(mesh.vertices, mesh.faces)
     if pair is not None:
         raise InputError(field, path, f"intersects itself (triangles {pair[0]} and {pair[1]})")
+    if mesh.body_count > 1:  # apart, or overlapping where no edge crosses a face (coplanar)
+        raise InputError(field, path, f"is {mesh.body_count} separate closed surfaces; the object must be "
+                                      "one body (merge them into one surface)")
     vertices = np.asarray(mesh.vertices - mesh.center_mass, float)
     faces = np.asarray(mesh.faces, int)
     lo, hi = vertices.min(axis=0), vertices.max(axis=0)
@@ -73,10 +82,22 @@ def read_mesh(path: str, field: str = "object.file") -> MeshData:
     axes = tuple(np.arange(lo[i] - 3 * step, hi[i] + 3.5 * step, step) for i in range(3))
     points = np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, 3)
     distance = mesh_sdf(vertices, faces, points).reshape(tuple(len(a) for a in axes))
+    check_encloses_once(float(mesh.volume), float(mesh.area), distance, step, field, path)
     from scipy.ndimage import spline_filter
 
     return MeshData(vertices, faces, axes, spline_filter(distance, order=3, mode="nearest"),
                     fold_vertices(vertices, faces))
+
+
+def check_encloses_once(volume: float, area: float, distance: np.ndarray, step: float, field: str, path) -> None:
+    """InputError unless the solid the signed ``distance`` (sampled every ``step`` mm) encloses, a
+    smoothed count of its inside points, is the surface's own ``volume`` (divergence theorem): they
+    differ where the surface overlaps itself along faces the crossing test cannot see (coplanar).
+    The count's error is a fraction of area x step (5 % of it on a 4 mm plate sampled every 5 mm)."""
+    enclosed = float(np.clip(0.5 - distance / step, 0.0, 1.0).sum()) * step ** 3
+    if abs(enclosed - volume) > 0.1 * area * step:
+        raise InputError(field, path, f"overlaps itself: its surface encloses {volume:.4g} mm^3, the "
+                                      f"solid it bounds {enclosed:.4g} mm^3")
 
 
 #: an edge whose two faces' normals differ by more than this [deg] is an edge of the object (a

@@ -159,6 +159,34 @@ def test_mesh_reading_distance_and_checks(tmp_path):
         object_mesh.read_mesh(_write(two, tmp_path / "two.stl"))
     apart = trimesh.util.concatenate([ball, ball.copy().apply_translation([300, 0, 0])])
     assert object_mesh.self_intersection(apart.vertices, apart.faces) is None
+    with pytest.raises(InputError, match="2 separate closed surfaces"):
+        object_mesh.read_mesh(_write(apart, tmp_path / "apart.stl"))
+    with pytest.raises(InputError, match="was it written in m"):
+        object_mesh.read_mesh(_write(ball.copy().apply_scale(1e-3), tmp_path / "metres.stl"))
+
+
+def test_a_surface_that_encloses_a_region_twice_is_refused():
+    """Two cubes overlapping along coplanar faces (no edge crosses a face): the surface's own
+    volume counts the overlap twice, the solid its distance bounds once; a box, a thin plate, a
+    torus and a fine ball pass with their count's error well inside the tolerance."""
+    cube = trimesh.creation.box(extents=[100.0, 100.0, 100.0])
+    both = trimesh.util.concatenate([cube, cube.copy().apply_translation([30.0, 0.0, 0.0])])
+    assert object_mesh.self_intersection(both.vertices, both.faces) is None  # what the volumes catch
+
+    def check(mesh):
+        V = np.asarray(mesh.vertices - mesh.center_mass)
+        lo, hi = V.min(axis=0), V.max(axis=0)
+        step = float(np.max(hi - lo)) / (object_mesh.MESH_GRID - 1)
+        axes = [np.arange(lo[i] - 3 * step, hi[i] + 3.5 * step, step) for i in range(3)]
+        points = np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, 3)
+        distance = object_mesh.mesh_sdf(V, mesh.faces, points)
+        object_mesh.check_encloses_once(float(mesh.volume), float(mesh.area), distance, step, "file", "x.stl")
+
+    with pytest.raises(InputError, match="overlaps itself"):
+        check(both)
+    for fine in (cube, trimesh.creation.box(extents=[200.0, 4.0, 100.0]), trimesh.creation.torus(60.0, 20.0),
+                 trimesh.creation.icosphere(subdivisions=4, radius=60.0)):
+        check(fine)
 
 
 def test_a_mesh_support_point_is_its_extreme_vertex_and_a_box_mesh_the_box(tmp_path):
