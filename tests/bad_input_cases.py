@@ -290,6 +290,8 @@ EXTRA_FILES.update({
     "m_kpa.csv": "mode,stretch,stress_MPa\n" + "".join(  # kPa under a stress_MPa header
         f"uniaxial,{lam},{1000 * float(v):g}\n" for lam, v in (r.split(",")[1:] for r in GOOD_MATERIAL.split()[1:])),
     "d_material_stiff.toml": '[finger.material]\nmodel = "neo-hookean"\nmu_MPa = 400.0\n',
+    "v_entities.vtu": '<?xml version="1.0"?><!DOCTYPE x [<!ENTITY a "aaaa"><!ENTITY b "&a;&a;&a;&a;">]>'
+                      '<VTKFile type="UnstructuredGrid">&b;</VTKFile>\n',
     "obj_task_tables.toml": '[object]\nshape = "sphere"\ndiameter_mm = 150.0\nmass_kg = 0.5\n[hold]\nmargin = 2.0\n',
     "task_hold_in_palm.toml": TASK.replace("[object]\ndiameter_mm = 180.0\n",
                                            '[object]\nshape = "sphere"\ndiameter_mm = 150.0\n'
@@ -345,7 +347,8 @@ def mixed_cases() -> list[tuple[str, list[str]]]:
                "--weights=1,-1,0,0,1e-12", "--normalise"],
               ["material", "fit", "--data", "m_kpa.csv", "--model", "neo-hookean", "--out", "kpa.toml"],
               ["curve", "--theta-deg", "30", "--design", "d_material_stiff.toml"],
-              ["curve", "--theta-deg", "30", "--compare", "missing.toml"]]
+              ["curve", "--theta-deg", "30", "--compare", "missing.toml"],
+              ["inspect", "v_entities.vtu", "--out", "o.png"]]
     return [("mixed", c) for c in cases]
 
 

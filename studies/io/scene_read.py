@@ -107,6 +107,8 @@ def _check_sizes(path: Path, depth: int = 0) -> None:
                 if count > MAX_ENTITIES:
                     raise InputError("file", str(path), f"declares {key} = {count}; "
                                      f"at most {MAX_ENTITIES} (not a result of this toolkit?)")
+            if b"<!DOCTYPE" in text or b"<!ENTITY" in text:  # entities expand (a "billion laughs")
+                raise InputError("file", str(path), "declares XML entities (a DOCTYPE); a VTK file has none")
             steps = steps or re.search(rb"<DataSet\b", text) is not None
             names += [(a or b) for a, b in _XML_FILE.findall(text)]
     except OSError:
