@@ -29,8 +29,8 @@ AXES = {"pressure": ("pump pressure", "MPa"), "mass": ("mass", "kg"), "size": ("
         "friction": ("friction coefficient", "-"), "pull": ("pull angle from straight down", "deg")}
 #: most points of a map (a 50 x 50 grid)
 MAX_MAP_POINTS = 2500
-#: each axis's values (the object's sizes are checked as the object's own, scaled)
-AXIS_LIMITS = {"pressure": (-1.0, 5.0), "mass": (0.0, 100.0), "size": (1e-3, 1000.0), "friction": (0.0, 10.0),
+#: each axis's values (a mass > 0: the margin is over the weight)
+AXIS_LIMITS = {"pressure": (-1.0, 5.0), "mass": (1e-3, 100.0), "size": (1e-3, 1000.0), "friction": (0.0, 10.0),
                "pull": (-180.0, 180.0)}
 
 
@@ -80,6 +80,9 @@ class HoldMap:
             bad = [v for v in values if not lo <= v <= hi]
             if bad:
                 raise InputError(f"--map {name}", bad[0], f"must be in [{lo:g}, {hi:g}] {AXES[name][1]}")
+        if "mass" not in (self.x[0], self.y[0]) and not self.obj.mass_kg > 0:
+            raise InputError("--mass-kg", self.obj.mass_kg, "must be > 0 for a map (its margin is the load "
+                                                            "borne over the weight)")
         count = len(self.x[1]) * len(self.y[1])
         if count > MAX_MAP_POINTS:
             raise InputError("--map", f"{len(self.x[1])} x {len(self.y[1])}",

@@ -332,7 +332,9 @@ def hold_cases() -> list[tuple[str, list[str]]]:
     cases += [["hold", "--object", "sphere:150", "--map", "pull=0,10", "mass=0.5,1", "--pressure-mpa", "1",
                "--pull", "x", "--no-progress"],
               ["hold", "--object", "sphere:150", "--map", "pull=0,1e300", "mass=0.5", "--pressure-mpa", "1"],
-              ["hold", "--object", "sphere:150", "--map", "pressure=-10,1", "mass=1,2"]]
+              ["hold", "--object", "sphere:150", "--map", "pressure=-10,1", "mass=1,2"],
+              ["hold", "--object", "sphere:150", "--map", "pressure=0.5,1", "mass=0,1"],
+              ["hold", "--object", "sphere:150", "--map", "pressure=0.5,1", "friction=0.5,1"]]  # no mass
     return [("hold", c) for c in cases]
 
 
