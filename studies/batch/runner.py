@@ -39,6 +39,7 @@ from softhand.studies.batch.cases import (FAILED, OWNER, RESULT, Case, case_key,
                                           own_study_dir, package_versions, plan, read_case, study_dir,
                                           remove_leftovers)
 from softhand.studies.batch.claims import Claims
+from softhand.studies.io.outputs import MANIFEST, check_owned
 from softhand.studies.batch.index import index_rows, other_sources, status, write_index  # noqa: F401
 from softhand.studies.batch.studyfile import Study
 from softhand.studies.io.files import kept_if_unwritable
@@ -78,6 +79,8 @@ def run_study(study: Study, *, results_root: str | Path = "results", workers: in
     cases = plan(study)
     # a case folder that is a symbolic link is a damaged case: recomputed, the link replaced
     check_output_tree(sdir, "--results", folders=[c.key for c in cases if not (sdir / c.key).is_symlink()])
+    if not (sdir / MANIFEST).exists():  # a folder no study run wrote: its case-named folders are the user's
+        check_owned(sdir, [c.key for c in cases], "--results")
     states = {c.key: case_state(sdir, c) for c in cases}
     todo = [c for c in cases if fresh or states[c.key] != "done"]
     summary = RunSummary(total=len(cases), reused=len(cases) - len(todo), not_run=len(todo),

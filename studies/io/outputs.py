@@ -11,7 +11,6 @@ from __future__ import annotations
 
 import fnmatch
 import glob
-import json
 import os
 import shutil
 import sys
@@ -20,7 +19,9 @@ import uuid
 from contextlib import contextmanager
 from pathlib import Path
 
-from softhand.studies.io.files import STAGED_RUNS, UNWRITTEN, EXIT_UNWRITTEN, read_bounded, write_json
+from softhand.studies.io.files import STAGED_RUNS, UNWRITTEN, EXIT_UNWRITTEN, write_json
+from softhand.studies.io.manifest import (MANIFEST, check_unchanged, entries_of, manifest_run,  # noqa: F401
+                                          owned_outputs, read_manifest)
 
 
 def check_output_tree(folder: str | Path, field: str, *, files=(), folders=()) -> None:
@@ -54,24 +55,10 @@ def check_output_tree(folder: str | Path, field: str, *, files=(), folders=()) -
                                                         "there; move it away or give another folder")
 
 
-#: the record of what the last run into a folder wrote there (see :func:`replaced_outputs`)
-MANIFEST = ".softhand-outputs.json"
 #: where a run that could not write all its outputs keeps the ones it did (if the user has a
 #: folder of that name, ``incomplete-<run>`` beside it)
 INCOMPLETE = "incomplete"
 _STAGE = ".softhand-stage-"
-
-
-def owned_outputs(folder: str | Path) -> set[str]:
-    """The names an earlier softhand run wrote into ``folder`` (its manifest); empty if none."""
-    try:
-        record = json.loads(read_bounded(Path(folder) / MANIFEST, 1 << 20))
-        names = record.get("outputs") if isinstance(record, dict) else None
-    except (OSError, ValueError, RecursionError):
-        return set()
-    # plain names only: a damaged or edited manifest cannot point a run outside the folder
-    return {n for n in names if isinstance(n, str) and n not in ("", ".", "..", MANIFEST) and "/" not in n
-            and "\0" not in n} if isinstance(names, list) else set()
 
 
 def check_owned(folder: str | Path, names, field: str) -> None:
@@ -87,13 +74,17 @@ def check_owned(folder: str | Path, names, field: str) -> None:
     if record.is_symlink() or record.exists() and not record.is_file():
         raise InputError(field, str(record), "is where a run records its outputs, and is no plain file; "
                                              "remove it or give another folder")
-    owned = owned_outputs(folder)
+    owned, entries = owned_outputs(folder), read_manifest(folder).get("entries")
+    entries = entries if isinstance(entries, dict) else {}
     for name in names:
         for path in folder.glob(name) if glob.has_magic(name) else [folder / name]:
-            if (path.exists() or path.is_symlink()) and path.name not in owned:
+            if not (path.exists() or path.is_symlink()):
+                continue
+            if path.name not in owned:
                 raise InputError(field, str(path), "was not written by an earlier softhand run into "
                                                    "this folder and the run writes there; move it away "
                                                    "or give another folder")
+            check_unchanged(path, entries.get(path.name), field)
 
 
 @contextmanager
@@ -122,7 +113,7 @@ def replaced_outputs(folder: str | Path | None, names, *, verb: str = "softhand"
     _remove_dead_stages(folder)
     stage = folder / f"{_STAGE}{os.getpid()}-{uuid.uuid4().hex[:8]}"
     stage.mkdir(parents=True)
-    seen, unwritten = _manifest_run(folder), len(UNWRITTEN)
+    seen, unwritten = manifest_run(folder), len(UNWRITTEN)
     STAGED_RUNS.append(stage)  # the warnings of writes refused in it: one line when it ends
     try:
         yield stage
@@ -140,24 +131,34 @@ def replaced_outputs(folder: str | Path | None, names, *, verb: str = "softhand"
         if len(UNWRITTEN) > unwritten:
             _keep_incomplete(folder, stage, record, UNWRITTEN[unwritten:], verb)
             return
-        if _manifest_run(folder) != seen:
+        if manifest_run(folder) != seen:
             print(f"softhand {verb}: warning: another run finished into {folder} while this one ran; "
                   f"its outputs are replaced by this run's", file=sys.stderr)
-        _commit(folder, stage, record)
+        _commit(folder, stage, record, names)
 
 
-def _commit(folder: Path, stage: Path, record: dict) -> None:
-    """Rename the staged outputs into ``folder`` and the earlier run's away (each in one step;
-    a folder cannot be replaced by a rename, so an earlier one goes first); the manifest last."""
+def _commit(folder: Path, stage: Path, record: dict, names) -> None:
+    """Rename the staged outputs into ``folder`` and the earlier run's of these ``names`` away
+    (each in one step; a folder cannot be replaced by a rename, so an earlier one goes first);
+    the manifest last. Another verb's outputs in the folder stay, and stay in the manifest."""
     trash = stage / ".earlier"
     trash.mkdir()
     new = set(record["outputs"])
+    earlier = read_manifest(folder).get("entries")
+    earlier = earlier if isinstance(earlier, dict) else {}
+    kept = set()
     for k, name in enumerate(sorted(owned_outputs(folder))):
+        if not (any(fnmatch.fnmatchcase(name, n) for n in names) or name.startswith(INCOMPLETE)):
+            kept.add(name)  # another verb's: not touched (an incomplete run's pieces are replaced)
+            continue
         path = folder / name
         if (path.exists() or path.is_symlink()) and (name not in new or path.is_dir() and not path.is_symlink()):
             os.replace(path, trash / str(k))
+    record = {**record, "outputs": sorted(new | kept),
+              "entries": {**{n: e for n, e in earlier.items() if n in kept}, **entries_of(stage, new)}}
     for name in record["outputs"]:
-        os.replace(stage / name, folder / name)
+        if name in new:
+            os.replace(stage / name, folder / name)
     write_json(stage / MANIFEST, record)
     os.replace(stage / MANIFEST, folder / MANIFEST)
     shutil.rmtree(stage, ignore_errors=True)
@@ -185,7 +186,10 @@ def _keep_incomplete(folder: Path, stage: Path, record: dict, missing, verb: str
         target = stage  # the pieces stay where they are; the warning says where
     else:
         try:
-            write_json(folder / MANIFEST, {**_manifest(folder), "outputs": sorted(owned | {target.name})})
+            record = read_manifest(folder)
+            entries = record.get("entries") if isinstance(record.get("entries"), dict) else {}
+            write_json(folder / MANIFEST, {**record, "outputs": sorted(owned | {target.name}),
+                                           "entries": {**entries, **entries_of(folder, [target.name])}})
         except OSError:
             pass
     print(f"softhand {verb}: warning: {'; '.join(missing)} not written; the results are printed on "
@@ -199,24 +203,15 @@ def record_outputs(folder: str | Path, names, *, verb: str) -> None:
     :func:`check_owned` knows them for softhand's. Call :func:`check_owned` before the work."""
     folder = Path(folder)
     with _folder_lock(folder):
-        record = _manifest(folder)
+        record = read_manifest(folder)
         owned = owned_outputs(folder)
+        entries = record.get("entries") if isinstance(record.get("entries"), dict) else {}
         write_json(folder / MANIFEST, {"run": record.get("run") or uuid.uuid4().hex, "verb": verb,
                                        "pid": os.getpid(),
                                        "finished_utc": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime()),
-                                       "outputs": sorted(owned | set(names))})
-
-
-def _manifest(folder: Path) -> dict:
-    try:
-        record = json.loads(read_bounded(folder / MANIFEST, 1 << 20))
-    except (OSError, ValueError, RecursionError):
-        return {}
-    return record if isinstance(record, dict) else {}
-
-
-def _manifest_run(folder: Path):
-    return _manifest(folder).get("run")
+                                       "outputs": sorted(owned | set(names)),
+                                       "entries": {**{n: e for n, e in entries.items() if n in owned},
+                                                   **entries_of(folder, names)}})
 
 
 @contextmanager

@@ -61,6 +61,56 @@ def test_a_run_replaces_only_its_own_earlier_outputs_and_commits_whole(tmp_path)
                              "notes.txt": b"the user's"}
 
 
+def test_a_run_leaves_another_verbs_outputs_and_names_the_manifest_was_given(tmp_path):
+    """Two verbs into one folder: each replaces its own earlier outputs only; a name of the
+    user's written into the manifest by hand is not this verb's output: never deleted."""
+    out = tmp_path / "out"
+    _run_into(out, ("a.txt",), lambda stage: (stage / "a.txt").write_text("verb A"))
+    _run_into(out, ("b.txt", "sub"), lambda stage: (stage / "b.txt").write_text("verb B"))
+    assert json.loads((out / MANIFEST).read_text())["outputs"] == ["a.txt", "b.txt"]
+    record = json.loads((out / MANIFEST).read_text())
+    (out / "notes.txt").write_text("the user's")
+    (out / MANIFEST).write_text(json.dumps({**record, "outputs": record["outputs"] + ["notes.txt"]}))
+    _run_into(out, ("a.txt",), lambda stage: (stage / "a.txt").write_text("verb A again"))
+    assert _listing(out) == {MANIFEST: (out / MANIFEST).read_bytes(), "a.txt": b"verb A again",
+                             "b.txt": b"verb B", "notes.txt": b"the user's"}
+
+
+def test_an_earlier_output_the_user_changed_is_refused_before_the_work(tmp_path):
+    """A file of the user's put into an earlier run's output folder, a folder or a link where
+    the run wrote a file, a link where it wrote a folder: refused before the work, untouched."""
+    out = tmp_path / "out"
+
+    def write(stage):
+        (stage / "a.txt").write_text("run")
+        (stage / "sub").mkdir()
+        (stage / "sub" / "x.txt").write_text("run")
+
+    _run_into(out, ("a.txt", "sub"), write)
+    (out / "sub" / "mine.txt").write_text("the user's")
+    with pytest.raises(InputError, match="sub/mine.txt.*not written by an earlier softhand run"):
+        _run_into(out, ("a.txt", "sub"), write)
+    assert (out / "sub" / "mine.txt").read_text() == "the user's"
+    (out / "sub" / "mine.txt").unlink()
+    _run_into(out, ("a.txt", "sub"), write)  # the folder as the run left it: replaced
+    (out / "a.txt").unlink()
+    (out / "a.txt").mkdir()
+    (out / "a.txt" / "data.txt").write_text("the user's")
+    with pytest.raises(InputError, match="is a folder where an earlier softhand run wrote a file"):
+        _run_into(out, ("a.txt", "sub"), write)
+    assert (out / "a.txt" / "data.txt").read_text() == "the user's"
+    elsewhere = tmp_path / "elsewhere"
+    elsewhere.mkdir()
+    (out / "a.txt" / "data.txt").rename(elsewhere / "data.txt")
+    (out / "a.txt").rmdir()
+    (out / "a.txt").write_text("run")
+    os.rename(out / "sub", tmp_path / "moved")
+    (out / "sub").symlink_to(elsewhere, target_is_directory=True)
+    with pytest.raises(InputError, match="is a link where an earlier softhand run wrote a folder"):
+        _run_into(out, ("a.txt", "sub"), write)
+    assert _listing(elsewhere) == {"data.txt": b"the user's"}
+
+
 def test_a_stopped_run_leaves_the_earlier_result_whole(tmp_path):
     out = tmp_path / "out"
     _run_into(out, ("a.txt", "sub"), lambda stage: (stage / "a.txt").write_text("complete"))

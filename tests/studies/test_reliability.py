@@ -430,6 +430,21 @@ def test_a_users_files_in_a_study_folder_are_never_replaced(quick_study, tmp_pat
     assert {n: (tmp_path / n).read_text() for n in mine} == mine
 
 
+def test_case_named_folders_in_a_folder_no_study_wrote_are_the_users(quick_study, tmp_path, capsys):
+    """A folder named like a case, with files of the user's, in a study folder no softhand run
+    wrote (no manifest): refused before any case runs, the files as they were."""
+    root = tmp_path / "res"
+    study = load_study(quick_study)
+    mine = study_dir(study, root) / plan(study)[0].key
+    mine.mkdir(parents=True)
+    (mine / "precious.txt").write_text("the user's")
+    argv = ["study", "run", str(quick_study), "--workers", "1", "--results", str(root), "--no-progress"]
+    assert main(argv) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "was not written by an earlier softhand run" in err[0]
+    assert (mine / "precious.txt").read_text() == "the user's"
+
+
 def test_a_read_only_finished_study_is_one_warning(quick_study, tmp_path, monkeypatch, capsys):
     """run and report of a finished study whose folder refuses writes (tests run as root, for
     whom chmod refuses nothing: the refusal is simulated): tracebacks before; now the summary,

@@ -1,0 +1,80 @@
+"""The manifest of an output folder: what earlier softhand runs wrote there, and whether it is
+still what they wrote (:mod:`softhand.studies.io.outputs` decides from it what a run may replace).
+
+``.softhand-outputs.json`` holds the last run's id, verb, process and time, ``outputs`` (the
+names softhand wrote into the folder) and ``entries`` (each name's kind, and a folder's every
+name inside it, as it was written).
+"""
+from __future__ import annotations
+
+import json
+import os
+from pathlib import Path
+
+from softhand.studies.io.files import read_bounded
+
+#: the record of what the runs into a folder wrote there (see :func:`softhand.studies.io.outputs.replaced_outputs`)
+MANIFEST = ".softhand-outputs.json"
+
+
+def owned_outputs(folder: str | Path) -> set[str]:
+    """The names an earlier softhand run wrote into ``folder`` (its manifest); empty if none."""
+    try:
+        record = json.loads(read_bounded(Path(folder) / MANIFEST, 1 << 20))
+        names = record.get("outputs") if isinstance(record, dict) else None
+    except (OSError, ValueError, RecursionError):
+        return set()
+    # plain names only: a damaged or edited manifest cannot point a run outside the folder
+    return {n for n in names if isinstance(n, str) and n not in ("", ".", "..", MANIFEST) and "/" not in n
+            and "\0" not in n} if isinstance(names, list) else set()
+
+
+def check_unchanged(path: Path, entry, field: str) -> None:
+    """An earlier run's output ``path`` is still what it wrote (its manifest ``entry``; none from
+    a manifest before entries were kept): a file still a file, a folder a folder holding nothing
+    but what the run put in it. Else InputError: replacing it would lose what the user put there."""
+    from softhand.reduced.vocabulary.errors import InputError
+
+    if not isinstance(entry, dict):
+        return
+    now = entry_of(path)
+    if now["kind"] != entry.get("kind"):
+        raise InputError(field, str(path), f"is a {now['kind']} where an earlier softhand run wrote a "
+                                           f"{entry.get('kind')}, and the run replaces it; move it away "
+                                           "or give another folder")
+    extra = sorted(set(now.get("contents", ())) - set(entry.get("contents", ())))
+    if extra:
+        raise InputError(field, str(path / extra[0]), "was not written by an earlier softhand run into "
+                                                      "this folder and the run replaces the folder; move "
+                                                      "it away or give another folder")
+
+
+def entry_of(path: Path) -> dict:
+    """What stands at ``path`` for the manifest: its kind and, for a folder, every name in it
+    (relative paths; links not followed)."""
+    if path.is_symlink():
+        return {"kind": "link"}
+    if not path.is_dir():
+        return {"kind": "file"}
+    contents = []
+    for root, dirs, files in os.walk(path):
+        rel = Path(root).relative_to(path)
+        contents += [str(rel / n) for n in dirs + files]
+    return {"kind": "folder", "contents": sorted(contents)}
+
+
+def entries_of(folder: Path, names) -> dict:
+    """The manifest's entries of ``names`` as they stand in ``folder`` now."""
+    return {n: entry_of(folder / n) for n in names if (folder / n).exists() or (folder / n).is_symlink()}
+
+
+def read_manifest(folder: Path) -> dict:
+    try:
+        record = json.loads(read_bounded(folder / MANIFEST, 1 << 20))
+    except (OSError, ValueError, RecursionError):
+        return {}
+    return record if isinstance(record, dict) else {}
+
+
+def manifest_run(folder: Path):
+    return read_manifest(folder).get("run")
