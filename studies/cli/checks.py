@@ -19,6 +19,7 @@ import tempfile
 from pathlib import Path
 
 from softhand.reduced.vocabulary.errors import InputError
+from softhand.studies.io.manifest import check_single
 
 #: picture suffixes of matplotlib's writers (--plot) and of the 3D renderer (inspect --out)
 PLOT_SUFFIXES = (".png", ".pdf", ".svg", ".jpg", ".jpeg", ".eps", ".ps", ".tif", ".tiff", ".webp")
@@ -34,6 +35,8 @@ VERB_OUTPUTS = {"fit": {"out": "toml"}, "material": {"out": "toml"},
 #: file suffixes an output kind must end in (a design TOML, a table)
 SUFFIXES = {"plot": PLOT_SUFFIXES, "render": RENDER_SUFFIXES, "animation": ANIMATION_SUFFIXES,
             "toml": (".toml",), "csv": (".csv",)}
+#: the first bytes of an output kind's files that say softhand wrote them (a calibration table)
+MARKS = {"csv": b"# FEM calibration of "}
 #: output kinds whose writer reads the suffix as it is spelled (the 3D renderer: not '.PNG')
 EXACT_SUFFIX = ("render", "animation")
 #: argument names of the files a verb reads (an output may not be one of them)
@@ -74,6 +77,32 @@ def check_outputs(verb: str, args, parser) -> None:
             check_writable(value, kind, option_name(dest, parser))
             if kind != "dir":
                 _not_an_input(value, option_name(dest, parser), args, parser)
+                if value not in run_outputs(verb, args):  # (those the run stages, checks, replaces)
+                    check_single(value, option_name(dest, parser), MARKS.get(kind))  # never the user's
+
+
+def single_outputs(verb: str, args) -> list[str]:
+    """The file outputs named on the command line (``--plot FILE``, ``--out FILE.toml``, ...)
+    that are not one of the run's own outputs in its ``--out`` folder."""
+    kinds = {**OUTPUTS, **VERB_OUTPUTS.get(verb, {})}
+    named = [getattr(args, d) for d, kind in kinds.items() if kind != "dir" and getattr(args, d, None) is not None]
+    return [v for v in named if v not in run_outputs(verb, args)]
+
+
+def run_outputs(verb: str, args) -> list[str]:
+    """Of the file outputs named, those that are outputs of the run's own ``--out`` folder by its
+    manifest (e.g. ``design --plot DIR/pareto.png``: staged and committed with the run)."""
+    from softhand.studies.io.manifest import read_manifest
+
+    kinds = {**OUTPUTS, **VERB_OUTPUTS.get(verb, {})}
+    out = getattr(args, "out", None) if kinds.get("out") == "dir" else None
+    if out is None:
+        return []
+    entries = read_manifest(Path(out)).get("entries") or {}
+    named = [getattr(args, d) for d, kind in kinds.items() if kind != "dir" and getattr(args, d, None) is not None]
+    return [v for v in named if os.path.abspath(os.path.dirname(v)) == os.path.abspath(out)
+            and isinstance(entries.get(os.path.basename(v)), dict)
+            and not entries[os.path.basename(v)].get("single")]
 
 
 def _not_an_input(path, field: str, args, parser) -> None:

@@ -20,7 +20,9 @@ import os
 import re
 import signal
 import sys
+import time
 import warnings
+from pathlib import Path
 
 from softhand.reduced.vocabulary.errors import InputError, Note, short
 from softhand.reduced.vocabulary.inputfiles import plain_float
@@ -130,7 +132,9 @@ def main(argv: list[str] | None = None) -> int:
     reset_unwritten()
     try:
         _check(verb, args, parser)
+        started = time.time()
         code = int(module.run(args) or 0)
+        _record_single_outputs(verb, args, started)
         sys.stdout.flush()  # a closed pipe shows here, not in Python's exit
         return EXIT_UNWRITTEN if code in (0, 1) and UNWRITTEN else code  # computed, printed, not all written
     except InputError as exc:
@@ -153,6 +157,21 @@ def main(argv: list[str] | None = None) -> int:
         _restore_float_warnings(float_errors)
         if previous is not None:
             signal.signal(signal.SIGTERM, previous)
+
+
+def _record_single_outputs(verb: str, args, started: float) -> None:
+    """The file outputs named on the command line that this run wrote, recorded as softhand's in
+    their folders' manifests (a later run may replace them; nothing else may): see docs/outputs.md."""
+    from softhand.studies.cli.checks import single_outputs
+    from softhand.studies.io.outputs import record_single
+
+    for name in single_outputs(verb, args):
+        path = Path(name)
+        try:
+            if path.is_file() and not path.is_symlink() and path.stat().st_mtime >= started - 1.0:
+                record_single(path, verb)
+        except OSError:  # a folder that takes the file but not its record: the file stands
+            pass
 
 
 def _check(verb: str, args, parser) -> None:

@@ -37,6 +37,9 @@ def check_unchanged(path: Path, entry, field: str) -> None:
 
     if not isinstance(entry, dict):
         return
+    if entry.get("single"):
+        raise InputError(field, str(path), "is the file another softhand command wrote there as its output "
+                                           "(--plot, --out FILE); move it away or give another folder")
     now = entry_of(path)
     if now["kind"] != entry.get("kind"):
         raise InputError(field, str(path), f"is a {now['kind']} where an earlier softhand run wrote a "
@@ -78,3 +81,29 @@ def read_manifest(folder: Path) -> dict:
 
 def manifest_run(folder: Path):
     return read_manifest(folder).get("run")
+
+
+def check_single(path, field: str, mark: bytes | None = None) -> None:
+    """A file output named on the command line (``--plot FILE``, ``--out FILE.toml``): if something
+    stands there, it is a file an earlier softhand command wrote there as such an output (its
+    folder's manifest says so; :func:`softhand.studies.io.outputs.record_single`), or a plain file
+    that begins with ``mark`` (a calibration table's first line: the shipped tables, regenerated
+    in place). Else InputError: a file of the user's, or one of a run's outputs, is never replaced."""
+    from softhand.reduced.vocabulary.errors import InputError
+
+    path = Path(path)
+    if not (path.exists() or path.is_symlink()):
+        return
+    if mark is not None and path.is_file() and not path.is_symlink():
+        try:
+            with path.open("rb") as f:
+                if f.read(len(mark)) == mark:
+                    return
+        except OSError:
+            pass
+    entry = (read_manifest(path.parent).get("entries") or {}).get(path.name) \
+        if path.name in owned_outputs(path.parent) else None
+    if not (isinstance(entry, dict) and entry.get("single") and entry.get("kind") == "file"
+            and entry_of(path)["kind"] == "file"):
+        raise InputError(field, str(path), "exists and was not written by an earlier softhand command as "
+                                           "this kind of output; move it away or give another file name")

@@ -197,6 +197,19 @@ def _keep_incomplete(folder: Path, stage: Path, record: dict, missing, verb: str
           f"exit code {EXIT_UNWRITTEN}", file=sys.stderr)
 
 
+def record_single(path: str | Path, verb: str) -> None:
+    """Record a file output named on the command line, just written whole (``--plot FILE``), in
+    its folder's manifest, so that a later command may replace it (:func:`softhand.studies.io.manifest.check_single`) and a
+    run into that folder leaves it alone."""
+    path = Path(path)
+    record_outputs(path.parent, [path.name], verb=verb)
+    with _folder_lock(path.parent):
+        record = read_manifest(path.parent)
+        entries = record.get("entries") if isinstance(record.get("entries"), dict) else {}
+        entries[path.name] = {"kind": "file", "single": True}
+        write_json(path.parent / MANIFEST, {**record, "entries": entries})
+
+
 def record_outputs(folder: str | Path, names, *, verb: str) -> None:
     """Add ``names`` (outputs just renamed into ``folder`` whole, one by one, by a run that keeps
     its pieces as they finish) to the folder's manifest, so that a later run replaces them and

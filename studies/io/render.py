@@ -26,6 +26,7 @@ import pyvista as pv
 from softhand.meshes.atomic import atomic_path
 from softhand.reduced.vocabulary.errors import InputError
 from softhand.studies.io.files import kept_if_unwritable
+from softhand.studies.io.manifest import check_single
 from softhand.studies.io.scene_read import field_names, field_values, load_scene
 from softhand.studies.io.render_style import (VIEWS, body_name, camera, clim_of, colour_label, default_field,
                                    default_png, finger_turns, has_display, title_of)
@@ -74,6 +75,8 @@ def inspect(path: str | Path, *, field: str | None = None, step: int | None = No
         raise InputError("--interactive", True, "needs a display (DISPLAY is not set); "
                                                 "omit it to render off-screen")
     png = None if interactive and out is None else Path(out or default_png(path, index, field))
+    if out is None and png is not None:  # the default name: never over a file of the user's
+        check_single(png, "--out")
     plotter = _plotter(interactive=interactive)
     _draw(plotter, scene, field, title=title_of(path, scene, index, n_steps), view=view, hand=hand)
     written = None
@@ -82,6 +85,10 @@ def inspect(path: str | Path, *, field: str | None = None, step: int | None = No
             with atomic_path(png) as tmp:
                 plotter.screenshot(str(tmp))
             written = str(png)
+            if out is None:  # (a name given is recorded by the command line, as every --out FILE)
+                from softhand.studies.io.outputs import record_single
+
+                record_single(png, "inspect")
     if interactive:
         plotter.show()
     plotter.close()

@@ -111,6 +111,29 @@ def test_an_earlier_output_the_user_changed_is_refused_before_the_work(tmp_path)
     assert _listing(elsewhere) == {"data.txt": b"the user's"}
 
 
+def test_a_file_named_on_the_command_line_replaces_only_its_own_earlier_self(tmp_path, monkeypatch, capsys):
+    """--plot FILE / --out FILE.toml: a file of the user's there, or a run's output of that name,
+    is refused before the work; the file this option wrote before is replaced; the inspect
+    default picture likewise."""
+    monkeypatch.chdir(tmp_path)
+    Path("photo.png").write_bytes(b"the user's")
+    assert main(["curve", "--theta-deg", "10,20", "--plot", "photo.png"]) == 2
+    assert "photo.png" in capsys.readouterr().err and Path("photo.png").read_bytes() == b"the user's"
+    assert main(["curve", "--theta-deg", "10,20", "--plot", "fig.png"]) == 0
+    first = Path("fig.png").stat().st_mtime_ns
+    assert main(["curve", "--theta-deg", "10,30", "--plot", "fig.png"]) == 0  # its own: replaced
+    assert Path("fig.png").stat().st_mtime_ns >= first
+    _run_into(Path("run"), ("design.toml",), lambda stage: (stage / "design.toml").write_text("a run's"))
+    Path("data.csv").write_text("theta_deg,P_MPa\n10,0.1\n20,0.2\n30,0.3\n")
+    assert main(["fit", "--data", "data.csv", "--params", "V0_mm3", "--out", "run/design.toml"]) == 2
+    assert Path("run/design.toml").read_text() == "a run's"
+    # and a run into a folder leaves a file an option wrote there alone
+    _run_into(Path("."), ("a.txt",), lambda stage: (stage / "a.txt").write_text("run"))
+    assert Path("fig.png").exists() and Path("photo.png").read_bytes() == b"the user's"
+    with pytest.raises(InputError, match="another softhand command wrote there"):
+        _run_into(Path("."), ("fig.png",), lambda stage: None)
+
+
 def test_a_stopped_run_leaves_the_earlier_result_whole(tmp_path):
     out = tmp_path / "out"
     _run_into(out, ("a.txt", "sub"), lambda stage: (stage / "a.txt").write_text("complete"))
