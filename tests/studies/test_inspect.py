@@ -41,7 +41,15 @@ def test_cli_prints_range_and_writes_default_png(series, capsys):
     assert main(["inspect", str(series), "--step", "1", "--field", "principal_stretches[0]"]) == 0
     out = capsys.readouterr().out
     assert "principal_stretches[0]" in out and "max" in out
-    assert (series.parent / "twist_step1_principal_stretches_0.png").is_file()
+    png = series.parent / "twist_step1_principal_stretches_0.png"
+    assert png.is_file()
+    argv = ["inspect", str(series), "--step", "0", "--field", "principal_stretches[0]"]
+    mine = series.parent / "twist_step0_principal_stretches_0.png"
+    mine.write_bytes(b"the user's picture")  # the default name of step 0: a file of the user's
+    assert main(argv) == 2 and mine.read_bytes() == b"the user's picture"
+    assert "--out" in capsys.readouterr().err
+    mine.unlink()
+    assert main(argv) == 0 and main(argv) == 0  # its own picture: replaced
 
 
 @pytest.mark.parametrize("argv, word", [
