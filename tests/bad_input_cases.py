@@ -350,7 +350,8 @@ def mixed_cases() -> list[tuple[str, list[str]]]:
               ["material", "fit", "--data", "m_kpa.csv", "--model", "neo-hookean", "--out", "kpa.toml"],
               ["curve", "--theta-deg", "30", "--design", "d_material_stiff.toml"],
               ["curve", "--theta-deg", "30", "--compare", "missing.toml"],
-              ["inspect", "v_entities.vtu", "--out", "o.png"]]
+              ["inspect", "v_entities.vtu", "--out", "o.png"],
+              ["control", "--theta-ref-deg", "50", "--mass-kg", "1", "--out", "same.png", "--plot", "same.png"]]
     return [("mixed", c) for c in cases]
 
 

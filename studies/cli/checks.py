@@ -71,9 +71,15 @@ def check_finite(args, parser) -> None:
 def check_outputs(verb: str, args, parser) -> None:
     """Every output argument given can be written; InputError naming the option."""
     kinds = {**OUTPUTS, **VERB_OUTPUTS.get(verb, {})}
+    seen = {}
     for dest, kind in kinds.items():
         value = getattr(args, dest, None)
         if value is not None:
+            same = next((d for d, p in seen.items() if os.path.abspath(p) == os.path.abspath(value)), None)
+            if same is not None:
+                raise InputError(option_name(dest, parser), value, f"is also {option_name(same, parser)}; "
+                                                                   "give each output its own name")
+            seen[dest] = value
             check_writable(value, kind, option_name(dest, parser))
             if kind != "dir":
                 _not_an_input(value, option_name(dest, parser), args, parser)

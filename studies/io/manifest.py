@@ -29,14 +29,18 @@ def owned_outputs(folder: str | Path) -> set[str]:
             and "\0" not in n} if isinstance(names, list) else set()
 
 
-def check_unchanged(path: Path, entry, field: str) -> None:
+def check_unchanged(path: Path, entry, field: str, verb: str | None = None) -> None:
     """An earlier run's output ``path`` is still what it wrote (its manifest ``entry``; none from
     a manifest before entries were kept): a file still a file, a folder a folder holding nothing
-    but what the run put in it. Else InputError: replacing it would lose what the user put there."""
+    but what the run put in it, each name of the kind it was; and it is an output of ``verb``'s
+    (None: any). Else InputError: replacing it would lose what the user, or another verb, put there."""
     from softhand.reduced.vocabulary.errors import InputError
 
     if not isinstance(entry, dict):
         return
+    if verb is not None and entry.get("verb") not in (None, verb) and not entry.get("single"):
+        raise InputError(field, str(path), f"was written by softhand {entry['verb']}, and softhand {verb} "
+                                           "writes its own there; give another folder")
     if entry.get("single"):
         raise InputError(field, str(path), "is the file another softhand command wrote there as its output "
                                            "(--plot, --out FILE); move it away or give another folder")
@@ -45,9 +49,11 @@ def check_unchanged(path: Path, entry, field: str) -> None:
         raise InputError(field, str(path), f"is a {now['kind']} where an earlier softhand run wrote a "
                                            f"{entry.get('kind')}, and the run replaces it; move it away "
                                            "or give another folder")
-    extra = sorted(set(now.get("contents", ())) - set(entry.get("contents", ())))
+    untyped = lambda names: {n.rstrip("/@") for n in names}  # noqa: E731  (an entry before kinds were kept)
+    extra = sorted(set(now.get("contents", ())) - set(entry.get("contents", ())) if entry.get("typed")
+                   else untyped(now.get("contents", ())) - untyped(entry.get("contents", ())))
     if extra:
-        raise InputError(field, str(path / extra[0]), "was not written by an earlier softhand run into "
+        raise InputError(field, str(path / extra[0].rstrip("/@")), "was not written by an earlier softhand run into "
                                                       "this folder and the run replaces the folder; move "
                                                       "it away or give another folder")
 
@@ -59,16 +65,18 @@ def entry_of(path: Path) -> dict:
         return {"kind": "link"}
     if not path.is_dir():
         return {"kind": "file"}
-    contents = []
+    contents = []  # a folder's names end in '/', a link's in '@': a name that changed kind is another name
     for root, dirs, files in os.walk(path):
         rel = Path(root).relative_to(path)
-        contents += [str(rel / n) for n in dirs + files]
-    return {"kind": "folder", "contents": sorted(contents)}
+        contents += [str(rel / n) + ("@" if (Path(root) / n).is_symlink() else "/") for n in dirs]
+        contents += [str(rel / n) + ("@" if (Path(root) / n).is_symlink() else "") for n in files]
+    return {"kind": "folder", "contents": sorted(contents), "typed": True}
 
 
-def entries_of(folder: Path, names) -> dict:
-    """The manifest's entries of ``names`` as they stand in ``folder`` now."""
-    return {n: entry_of(folder / n) for n in names if (folder / n).exists() or (folder / n).is_symlink()}
+def entries_of(folder: Path, names, verb: str | None = None) -> dict:
+    """The manifest's entries of ``names`` as they stand in ``folder`` now (written by ``verb``)."""
+    return {n: {**entry_of(folder / n), **({"verb": verb} if verb else {})}
+            for n in names if (folder / n).exists() or (folder / n).is_symlink()}
 
 
 def read_manifest(folder: Path) -> dict:

@@ -61,7 +61,7 @@ INCOMPLETE = "incomplete"
 _STAGE = ".softhand-stage-"
 
 
-def check_owned(folder: str | Path, names, field: str) -> None:
+def check_owned(folder: str | Path, names, field: str, verb: str | None = None) -> None:
     """Before any work: every output ``names`` that already stands in ``folder`` was written
     there by an earlier softhand run (its manifest names it); else InputError: a run replaces
     only its own earlier outputs, never a file or folder of the user's of the same name."""
@@ -84,7 +84,7 @@ def check_owned(folder: str | Path, names, field: str) -> None:
                 raise InputError(field, str(path), "was not written by an earlier softhand run into "
                                                    "this folder and the run writes there; move it away "
                                                    "or give another folder")
-            check_unchanged(path, entries.get(path.name), field)
+            check_unchanged(path, entries.get(path.name), field, verb)
 
 
 @contextmanager
@@ -108,7 +108,7 @@ def replaced_outputs(folder: str | Path | None, names, *, verb: str = "softhand"
         yield None
         return
     folder, names = Path(folder), tuple(names)
-    check_owned(folder, names, field)
+    check_owned(folder, names, field, verb)
     made = not folder.exists()
     _remove_dead_stages(folder)
     stage = folder / f"{_STAGE}{os.getpid()}-{uuid.uuid4().hex[:8]}"
@@ -154,8 +154,9 @@ def _commit(folder: Path, stage: Path, record: dict, names) -> None:
         path = folder / name
         if (path.exists() or path.is_symlink()) and (name not in new or path.is_dir() and not path.is_symlink()):
             os.replace(path, trash / str(k))
+    kept_entries = {n: e for n, e in earlier.items() if n in kept}
     record = {**record, "outputs": sorted(new | kept),
-              "entries": {**{n: e for n, e in earlier.items() if n in kept}, **entries_of(stage, new)}}
+              "entries": {**kept_entries, **entries_of(stage, new, record["verb"])}}
     for name in record["outputs"]:
         if name in new:
             os.replace(stage / name, folder / name)
@@ -189,7 +190,7 @@ def _keep_incomplete(folder: Path, stage: Path, record: dict, missing, verb: str
             record = read_manifest(folder)
             entries = record.get("entries") if isinstance(record.get("entries"), dict) else {}
             write_json(folder / MANIFEST, {**record, "outputs": sorted(owned | {target.name}),
-                                           "entries": {**entries, **entries_of(folder, [target.name])}})
+                                           "entries": {**entries, **entries_of(folder, [target.name], verb)}})
         except OSError:
             pass
     print(f"softhand {verb}: warning: {'; '.join(missing)} not written; the results are printed on "
@@ -206,7 +207,7 @@ def record_single(path: str | Path, verb: str) -> None:
     with _folder_lock(path.parent):
         record = read_manifest(path.parent)
         entries = record.get("entries") if isinstance(record.get("entries"), dict) else {}
-        entries[path.name] = {"kind": "file", "single": True}
+        entries[path.name] = {"kind": "file", "single": True, "verb": verb}
         write_json(path.parent / MANIFEST, {**record, "entries": entries})
 
 
@@ -224,7 +225,7 @@ def record_outputs(folder: str | Path, names, *, verb: str) -> None:
                                        "finished_utc": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime()),
                                        "outputs": sorted(owned | set(names)),
                                        "entries": {**{n: e for n, e in entries.items() if n in owned},
-                                                   **entries_of(folder, names)}})
+                                                   **entries_of(folder, names, verb)}})
 
 
 @contextmanager

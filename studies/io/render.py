@@ -76,7 +76,7 @@ def inspect(path: str | Path, *, field: str | None = None, step: int | None = No
                                                 "omit it to render off-screen")
     png = None if interactive and out is None else Path(out or default_png(path, index, field))
     if out is None and png is not None:  # the default name: never over a file of the user's
-        check_single(png, "--out")
+        check_single(png, "--out (not given: the default name)")
     plotter = _plotter(interactive=interactive)
     _draw(plotter, scene, field, title=title_of(path, scene, index, n_steps), view=view, hand=hand)
     written = None

@@ -134,6 +134,35 @@ def test_a_file_named_on_the_command_line_replaces_only_its_own_earlier_self(tmp
         _run_into(Path("."), ("fig.png",), lambda stage: None)
 
 
+def test_a_name_inside_an_output_folder_that_changed_kind_and_another_verbs_file_are_refused(tmp_path):
+    """Inside an earlier run's output folder, a file replaced by a link or a folder: refused like
+    a file added there; another verb's output of the same name (two verbs' result.json): refused."""
+    out = tmp_path / "out"
+
+    def write(stage):
+        (stage / "result.json").write_text("bend's")
+        (stage / "sub" / "deep").mkdir(parents=True)
+        (stage / "sub" / "x.vtu").write_text("run")
+
+    _run_into(out, ("result.json", "sub"), write, verb="bend")
+    elsewhere = tmp_path / "elsewhere"
+    elsewhere.mkdir()
+    for change in ("link", "folder"):
+        (out / "sub" / "x.vtu").unlink()
+        if change == "link":
+            (out / "sub" / "x.vtu").symlink_to(elsewhere / "y.vtu")
+        else:
+            (out / "sub" / "x.vtu").mkdir()
+        with pytest.raises(InputError, match="sub/x.vtu'.*not written by an earlier softhand run"):
+            _run_into(out, ("result.json", "sub"), write, verb="bend")
+        (out / "sub" / "x.vtu").unlink() if change == "link" else (out / "sub" / "x.vtu").rmdir()
+        (out / "sub" / "x.vtu").write_text("run")
+    with pytest.raises(InputError, match="was written by softhand bend, and softhand hold writes its own"):
+        _run_into(out, ("result.json", "hold.pvd"), lambda stage: None, verb="hold")
+    assert (out / "result.json").read_text() == "bend's"
+    _run_into(out, ("result.json", "sub"), write, verb="bend")  # its own: replaced
+
+
 def test_a_stopped_run_leaves_the_earlier_result_whole(tmp_path):
     out = tmp_path / "out"
     _run_into(out, ("a.txt", "sub"), lambda stage: (stage / "a.txt").write_text("complete"))
@@ -167,7 +196,7 @@ def test_a_write_the_disk_refuses_keeps_the_earlier_result_and_the_pieces_writte
     before = _listing(out)
     files.reset_unwritten()
 
-    _run_into(out, ("a.txt", "b.txt"), _partly(out, errno.EFBIG, "File too large"), verb="test")
+    _run_into(out, ("a.txt", "b.txt"), _partly(out, errno.EFBIG, "File too large"))
     err = capsys.readouterr().err
     lines = err.strip().splitlines()
     assert len(lines) == 1 and "a.txt (File too large) not written" in err and f"exit code {EXIT_UNWRITTEN}" in err
@@ -192,7 +221,7 @@ def test_a_users_folder_named_incomplete_neither_blocks_a_run_nor_is_touched(tmp
     assert (out / "a.txt").read_text() == "complete"
     files.reset_unwritten()
 
-    _run_into(out, ("a.txt", "b.txt"), _partly(out, errno.ENOSPC, "No space left on device"), verb="test")
+    _run_into(out, ("a.txt", "b.txt"), _partly(out, errno.ENOSPC, "No space left on device"))
     files.reset_unwritten()
     kept = [p for p in out.iterdir() if p.name.startswith(f"{INCOMPLETE}-")]
     assert len(kept) == 1 and (kept[0] / "b.txt").read_text() == "written"

@@ -144,7 +144,7 @@ def run(args) -> int:
 
     pressures = _check(args)
     out = Path(args.out)
-    check_owned(out, OUTPUT_NAMES, "--out")
+    check_owned(out, OUTPUT_NAMES, "--out", "bend")
     design = design_from_args(args)
     if args.tie_width_mm is not None and args.tie_width_mm >= min(design.link_lengths):
         from softhand.reduced.vocabulary.errors import InputError

@@ -147,7 +147,7 @@ def run(args) -> int:
     study = study_from_args(args)
     if args.out:
         check_output_tree(args.out, "--out", files=FILES)
-        check_owned(args.out, FILES, "--out")
+        check_owned(args.out, FILES, "--out", "control")
     result = run_study(study)
     with replaced_outputs(args.out, FILES, verb="control") as stage:  # renamed into place when whole
         if stage is not None:

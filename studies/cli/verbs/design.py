@@ -61,7 +61,7 @@ def run(args) -> int:
     out = Path(args.out) if args.out else _default_out(task, args.task)
     check_writable(out, "dir", "--out")  # also the default folder, which argparse's checks do not see
     check_output_tree(out, "--out")
-    check_owned(out, OUTPUT_FILES + OUTPUT_FOLDERS, "--out")
+    check_owned(out, OUTPUT_FILES + OUTPUT_FOLDERS, "--out", "design")
     if not args.no_fem:
         _check_proof_size(task, args)
     say = (lambda text: print(f"softhand design: {text}", file=sys.stderr)) if args.json else print

@@ -76,7 +76,7 @@ def run(args) -> int:
     if args.out:  # a file or folder of the user's where an output goes: refused before any work
         from softhand.studies.io.outputs import check_owned
 
-        check_owned(args.out, OUTPUT_NAMES, "--out")
+        check_owned(args.out, OUTPUT_NAMES, "--out", "hold")
     if args.map:
         return _run_map(args, design, obj, pull, max_pump)
     if args.check:

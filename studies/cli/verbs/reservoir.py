@@ -77,7 +77,7 @@ def run(args) -> int:
     if args.out:
         from softhand.studies.io.outputs import check_owned
 
-        check_owned(args.out, OUTPUT_NAMES, "--out")  # a folder of the user's named sheet/: before the FEM
+        check_owned(args.out, OUTPUT_NAMES, "--out", "reservoir")  # a folder of the user's named sheet/: before the FEM
     if args.write_calibration:
         from softhand.studies.reservoir import write_calibration
 

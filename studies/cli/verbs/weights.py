@@ -131,6 +131,10 @@ def _run(args) -> int:
                          "(--diameter-mm a,b,.. or start:stop:step), not to one or to --fig8")
     if args.out is not None and (diameters.size > 1 or args.fig8 is not None):
         raise InputError("--out", args.out, "applies to one diameter, not to a sweep or --fig8")
+    if args.out is not None:  # a file or folder of the user's (or another verb's) there: before the FEM
+        from softhand.studies.io.outputs import check_owned
+
+        check_owned(args.out, OUTPUT_NAMES, "--out", "weights")
     if args.fig8 is not None and diameters.size > 1:
         raise InputError("--fig8", args.fig8, "is for one object: give one --diameter-mm")
     if args.plot is not None and diameters.size == 1 and args.fig8 is None:
