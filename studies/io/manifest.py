@@ -53,9 +53,10 @@ def check_unchanged(path: Path, entry, field: str, verb: str | None = None) -> N
     extra = sorted(set(now.get("contents", ())) - set(entry.get("contents", ())) if entry.get("typed")
                    else untyped(now.get("contents", ())) - untyped(entry.get("contents", ())))
     if extra:
-        raise InputError(field, str(path / extra[0].rstrip("/@")), "was not written by an earlier softhand run into "
-                                                      "this folder and the run replaces the folder; move "
-                                                      "it away or give another folder")
+        inside = path / extra[0].rstrip("/@")
+        raise InputError(field, str(inside), "was not written by an earlier softhand run into this folder "
+                                             "and the run replaces the folder; move it away or give "
+                                             "another folder")
 
 
 def entry_of(path: Path) -> dict:
@@ -80,6 +81,7 @@ def entries_of(folder: Path, names, verb: str | None = None) -> dict:
 
 
 def read_manifest(folder: Path) -> dict:
+    """The folder's manifest as a dict ({} if there is none or it does not parse)."""
     try:
         record = json.loads(read_bounded(folder / MANIFEST, 1 << 20))
     except (OSError, ValueError, RecursionError):
@@ -88,6 +90,7 @@ def read_manifest(folder: Path) -> dict:
 
 
 def manifest_run(folder: Path):
+    """The id of the last run recorded in the folder's manifest (None: none)."""
     return read_manifest(folder).get("run")
 
 
