@@ -87,12 +87,16 @@ def check_outputs(verb: str, args, parser) -> None:
                     check_single(value, option_name(dest, parser), MARKS.get(kind))  # never the user's
 
 
-def single_outputs(verb: str, args) -> list[str]:
-    """The file outputs named on the command line (``--plot FILE``, ``--out FILE.toml``, ...)
-    that are not one of the run's own outputs in its ``--out`` folder."""
+def _named_files(verb: str, args) -> list[str]:
+    """The file outputs named on the command line (``--plot FILE``, ``--out FILE.toml``, ...)."""
     kinds = {**OUTPUTS, **VERB_OUTPUTS.get(verb, {})}
-    named = [getattr(args, d) for d, kind in kinds.items() if kind != "dir" and getattr(args, d, None) is not None]
-    return [v for v in named if v not in run_outputs(verb, args)]
+    return [getattr(args, d) for d, kind in kinds.items() if kind != "dir" and getattr(args, d, None) is not None]
+
+
+def single_outputs(verb: str, args) -> list[str]:
+    """The file outputs named on the command line that are not one of the run's own outputs in
+    its ``--out`` folder."""
+    return [v for v in _named_files(verb, args) if v not in run_outputs(verb, args)]
 
 
 def run_outputs(verb: str, args) -> list[str]:
@@ -100,13 +104,11 @@ def run_outputs(verb: str, args) -> list[str]:
     manifest (e.g. ``design --plot DIR/pareto.png``: staged and committed with the run)."""
     from softhand.studies.io.manifest import read_manifest
 
-    kinds = {**OUTPUTS, **VERB_OUTPUTS.get(verb, {})}
-    out = getattr(args, "out", None) if kinds.get("out") == "dir" else None
+    out = getattr(args, "out", None) if {**OUTPUTS, **VERB_OUTPUTS.get(verb, {})}.get("out") == "dir" else None
     if out is None:
         return []
     entries = read_manifest(Path(out)).get("entries") or {}
-    named = [getattr(args, d) for d, kind in kinds.items() if kind != "dir" and getattr(args, d, None) is not None]
-    return [v for v in named if os.path.abspath(os.path.dirname(v)) == os.path.abspath(out)
+    return [v for v in _named_files(verb, args) if os.path.abspath(os.path.dirname(v)) == os.path.abspath(out)
             and isinstance(entries.get(os.path.basename(v)), dict)
             and not entries[os.path.basename(v)].get("single")]
 

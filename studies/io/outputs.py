@@ -200,32 +200,30 @@ def _keep_incomplete(folder: Path, stage: Path, record: dict, missing, verb: str
 
 def record_single(path: str | Path, verb: str) -> None:
     """Record a file output named on the command line, just written whole (``--plot FILE``), in
-    its folder's manifest, so that a later command may replace it (:func:`softhand.studies.io.manifest.check_single`) and a
-    run into that folder leaves it alone."""
+    its folder's manifest, so that a later command may replace it
+    (:func:`softhand.studies.io.manifest.check_single`) and a run into that folder leaves it alone."""
     path = Path(path)
-    record_outputs(path.parent, [path.name], verb=verb)
-    with _folder_lock(path.parent):
-        record = read_manifest(path.parent)
-        entries = record.get("entries") if isinstance(record.get("entries"), dict) else {}
-        entries[path.name] = {"kind": "file", "single": True, "verb": verb}
-        write_json(path.parent / MANIFEST, {**record, "entries": entries})
+    record_outputs(path.parent, [path.name], verb=verb, single=True)
 
 
-def record_outputs(folder: str | Path, names, *, verb: str) -> None:
+def record_outputs(folder: str | Path, names, *, verb: str, single: bool = False) -> None:
     """Add ``names`` (outputs just renamed into ``folder`` whole, one by one, by a run that keeps
-    its pieces as they finish) to the folder's manifest, so that a later run replaces them and
-    :func:`check_owned` knows them for softhand's. Call :func:`check_owned` before the work."""
+    its pieces as they finish; ``single``: files named on the command line) to the folder's
+    manifest, so that a later run replaces them and :func:`check_owned` knows them for
+    softhand's. Call :func:`check_owned` before the work."""
     folder = Path(folder)
     with _folder_lock(folder):
         record = read_manifest(folder)
         owned = owned_outputs(folder)
         entries = record.get("entries") if isinstance(record.get("entries"), dict) else {}
+        new = entries_of(folder, names, verb)
+        if single:
+            new = {n: {**e, "single": True} for n, e in new.items()}
         write_json(folder / MANIFEST, {"run": record.get("run") or uuid.uuid4().hex, "verb": verb,
                                        "pid": os.getpid(),
                                        "finished_utc": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime()),
                                        "outputs": sorted(owned | set(names)),
-                                       "entries": {**{n: e for n, e in entries.items() if n in owned},
-                                                   **entries_of(folder, names, verb)}})
+                                       "entries": {**{n: e for n, e in entries.items() if n in owned}, **new}})
 
 
 @contextmanager
