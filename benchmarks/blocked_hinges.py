@@ -10,7 +10,9 @@ stiffness, dq the hinge angles' change under the same Q from P to P + dP), again
 A_j(theta_j, P); and S itself (its diagonal and the coupling of neighbouring hinges) against the
 fast model's dM_j/dq_j. Prints one block per Q; no assertions.
 
-    python benchmarks/blocked_hinges.py [--pressure-mpa 0.9] [--q=-600,-300,0,0,0 --q=...]
+    python benchmarks/blocked_hinges.py [--pressure-mpa 0.9] [--q=-600,-300,0,0,0 --q=...] [--design FILE]
+
+(``--design``: another design, with its own ``hinge_table`` if the file names one.)
 """
 from __future__ import annotations
 
@@ -22,7 +24,7 @@ import numpy as np
 from softhand.fem.hand.finger import FingerModel, FingerOptions
 from softhand.fem.hand.hold_finger import HeldFinger
 from softhand.reduced.calibrated.grasp_fem import fem_finger, hinge_moments, volume_rate
-from softhand.reduced.vocabulary.design import HandDesign
+from softhand.reduced.vocabulary.design_files import load_design
 
 
 def main() -> None:
@@ -32,9 +34,10 @@ def main() -> None:
     parser.add_argument("--q", action="append", default=None,
                         help="generalised hinge forces Q [N mm], comma-separated, base hinge first "
                              "(--q=-600,-300,0,0,0; repeat for more)")
+    parser.add_argument("--design", default=None, help="design TOML file (default: the paper's design)")
     args = parser.parse_args()
     args.q = args.q or ["-600,-300,0,0,0", "-900,-600,-300,0,0"]
-    design = HandDesign()
+    design = fem_finger(load_design(args.design))
     unit = design.a ** 2 * math.pi * design.d
     finger = HeldFinger(FingerModel(design, FingerOptions()))
     P, dP = args.pressure_mpa, args.dp_mpa

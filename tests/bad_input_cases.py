@@ -111,6 +111,14 @@ EXTRA_FILES = {
     "t_free_breaks_rules.toml": TASK.replace("a_mm = [3.5, 4.5]", "t_mm = [40.0, 50.0]"),
     "t_material_twice.toml": _task("[material]\nmu_sf_MPa = 2.0\n[design]\nmu_sf_MPa = 1.0\n"),
     "t_table_unused.toml": _task('[design]\nfinger_model = "paper"\nfinger_table = "nope.csv"\n'),
+    "t_hinge_table_free.toml": _task('[design]\nhinge_table = "hinges_small.csv"\n'),
+    "d_hinge_missing.toml": 'finger_model = "fem"\nhinge_table = "nope.csv"\n',
+    "d_hinge_not_hinges.toml": 'finger_model = "fem"\nhinge_table = "ft_long_term.csv"\n',
+    "d_hinge_three.toml": 'finger_model = "fem"\nhinge_table = "hinges_small.csv"\nn_s = 3\n'
+                          'hinge_s_mm = [40.0, 80.0, 120.0]\n',
+    # a blocked-hinge table of five hinges at two bends (a design's own, as the hinges study writes it)
+    "hinges_small.csv": "theta,P,a_1,a_2,a_3,a_4,a_5\n" + "".join(
+        f"{t},{p},1.8,1.8,1.8,1.7,1.3\n" for t in (0, 0.1) for p in (0.05, 0.15)),
     "t_fem_mesh.toml": _task("[fem]\nmesh_size_mm = 1e-9\n"),
     "t_fem_ratio.toml": _task("[fem]\nedge_ratio = 50.0\n"),
     "t_fem_dp.toml": _task("[fem]\ndP_MPa = 0.0\n"),
@@ -317,6 +325,9 @@ def hold_cases() -> list[tuple[str, list[str]]]:
               ["hold", "--object", "sphere:150", "--pull", "sideways", *at],
               ["hold", "--object", "sphere:150", "--friction", "nan", *at],
               ["hold", "--object", "sphere:150", "--mass-kg", "-1", *at],
+              *(["hold", "--object", "sphere:150", "--design", d, *at] for d in (
+                  "d_hinge_missing.toml", "d_hinge_not_hinges.toml", "d_hinge_three.toml")),
+              ["design", "--task", "t_hinge_table_free.toml", "--no-fem", "--no-progress"],
               ["hold", "--object", "sphere:150", "--map", "pressure=0:2:0.001", "mass=0:5:0.001"],
               ["hold", "--object", "sphere:150", "--map", "pressure=0.5:1:0.5", "colour=1,2"],
               ["hold", "--object", "sphere:150", "--check"],

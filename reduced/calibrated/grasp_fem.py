@@ -100,15 +100,39 @@ def hinge_moments(q, P: float, design: HandDesign) -> np.ndarray:
     angles q (..., n_s) [rad] and cavity pressure P [MPa], theta_j = n_s q_j; P_free of finger_model "fem"."""
     design = fem_finger(design)
     theta = design.n_s * np.asarray(q, float)
-    M = hinge_table.moment(_table(design), theta, P, hand.finger_pressure(theta, design))
+    M = hinge_table.moment(_table(design), theta, P, hand.finger_pressure(theta, design), _reverse_scale(design))
     return M * design.a ** 2 * math.pi * design.d
 
 
+#: the small bend [rad] at which the free curves' pressures carry the table's reverse moments to a design
+REVERSE_SECANT = math.radians(2.0)
+
+
+@lru_cache(maxsize=16)
+def _reverse_scale(design: HandDesign) -> float:
+    """The factor carrying the table's moments at zero pressure of a hinge bent backwards
+    (:mod:`~softhand.reduced.calibrated.hinge_table`, the paper's design) to ``design``: the ratio of
+    the two free curves' pressures at a small bend, P_free(2 deg) — the unpressurised tube's
+    bending stiffness against its volume rate, forward, assumed to hold backwards in the same ratio."""
+    paper = fem_finger(HandDesign())
+    if design.hinge_table or design == paper:
+        return 1.0
+    return float(hand.finger_pressure(REVERSE_SECANT, design) / hand.finger_pressure(REVERSE_SECANT, paper))
+
+
 def _table(design: HandDesign) -> hinge_table.HingeTable:
-    t = hinge_table.read(str(HINGE_TABLE))
+    own = bool(design.hinge_table)
+    t = hinge_table.read(design.hinge_table if own else str(HINGE_TABLE))
     if t.a.shape[-1] != design.n_s:
-        raise InputError("n_s", design.n_s, f"the hinge table has {t.a.shape[-1]} hinges")
+        raise InputError("hinge_table" if own else "n_s", design.hinge_table if own else design.n_s,
+                         f"{'has' if own else 'the hinge table has'} {t.a.shape[-1]} hinges; the design has {design.n_s}")
     return t
+
+
+def hinge_data(design: HandDesign) -> hinge_table.HingeTable:
+    """The blocked-hinge table the design's fast hold uses (its own ``hinge_table``, else the
+    paper's design's); InputError if it cannot be read or does not fit the design."""
+    return _table(design)
 
 
 #: Gauss-Legendre rule on [0, 1] for E, per piece between the table's nodes

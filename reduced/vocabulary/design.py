@@ -86,6 +86,9 @@ class HandDesign:
     tie_width: float = 10.0
     #: calibration table of finger_model "fem" (a CSV file); "" = the one in the package
     finger_table: str = ""
+    #: the fast hold's blocked-hinge table made for this design (a CSV file of ``python -m
+    #: softhand.studies.calibration.hinges --design``); "" = the paper's design's, carried over
+    hinge_table: str = ""
     #: the hand's layout: each finger's azimuth about the palm's axis, finger 0 first [rad];
     #: () = n fingers evenly spaced from 0 (the paper's four at 0, 90, 180, 270 deg). Not in the paper
     finger_azimuths: tuple[float, ...] = ()
@@ -183,10 +186,10 @@ KEY_OF = {
     "mu_sf": "mu_sf_MPa", "mu_sr": "mu_sr_MPa", "hinge_s": "hinge_s_mm",
     "base_offset": "base_offset_mm", "g": "g_N_per_kg", "reservoir_model": "reservoir_model",
     "finger_model": "finger_model", "tie_width": "tie_width_mm", "finger_table": "finger_table",
-    "finger_azimuths": "finger_azimuths_deg", "pad_width": "pad_width_mm",
+    "finger_azimuths": "finger_azimuths_deg", "pad_width": "pad_width_mm", "hinge_table": "hinge_table",
 }
 #: the hand layout's fields: written only when set, so that every design's hash stays what it was
-_OMITTED_AT_DEFAULT = ("finger_azimuths", "pad_width")
+_OMITTED_AT_DEFAULT = ("finger_azimuths", "pad_width", "hinge_table")
 
 
 def _default(name: str):

@@ -87,6 +87,12 @@ def design_from_dict(values: dict, base: HandDesign | None = None, *, source: st
             finger.check_data(design)
         except InputError as exc:
             raise exc.renamed(f"{source}: finger_table") from None
+    if changes.get("hinge_table"):
+        from softhand.reduced.calibrated import grasp_fem
+        try:  # read now, not where a hold first uses it
+            grasp_fem.hinge_data(design)
+        except InputError as exc:
+            raise exc.renamed(f"{source}: hinge_table") from None
     return design
 
 
@@ -110,9 +116,10 @@ def load_design(path: str | Path | None = None) -> HandDesign:
         return HandDesign()
     path = Path(path)
     values = read_toml(path, "--design", "a design TOML file")
-    table = values.get("finger_table")
-    if isinstance(table, str) and table and not Path(table).is_absolute():
-        # relative to the file; absolute without touching the file system (a link loop or a NUL
-        # in the name is the table reader's one line to say)
-        values["finger_table"] = os.path.abspath(path.parent / table)
+    for key in ("finger_table", "hinge_table"):
+        table = values.get(key)
+        if isinstance(table, str) and table and not Path(table).is_absolute():
+            # relative to the file; absolute without touching the file system (a link loop or a NUL
+            # in the name is the table reader's one line to say)
+            values[key] = os.path.abspath(path.parent / table)
     return design_from_dict(values, source=path.name)

@@ -198,9 +198,10 @@ def _design(spec, base: Path, src: str) -> HandDesign:
         start = load_design(base / file) if file else HandDesign()
     except InputError as exc:
         raise (exc.renamed(f"{src}: design.file") if exc.field == "--design" else exc) from None
-    table = overrides.get("finger_table")
-    if isinstance(table, str) and table and "\0" not in table:  # next to the study file, as a design file's
-        overrides["finger_table"] = os.path.abspath(base / table)
+    for key in ("finger_table", "hinge_table"):
+        table = overrides.get(key)
+        if isinstance(table, str) and table and "\0" not in table:  # next to the study file, as a design file's
+            overrides[key] = os.path.abspath(base / table)
     return design_from_dict(overrides, start, source=f"{src}: design")
 
 

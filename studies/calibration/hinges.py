@@ -8,19 +8,27 @@ pressure raised in steps of ``DP`` up to ``TOP`` (or as far as the locked finger
 spring takes up per MPa is dM_j/dP = -A_j at fixed hinge angles (a Maxwell relation of the
 finger's potential E(q, P), dE/dP = -V), read at the middle of each step. At P0 = 0 the finger
 is straight. Written nondimensionally against the hinge's bend theta = n_s theta_hat_j:
-a_j = A_j / (a^2 pi d). Run::
+a_j = A_j / (a^2 pi d).
+
+A heavy object's pads push the base hinges past straight, where no free state at P >= 0 exists:
+at each bend of ``REVERSE`` the unpressurised finger is bent backwards by the springs (in a few
+steps from straight), its moment there written as the node's row at P = 0
+(m0_j = M_j / (a^2 pi d), MPa), and the pressure raised as above. Run::
 
     python -m softhand.studies.calibration.hinges --out reduced/calibrated/data/grasp_hinges.csv
+    python -m softhand.studies.calibration.hinges --design my_hand.toml --out my_hinges.csv
 """
 from __future__ import annotations
 
 import argparse
 import math
 import sys
+from dataclasses import replace
 
 import numpy as np
 
 from softhand.reduced.vocabulary.design import HandDesign
+from softhand.reduced.vocabulary.design_files import load_design
 from softhand.studies.calibration import tables
 from softhand.studies.io.files import write_atomic
 
@@ -28,40 +36,78 @@ from softhand.studies.io.files import write_atomic
 SPRING = 1e7
 #: cavity pressures of the free states [MPa], the pressure step with the hinges locked, the highest pressure
 PRESSURES, DP, TOP = (0.0, 0.1, 0.2, 0.3, 0.4, 0.6, 0.8, 1.0, 1.2, 1.6, 2.0, 2.5, 3.0), 0.1, 4.0
+#: the reverse bends theta = n_s theta_hat < 0 locked from P = 0 [deg]
+REVERSE = (-1.5, -3.0, -6.0, -12.0, -20.0)
+
+
+def _locked(q, P):
+    """The springs holding the hinges at q (half model): (Q(q'), dQ/dq') of the hinge angles q'."""
+    return lambda qq: (-SPRING * (qq - q), -SPRING * np.eye(len(q)))
+
+
+def _raise(model, y, q, P0: float, dP: float, top: float):
+    """The locked finger (hinges at q, state y at P0) from P0 up in steps of dP to ``top`` (or as
+    far as it converges): rows (P of the step's middle, A (n_s,) [mm^3/rad]), A = -dM/dP with
+    M = -2 SPRING (q' - q) the physical moment the springs take up."""
+    from softhand.fem.linsolve import make_solver
+    from softhand.fem.newton import NewtonOptions, NotConverged
+    from softhand.fem.newton_path import PathOptions, solve_path
+
+    d = model.design
+    levels = P0 + dP * np.arange(1, int(round((top - P0) / dP)) + 1)
+    if not len(levels):
+        return []
+    moments = {round(P0, 9): 2.0 * SPRING * (np.asarray(model.constraint.q(y)) - q)}
+
+    def keep(P, yy):
+        moments[round(P, 9)] = 2.0 * SPRING * (np.asarray(model.constraint.q(yy)) - q)
+
+    try:
+        solve_path(lambda yy, P: model.residual_tangent(yy, P, _locked(q, P)), y,
+                   PathOptions(steps=len(levels), predictor="secant", newton=NewtonOptions(rtol=1e-10)),
+                   solver=make_solver(symmetric=True), scale_t=lambda P: d.mu_sf * d.a ** 2 * d.l0, t0=P0,
+                   stops=levels, callback=keep)
+    except NotConverged:  # the locked finger's path ends below ``top``: the table keeps what it reached
+        pass
+    P = [round(P0, 9)] + [round(p, 9) for p in levels if round(p, 9) in moments]
+    P = P[:next((k for k in range(1, len(P)) if round(P[k - 1] + dP, 9) != P[k]), len(P))]
+    return [(0.5 * (p0 + p1), (moments[p1] - moments[p0]) / dP) for p0, p1 in zip(P[:-1], P[1:])]
 
 
 def volume_rates(model, pressures=PRESSURES, dP: float = DP, top: float = TOP, progress=None):
     """Rows (theta_free(P0) [rad], P [MPa], A (n_s,) [mm^3/rad]): the locked hinges' A_j at the
     middle P of each pressure step above each free state."""
     from softhand.fem.hand.finger import solve_pressures
-    from softhand.fem.linsolve import make_solver
-    from softhand.fem.newton import NewtonOptions, NotConverged
-    from softhand.fem.newton_path import PathOptions, solve_path
 
-    d = model.design
-    n, scale = d.n_s, d.mu_sf * d.a ** 2 * d.l0
     free, _ = solve_pressures(model, pressures)
     rows = []
     for s in free:
-        levels = s.P + dP * np.arange(1, int(round((top - s.P) / dP)) + 1)
-        moments = {}
-
-        def fun(y, P, s=s):
-            return model.residual_tangent(y, P, lambda q: (-SPRING * (q - s.q), -SPRING * np.eye(n)))
-
-        def keep(P, y, s=s, moments=moments):
-            moments[round(P, 9)] = 2.0 * SPRING * (np.asarray(model.constraint.q(y)) - s.q)
-
-        try:
-            solve_path(fun, s.y, PathOptions(steps=len(levels), predictor="secant", newton=NewtonOptions(rtol=1e-10)),
-                       solver=make_solver(symmetric=True), scale_t=lambda P: scale, t0=s.P, stops=levels, callback=keep)
-        except NotConverged:  # the locked finger's path ends below TOP: the table keeps what it reached
-            levels = levels[:sum(round(P, 9) in moments for P in levels)]
-        M = [np.zeros(n)] + [moments[round(P, 9)] for P in levels]
-        for k, P in enumerate(levels):
-            rows.append((s.theta, P - 0.5 * dP, (M[k + 1] - M[k]) / dP))
+        rows += [(s.theta, P, A) for P, A in _raise(model, s.y, s.q, s.P, dP, top)]
         if progress is not None:
-            progress(s)
+            progress(f"free state at {s.P:g} MPa")
+    return rows
+
+
+def reverse_rates(model, bends_deg=REVERSE, dP: float = DP, top: float = TOP, progress=None):
+    """Rows (theta [rad], P [MPa], value (n_s,)) of the reverse bends: first (theta, 0, M_j at P = 0
+    [N mm]), then the locked hinges' A_j [mm^3/rad] at the middle P of each step from P = 0."""
+    from softhand.fem.linsolve import make_solver
+    from softhand.fem.newton import NewtonOptions
+    from softhand.fem.newton_path import PathOptions, solve_path
+
+    d = model.design
+    rows = []
+    for bend in bends_deg:
+        theta = math.radians(bend)
+        q = np.full(d.n_s, theta / d.n_s)
+        bent = solve_path(lambda y, t: model.residual_tangent(y, 0.0, _locked(t * q, 0.0)), model.constraint.zero(),
+                          PathOptions(steps=4, newton=NewtonOptions(rtol=1e-10)), solver=make_solver(symmetric=True),
+                          scale_t=lambda t: d.mu_sf * d.a ** 2 * d.l0)
+        y = bent.x[-1]
+        rows.append((theta, 0.0, -2.0 * SPRING * (np.asarray(model.constraint.q(y)) - q)))
+        rows += [(theta, P, A) for P, A in _raise(model, y, q, 0.0, dP, top)]
+        if progress is not None:
+            progress(f"reverse bend {bend:g} deg")
     return rows
 
 
@@ -72,16 +118,21 @@ def table_text(design: HandDesign, mesh_size_mm: float | None = None, command: s
 
     options = FingerOptions() if mesh_size_mm is None else finger_options(mesh_size_mm)
     model = FingerModel(design, options)
-    rows = volume_rates(model, progress=lambda s: print(f"free state at {s.P:g} MPa done", file=sys.stderr))
+    say = lambda what: print(f"{what} done", file=sys.stderr, flush=True)  # noqa: E731
+    rows = reverse_rates(model, progress=say) + volume_rates(model, progress=say)
     unit = design.a ** 2 * math.pi * design.d
     mesh = "the default mesh" if mesh_size_mm is None else f"the grasp mesh (h = {mesh_size_mm:g} mm)"
+    which = "the paper's design (Table I)" if design == HandDesign(finger_model=design.finger_model) else \
+        f"the design a {design.a:g}, b {design.b:g}, d {design.d:g}, l0 {design.l0:g}, tie {design.tie_width:g} mm"
     head = [tables.written_by("FEM hinge table of reduced/calibrated/grasp_fem.py"),
             command,
-            f"model: finger FEM (fem/hand/finger.py) of the paper's design (Table I) on {mesh} "
-            f"({model.ndofs} unknowns); free states at P0 = {', '.join(f'{p:g}' for p in PRESSURES)} MPa, "
+            f"model: finger FEM (fem/hand/finger.py) of {which} on {mesh} "
+            f"({model.ndofs} unknowns); free states at P0 = {', '.join(f'{p:g}' for p in PRESSURES)} MPa "
+            f"and reverse bends {', '.join(f'{b:g}' for b in REVERSE)} deg at P0 = 0, "
             f"hinges locked there by springs of {SPRING:g} N mm/rad (half model), P raised in steps of {DP:g} MPa to {TOP:g}",
-            "theta = the free bend at P0 [rad] (a hinge's bend n_s theta_hat); P = the step's middle [MPa]; "
-            "a_j = A_j/(a^2 pi d), A_j = dV/d theta_hat_j at fixed P"]
+            "theta = the locked bend [rad] (a hinge's bend n_s theta_hat); P = the step's middle [MPa]; "
+            "a_j = A_j/(a^2 pi d), A_j = dV/d theta_hat_j at fixed P; a reverse bend's row at P = 0 holds "
+            "m0_j = M_j/(a^2 pi d) [MPa], its moment there"]
     columns = ["theta", "P", *(f"a_{j}" for j in range(1, design.n_s + 1))]
     return tables.table_text(head, columns, [(t, P, *(A / unit)) for t, P, A in rows])
 
@@ -91,9 +142,11 @@ def main(argv=None) -> int:
     parser.add_argument("--out", required=True, help="CSV file to write")
     parser.add_argument("--mesh-size-mm", type=float, default=None,
                         help="finger element size of a graded grasp-style mesh (default: the finger FEM's default mesh)")
+    parser.add_argument("--design", default=None, help="design TOML file (default: the paper's design)")
     args = parser.parse_args(argv)
     command = "python -m softhand.studies.calibration.hinges " + " ".join(sys.argv[1:] if argv is None else argv)
-    text = table_text(HandDesign(), args.mesh_size_mm, command)
+    design = HandDesign() if args.design is None else load_design(args.design)
+    text = table_text(replace(design, hinge_table=""), args.mesh_size_mm, command)
     write_atomic(args.out, text)
     return 0
 

@@ -58,7 +58,7 @@ from softhand.reduced.vocabulary.design_files import design_from_dict
 from softhand.reduced.vocabulary.inputfiles import read_toml
 from softhand.reduced.vocabulary.errors import InputError
 from softhand.reduced.holding.objects import GraspObject
-from softhand.studies.design.task_values import (UPPER, base_design, calibrated_bounds,
+from softhand.studies.design.task_values import (FINGER_KEYS, UPPER, base_design, calibrated_bounds,
                                                  check_free_bounds_keep_the_rules, checked_number, free_bounds)
 
 OBJECTIVES = ("pressure", "margin")
@@ -154,11 +154,17 @@ def task_from_dict(data: dict, *, folder: Path = Path("."), name: str = "task") 
                              "is also in [material]; give it in one of them")
     base = base_design(data.get("base_design"), folder)
     fixed = dict(tables["design"])
-    table = fixed.get("finger_table")
-    if isinstance(table, str) and table and not Path(table).is_absolute():
-        fixed["finger_table"] = os.path.abspath(folder / table)  # next to the task, as a design file's
+    for key in ("finger_table", "hinge_table"):
+        table = fixed.get(key)
+        if isinstance(table, str) and table and not Path(table).is_absolute():
+            fixed[key] = os.path.abspath(folder / table)  # next to the task, as a design file's
     base = design_from_dict({**MODELS, **fixed, **tables["material"]}, base, source="design")
     free, clipped = calibrated_bounds(free_bounds(tables["free"], base), base)
+    finger_free = [key for key, _, _ in free if key in FINGER_KEYS]
+    if base.hinge_table and finger_free:
+        raise InputError("design.hinge_table", base.hinge_table,
+                         f"is made for one finger; with {', '.join(finger_free)} free the optimiser tries others "
+                         "(leave it out: each design's hold then carries the paper's design's table over)")
     check_free_bounds_keep_the_rules(free, base)
     obj, grasp, pump, limits, fem = (tables[s] for s in ("object", "grasp", "pump", "limits", "fem"))
     if "force_factor" in grasp and "margin_N" in grasp:

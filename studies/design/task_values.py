@@ -13,6 +13,8 @@ from softhand.reduced.vocabulary.errors import InputError
 
 #: design keys the optimiser may vary; "l0_mm" scales the hinge positions with the tube
 FREE_KEYS = ("a_mm", "b_mm", "d_mm", "l0_mm", "R_mm", "t_mm", "V0_mm3", "tie_width_mm")
+#: the free keys that change the finger (a design's own hinge table no longer fits)
+FINGER_KEYS = ("a_mm", "b_mm", "d_mm", "l0_mm", "tie_width_mm")
 #: the design space the packaged finger table was calibrated on (its [space] box)
 CALIBRATED_SPACE = PAPER_DESIGN_FILE.parents[1] / "finger_space.toml"
 #: highest value of each number of a task (the lowest: > 0, or >= 0 where zero makes sense)

@@ -23,8 +23,9 @@ def test_toml_round_trip(tmp_path):
     path = tmp_path / "d.toml"
     path.write_text(d.to_toml())
     assert load_design(path) == d
-    # the hand layout's keys are written only when set (every older design keeps its hash)
-    assert set(d.to_dict()) == set(PUBLIC_KEYS) - {"finger_azimuths_deg", "pad_width_mm"}
+    # the hand layout's keys and a design's own hinge table are written only when set (every
+    # older design keeps its hash)
+    assert set(d.to_dict()) == set(PUBLIC_KEYS) - {"finger_azimuths_deg", "pad_width_mm", "hinge_table"}
 
 
 @pytest.mark.parametrize("values, field", [
