@@ -111,7 +111,7 @@ def reverse_rates(model, bends_deg=REVERSE, dP: float = DP, top: float = TOP, pr
     return rows
 
 
-def table_text(design: HandDesign, mesh_size_mm: float | None = None, command: str = "") -> str:
+def table_text(design: HandDesign, mesh_size_mm: float | None = None, command: str = "", top: float = TOP) -> str:
     """The CSV: provenance lines, then theta, P, a_1..a_n."""
     from softhand.fem.hand.finger import FingerModel, FingerOptions
     from softhand.studies.weights import finger_options
@@ -119,7 +119,8 @@ def table_text(design: HandDesign, mesh_size_mm: float | None = None, command: s
     options = FingerOptions() if mesh_size_mm is None else finger_options(mesh_size_mm)
     model = FingerModel(design, options)
     say = lambda what: print(f"{what} done", file=sys.stderr, flush=True)  # noqa: E731
-    rows = reverse_rates(model, progress=say) + volume_rates(model, progress=say)
+    pressures = tuple(p for p in PRESSURES if p < top)
+    rows = reverse_rates(model, top=top, progress=say) + volume_rates(model, pressures, top=top, progress=say)
     unit = design.a ** 2 * math.pi * design.d
     mesh = "the default mesh" if mesh_size_mm is None else f"the grasp mesh (h = {mesh_size_mm:g} mm)"
     which = "the paper's design (Table I)" if design == HandDesign(finger_model=design.finger_model) else \
@@ -127,9 +128,9 @@ def table_text(design: HandDesign, mesh_size_mm: float | None = None, command: s
     head = [tables.written_by("FEM hinge table of reduced/calibrated/grasp_fem.py"),
             command,
             f"model: finger FEM (fem/hand/finger.py) of {which} on {mesh} "
-            f"({model.ndofs} unknowns); free states at P0 = {', '.join(f'{p:g}' for p in PRESSURES)} MPa "
+            f"({model.ndofs} unknowns); free states at P0 = {', '.join(f'{p:g}' for p in pressures)} MPa "
             f"and reverse bends {', '.join(f'{b:g}' for b in REVERSE)} deg at P0 = 0, "
-            f"hinges locked there by springs of {SPRING:g} N mm/rad (half model), P raised in steps of {DP:g} MPa to {TOP:g}",
+            f"hinges locked there by springs of {SPRING:g} N mm/rad (half model), P raised in steps of {DP:g} MPa to {top:g}",
             "theta = the locked bend [rad] (a hinge's bend n_s theta_hat); P = the step's middle [MPa]; "
             "a_j = A_j/(a^2 pi d), A_j = dV/d theta_hat_j at fixed P; a reverse bend's row at P = 0 holds "
             "m0_j = M_j/(a^2 pi d) [MPa], its moment there"]
@@ -143,10 +144,15 @@ def main(argv=None) -> int:
     parser.add_argument("--mesh-size-mm", type=float, default=None,
                         help="finger element size of a graded grasp-style mesh (default: the finger FEM's default mesh)")
     parser.add_argument("--design", default=None, help="design TOML file (default: the paper's design)")
+    parser.add_argument("--top-mpa", type=float, default=TOP,
+                        help=f"highest cavity pressure of the locked paths [MPa] (default {TOP:g}; a hand that holds "
+                             "below 2 MPa needs no more than 2.5, at about half the time)")
     args = parser.parse_args(argv)
     command = "python -m softhand.studies.calibration.hinges " + " ".join(sys.argv[1:] if argv is None else argv)
     design = HandDesign() if args.design is None else load_design(args.design)
-    text = table_text(replace(design, hinge_table=""), args.mesh_size_mm, command)
+    if not 0.2 <= args.top_mpa <= 10.0:
+        parser.error(f"--top-mpa {args.top_mpa:g}: must be in [0.2, 10] MPa")
+    text = table_text(replace(design, hinge_table=""), args.mesh_size_mm, command, args.top_mpa)
     write_atomic(args.out, text)
     return 0
 

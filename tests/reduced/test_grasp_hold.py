@@ -326,15 +326,18 @@ def test_a_pump_pressure_at_a_snap_is_the_state_just_below_it(monkeypatch, a, d,
 def test_a_later_pads_force_is_the_first_root_where_the_root_finder_took_a_second():
     """A held-out-style task's design (200 mm, 3 kg, F_v 17.35 N): on pad 3 F_v rises to 17.35 N
     at 0.940 MPa, drops by 2 N at 0.98 MPa (the contact moves to the pad's far end) and
-    reaches 17.35 N again at 1.044 MPa. The root finder's bracket held both roots and gave the
-    second; the fast path's pad-3 solve, checked on the root finder's grid, gives the first:
-    F_v stays below the asked force on a fine scan up to it."""
+    reaches 17.35 N again at 1.044 MPa. The root finder's bracket holds both roots (it gave the
+    second until the hinge table measured hinges bent backwards; now the first); the fast path's
+    pad-3 solve, checked on the root finder's grid, gives the first: F_v stays below the asked
+    force on a fine scan up to it."""
     design = PAPER.replace(b=3.13164975, V0=15384.3122, R=20.0, mu_sf=1.5, mu_sr=1.5)
     F_v = 17.3549875
     fast = grasp_hold_fast.fast_hold(design, 200.0, 3.0, "F_v", F_v)
     slow = grasp_hold.slow_hold(design, 200.0, 3.0, "F_v", F_v)
     assert fast is not None and fast.link == slow.link == 3
-    assert fast.P_cavity == pytest.approx(0.9405, abs=1e-3) and slow.P_cavity == pytest.approx(1.0438, abs=1e-3)
+    assert fast.P_cavity == pytest.approx(0.9405, abs=1e-3)
+    assert min(abs(slow.P_cavity - 0.9405), abs(slow.P_cavity - 1.0438)) < 1e-3
+    assert grasp_fem.grasp_state(design, 200.0, 1.0438, 3.0).F_v == pytest.approx(F_v, abs=0.02)  # the second root
     theta_c, _ = grasp_hold.contact.contact_angle(200.0, grasp_fem.fem_finger(design))
     P_c = float(grasp_hold.hand.finger_pressure(theta_c, grasp_fem.fem_finger(design)))
     below = [grasp_fem.grasp_state(design, 200.0, P, 3.0).F_v for P in np.arange(P_c + 1e-6, fast.P_cavity, 0.005)]

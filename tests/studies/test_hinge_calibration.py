@@ -40,10 +40,10 @@ def test_the_reverse_moments_hold_the_finger_where_they_were_measured(measured):
 
 def test_the_study_writes_the_table_the_fast_hold_reads(measured, tmp_path, monkeypatch):
     model, rows = measured
-    monkeypatch.setattr(hinges, "reverse_rates", lambda model, progress=None: rows)
+    monkeypatch.setattr(hinges, "reverse_rates", lambda model, **kw: rows)
     free = [(0.0, 0.05, np.full(5, 1380.0)), (0.0, 0.15, np.full(5, 1381.0)),
             (0.1, 0.25, np.full(5, 900.0))]
-    monkeypatch.setattr(hinges, "volume_rates", lambda model, progress=None: free)
+    monkeypatch.setattr(hinges, "volume_rates", lambda model, *a, **kw: free)
     path = tmp_path / "h.csv"
     path.write_text(hinges.table_text(HandDesign(), 6.0, "test"))
     hinge_table.read.cache_clear()
