@@ -23,7 +23,8 @@ and drops the tip assumption:
   for a bent one at its free pressure, growing with the pressure above it (a locked tube
   swells), against dQ/dtheta = 1.86 a^2 pi d of the free finger, which includes the tube's
   swelling with P along the free curve. The table is the paper's design (Table I): other
-  designs reuse its A_j / (a^2 pi d) with their own free curve. Without this, the free
+  designs reuse its A_j / (a^2 pi d) with their own free curve, or name a table of their own
+  (``hinge_table``, made by the same study with ``--design``). Without this, the free
   finger's W_f and Q split equally over the hinges, the contact force of a finger held by
   the object low on it comes out 50 % too large.
 * **The contact where it is** (:mod:`softhand.reduced.equations.contact`, the grasp FEM's geometry): the
