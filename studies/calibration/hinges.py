@@ -69,8 +69,7 @@ def _raise(model, y, q, P0: float, dP: float, top: float):
                    stops=levels, callback=keep)
     except NotConverged:  # the locked finger's path ends below ``top``: the table keeps what it reached
         pass
-    P = [round(P0, 9)] + [round(p, 9) for p in levels if round(p, 9) in moments]
-    P = P[:next((k for k in range(1, len(P)) if round(P[k - 1] + dP, 9) != P[k]), len(P))]
+    P = [round(P0, 9)] + [round(p, 9) for p in levels if round(p, 9) in moments]  # the path stops at its first failure
     return [(0.5 * (p0 + p1), (moments[p1] - moments[p0]) / dP) for p0, p1 in zip(P[:-1], P[1:])]
 
 
