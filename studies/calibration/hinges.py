@@ -45,10 +45,16 @@ def _locked(q, P):
     return lambda qq: (-SPRING * (qq - q), -SPRING * np.eye(len(q)))
 
 
+def _moment(model, y, q) -> np.ndarray:
+    """The physical moment M = -2 SPRING (q(y) - q) [N mm] the springs locking the hinges at q hold
+    the state y with (the half model carries half of it)."""
+    return -2.0 * SPRING * (np.asarray(model.constraint.q(y)) - q)
+
+
 def _raise(model, y, q, P0: float, dP: float, top: float):
     """The locked finger (hinges at q, state y at P0) from P0 up in steps of dP to ``top`` (or as
     far as it converges): rows (P of the step's middle, A (n_s,) [mm^3/rad]), A = -dM/dP with
-    M = -2 SPRING (q' - q) the physical moment the springs take up."""
+    M the springs' moment (:func:`_moment`)."""
     from softhand.fem.linsolve import make_solver
     from softhand.fem.newton import NewtonOptions, NotConverged
     from softhand.fem.newton_path import PathOptions, solve_path
@@ -57,10 +63,10 @@ def _raise(model, y, q, P0: float, dP: float, top: float):
     levels = P0 + dP * np.arange(1, int(round((top - P0) / dP)) + 1)
     if not len(levels):
         return []
-    moments = {round(P0, 9): 2.0 * SPRING * (np.asarray(model.constraint.q(y)) - q)}
+    moments = {round(P0, 9): _moment(model, y, q)}
 
     def keep(P, yy):
-        moments[round(P, 9)] = 2.0 * SPRING * (np.asarray(model.constraint.q(yy)) - q)
+        moments[round(P, 9)] = _moment(model, yy, q)
 
     try:
         solve_path(lambda yy, P: model.residual_tangent(yy, P, _locked(q, P)), y,
@@ -70,7 +76,7 @@ def _raise(model, y, q, P0: float, dP: float, top: float):
     except NotConverged:  # the locked finger's path ends below ``top``: the table keeps what it reached
         pass
     P = [round(P0, 9)] + [round(p, 9) for p in levels if round(p, 9) in moments]  # the path stops at its first failure
-    return [(0.5 * (p0 + p1), (moments[p1] - moments[p0]) / dP) for p0, p1 in zip(P[:-1], P[1:])]
+    return [(0.5 * (p0 + p1), -(moments[p1] - moments[p0]) / dP) for p0, p1 in zip(P[:-1], P[1:])]
 
 
 def volume_rates(model, pressures=PRESSURES, dP: float = DP, top: float = TOP, progress=None):
@@ -103,7 +109,7 @@ def reverse_rates(model, bends_deg=REVERSE, dP: float = DP, top: float = TOP, pr
                           PathOptions(steps=4, newton=NewtonOptions(rtol=1e-10)), solver=make_solver(symmetric=True),
                           scale_t=lambda t: d.mu_sf * d.a ** 2 * d.l0)
         y = bent.x[-1]
-        rows.append((theta, 0.0, -2.0 * SPRING * (np.asarray(model.constraint.q(y)) - q)))
+        rows.append((theta, 0.0, _moment(model, y, q)))
         rows += [(theta, P, A) for P, A in _raise(model, y, q, 0.0, dP, top)]
         if progress is not None:
             progress(f"reverse bend {bend:g} deg")
