@@ -22,8 +22,9 @@ and drops the tip assumption:
   softhand.studies.calibration.hinges``): about 1.8 a^2 pi d for a straight hinge and 1.2 a^2 pi d
   for a bent one at its free pressure, growing with the pressure above it (a locked tube
   swells), against dQ/dtheta = 1.86 a^2 pi d of the free finger, which includes the tube's
-  swelling with P along the free curve. The table is the paper's design (Table I): other
-  designs reuse its A_j / (a^2 pi d) with their own free curve, or name a table of their own
+  swelling with P along the free curve. The table is the paper's design (Table I); another
+  design's is that table carried to its geometry by ratios measured on a coarse grid over the
+  design space (:mod:`softhand.reduced.calibrated.hinge_space`), or a table of its own
   (``hinge_table``, made by the same study with ``--design``). Without this, the free
   finger's W_f and Q split equally over the hinges, the contact force of a finger held by
   the object low on it comes out 50 % too large.
@@ -49,21 +50,18 @@ from __future__ import annotations
 import math
 from dataclasses import replace
 from functools import lru_cache
-from pathlib import Path
 from typing import NamedTuple
 
 import numpy as np
 from scipy.optimize import brentq, root
 
-from softhand.reduced.calibrated import hinge_table
+from softhand.reduced.calibrated import hinge_space, hinge_table
 from softhand.reduced.equations import contact, hand, kinematics
 from softhand.reduced.vocabulary.design import HandDesign
 from softhand.reduced.vocabulary.errors import InputError
 
 #: a pad other than the touching one penetrating by more than this [mm] moves the contact there
 PENETRATION = 1e-6
-#: the finger FEM's locked-hinge volume rates A_j(theta, P) (written by ``python -m softhand.studies.calibration.hinges``)
-HINGE_TABLE = Path(__file__).resolve().parent / "data" / "grasp_hinges.csv"
 #: the equilibrium's tolerance (scipy hybr, relative on the unknowns)
 _XTOL = 1e-10
 
@@ -101,33 +99,12 @@ def hinge_moments(q, P: float, design: HandDesign) -> np.ndarray:
     angles q (..., n_s) [rad] and cavity pressure P [MPa], theta_j = n_s q_j; P_free of finger_model "fem"."""
     design = fem_finger(design)
     theta = design.n_s * np.asarray(q, float)
-    M = hinge_table.moment(_table(design), theta, P, hand.finger_pressure(theta, design), _reverse_scale(design))
+    M = hinge_table.moment(_table(design), theta, P, hand.finger_pressure(theta, design), hinge_space.reverse_scale(design))
     return M * design.a ** 2 * math.pi * design.d
 
 
-#: the small bend [rad] at which the free curves' pressures carry the table's reverse moments to a design
-REVERSE_SECANT = math.radians(2.0)
-
-
-@lru_cache(maxsize=16)
-def _reverse_scale(design: HandDesign) -> float:
-    """The factor carrying the table's moments at zero pressure of a hinge bent backwards
-    (:mod:`~softhand.reduced.calibrated.hinge_table`, the paper's design) to ``design``: the ratio of
-    the two free curves' pressures at a small bend, P_free(2 deg) — the unpressurised tube's
-    bending stiffness against its volume rate, forward, assumed to hold backwards in the same ratio."""
-    paper = fem_finger(HandDesign())
-    if design.hinge_table or design == paper:
-        return 1.0
-    return float(hand.finger_pressure(REVERSE_SECANT, design) / hand.finger_pressure(REVERSE_SECANT, paper))
-
-
 def _table(design: HandDesign) -> hinge_table.HingeTable:
-    own = bool(design.hinge_table)
-    t = hinge_table.read(design.hinge_table if own else str(HINGE_TABLE))
-    if t.a.shape[-1] != design.n_s:
-        raise InputError("hinge_table" if own else "n_s", design.hinge_table if own else design.n_s,
-                         f"{'has' if own else 'the hinge table has'} {t.a.shape[-1]} hinges; the design has {design.n_s}")
-    return t
+    return hinge_space.design_table(fem_finger(design))
 
 
 def hinge_data(design: HandDesign) -> hinge_table.HingeTable:

@@ -58,6 +58,12 @@ def read(path: str) -> HingeTable:
     n = len(columns) - 2
     if n < 1 or columns != ("theta", "P", *(f"a_{j}" for j in range(1, n + 1))):
         raise InputError("hinge_table", path, "needs the header theta,P,a_1,...,a_n")
+    return from_rows(data, path)
+
+
+def from_rows(data: np.ndarray, path="") -> HingeTable:
+    """The table of rows (theta, P, a_1..a_n) as :func:`read` parses them (``path`` names them in errors)."""
+    n = data.shape[1] - 2
     anchor = data[:, 1] == 0.0
     if np.any(data[anchor, 0] >= 0) or not np.array_equal(np.unique(data[anchor, 0]), np.sort(data[anchor, 0])) \
             or not np.array_equal(np.unique(data[anchor, 0]), np.unique(data[data[:, 0] < 0, 0])):
@@ -76,13 +82,19 @@ def read(path: str) -> HingeTable:
         if not len(rows) or np.any(np.diff(rows) != 1):
             raise InputError("hinge_table", path, f"needs the pressures of bend {theta[i]:.6g} in one run")
         a[i, :rows[0]], a[i, rows[-1] + 1:] = a[i, rows[0]], a[i, rows[-1]]
-    cum = np.concatenate([np.zeros((len(theta), 1, n)),
-                          np.cumsum(0.5 * (a[:, 1:] + a[:, :-1]) * step[0], axis=1)], axis=1)
     at = np.searchsorted(theta, anchors[:, 0])
     if np.any(theta[np.minimum(at, len(theta) - 1)] != anchors[:, 0]):
         raise InputError("hinge_table", path, "needs rates for every bend whose moment at P = 0 it gives")
     m0 = np.zeros((len(theta), n))
     m0[at] = anchors[:, 2:]
+    return with_rates(theta, p, a, m0)
+
+
+def with_rates(theta, p, a, m0) -> HingeTable:
+    """The table of nodes theta (increasing), equally spaced pressures p, rates a (nodes, K, n_s)
+    and reverse moments m0 (nodes, n_s): the rates' integrals in p added."""
+    cum = np.concatenate([np.zeros((len(theta), 1, a.shape[-1])),
+                          np.cumsum(0.5 * (a[:, 1:] + a[:, :-1]) * (p[1] - p[0]), axis=1)], axis=1)
     return HingeTable(theta, p, a, cum, m0)
 
 

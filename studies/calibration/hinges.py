@@ -24,6 +24,7 @@ import argparse
 import math
 import sys
 from dataclasses import replace
+from pathlib import Path
 
 import numpy as np
 
@@ -82,12 +83,17 @@ def _raise(model, y, q, P0: float, dP: float, top: float):
 def volume_rates(model, pressures=PRESSURES, dP: float = DP, top: float = TOP, progress=None):
     """Rows (theta_free(P0) [rad], P [MPa], A (n_s,) [mm^3/rad]): the locked hinges' A_j at the
     middle P of each pressure step above each free state."""
+    return [row[1:] for row in _free_rows(model, pressures, dP, top, progress)]
+
+
+def _free_rows(model, pressures, dP, top, progress):
+    """Rows (P0, theta_free(P0), P, A) of :func:`volume_rates`."""
     from softhand.fem.hand.finger import solve_pressures
 
     free, _ = solve_pressures(model, pressures)
     rows = []
     for s in free:
-        rows += [(s.theta, P, A) for P, A in _raise(model, s.y, s.q, s.P, dP, top)]
+        rows += [(s.P, s.theta, P, A) for P, A in _raise(model, s.y, s.q, s.P, dP, top)]
         if progress is not None:
             progress(f"free state at {s.P:g} MPa")
     return rows
@@ -143,17 +149,96 @@ def table_text(design: HandDesign, mesh_size_mm: float | None = None, command: s
     return tables.table_text(head, columns, [(t, P, *(A / unit)) for t, P, A in rows])
 
 
+#: the grid of a design space's tables (:mod:`softhand.reduced.calibrated.hinge_space`): reverse bends
+#: [deg], free states' pressures, the pressure step and the highest pressure [MPa]
+GRID_REVERSE, GRID_PRESSURES, GRID_DP, GRID_TOP = (-3.0, -12.0), (0.0, 0.4, 0.8), 0.2, 2.4
+
+
+def grid_rows(design: HandDesign) -> list[tuple]:
+    """One design's rows (P0, theta, P, a_1..a_n) on the grid, on the finger FEM's default mesh
+    (a reverse node's P0 is 0; its row at P = 0 holds m0_j)."""
+    from softhand.fem.hand.finger import FingerModel, FingerOptions
+
+    model = FingerModel(design, FingerOptions())
+    unit = design.a ** 2 * math.pi * design.d
+    rows = [(0.0, *row) for row in reverse_rates(model, GRID_REVERSE, GRID_DP, GRID_TOP)]
+    rows += _free_rows(model, GRID_PRESSURES, GRID_DP, GRID_TOP, None)
+    return [(P0, t, P, *(A / unit)) for P0, t, P, A in rows]
+
+
+def _grid_file(work: Path, design: HandDesign) -> Path:
+    key = "_".join(f"{v:g}" for v in (design.a, design.b, design.d, design.l0, design.tie_width))
+    return work / f"hinge_grid_{key}.csv"
+
+
+def _grid_case(design: HandDesign, path: Path) -> Path:
+    """Run one design's grid and write it (atomically: a file there is a finished design)."""
+    return tables.write_table(path, [f"a {design.a:g}, b {design.b:g}, d {design.d:g}, l0 {design.l0:g}, "
+                                     f"tie {design.tie_width:g} mm"],
+                              ["P0", "theta", "P", *(f"a_{j}" for j in range(1, design.n_s + 1))], grid_rows(design))
+
+
+def space_text(space_file: str, work: str, workers: int = 1, command: str = "") -> str:
+    """The grid CSV of :mod:`softhand.reduced.calibrated.hinge_space` over the designs of a design
+    space (:mod:`softhand.studies.calibration.space`) and the paper's: each design's grid is kept
+    in ``work`` as it finishes, so a second run does only the designs not yet there."""
+    from concurrent.futures import ProcessPoolExecutor
+
+    from softhand.reduced.calibrated.finger_fem import groups_of
+    from softhand.reduced.calibrated.hinge_space import COLUMNS
+    from softhand.reduced.vocabulary.inputfiles import read_number_table
+    from softhand.studies.batch.pool import limit_threads, thread_share
+    from softhand.studies.calibration.space import load_space
+
+    designs = [HandDesign()] + [d for d in load_space(space_file).designs() if d != HandDesign()]
+    folder = Path(work)
+    folder.mkdir(parents=True, exist_ok=True)
+    todo = [d for d in designs if not _grid_file(folder, d).exists()]
+    print(f"hinge grid: {len(designs)} designs, {len(todo)} to run", file=sys.stderr, flush=True)
+    with ProcessPoolExecutor(max_workers=workers, initializer=limit_threads, initargs=(thread_share(workers),)) as pool:
+        for k, done in enumerate(pool.map(_grid_case, todo, [_grid_file(folder, d) for d in todo]), 1):
+            print(f"hinge grid: {done.name} ({k}/{len(todo)})", file=sys.stderr, flush=True)
+    rows = []
+    for i, d in enumerate(designs):
+        g = groups_of(d)
+        rows += [(i, *(g[k] for k in COLUMNS[1:5]), *row)
+                 for row in read_number_table(_grid_file(folder, d), "work", "a design's hinge grid")[2]]
+    head = [tables.written_by("FEM hinge grid of reduced/calibrated/hinge_space.py"), command,
+            f"model: finger FEM (fem/hand/finger.py) on the default mesh, {len(designs)} designs (the paper's and "
+            f"those of {Path(space_file).name}); reverse bends {', '.join(f'{b:g}' for b in GRID_REVERSE)} deg and "
+            f"free states at P0 = {', '.join(f'{p:g}' for p in GRID_PRESSURES)} MPa, hinges locked by springs of "
+            f"{SPRING:g} N mm/rad (half model), P raised in steps of {GRID_DP:g} MPa to {GRID_TOP:g}",
+            "groups as the finger table's; P0 = the free state's pressure (0 for a reverse bend); theta = the locked "
+            "bend [rad]; P = the step's middle [MPa]; a_j = A_j/(a^2 pi d); a reverse bend's row at P = 0 holds "
+            "m0_j = M_j/(a^2 pi d) [MPa]"]
+    return tables.table_text(head, [*COLUMNS, *(f"a_{j}" for j in range(1, HandDesign().n_s + 1))], rows)
+
+
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--out", required=True, help="CSV file to write")
     parser.add_argument("--mesh-size-mm", type=float, default=None,
                         help="finger element size of a graded grasp-style mesh (default: the finger FEM's default mesh)")
     parser.add_argument("--design", default=None, help="design TOML file (default: the paper's design)")
+    parser.add_argument("--space", default=None,
+                        help="design-space TOML file: write the grid of hinge tables over its designs instead")
+    parser.add_argument("--work", default="hinge_grid", help="folder keeping each design's grid (with --space)")
+    parser.add_argument("--workers", type=int, default=1, help="designs run at once (with --space)")
     parser.add_argument("--top-mpa", type=float, default=TOP,
                         help=f"highest cavity pressure of the locked paths [MPa] (default {TOP:g}; a hand that holds "
                              "below 2 MPa needs no more than 2.5, at about half the time)")
     args = parser.parse_args(argv)
     command = "python -m softhand.studies.calibration.hinges " + " ".join(sys.argv[1:] if argv is None else argv)
+    if args.space is not None:
+        from softhand.reduced.calibrated import hinge_space
+
+        write_atomic(args.out, space_text(args.space, args.work, max(1, args.workers), command))
+        hinge_space.read.cache_clear()
+        loo = hinge_space.leave_one_out(hinge_space.read(args.out))
+        print(f"leave-one-out over {len(loo)} designs: rates rms {100 * np.sqrt(np.mean(loo[:, 0] ** 2)):.2f} %, "
+              f"worst {100 * loo[:, 1].max():.1f} %; moments bent backwards rms {100 * np.sqrt(np.mean(loo[:, 2] ** 2)):.2f} "
+              f"%, worst {100 * loo[:, 3].max():.1f} %", file=sys.stderr)
+        return 0
     design = HandDesign() if args.design is None else load_design(args.design)
     if not 0.2 <= args.top_mpa <= 10.0:
         parser.error(f"--top-mpa {args.top_mpa:g}: must be in [0.2, 10] MPa")

@@ -5,7 +5,8 @@ import math
 import numpy as np
 import pytest
 
-from softhand.reduced.calibrated import grasp_fem, grasp_hold, grasp_hold_end, grasp_hold_fast, grasp_hold_solve
+from softhand.reduced.calibrated import (grasp_fem, grasp_hold, grasp_hold_end, grasp_hold_fast, grasp_hold_solve,
+                                         hinge_space, hinge_table)
 from softhand.reduced.equations import hand, kinematics
 from softhand.reduced.vocabulary.design import HandDesign
 
@@ -301,14 +302,27 @@ def test_a_reservoir_pressure_below_zero_does_not_hide_the_pump_pressure():
     _same_hold(fast, slow)
 
 
+@pytest.fixture
+def papers_table(monkeypatch):
+    """Every design on the paper's design's hinge table as it is (not carried to its geometry)."""
+    fine = hinge_table.read(str(hinge_space.TABLE_FILE))
+    monkeypatch.setattr(hinge_space, "design_table", lambda design: fine)
+    grasp_fem._energy_cuts.cache_clear()
+    yield
+    grasp_fem._energy_cuts.cache_clear()
+
+
 @pytest.mark.parametrize("a, d, l0", [(6.0, 13.59, 162.49), (5.99558128, 13.5871418, 162.41546091)])
-def test_a_pump_pressure_at_a_snap_is_the_state_just_below_it(monkeypatch, a, d, l0):
+def test_a_pump_pressure_at_a_snap_is_the_state_just_below_it(monkeypatch, papers_table, a, d, l0):
     """Near a held-out-style margin task's optimum (150 mm, 1 kg, 1.5 MPa): where the object held
     by pad 3 slides to the pad's far end, the finger snaps to another state (F_v 16.55 N to 14.65 N)
     and the pump pressure jumps past 1.50235 MPa (by 1.2e-4 MPa): no equilibrium has it. The slow
     path's root finder closes on the jump; the fast path solves for the snap and checks it with
     two states: the same state, to grasp_state's 1e-6 mm tolerance. The root finder lands on
-    either side of the jump: it takes the state below, as the fast path."""
+    either side of the jump: it takes the state below, as the fast path. (The snap is the paper's
+    hinge table's, as it was measured: carried over the design space, the table moves this
+    design's change of pad to 1.66 MPa, through the crease between pads 3 and 4, where both
+    touch and the one-contact finger has no state for 2.5e-3 MPa.)"""
     design = PAPER.replace(a=a, d=d, l0=l0, hinge_s=tuple(s * l0 / PAPER.l0 for s in PAPER.hinge_s))
     state = grasp_fem.grasp_state
     calls = _count_states(monkeypatch)
@@ -323,13 +337,14 @@ def test_a_pump_pressure_at_a_snap_is_the_state_just_below_it(monkeypatch, a, d,
     assert slow.F_v == pytest.approx(held.F_v, rel=1e-5)
 
 
-def test_a_later_pads_force_is_the_first_root_where_the_root_finder_took_a_second():
+def test_a_later_pads_force_is_the_first_root_where_the_root_finder_took_a_second(papers_table):
     """A held-out-style task's design (200 mm, 3 kg, F_v 17.35 N): on pad 3 F_v rises to 17.35 N
     at 0.940 MPa, drops by 2 N at 0.98 MPa (the contact moves to the pad's far end) and
     reaches 17.35 N again at 1.044 MPa. The root finder's bracket holds both roots (it gave the
     second until the hinge table measured hinges bent backwards; now the first); the fast path's
     pad-3 solve, checked on the root finder's grid, gives the first: F_v stays below the asked
-    force on a fine scan up to it."""
+    force on a fine scan up to it. (With the paper's hinge table, as the two roots were found:
+    carried over the design space, the table gives this design one root on pad 3, at 1.093 MPa.)"""
     design = PAPER.replace(b=3.13164975, V0=15384.3122, R=20.0, mu_sf=1.5, mu_sr=1.5)
     F_v = 17.3549875
     fast = grasp_hold_fast.fast_hold(design, 200.0, 3.0, "F_v", F_v)

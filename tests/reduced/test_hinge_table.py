@@ -5,7 +5,7 @@ its measured moment at zero pressure, and bad tables are refused."""
 import numpy as np
 import pytest
 
-from softhand.reduced.calibrated import grasp_fem, hinge_table
+from softhand.reduced.calibrated import grasp_fem, hinge_space, hinge_table
 from softhand.reduced.vocabulary.design import HandDesign
 from softhand.reduced.vocabulary.errors import InputError
 
@@ -108,7 +108,7 @@ def test_a_bad_table_is_one_line(tmp_path, header, rows, says):
 
 def _scaled_copy(tmp_path, factor: float, drop_last: bool = False):
     """The shipped table with every rate and moment times ``factor`` (or its last hinge dropped)."""
-    lines = grasp_fem.HINGE_TABLE.read_text().splitlines()
+    lines = hinge_space.TABLE_FILE.read_text().splitlines()
     out = []
     for line in lines:
         cells = line.split(",")
