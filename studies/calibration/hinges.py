@@ -17,6 +17,13 @@ steps from straight), its moment there written as the node's row at P = 0
 
     python -m softhand.studies.calibration.hinges --out reduced/calibrated/data/grasp_hinges.csv
     python -m softhand.studies.calibration.hinges --design my_hand.toml --out my_hinges.csv
+
+``--space FILE`` writes instead the grid of :mod:`softhand.reduced.calibrated.hinge_space`: every
+design of a design space (and the paper's) locked on a few nodes (``GRID_*``), each design's grid
+kept in ``--work`` as it finishes (a second run does only the others), ``--workers`` at once::
+
+    python -m softhand.studies.calibration.hinges --space studies/hinge_space.toml --workers 2 \
+        --out reduced/calibrated/data/grasp_hinge_space.csv
 """
 from __future__ import annotations
 
