@@ -44,9 +44,9 @@ from softhand.reduced.vocabulary.design import HandDesign
 from softhand.reduced.vocabulary.errors import InputError
 from softhand.reduced.vocabulary.inputfiles import read_number_table
 
-#: the paper's design's table (written by ``python -m softhand.studies.calibration.hinges``)
+#: the paper's design's table, written by the hinges study
 TABLE_FILE = Path(__file__).resolve().parent / "data" / "grasp_hinges.csv"
-#: the grid over the design space (``... hinges --space studies/hinge_space.toml``)
+#: the grid over the design space, written by the hinges study with its space option
 SPACE_FILE = Path(__file__).resolve().parent / "data" / "grasp_hinge_space.csv"
 #: the columns before the rates a_1..a_n
 COLUMNS = ("design", *GROUPS, "P0", "theta", "P")
@@ -66,15 +66,18 @@ class Space(NamedTuple):
 
 
 def features(design: HandDesign) -> np.ndarray:
-    """The design's kernel features (:data:`KERNEL_FEATURES`)."""
+    """The design's kernel features, those of the finger table's fit
+    (:data:`~softhand.reduced.calibrated.finger_fem_terms.KERNEL_FEATURES`)."""
     g = groups_of(design)
     return np.array([float(BASE[f](g, 0.0)) for f in KERNEL_FEATURES])
 
 
 @lru_cache(maxsize=2)
 def read(path: str = str(SPACE_FILE)) -> Space:
-    """The grid CSV (:data:`COLUMNS`, a_1..a_n; each design's rows one hinge table, all on the
-    same nodes and pressures, one design the paper's)."""
+    """The grid CSV: the columns :data:`COLUMNS`, then the rates a_1 to a_n.
+
+    Each design's rows are one hinge table, all on the same nodes and pressures; one design is
+    the paper's."""
     _, columns, data = read_number_table(path, "hinge_space", "the grid CSV of softhand.studies.calibration.hinges")
     n = len(columns) - len(COLUMNS)
     if n < 1 or columns != (*COLUMNS, *(f"a_{j}" for j in range(1, n + 1))):
@@ -106,8 +109,10 @@ def read(path: str = str(SPACE_FILE)) -> Space:
 
 
 def ratios(space: Space, design: HandDesign, leave_out: int | None = None) -> tuple[np.ndarray, np.ndarray]:
-    """(r (nodes, K, n), r_m (reverse nodes, n)) of the design, interpolated over the grid's
-    designs (all but ``leave_out``, for a leave-one-out check)."""
+    """The design's ratios to the paper's, interpolated over the grid's designs.
+
+    Returns (r (nodes, K, n), r_m (reverse nodes, n)); ``leave_out``: a design of the grid the
+    interpolant leaves out (a leave-one-out check)."""
     return _ratios_at(space, features(design), leave_out)
 
 
@@ -123,9 +128,10 @@ def _ratios_at(space: Space, x, leave_out: int | None):
 
 
 def leave_one_out(space: Space) -> np.ndarray:
-    """(D, 4): per design of the grid, its ratios predicted without it against its own: the rms and
-    the largest relative error of the rates, then of the moments bent backwards (the paper's row:
-    its ratios are 1 by definition, predicted all the same)."""
+    """Each design of the grid predicted without it: (D, 4) relative errors of its ratios.
+
+    Per design the rms and the largest error of the rates, then of the moments bent backwards
+    (the paper's row too: its ratios are 1 by definition, predicted all the same)."""
     out = []
     for k in range(len(space.x)):
         x = space.lo + space.span * space.x[k]
@@ -145,14 +151,17 @@ def _lerp(x, xp):
 
 
 def carried(fine: hinge_table.HingeTable, design: HandDesign, space: Space, leave_out: int | None = None):
-    """The design's hinge table: ``fine`` (the paper's design's) carried by the grid's ratios
-    (module doc). ``design`` has the calibrated finger (``finger_model = "fem"``)."""
+    """The design's hinge table: the paper's design's carried by the grid's ratios.
+
+    ``fine`` is the paper's design's table; ``design`` has the calibrated finger
+    (``finger_model = "fem"``); see the module doc."""
     return carry(fine, design, space, *ratios(space, design, leave_out))
 
 
 def carry(fine: hinge_table.HingeTable, design: HandDesign, space: Space, r, rm):
-    """``fine`` carried to ``design`` by the ratios r (grid nodes, K, n) and r_m (reverse grid
-    nodes, n) on the grid of ``space`` (:func:`carried`)."""
+    """A fine table carried to a design by ratios given on the grid (:func:`carried`).
+
+    r (grid nodes, K, n) and r_m (reverse grid nodes, n) on the grid of ``space``."""
     paper = HandDesign(finger_model="fem")
     forward = fine.theta >= 0
     P0 = np.zeros(len(fine.theta))
@@ -191,8 +200,10 @@ def reverse_scale(design: HandDesign) -> float:
 
 
 def design_table(design: HandDesign) -> hinge_table.HingeTable:
-    """The blocked-hinge table of a design with the calibrated finger: its own ``hinge_table``, else
-    the paper's design's carried to its geometry (:func:`carried`); InputError if it does not fit."""
+    """The blocked-hinge table a design's fast hold uses.
+
+    Its own ``hinge_table``, else the paper's design's carried to its geometry (:func:`carried`);
+    the design has the calibrated finger. InputError if the table does not fit the design."""
     own = bool(design.hinge_table)
     t = hinge_table.read(design.hinge_table if own else str(TABLE_FILE))
     if t.a.shape[-1] != design.n_s:
