@@ -91,7 +91,7 @@ def fem_finger(design: HandDesign) -> HandDesign:
 def volume_rate(theta, P, design: HandDesign) -> np.ndarray:
     """A_j [mm^3/rad] (..., n_s): oil hinge j draws per radian at fixed pressure, at hinge bends theta
     = n_s theta_hat (..., n_s) [rad] and cavity pressure P [MPa] (:mod:`softhand.reduced.calibrated.hinge_table`)."""
-    return hinge_table.volume_rate(_table(design), theta, P) * design.a ** 2 * math.pi * design.d
+    return hinge_table.volume_rate(hinge_data(design), theta, P) * design.a ** 2 * math.pi * design.d
 
 
 def hinge_moments(q, P: float, design: HandDesign) -> np.ndarray:
@@ -99,18 +99,14 @@ def hinge_moments(q, P: float, design: HandDesign) -> np.ndarray:
     angles q (..., n_s) [rad] and cavity pressure P [MPa], theta_j = n_s q_j; P_free of finger_model "fem"."""
     design = fem_finger(design)
     theta = design.n_s * np.asarray(q, float)
-    M = hinge_table.moment(_table(design), theta, P, hand.finger_pressure(theta, design), hinge_space.reverse_scale(design))
+    M = hinge_table.moment(hinge_data(design), theta, P, hand.finger_pressure(theta, design), hinge_space.reverse_scale(design))
     return M * design.a ** 2 * math.pi * design.d
-
-
-def _table(design: HandDesign) -> hinge_table.HingeTable:
-    return hinge_space.design_table(fem_finger(design))
 
 
 def hinge_data(design: HandDesign) -> hinge_table.HingeTable:
     """The blocked-hinge table the design's fast hold uses (its own ``hinge_table``, else the
     paper's design's); InputError if it cannot be read or does not fit the design."""
-    return _table(design)
+    return hinge_space.design_table(fem_finger(design))
 
 
 #: Gauss-Legendre rule on [0, 1] for E, per piece between the table's nodes
@@ -138,7 +134,7 @@ def hinge_energy(q, P: float, design: HandDesign) -> float:
 def _energy_cuts(design: HandDesign) -> np.ndarray:
     """Hinge angles theta_hat where M_j's second derivative may jump: the table's bends, and the
     free bends at its pressures (where P_free(theta) crosses a kink of A_j in p)."""
-    t = _table(design)
+    t = hinge_data(design)
     lo, hi = hand.pressure_span(design, reservoir=False)
     p = t.p[(t.p > lo) & (t.p < hi)]
     free = np.asarray(hand.bend_angle(p, design, reservoir=False), float) if len(p) else np.zeros(0)

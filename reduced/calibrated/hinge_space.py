@@ -68,8 +68,11 @@ class Space(NamedTuple):
 def features(design: HandDesign) -> np.ndarray:
     """The design's kernel features, those of the finger table's fit
     (:data:`~softhand.reduced.calibrated.finger_fem_terms.KERNEL_FEATURES`)."""
-    g = groups_of(design)
-    return np.array([float(BASE[f](g, 0.0)) for f in KERNEL_FEATURES])
+    return _features(groups_of(design))
+
+
+def _features(groups: dict) -> np.ndarray:
+    return np.array([float(BASE[f](groups, 0.0)) for f in KERNEL_FEATURES])
 
 
 @lru_cache(maxsize=2)
@@ -90,7 +93,7 @@ def read(path: str = str(SPACE_FILE)) -> Space:
         tables.append(t)
         free = rows[:, len(COLUMNS) - 2] >= 0
         nodes.append(np.r_[t.theta[t.theta < 0], np.unique(rows[free, len(COLUMNS) - 3])])
-        X.append([float(BASE[f](dict(zip(GROUPS, rows[0, 1:5])), 0.0)) for f in KERNEL_FEATURES])
+        X.append(_features(dict(zip(GROUPS, rows[0, 1:5]))))
     X = np.array(X)
     ref = np.flatnonzero(np.all(np.abs(X - paper) < 1e-6, axis=1))
     same = all(len(k) == len(nodes[0]) and np.allclose(k, nodes[0]) and t.a.shape == tables[0].a.shape
