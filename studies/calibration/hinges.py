@@ -158,7 +158,7 @@ def table_text(design: HandDesign, mesh_size_mm: float | None = None, command: s
 
 #: the grid of a design space's tables (:mod:`softhand.reduced.calibrated.hinge_space`): reverse bends
 #: [deg], free states' pressures, the pressure step and the highest pressure [MPa]
-GRID_REVERSE, GRID_PRESSURES, GRID_DP, GRID_TOP = (-3.0, -12.0), (0.0, 0.4, 0.8), 0.2, 2.4
+GRID_REVERSE, GRID_PRESSURES, GRID_DP, GRID_TOP = (-3.0, -6.0, -12.0), (0.0, 0.4, 0.8), 0.2, 2.4
 
 
 def grid_rows(design: HandDesign) -> list[tuple]:
