@@ -42,6 +42,8 @@ def state_fem(P: float, theta_deg: float, mass: float, diameter: float, design) 
             "F_x_N": float(s.F[0]), "F_y_N": float(s.F[1]), "F_v_N": s.F_v, "F_v_kgf": s.F_v / grasp.KGF,
             "model": "fem", "diameter_mm": diameter, "P_cavity_MPa": P_cavity,
             "contact_link": s.link, "contact_force_N": s.N, "contact_point_mm": s.point.tolist() if s.link >= 0 else None,
+            **({} if s.crease is None else {"crease_link": s.link + 1, "crease_force_N": s.crease[0],
+                                            "crease_point_mm": s.crease[1].tolist()}),
             "depth_mm": s.depth, "hinge_deg": np.degrees(s.q).tolist(),
             "P_pump_free_MPa": P_free}
 

@@ -37,7 +37,9 @@ and drops the tip assumption:
             \quad (j = 1..n_s), \qquad g_k(\hat\theta) = 0.
 
   Hinges beyond the touching link carry no load: they bend as the free finger's. The n_s
-  equations and the gap fix the k proximal hinge angles and N.
+  equations and the gap fix the k proximal hinge angles and N. Where no pad settles alone,
+  the object sits in the crease of pads k and k + 1 (a gap and an N each, the weight shared
+  in proportion to N): the state between the two pads' own, continuous with the distal one's.
 
 F_v is the FEM's: the resultant F projected on the tip link's outward normal (eq. (29)).
 Two ways to pose a grasp: :func:`grasp_state` at a placement (depth; default the grasp
@@ -77,6 +79,9 @@ class GraspState(NamedTuple):
     point: np.ndarray   #: contact point x* (2,) [mm]
     F: np.ndarray       #: force of the object on the finger (2,), x out, y down [N]
     F_v: float          #: F . n_out of the tip link (29) [N]
+    #: in a crease (the object on pads link and link + 1 at once): (N [N], x* (2,) [mm]) of pad
+    #: link + 1, whose force F includes; None on one pad
+    crease: tuple | None = None
 
     @property
     def theta(self) -> float:
@@ -152,35 +157,56 @@ def _load(q, centre, link: int, weight: float, design: HandDesign, corner: bool 
 
 
 def _state(P, depth, q, link, N, weight, design, corner=False) -> GraspState:
+    """The state with pad ``link`` (its far end if ``corner``) pressed by N; N a pair in a crease
+    (pads link and link + 1; the weight shared in proportion to N)."""
     if link < 0:
         return GraspState(P, depth, q, -1, 0.0, np.full(2, np.nan), np.zeros(2), 0.0)
-    _, _, _, xs, nu, t = _load(q, (0.0, depth), link, weight, design, corner)
-    F = -N * nu + weight * t
+    Ns = np.atleast_1d(np.asarray(N, float))
+    share = Ns / Ns.sum() if len(Ns) > 1 else np.ones(1)
+    at = [_load(q, (0.0, depth), k, 1.0, design, corner)[3:] for k in range(link, link + len(Ns))]  # (x*, nu, t)
+    F = sum(-Nk * nu + weight * sk * t for Nk, sk, (_, nu, t) in zip(Ns, share, at))
     alpha = q.sum() - design.theta0
-    return GraspState(P, depth, q, link, float(N), xs, F, float(F @ [math.cos(alpha), math.sin(alpha)]))
+    return GraspState(P, depth, q, link, float(Ns[0]), at[0][0], F, float(F @ [math.cos(alpha), math.sin(alpha)]),
+                      (float(Ns[1]), at[1][0]) if len(Ns) > 1 else None)
 
 
-def _solve_link(P, depth, radius, link, weight, q0, design, corner=False):
-    """Hinges 1..link and N with pad ``link`` (its far end if ``corner``) on the object; distal
-    hinges as q0's."""
-    centre, k = (0.0, depth), link
+def _solve_link(P, depth, radius, link, weight, q0, design, corner=False, crease=False):
+    """Hinges 1..link and N with pad ``link`` (its far end if ``corner``) on the object, distal hinges
+    as q0's; ``crease``: pads link and link + 1 (hinges 1..link + 1, N a pair; the weight shared by N)."""
+    centre, k, m = (0.0, depth), link + crease, 1 + crease  # k held hinges, m contacts
+
+    def terms(q):  # per contact (rho, dg/dq, unit weight's generalised force)
+        return [_load(q, centre, link + i, 1.0, design, corner)[:3] for i in range(m)]
 
     def residual(x):
-        q = np.concatenate([x[:k], q0[k:]])
-        rho, grad, Tq, *_ = _load(q, centre, k, weight, design, corner)
-        return np.concatenate([(hinge_moments(q, P, design) - x[k] * grad - Tq)[:k], [rho - radius]])
+        q, N = np.concatenate([x[:k], q0[k:]]), x[k:]
+        share = weight * (N / N.sum() if crease and N.sum() != 0.0 else np.ones(m))
+        at = terms(q)
+        f = hinge_moments(q, P, design) - sum(Ni * grad + wi * Tq for (_, grad, Tq), Ni, wi in zip(at, N, share))
+        return np.concatenate([f[:k], [rho - radius for rho, *_ in at]])
 
-    _, grad, Tq, *_ = _load(q0, centre, k, weight, design, corner)
-    M = (hinge_moments(q0, P, design) - Tq)[:k]
+    _, grad, Tq = terms(q0)[0]
+    M = (hinge_moments(q0, P, design) - weight * Tq)[:k]
     N0 = max(float(M @ grad[:k]) / max(float(grad[:k] @ grad[:k]), 1e-12), 0.0)
-    x0 = np.concatenate([q0[:k], [N0]])
+    x0 = np.concatenate([q0[:k], [N0] if m == 1 else [0.5 * N0, 0.5 * N0]])
     sol = root(residual, x0, method="hybr", options={"xtol": _XTOL})
     if not sol.success:  # hybr stalls where the table's kinks meet a poor start: Levenberg-Marquardt
         sol = root(residual, x0, method="lm", options={"xtol": _XTOL, "ftol": _XTOL})
-    if not sol.success or np.max(np.abs(residual(sol.x)) / [*np.maximum(np.abs(M), 1.0), 1.0]) > 1e-7:
-        raise InputError("pressure_MPa", P, f"no equilibrium with pad {k} on the object "
-                                            f"(depth {depth:.4g} mm): {sol.message}")
-    return np.concatenate([sol.x[:k], q0[k:]]), float(sol.x[k])
+    if not sol.success or np.max(np.abs(residual(sol.x)) / [*np.maximum(np.abs(M), 1.0), *[1.0] * m]) > 1e-7:
+        raise InputError("pressure_MPa", P, f"no equilibrium with pad {link}{' and the next' * crease} on the "
+                                            f"object (depth {depth:.4g} mm): {sol.message}")
+    return np.concatenate([sol.x[:k], q0[k:]]), (float(sol.x[k]) if m == 1 else sol.x[k:])
+
+
+def _crease(P, depth, radius, k, weight, q0, design) -> GraspState | None:
+    """Pads k and k + 1 both pressing the object; None where no such state is (no equilibrium,
+    an N not positive, another pad in the object)."""
+    try:
+        q, N = _solve_link(P, depth, radius, k, weight, q0, design, crease=True)
+    except InputError:
+        return None
+    others = np.delete(contact.pad_gaps(q, (0.0, depth), radius, design), [k, k + 1])
+    return _state(P, depth, q, k, N, weight, design) if np.all(N > 0.0) and np.min(others) >= -PENETRATION else None
 
 
 def grasp_state(design: HandDesign, diameter_mm: float, P: float, mass_kg: float = 0.0, *,
@@ -203,7 +229,7 @@ def grasp_state(design: HandDesign, diameter_mm: float, P: float, mass_kg: float
     if clear and float(np.sum(q_free)) < theta_c:
         return _state(P, depth, q_free, -1, 0.0, weight, design)
     q0 = np.concatenate([np.full(link, theta_c / design.n_s), q_free[link:]])
-    corner, seen = False, set()
+    corner, seen, creases = False, set(), {}
     for _ in range(design.n_s + 2):
         if link == 0:
             raise InputError("diameter_mm", diameter_mm, "touches the base link, which cannot press")
@@ -218,10 +244,14 @@ def grasp_state(design: HandDesign, diameter_mm: float, P: float, mass_kg: float
         nxt = int(np.argmin(gaps))
         if nxt in seen and abs(nxt - link) == 1 and not corner:  # both sides of a hinge: its corner
             link, corner = min(nxt, link), True
+            creases.setdefault(link, np.concatenate([q[:link], q_free[link:]]))
         else:
             link, corner = nxt, False
         q0 = np.concatenate([q[:link], q_free[link:]])
-    raise InputError("diameter_mm", diameter_mm, "the contact does not settle on one pad")
+    for k, start in creases.items():  # no state on one pad: the object in the crease of two
+        if (both := _crease(P, depth, radius, k, weight, start, design)) is not None:
+            return both
+    raise InputError("diameter_mm", diameter_mm, "the contact settles on no pad and in no crease")
 
 
 def grasp_state_at_angle(design: HandDesign, diameter_mm: float, P: float, theta: float,

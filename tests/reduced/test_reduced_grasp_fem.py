@@ -95,6 +95,63 @@ def test_the_contact_force_does_the_energys_virtual_work(diameter, P, mass):
         assert dE == pytest.approx(dW, rel=1e-5, abs=1e-3)
 
 
+#: a design an optimiser proposed whose 150 mm, 1 kg ball passes from pad 3 to pad 4 between
+#: cavity pressures of about 1.6775 and 1.6800 MPa through the crease between them
+CREASE = grasp_fem.fem_finger(HandDesign(a=6.0, d=13.59, l0=162.49,
+                                         hinge_s=tuple(np.array(HandDesign().hinge_s) * 162.49 / 180.0)))
+
+
+def test_an_object_in_the_crease_of_two_pads_does_the_energys_virtual_work():
+    """Where neither pad alone settles, the ball sits in the crease of pads 3 and 4: both gaps
+    closed, both N positive, and dE = F_3 . dx_3 + F_4 . dx_4 for every virtual hinge motion,
+    each pad's force rebuilt from its point's geometry (normal towards the centre, the weight
+    shared in proportion to N along the link), by central differences."""
+    P, mass, D = 1.6785, 1.0, 150.0
+    s = grasp_fem.grasp_state(CREASE, D, P, mass)
+    assert s.link == 3 and s.crease is not None and s.N > 0.0 and s.crease[0] > 0.0
+    centre = np.array([0.0, s.depth])
+    gaps = contact.pad_gaps(s.q, centre, 0.5 * D, CREASE)
+    np.testing.assert_allclose(gaps[3:5], 0.0, atol=1e-7)
+    assert np.min(np.delete(gaps, [3, 4])) > 0.0
+    weight = mass * CREASE.g / CREASE.n
+    pads = [(3, s.N, s.point), (4, s.crease[0], s.crease[1])]
+    joints, angles = kinematics.joint_positions(s.q, CREASE), kinematics.link_angles(s.q, CREASE)
+    forces, alongs = [], []
+    for k, N, x in pads:
+        nu = (centre - x) / np.linalg.norm(centre - x)
+        t = np.array([-math.sin(angles[k]), math.cos(angles[k])])
+        forces.append(-N * nu + weight * N / (s.N + s.crease[0]) * t)
+        alongs.append(float(np.linalg.norm(x - joints[k])))
+    np.testing.assert_allclose(forces[0] + forces[1], s.F, rtol=1e-9)
+    at = grasp_fem.grasp_state_at_angle(CREASE, D, P, s.theta, mass)  # the same state by its bend
+    assert at.crease is not None and at.depth == pytest.approx(s.depth, abs=1e-6)
+
+    def point(q, k, along):
+        a = kinematics.link_angles(q, CREASE)[k]
+        return kinematics.joint_positions(q, CREASE)[k] + along * np.array([-math.sin(a), math.cos(a)])
+
+    h = 1e-6
+    for dq in np.random.default_rng(7).normal(size=(4, CREASE.n_s)):
+        dE = (grasp_fem.hinge_energy(s.q + h * dq, P, CREASE) - grasp_fem.hinge_energy(s.q - h * dq, P, CREASE)) / (2 * h)
+        dW = sum(F @ (point(s.q + h * dq, k, a) - point(s.q - h * dq, k, a)) / (2 * h)
+                 for F, (k, _, _), a in zip(forces, pads, alongs))
+        assert dE == pytest.approx(dW, rel=1e-5, abs=1e-3)
+
+
+def test_the_crease_state_continues_into_the_distal_pads():
+    """As the pressure rises, pad 3's N in the crease falls to zero where pad 4's own state
+    begins: the bend and F_v meet there (the one-pad states on either side jump by 2 deg)."""
+    P1, P2 = 1.6780, 1.6790
+    a, b = (grasp_fem.grasp_state(CREASE, 150.0, P, 1.0) for P in (P1, P2))
+    assert a.crease is not None and b.crease is not None and b.N < a.N
+    P0 = P1 + (P2 - P1) * a.N / (a.N - b.N)  # where pad 3's N reaches zero (linear to ~1e-4)
+    below, above = (grasp_fem.grasp_state(CREASE, 150.0, P, 1.0) for P in (P0 - 2e-6, P0 + 2e-6))
+    assert below.crease is not None and below.N < 0.01 and above.link == 4 and above.crease is None
+    assert above.theta == pytest.approx(below.theta, abs=1e-5)
+    assert above.F_v == pytest.approx(below.F_v, abs=2e-3)
+    assert above.N == pytest.approx(below.crease[0], abs=2e-2)
+
+
 def test_tip_contact_is_eq_25s_virtual_work_balance():
     """The tip corner touching (150 mm object at depth 180 mm): eq. (25)'s balance, the tip force
     through the tip Jacobian (20) of eq. (25) at theta_hat = w theta, holds along the state's
