@@ -266,3 +266,26 @@ def test_curve_compare_overlays_designs_and_models_on_one_plot(tmp_path, capsys,
     assert main(["curve", "--theta-deg", "0:60:30", "--design", str(tmp_path / "gripper.toml"),
                  "--model", "fem", "--json"]) == 0
     assert json.loads(capsys.readouterr().out)["rows"] == out[3]["rows"]
+
+
+def test_grasp_fem_in_the_crease_of_two_pads_prints_both(tmp_path, capsys):
+    """A ball between pads 3 and 4 (the state of neither pad alone): the JSON names the second
+    pad, its normal force and its point beside the first, and F_v is the state's."""
+    from softhand.reduced.calibrated import grasp_fem
+    from softhand.reduced.vocabulary.design_files import load_design
+
+    design = tmp_path / "crease.toml"
+    design.write_text("a_mm = 6.0\nd_mm = 13.59\nl0_mm = 162.49\nhinge_s_mm = ["
+                      + ", ".join(f"{s * 162.49 / 180.0!r}" for s in (30.0, 60.0, 90.0, 120.0, 150.0)) + "]\n")
+    fem = grasp_fem.fem_finger(load_design(design))
+    s = grasp_fem.grasp_state(fem, 150.0, 1.6785, 1.0)
+    assert s.crease is not None
+    P_pump = 1.6785 - float(hand.finger_pressure(s.theta, fem)) + float(hand.pressure(s.theta, fem))
+    assert main(["grasp", "--model", "fem", "--diameter-mm", "150", "--mass-kg", "1", "--pressure-mpa", repr(P_pump),
+                 "--theta-deg", repr(math.degrees(s.theta)), "--design", str(design), "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert (out["contact_link"], out["crease_link"]) == (3, 4)
+    assert out["crease_force_N"] == pytest.approx(s.crease[0], rel=1e-5)
+    assert out["contact_force_N"] == pytest.approx(s.N, rel=1e-3, abs=1e-4)
+    assert out["F_v_N"] == pytest.approx(s.F_v, rel=1e-6)
+    np.testing.assert_allclose(out["crease_point_mm"], s.crease[1], atol=1e-4)
