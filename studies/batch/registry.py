@@ -212,6 +212,8 @@ KINDS: dict[str, Kind] = {
                          "p_step_mpa": Num(0.01, 5.0), "axial_size_mm": Num(0.25, 20.0)},
                         fem=True, mesh=Num(2.0, 12.0), checks=(_one_mesh, finger_mesh_fits, _path_within_p_max),
                         required=("pressures_mpa", "theta_target_deg", "p_max_mpa", "p_step_mpa")),
+    # one design's blocked-hinge grid (studies.calibration.hinges: --space); no parameters
+    "hinge_grid": Kind("softhand.studies.calibration.hinges:grid_case", {}),
 }
 #: the entry-point group where installed packages declare more kinds
 ENTRY_POINT_GROUP = "softhand.kinds"

@@ -19,8 +19,9 @@ steps from straight), its moment there written as the node's row at P = 0
     python -m softhand.studies.calibration.hinges --design my_hand.toml --out my_hinges.csv
 
 ``--space FILE`` writes instead the grid of :mod:`softhand.reduced.calibrated.hinge_space`: every
-design of a design space (and the paper's) locked on a few nodes (``GRID_*``), each design's grid
-kept in ``--work`` as it finishes (a second run does only the others), ``--workers`` at once::
+design of a design space (and the paper's) locked on a few nodes (``GRID_*``), each design one case
+of the batch runner (``--results``/<space>_hinges/, kept as it finishes: a second run does only the
+others; ``--workers`` at once, or a Dask ``--scheduler``)::
 
     python -m softhand.studies.calibration.hinges --space studies/hinge_space.toml --workers 2 \
         --out reduced/calibrated/data/grasp_hinge_space.csv
@@ -173,43 +174,38 @@ def grid_rows(design: HandDesign) -> list[tuple]:
     return [(P0, t, P, *(A / unit)) for P0, t, P, A in rows]
 
 
-def _grid_file(work: Path, design: HandDesign) -> Path:
-    key = "_".join(f"{v:g}" for v in (design.a, design.b, design.d, design.l0, design.tie_width))
-    return work / f"hinge_grid_{key}.csv"
+def grid_case(params: dict, design: HandDesign, outdir: Path) -> dict:
+    """Kind ``hinge_grid`` of the batch runner: one design's rows on the grid (:func:`grid_rows`)."""
+    return {"rows": [[float(v) for v in row] for row in grid_rows(design)]}
 
 
-def _grid_case(design: HandDesign, path: Path) -> Path:
-    """Run one design's grid and write it (atomically: a file there is a finished design)."""
-    return tables.write_table(path, [f"a {design.a:g}, b {design.b:g}, d {design.d:g}, l0 {design.l0:g}, "
-                                     f"tie {design.tie_width:g} mm"],
-                              ["P0", "theta", "P", *(f"a_{j}" for j in range(1, design.n_s + 1))], grid_rows(design))
-
-
-def space_text(space_file: str, work: str, workers: int = 1, command: str = "") -> str:
+def space_text(space_file: str, results: str = "results", workers: int = 1, command: str = "",
+               scheduler: str | None = None, progress: bool = True) -> str:
     """The grid CSV of :mod:`softhand.reduced.calibrated.hinge_space` over the designs of a design
-    space (:mod:`softhand.studies.calibration.space`) and the paper's: each design's grid is kept
-    in ``work`` as it finishes, so a second run does only the designs not yet there."""
-    from concurrent.futures import ProcessPoolExecutor
-
+    space (:mod:`softhand.studies.calibration.space`) and the paper's: one ``hinge_grid`` case per
+    design of the batch runner (results/<space>_hinges/, resumable, a local pool or Dask)."""
     from softhand.reduced.calibrated.finger_fem import groups_of
     from softhand.reduced.calibrated.hinge_space import COLUMNS
-    from softhand.reduced.vocabulary.inputfiles import read_number_table
-    from softhand.studies.batch.pool import limit_threads, thread_share
-    from softhand.studies.calibration.space import load_space
+    from softhand.studies.batch.runner import plan, read_case, run_study, study_dir
+    from softhand.studies.calibration.finger import SpaceStudy
+    from softhand.studies.calibration.space import VARIABLES, load_space
 
-    designs = [HandDesign()] + [d for d in load_space(space_file).designs() if d != HandDesign()]
-    folder = Path(work)
-    folder.mkdir(parents=True, exist_ok=True)
-    todo = [d for d in designs if not _grid_file(folder, d).exists()]
-    print(f"hinge grid: {len(designs)} designs, {len(todo)} to run", file=sys.stderr, flush=True)
-    with ProcessPoolExecutor(max_workers=workers, initializer=limit_threads, initargs=(thread_share(workers),)) as pool:
-        for k, done in enumerate(pool.map(_grid_case, todo, [_grid_file(folder, d) for d in todo]), 1):
-            print(f"hinge grid: {done.name} ({k}/{len(todo)})", file=sys.stderr, flush=True)
+    space = load_space(space_file)
+    designs = [HandDesign()] + [d for d in space.designs() if d != HandDesign()]
+    study = SpaceStudy(name=f"{space.name}_hinges", kind="hinge_grid", design=HandDesign(),
+                       axes=tuple((key, ()) for key in VARIABLES), params={},
+                       description="blocked-hinge grid over a design space",
+                       case_list=tuple(({}, d) for d in designs))
+    run = run_study(study, results_root=results, workers=workers, scheduler=scheduler, progress=progress)
+    if not run.ok:
+        failed = "; ".join(f"{key}: {error}" for key, error in run.failed.items())
+        raise RuntimeError(f"hinge grid: {len(run.failed)} designs failed, {run.not_run} not run "
+                           f"({failed or 'rerun to finish them'})")
     rows = []
-    for i, d in enumerate(designs):
+    for i, (d, case) in enumerate(zip(designs, plan(study))):
         g = groups_of(d)
         rows += [(i, *(g[k] for k in COLUMNS[1:5]), *row)
-                 for row in read_number_table(_grid_file(folder, d), "work", "a design's hinge grid")[2]]
+                 for row in read_case(study_dir(study, results), case)["numbers"]["rows"]]
     head = [tables.written_by("FEM hinge grid of reduced/calibrated/hinge_space.py"), command,
             f"model: finger FEM (fem/hand/finger.py) on the default mesh, {len(designs)} designs (the paper's and "
             f"those of {Path(space_file).name}); reverse bends {', '.join(f'{b:g}' for b in GRID_REVERSE)} deg and "
@@ -229,8 +225,11 @@ def main(argv=None) -> int:
     parser.add_argument("--design", default=None, help="design TOML file (default: the paper's design)")
     parser.add_argument("--space", default=None,
                         help="design-space TOML file: write the grid of hinge tables over its designs instead")
-    parser.add_argument("--work", default="hinge_grid", help="folder keeping each design's grid (with --space)")
+    parser.add_argument("--results", default="results",
+                        help="with --space: the batch runner's results folder (each design a case, resumable)")
     parser.add_argument("--workers", type=int, default=1, help="designs run at once (with --space)")
+    parser.add_argument("--scheduler", default=None, help="with --space: a Dask scheduler address, or 'local'")
+    parser.add_argument("--no-progress", action="store_true", help="with --space: no progress bar")
     parser.add_argument("--top-mpa", type=float, default=TOP,
                         help=f"highest cavity pressure of the locked paths [MPa] (default {TOP:g}; a hand that holds "
                              "below 2 MPa needs no more than 2.5, at about half the time)")
@@ -239,7 +238,8 @@ def main(argv=None) -> int:
     if args.space is not None:
         from softhand.reduced.calibrated import hinge_space
 
-        write_atomic(args.out, space_text(args.space, args.work, max(1, args.workers), command))
+        write_atomic(args.out, space_text(args.space, args.results, max(1, args.workers), command,
+                                          args.scheduler, not args.no_progress))
         hinge_space.read.cache_clear()
         loo = hinge_space.leave_one_out(hinge_space.read(args.out))
         print(f"leave-one-out over {len(loo)} designs: rates rms {100 * np.sqrt(np.mean(loo[:, 0] ** 2)):.2f} %, "

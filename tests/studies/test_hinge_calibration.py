@@ -68,7 +68,7 @@ def _fake_grid(design):
 
 
 def test_the_space_grid_is_written_once_per_design_and_resumed(tmp_path, monkeypatch):
-    """--space: every design's grid kept in the work folder as it finishes; the table assembled
+    """--space: every design's grid kept as a batch case as it finishes; the table assembled
     from them is the grid the fast hold reads; a second run computes nothing."""
     from softhand.reduced.calibrated import hinge_space
 
@@ -81,12 +81,12 @@ def test_the_space_grid_is_written_once_per_design_and_resumed(tmp_path, monkeyp
                                                (5.5, 4.5, 13.0, 160.0, 9.0), (4.2, 6.5, 19.0, 140.0, 7.0)]))
     monkeypatch.setattr(hinges, "grid_rows", _fake_grid)
     out = tmp_path / "grid.csv"
-    assert hinges.main(["--space", str(space), "--work", str(tmp_path / "w"), "--out", str(out)]) == 0
-    assert len(list((tmp_path / "w").glob("*.csv"))) == 7
+    assert hinges.main(["--space", str(space), "--results", str(tmp_path / "w"), "--no-progress", "--out", str(out)]) == 0
+    assert len(list((tmp_path / "w").rglob("result.json"))) == 7
     hinge_space.read.cache_clear()
     grid = hinge_space.read(str(out))
     np.testing.assert_allclose(np.exp(grid.log_r[1:, 0, 0, 0]), [4.0 / 5, 6.0 / 5, 3.5 / 5, 5.5 / 5, 4.5 / 5, 6.5 / 5])
     monkeypatch.setattr(hinges, "grid_rows", lambda design: pytest.fail("a finished design was run again"))
     text = out.read_text()
-    assert hinges.main(["--space", str(space), "--work", str(tmp_path / "w"), "--out", str(out)]) == 0
+    assert hinges.main(["--space", str(space), "--results", str(tmp_path / "w"), "--no-progress", "--out", str(out)]) == 0
     assert out.read_text().splitlines()[3:] == text.splitlines()[3:]
