@@ -110,7 +110,7 @@ def hinge_moments(q, P: float, design: HandDesign) -> np.ndarray:
 
 def hinge_data(design: HandDesign) -> hinge_table.HingeTable:
     """The blocked-hinge table the design's fast hold uses (its own ``hinge_table``, else the
-    paper's design's); InputError if it cannot be read or does not fit the design."""
+    paper's design's carried to its geometry); InputError if it cannot be read or does not fit."""
     return hinge_space.design_table(fem_finger(design))
 
 
