@@ -6,6 +6,7 @@ ratios, on nodes at the design's own free bends; the paper's geometry keeps the 
 bad grids are refused."""
 import math
 from dataclasses import replace
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -152,3 +153,32 @@ def test_a_grid_with_a_negative_rate_or_a_wrong_header_is_refused(tmp_path):
     bad.write_text("design,theta,P,a_1\n0,0,0.1,1\n")
     with pytest.raises(InputError, match="needs the header"):
         hinge_space.read(str(bad))
+
+
+#: a design of no grid row and no test fitted to it, and its own blocked-hinge table, run by the
+#: finger FEM (``python -m softhand.studies.calibration.hinges --design B.toml --top-mpa 2.5``)
+DESIGN_B = replace(PAPER, a=5.0, b=4.0, d=16.0, l0=160.0, tie_width=8.0,
+                   hinge_s=tuple(160.0 * k / 6 for k in range(1, 6)))
+OWN_B = str(Path(__file__).resolve().parents[1] / "data" / "hinges_design_b.csv")
+
+
+def test_the_shipped_grid_carries_the_table_to_a_held_out_design_as_its_own_fem_table_says():
+    """The paper's table carried by the shipped grid against design B's own FEM table, over hinge
+    bends -12..60 deg and cavity pressures 0.1..2 MPa: rates within 2 % rms (1.1 % measured),
+    none off by 10 % (7.4 %); moments within 0.5 % rms of the largest (0.28 %). The paper's table
+    as is misses by 14 % rms: the grid is what brings it there."""
+    own = hinge_table.read(OWN_B)
+    hinge_space.read.cache_clear()
+    t = hinge_space.design_table(DESIGN_B)
+    theta = np.radians(np.r_[-12, -6, -3, np.linspace(0, 60, 13)])
+    T, PP = np.meshgrid(theta, np.linspace(0.1, 2.0, 20), indexing="ij")
+    x, p = T[..., None] * np.ones(5), PP[..., None]
+    free = hand.finger_pressure(np.maximum(x, 1e-6), DESIGN_B)
+    rates = hinge_table.volume_rate(t, x, p) / hinge_table.volume_rate(own, x, p) - 1
+    mo = hinge_table.moment(own, x, p, free)
+    moments = (hinge_table.moment(t, x, p, free) - mo) / np.max(np.abs(mo), axis=(0, 1))
+    assert np.sqrt(np.mean(rates ** 2)) < 0.02 and np.max(np.abs(rates)) < 0.10
+    assert np.sqrt(np.mean(moments ** 2)) < 0.005
+    as_is = hinge_table.volume_rate(hinge_table.read(str(hinge_space.TABLE_FILE)), x, p) / \
+        hinge_table.volume_rate(own, x, p) - 1
+    assert np.sqrt(np.mean(as_is ** 2)) > 0.1
