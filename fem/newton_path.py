@@ -63,7 +63,7 @@ class PathResult:
 
 def solve_path(fun_t, x0, options: PathOptions = PathOptions(), *, solver=None, scale_t=None,
                callback=None, on_accept=None, residual_t=None, converged_t=None, merit_t=None, t0=0.0,
-               stops=(1.0,)) -> PathResult:
+               stops=(1.0,), first_direction=None) -> PathResult:
     """Follow R(x, t) = 0 for t from t0 (state x0) through ``stops``; fun_t(x, t) -> (R, K).
 
     stops: the values of t the path lands on, running strictly monotonically away from t0
@@ -72,7 +72,8 @@ def solve_path(fun_t, x0, options: PathOptions = PathOptions(), *, solver=None, 
     converged step; on_accept: passed to :func:`softhand.fem.newton.newton` (also called before each predictor);
     residual_t(x, t) -> R, converged_t(x, R, it, t) -> bool and merit_t(x, R, t) -> float:
     optional, :func:`softhand.fem.newton.newton`'s ``residual``, ``converged`` and ``merit`` at t. On failure the :class:`~softhand.fem.newton.NotConverged` also carries ``t``,
-    the load it failed at.
+    the load it failed at. first_direction: the first step's predictor direction, already
+    computed by the caller for the first increment the options give (not used after a cut-back).
     """
     solver = solver or make_solver()
     stops = np.asarray(stops, dtype=float)
@@ -90,8 +91,11 @@ def solve_path(fun_t, x0, options: PathOptions = PathOptions(), *, solver=None, 
             t = float(stop if dt >= sign * (stop - res.t[-1]) else res.t[-1] + sign * dt)
             if on_accept is not None:
                 on_accept(res.x[-1])
-            x_start, step = predict(res, t, fun_t, solver, options.predictor, residual_t, reuse,
-                                    rtol=options.newton.forcing)
+            if first_direction is not None and len(res.t) == 1 and not res.cutbacks:
+                x_start, step = res.x[-1], first_direction
+            else:
+                x_start, step = predict(res, t, fun_t, solver, options.predictor, residual_t, reuse,
+                                        rtol=options.newton.forcing)
             try:
                 r = newton(lambda x: fun_t(x, t), x_start, options.newton, solver=solver,
                            scale=None if scale_t is None else scale_t(t), direction=step,

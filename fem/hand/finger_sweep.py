@@ -112,10 +112,10 @@ def softened(model, kappa_ratio: float = PATH_KAPPA_RATIO):
     return soft
 
 
-def predicted_bend(model, y, P1, P, link_load, solver, options) -> float:
-    """The bend [rad] (sum of hinge angles) the tangent predictor adds from the state y at P1 to
-    P, solved with the solver's factorisation when it has one of this size (as the load step's
-    predictor then is, which reuses the one made here otherwise)."""
+def predicted_bend(model, y, P1, P, link_load, solver, options):
+    """(the bend [rad] (sum of hinge angles) the tangent predictor adds from the state y at P1 to
+    P, the predictor's direction or None): solved with the solver's factorisation when it has one
+    of this size, as the load step's predictor then is; the step starts along this direction."""
     eps = 1e-7 * max(abs(P - P1), 1e-3)
     if factored_size(solver) == len(y):
         R0 = model.residual(y, P1, link_load)
@@ -127,8 +127,8 @@ def predicted_bend(model, y, P1, P, link_load, solver, options) -> float:
     try:
         dy = solve(-rhs)
     except (RuntimeError, np.linalg.LinAlgError, ValueError):
-        return np.inf
-    return abs(float(np.sum(dy[len(model.constraint.free):])))
+        return np.inf, None
+    return abs(float(np.sum(dy[len(model.constraint.free):]))), dy
 
 
 def _solve_one(model, soft, P, history, link_load, solver, options, scale, totals):
@@ -145,20 +145,21 @@ def _solve_one(model, soft, P, history, link_load, solver, options, scale, total
     """
     P1, y1 = history[-1]
 
-    def step(m, steps=1, min_dt=PathOptions.min_dt):
+    def step(m, steps=1, min_dt=PathOptions.min_dt, direction=None):
         return solve_path(lambda y, t: m.residual_tangent(y, P1 + t * (P - P1), link_load), y1,
                           PathOptions(steps=steps, newton=options, min_dt=min_dt), solver=solver,
-                          scale_t=lambda t: scale, residual_t=lambda y, t: m.residual(y, P1 + t * (P - P1), link_load))
+                          scale_t=lambda t: scale, residual_t=lambda y, t: m.residual(y, P1 + t * (P - P1), link_load),
+                          first_direction=direction)
 
     def failed():  # counted as a cut-back; the failed solve's last factor is of an iterate off the path
         totals[3] += 1
         solver.forget()
 
     if soft is not None and P != P1:
-        bend = predicted_bend(model, y1, P1, P, link_load, solver, options)
+        bend, direction = predicted_bend(model, y1, P1, P, link_load, solver, options)
         if bend <= BEND_STEP:
             try:
-                path = step(model, min_dt=1.0)  # not cut back
+                path = step(model, min_dt=1.0, direction=direction)  # not cut back
                 totals[:4] += (path.assembly_seconds, path.solve_seconds, path.total_iterations, 0)
                 return path.x[-1], path.total_iterations
             except NotConverged:

@@ -312,3 +312,23 @@ def test_inexact_newton_gives_the_answer_to_tolerance_with_fewer_refinement_step
     # both meet ||R|| <= 1e-10 ||R0||: their difference is of the size of that residual's error
     scale = np.abs(exact.x).max()
     np.testing.assert_allclose(inexact.x, exact.x, atol=1e-8 * scale)
+
+
+def test_a_given_first_direction_starts_the_path_and_is_not_reused_after_a_cut_back():
+    """x^3 + x = 30 t: the caller's first direction is the step's predictor (no predictor
+    evaluated for it); the same converged root as with the path's own predictor; a first
+    direction that fails is dropped for the cut-back's retry (the path's own predictor)."""
+    calls = []
+
+    def fun_t(x, t):
+        calls.append(t)
+        return np.array([x[0] ** 3 + x[0] - 30 * t]), sp.csr_matrix([[3 * x[0] ** 2 + 1]])
+    opts = PathOptions(steps=1, newton=NewtonOptions(rtol=0.0, atol=1e-12))
+    own = solve_path(fun_t, [0.0], opts)
+    calls.clear()
+    given = solve_path(fun_t, [0.0], opts, first_direction=np.array([30.0]))  # the Euler step from x = 0
+    assert 0.0 not in calls  # no predictor at t = 0
+    assert given.x[-1][0] == pytest.approx(own.x[-1][0], abs=1e-11)
+    plain = PathOptions(steps=1, newton=NewtonOptions(max_iter=3, line_search=False))
+    wild = solve_path(fun_t, [0.0], plain, first_direction=np.array([1e6]))  # diverges: cut back
+    assert wild.cutbacks >= 1 and wild.x[-1][0] ** 3 + wild.x[-1][0] == pytest.approx(30.0, rel=1e-8)
