@@ -325,6 +325,8 @@ def hold_cases() -> list[tuple[str, list[str]]]:
               ["hold", "--object", "sphere:150", "--pull", "sideways", *at],
               ["hold", "--object", "sphere:150", "--friction", "nan", *at],
               ["hold", "--object", "sphere:150", "--mass-kg", "-1", *at],
+              ["hold", "--object", "sphere:150", "--max-pump-mpa", "1", *at],   # above the pump's limit
+              ["hold", "--object", "cylinder:180x1e-300", *at],                 # thinner than a millimetre
               *(["hold", "--object", "sphere:150", "--design", d, *at] for d in (
                   "d_hinge_missing.toml", "d_hinge_not_hinges.toml", "d_hinge_three.toml")),
               ["design", "--task", "t_hinge_table_free.toml", "--no-fem", "--no-progress"],

@@ -48,8 +48,10 @@ PRESSURE_TOL = 1e-4
 
 def pull_unit(pull, field: str = "--pull") -> np.ndarray:
     """The pull direction as a unit vector (3,); InputError for a zero, non-finite or wrong-sized one."""
-    v = np.asarray(pull, float).ravel() if not isinstance(pull, str) else None
-    if v is None or v.shape != (3,) or not np.all(np.isfinite(v)):
+    numbers = isinstance(pull, (list, tuple, np.ndarray)) and len(pull) == 3 and all(
+        isinstance(x, (int, float, np.integer, np.floating)) and not isinstance(x, (bool, np.bool_)) for x in pull)
+    v = np.asarray(pull, float).ravel() if numbers else None
+    if v is None or not np.all(np.isfinite(v)):
         raise InputError(field, pull, "must be three numbers x,y,z (hand frame, y down)")
     top = float(np.abs(v).max())
     if not top > 1e-12:

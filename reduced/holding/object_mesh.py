@@ -48,7 +48,7 @@ def read_mesh(path: str, field: str = "object.file") -> MeshData:
     if p.suffix.lower() not in MESH_SUFFIXES:
         raise InputError(field, path, f"must be a mesh file ending in {', '.join(MESH_SUFFIXES)}")
     if not p.is_file():
-        raise InputError(field, path, "no such file")
+        raise InputError(field, path, "is not a regular file" if p.exists() else "no such file")
     import trimesh  # only a mesh object needs it
 
     try:

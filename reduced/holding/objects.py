@@ -50,6 +50,8 @@ PALM_GAP, CLEARANCE = 10.0, 2.0
 #: largest object dimension [mm], mass [kg], friction coefficient
 UPPER = {"diameter_mm": 1000.0, "length_mm": 2000.0, "size_mm": 1000.0, "mass_kg": 100.0, "friction": 10.0,
          "offset_mm": 1000.0, "rotation_deg": 360.0}
+#: the smallest dimension of a primitive [mm] (an object is given in mm: a smaller one is a unit slip)
+SMALLEST_MM = 1.0
 #: the friction coefficient when none is given
 DEFAULT_FRICTION = 0.5
 
@@ -131,9 +133,9 @@ def check_object(obj: GraspObject, source: str = "object") -> None:
                 raise InputError(f"{source}.file", value, "must name a mesh file (STL, OBJ or PLY)")
             continue
         values = value if isinstance(value, tuple) else (value,)
-        if not all(_is_number(v) and 0.0 < v <= UPPER[key] for v in values):
+        if not all(_is_number(v) and SMALLEST_MM <= v <= UPPER[key] for v in values):
             raise InputError(f"{source}.{key}", list(values) if isinstance(value, tuple) else value,
-                             f"must be {'three numbers' if key == 'size_mm' else 'a number'} > 0 and "
+                             f"must be {'three numbers' if key == 'size_mm' else 'a number'} >= {SMALLEST_MM:g} and "
                              f"<= {UPPER[key]:g} mm")
     if obj.shape == "capsule" and obj.length_mm < obj.diameter_mm:
         raise InputError(f"{source}.length_mm", obj.length_mm,

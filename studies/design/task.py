@@ -213,6 +213,9 @@ def _hold_object(obj: dict, hold: dict, folder: Path):
     thing = object_from_table(obj, source="object", base_dir=folder)
     pts = place(thing, (0.0, 0.0, 0.0)).surface(resolution=32)[0]
     span = 2.0 * float(np.max(np.hypot(pts[:, 0], pts[:, 2])))
+    if span > UPPER["diameter_mm"]:  # as a grasp task's diameter: no design's open hand passes more
+        raise InputError("object", thing.describe(),
+                         f"spans {span:.4g} mm across the palm's axis: at most {UPPER['diameter_mm']:g} mm")
     if "margin" in hold and "pull_N" in hold:
         raise InputError("hold.pull_N", hold["pull_N"], "give margin or pull_N, not both")
     fields = {"hold_margin": checked_number(hold, "hold", "margin", default=2.0),

@@ -31,6 +31,8 @@ def test_short_forms_and_legacy_table():
     ({"diameter_mm": 100, "colour": "red"}, "colour"),
     ({"shape": "capsule", "diameter_mm": 100, "length_mm": 50}, "length_mm"),
     ({"shape": "box", "size_mm": [1, 2]}, "size_mm"),
+    ({"shape": "box", "size_mm": [1e-300, 10, 10]}, "size_mm"),       # below a millimetre: a unit slip
+    ({"shape": "cylinder", "diameter_mm": 180, "length_mm": 0.5}, "length_mm"),
 ])
 def test_bad_tables_name_the_field(table, field):
     with pytest.raises(InputError) as exc:
@@ -163,6 +165,9 @@ def test_mesh_reading_distance_and_checks(tmp_path):
         object_mesh.read_mesh(_write(apart, tmp_path / "apart.stl"))
     with pytest.raises(InputError, match="was it written in m"):
         object_mesh.read_mesh(_write(ball.copy().apply_scale(1e-3), tmp_path / "metres.stl"))
+    (tmp_path / "folder.stl").mkdir()
+    with pytest.raises(InputError, match="is not a regular file"):
+        object_mesh.read_mesh(str(tmp_path / "folder.stl"))
 
 
 def test_a_surface_that_encloses_a_region_twice_is_refused():

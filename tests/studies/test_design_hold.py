@@ -39,6 +39,16 @@ def test_hold_task_bad_input():
         task_from_dict({**base, "object": {"diameter_mm": 100.0, "mass_kg": 1.0}, "hold": {"pull": [0, 0, 0]}})
     with pytest.raises(InputError, match="friction"):
         task_from_dict({**base, "object": {"shape": "sphere", "diameter_mm": 100.0, "mass_kg": 1.0, "friction": -1}})
+    # the pull's three numbers: not strings, booleans, tables or nested lists
+    for pull in (["a", "b", "c"], [True, 1.0, 0.0], ["1", "1", "0"], {"x": 1}, [[1.0], [2.0, 3.0]]):
+        with pytest.raises(InputError, match="hold.pull.*three numbers"):
+            task_from_dict({**base, "object": {"shape": "sphere", "diameter_mm": 100.0, "mass_kg": 1.0},
+                            "hold": {"pull": pull}})
+    # an object no open hand passes, refused before any design is tried
+    with pytest.raises(InputError, match="spans 1273 mm .* at most 500"):
+        task_from_dict({**base, "object": {"shape": "box", "size_mm": [900.0, 10.0, 900.0], "mass_kg": 0.3}})
+    with pytest.raises(InputError, match="size_mm.*>= 1 and"):
+        task_from_dict({**base, "object": {"shape": "box", "size_mm": [1e-300, 10.0, 90.0], "mass_kg": 0.3}})
 
 
 def test_a_hold_proof_the_fem_does_not_answer_is_reported_not_raised(monkeypatch):

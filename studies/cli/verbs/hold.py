@@ -88,6 +88,9 @@ def run(args) -> int:
         raise InputError("--margin" if args.margin is not None else "--pull-n",
                          args.margin if args.margin is not None else args.pull_n,
                          "asks for the least pressure; give no --pressure-mpa with it")
+    if P_pump is not None and P_pump > max_pump:
+        raise InputError("--pressure-mpa", P_pump, f"is above the pump's limit --max-pump-mpa = {max_pump:g} "
+                                                   "(raise that limit to hold there)")
     d = hold.hold_fast.finger_design(design, args.finger)
     placed = hold.place_object(obj, d)
     if P_cav is None:
