@@ -13,10 +13,10 @@ from __future__ import annotations
 import argparse
 import time
 
-from softhand.reduced.calibrated import grasp_fem, grasp_hold, grasp_hold_fast, grasp_hold_solve
+from softhand.reduced.calibrated import finger_hinges, grasp_hold, grasp_hold_fast, grasp_hold_solve
 from softhand.reduced.vocabulary.design import HandDesign
 
-PAPER = grasp_fem.fem_finger(HandDesign(reservoir_model="fem"))
+PAPER = finger_hinges.fem_finger(HandDesign(reservoir_model="fem"))
 CASES = {
     "paper 180 mm, 2 kg": (PAPER.replace(a=4.5, b=4.5, d=18.0, V0=26312.0), 180.0, 2.0, 9.80665),
     "small 140 mm, 0.5 kg": (PAPER.replace(a=4.5, b=4.5, d=12.0, V0=16226.0, l0=185.7,

@@ -5,7 +5,8 @@ M_j = -int A_j(theta_j, p) dp from P_free(theta_j) to P, A_j from the hinge tabl
 equally bent fingers locked at their free bends while the pressure rises. Here the finger FEM
 (default mesh) is held by generalised forces Q on its hinges, as an object's pad holds it, at
 cavity pressure P: its hinge angles q, the fast model's moments at those q (equal to Q where the
-fast model is exact), and the FEM's volume rates at fixed q, A = S dq/dP (S the condensed
+fast model is exact) and the moments coupled through the tube
+(:func:`softhand.reduced.calibrated.finger_hinges.coupled_moments`), and the FEM's volume rates at fixed q, A = S dq/dP (S the condensed
 stiffness, dq the hinge angles' change under the same Q from P to P + dP), against the table's
 A_j(theta_j, P); and S itself (its diagonal and the coupling of neighbouring hinges) against the
 fast model's dM_j/dq_j. Prints one block per Q; no assertions.
@@ -23,7 +24,7 @@ import numpy as np
 
 from softhand.fem.hand.finger import FingerModel, FingerOptions
 from softhand.fem.hand.hold_finger import HeldFinger
-from softhand.reduced.calibrated.grasp_fem import fem_finger, hinge_moments, volume_rate
+from softhand.reduced.calibrated.finger_hinges import coupled_moments, fem_finger, hinge_moments, volume_rate
 from softhand.reduced.vocabulary.design_files import load_design
 
 
@@ -52,6 +53,7 @@ def main() -> None:
         A = 0.5 * (S0 + finger.S) @ (finger.q - q0) / dP
         print(f"Q = {Q} N mm: q = {np.round(np.degrees(q0), 3)} deg")
         print(f"  fast model's M(q)       {np.round(hinge_moments(q0, P, design), 1)} N mm")
+        print(f"  coupled through the tube {np.round(coupled_moments(q0, P, design), 1)} N mm")
         print(f"  FEM A / (a^2 pi d)      {np.round(A / unit, 3)}")
         print(f"  table A(theta_j, P) / ...{np.round(volume_rate(design.n_s * q0, P, fem_finger(design)) / unit, 3)}")
         h = 1e-6

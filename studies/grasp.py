@@ -29,10 +29,10 @@ def state(P: float, theta_deg: float, mass: float, w, design) -> dict:
 
 def state_fem(P: float, theta_deg: float, mass: float, diameter: float, design) -> dict:
     """One grasp state by the FEM-informed model at pump pressure P [MPa] -> the flat result."""
-    from softhand.reduced.calibrated import grasp_fem
+    from softhand.reduced.calibrated import finger_hinges, grasp_fem
 
     theta = math.radians(theta_deg)
-    fem = grasp_fem.fem_finger(design)
+    fem = finger_hinges.fem_finger(design)
     P_free = float(hand.pressure(theta, fem))  # the pump pressure of the free finger at theta
     P_cavity = P + float(hand.finger_pressure(theta, fem)) - P_free  # the same reservoir offset at P
     s = grasp_fem.grasp_state_at_angle(design, diameter, P_cavity, theta, mass)

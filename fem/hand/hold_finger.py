@@ -69,18 +69,16 @@ class HeldFinger:
 
     def stiffness(self) -> np.ndarray:
         """Condensed stiffness S [N mm/rad] of the whole finger from the last factorisation."""
-        n = self.model.ndofs
-        n_s = self.model.design.n_s
-        C = np.empty((n_s, n_s))
-        for j in range(n_s):
-            e = np.zeros(n)
-            e[n - n_s + j] = 1.0
-            C[:, j] = self.solver.apply(e)[n - n_s:]
-        C = 0.5 * (C + C.T)
-        return 2.0 * np.linalg.inv(C)
+        return condensed_stiffness(self.solver, self.model.ndofs, self.model.design.n_s)
 
-    def residual_norm(self) -> float:
-        """||r(y; P) - (0, Q/2)|| of the current state [N mm] (the FEM equilibrium check)."""
-        n_s = self.model.design.n_s
-        return float(np.linalg.norm(self.model.residual(
-            self.y, self.P, lambda q: (0.5 * self.Q, np.zeros((n_s, n_s))))))
+
+def condensed_stiffness(solver, ndofs: int, n_s: int) -> np.ndarray:
+    """S = 2 [(K_r^{-1})_qq]^{-1} [N mm/rad] (module doc) of the whole finger from the reduced tangent
+    K_r of the half model factorised in ``solver`` (q the last n_s unknowns of ``ndofs``)."""
+    C = np.empty((n_s, n_s))
+    for j in range(n_s):
+        e = np.zeros(ndofs)
+        e[ndofs - n_s + j] = 1.0
+        C[:, j] = solver.apply(e)[ndofs - n_s:]
+    C = 0.5 * (C + C.T)
+    return 2.0 * np.linalg.inv(C)

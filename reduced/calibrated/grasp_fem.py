@@ -5,29 +5,10 @@ Eq. (25) charges all the pressure work beyond the free curve to a force at the f
 link's pad, often far from the tip, and rolls on it; this model keeps what the FEM knows
 and drops the tip assumption:
 
-* **The finger, hinge by hinge.** Each hinge j carries its own energy E_j(theta_hat_j; P)
-  (no coupling between hinges, E = sum E_j). At fixed hinge angles dE/dP = -V, the oil
-  inside, so the moment holding hinge j, M_j = dE/d theta_hat_j, changes with P by
-  dM_j/dP = -A_j, A_j = dV/d theta_hat_j the oil the hinge draws per radian *at fixed P*.
-  With A_j a function of the hinge's bend theta_j = n_s theta_hat_j and the pressure, and
-  M_j = 0 on the free curve P_free(theta) of the calibrated finger (``finger_model = "fem"``,
-  :mod:`softhand.reduced.calibrated.finger_fem`; it bends its equal hinges equally),
-
-  .. math:: M_j = -\int_{P_{free}(\theta_j)}^{P} A_j(\theta_j, p)\,dp, \qquad
-            E_j = \int_0^{\hat\theta_j} M_j .
-
-  A_j is measured by the finger FEM with its hinges locked by springs at free bends and the
-  pressure raised (:mod:`softhand.reduced.calibrated.hinge_table`,
-  ``reduced/calibrated/data/grasp_hinges.csv``, written by ``python -m
-  softhand.studies.calibration.hinges``): about 1.8 a^2 pi d for a straight hinge and 1.2 a^2 pi d
-  for a bent one at its free pressure, growing with the pressure above it (a locked tube
-  swells), against dQ/dtheta = 1.86 a^2 pi d of the free finger, which includes the tube's
-  swelling with P along the free curve. The table is the paper's design (Table I); another
-  design's is that table carried to its geometry by ratios measured on a coarse grid over the
-  design space (:mod:`softhand.reduced.calibrated.hinge_space`), or a table of its own
-  (``hinge_table``, made by the same study with ``--design``). Without this, the free
-  finger's W_f and Q split equally over the hinges, the contact force of a finger held by
-  the object low on it comes out 50 % too large.
+* **The finger, hinge by hinge** (:mod:`softhand.reduced.calibrated.finger_hinges`): each hinge's
+  moment M_j(theta_hat_j; P) from the finger FEM locked at its hinges (a blocked-hinge table), no
+  coupling between hinges. Without it, the free finger's W_f and Q split equally over the hinges,
+  the contact force of a finger held by the object low on it comes out 50 % too large.
 * **The contact where it is** (:mod:`softhand.reduced.equations.contact`, the grasp FEM's geometry): the
   object's force on pad k at its closest point x*, F = -N nu + T t_k (normal force N along
   the outward normal -nu, the weight share T = m g / n along the link, as in the grasp FEM).
@@ -50,14 +31,12 @@ P is the finger's cavity pressure. Units: mm, N, MPa, rad.
 from __future__ import annotations
 
 import math
-from dataclasses import replace
-from functools import lru_cache
 from typing import NamedTuple
 
 import numpy as np
 from scipy.optimize import brentq, root
 
-from softhand.reduced.calibrated import hinge_space, hinge_table
+from softhand.reduced.calibrated.finger_hinges import fem_finger, hinge_moments
 from softhand.reduced.equations import contact, hand, kinematics
 from softhand.reduced.vocabulary.design import HandDesign
 from softhand.reduced.vocabulary.errors import InputError
@@ -86,64 +65,6 @@ class GraspState(NamedTuple):
     @property
     def theta(self) -> float:
         return float(np.sum(self.q))
-
-
-def fem_finger(design: HandDesign) -> HandDesign:
-    """The design with the calibrated finger (``finger_model = "fem"``; its table kept)."""
-    return design if design.finger_model == "fem" else replace(design, finger_model="fem")
-
-
-def volume_rate(theta, P, design: HandDesign) -> np.ndarray:
-    """A_j [mm^3/rad] (..., n_s): oil hinge j draws per radian at fixed pressure, at hinge bends theta
-    = n_s theta_hat (..., n_s) [rad] and cavity pressure P [MPa] (:mod:`softhand.reduced.calibrated.hinge_table`)."""
-    return hinge_table.volume_rate(hinge_data(design), theta, P) * design.a ** 2 * math.pi * design.d
-
-
-def hinge_moments(q, P: float, design: HandDesign) -> np.ndarray:
-    """M_j = dE/d theta_hat_j = -int_{P_free(theta_j)}^P A_j(theta_j, p) dp [N mm/rad] (..., n_s) at hinge
-    angles q (..., n_s) [rad] and cavity pressure P [MPa], theta_j = n_s q_j; P_free of finger_model "fem"."""
-    design = fem_finger(design)
-    theta = design.n_s * np.asarray(q, float)
-    M = hinge_table.moment(hinge_data(design), theta, P, hand.finger_pressure(theta, design), hinge_space.reverse_scale(design))
-    return M * design.a ** 2 * math.pi * design.d
-
-
-def hinge_data(design: HandDesign) -> hinge_table.HingeTable:
-    """The blocked-hinge table the design's fast hold uses (its own ``hinge_table``, else the
-    paper's design's carried to its geometry); InputError if it cannot be read or does not fit."""
-    return hinge_space.design_table(fem_finger(design))
-
-
-#: Gauss-Legendre rule on [0, 1] for E, per piece between the table's nodes
-_GX, _GW = np.polynomial.legendre.leggauss(12)
-_GX, _GW = 0.5 * (_GX + 1.0), 0.5 * _GW
-
-
-def hinge_energy(q, P: float, design: HandDesign) -> float:
-    """E = sum_j int_0^q_j M_j [N mm] at hinge angles q (n_s,) [rad] (12-point Gauss on every
-    piece between the table's bends and the free bends of its pressures: M is smooth there)."""
-    nodes = _energy_cuts(fem_finger(design))
-    total = 0.0
-    for j, qj in enumerate(np.asarray(q, float)):  # n_s hinges
-        inside = np.sort(nodes[(nodes > min(qj, 0.0)) & (nodes < max(qj, 0.0))])
-        cuts = np.r_[0.0, inside if qj >= 0 else inside[::-1], qj]  # from 0 to q_j
-        x = cuts[:-1, None] + np.diff(cuts)[:, None] * _GX
-        Q = np.zeros(x.shape + (design.n_s,))
-        Q[..., j] = x
-        M = hinge_moments(Q, P, design)[..., j]
-        total += float(np.sum(M * _GW * np.diff(cuts)[:, None]))
-    return total
-
-
-@lru_cache(maxsize=16)
-def _energy_cuts(design: HandDesign) -> np.ndarray:
-    """Hinge angles theta_hat where M_j's second derivative may jump: the table's bends, and the
-    free bends at its pressures (where P_free(theta) crosses a kink of A_j in p)."""
-    t = hinge_data(design)
-    lo, hi = hand.pressure_span(design, reservoir=False)
-    p = t.p[(t.p > lo) & (t.p < hi)]
-    free = np.asarray(hand.bend_angle(p, design, reservoir=False), float) if len(p) else np.zeros(0)
-    return np.unique(np.r_[t.theta, free]) / design.n_s
 
 
 def _load(q, centre, link: int, weight: float, design: HandDesign, corner: bool = False):

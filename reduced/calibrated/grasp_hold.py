@@ -41,7 +41,7 @@ import numpy as np
 from scipy.optimize import brentq
 
 from softhand.reduced.equations import contact, hand
-from softhand.reduced.calibrated import grasp_fem, grasp_hold_fast
+from softhand.reduced.calibrated import finger_hinges, grasp_fem, grasp_hold_fast
 from softhand.reduced.calibrated.grasp_hold_end import end_between, one_pad_end
 from softhand.reduced.calibrated.grasp_hold_solve import (LARGEST_BEND, PTOL, Hold, hold_of_state, largest_pressure,
                                                           pressure_grid, pump_pressure)
@@ -76,7 +76,7 @@ def slow_hold(design: HandDesign, diameter_mm: float, mass_kg: float, target: st
     stops holding the object alone before the condition is met, the end is solved for
     (:func:`softhand.reduced.calibrated.grasp_hold_end.one_pad_end`'s way) and the refusal names
     it: its cavity and pump pressures and F_v."""
-    design = grasp_fem.fem_finger(design)
+    design = finger_hinges.fem_finger(design)
     P_max = largest_pressure(design)
     depth = contact.object_depth(diameter_mm, design)
     theta_c, _ = contact.contact_angle(diameter_mm, design, depth=depth)

@@ -11,7 +11,7 @@ import itertools
 import numpy as np
 
 from softhand.reduced.equations import contact, hand
-from softhand.reduced.calibrated import grasp_fem
+from softhand.reduced.calibrated import finger_hinges, grasp_fem
 from softhand.reduced.calibrated.grasp_hold_fast import nearest_pad, newton_start, next_to, pad_order, pad_solves
 from softhand.reduced.calibrated.grasp_hold_solve import (LARGEST_BEND, ONE_PAD_END, PTOL, Hold, hold_of_state,
                                                           hold_on_pad, is_state, largest_pressure, pressure_grid,
@@ -45,7 +45,7 @@ def one_pad_end(design: HandDesign, diameter_mm: float, mass_kg: float, *, reser
     stepped up through the slow path's grid
     (:func:`softhand.reduced.calibrated.grasp_hold_solve.pressure_grid`) until it has no state
     and the end found between (:func:`end_between`)."""
-    design = grasp_fem.fem_finger(design)
+    design = finger_hinges.fem_finger(design)
     P_top = largest_pressure(design)
     depth = contact.object_depth(diameter_mm, design)
     theta_c, first = contact.contact_angle(diameter_mm, design, depth=depth)

@@ -8,7 +8,7 @@ from __future__ import annotations
 import numpy as np
 
 from softhand.reduced.equations import contact, hand
-from softhand.reduced.calibrated import grasp_fem
+from softhand.reduced.calibrated import finger_hinges, grasp_fem
 from softhand.reduced.calibrated.grasp_hold_solve import (Hold, hold_of_solution, hold_on_pad, is_state,
                                                           largest_pressure, pressure_grid, pump_pressure,
                                                           reservoir_pressure, solve_on_pad)
@@ -33,7 +33,7 @@ def fast_hold(design: HandDesign, diameter_mm: float, mass_kg: float, target: st
     cavity's, so its answer is the only one; F_v need not (it drops where the touching pad
     changes): a later pad's F_v is kept only if it is the root the slow path finds, the one
     in the first interval of its grid (``_first_on_the_grid()``)."""
-    design = grasp_fem.fem_finger(design)
+    design = finger_hinges.fem_finger(design)
     depth = contact.object_depth(diameter_mm, design)
     theta_c, first = contact.contact_angle(diameter_mm, design, depth=depth)
     if first == 0:

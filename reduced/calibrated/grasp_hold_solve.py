@@ -12,7 +12,7 @@ from typing import NamedTuple
 import numpy as np
 
 from softhand.reduced.equations import contact, hand, kinematics
-from softhand.reduced.calibrated import grasp_fem
+from softhand.reduced.calibrated import finger_hinges, grasp_fem
 from softhand.reduced.vocabulary.design import HandDesign
 from softhand.reduced.vocabulary.errors import InputError
 from softhand.reduced.equations.reservoir import oil_volume, pressure as p_r
@@ -78,7 +78,7 @@ def _residuals(Z, k: int, depth: float, radius: float, weight: float, target: st
     dx = (xs[:, None, :] - p[:, 1:-1]) @ contact.OMEGA.T            # hinge j turns x* about x_j
     dx[:, k:] = 0.0                                                 # ... for j <= k only
     grad, Tq = -np.einsum("bji,bi->bj", dx, nu), weight * np.einsum("bji,bi->bj", dx, t)
-    moments = grasp_fem.hinge_moments(q, P[:, None], design) - N[:, None] * grad - Tq
+    moments = finger_hinges.hinge_moments(q, P[:, None], design) - N[:, None] * grad - Tq
     tip = np.stack([np.cos(alpha[:, -1]), np.sin(alpha[:, -1])], axis=1)
     F_v = np.einsum("bi,bi->b", -N[:, None] * nu + weight * t, tip)
     if target == "F_v":

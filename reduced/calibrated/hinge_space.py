@@ -212,15 +212,14 @@ def design_table(design: HandDesign) -> hinge_table.HingeTable:
     if t.a.shape[-1] != design.n_s:
         raise InputError("hinge_table" if own else "n_s", design.hinge_table if own else design.n_s,
                          f"{'has' if own else 'the hinge table has'} {t.a.shape[-1]} hinges; the design has {design.n_s}")
-    return t if own else _carried(design)
+    paper = HandDesign()
+    if own or all(getattr(design, k) == getattr(paper, k) for k in ("a", "b", "d", "l0", "tie_width", "hinge_s")):
+        return t  # the paper's geometry: the table itself
+    return _carried(design)
 
 
 @lru_cache(maxsize=16)
 def _carried(design: HandDesign) -> hinge_table.HingeTable:
     """The paper's design's table, carried to the design's geometry by the grid over the design
-    space (:mod:`softhand.reduced.calibrated.hinge_space`; the paper's geometry: the table itself)."""
-    fine = hinge_table.read(str(TABLE_FILE))
-    paper = HandDesign()
-    if all(getattr(design, k) == getattr(paper, k) for k in ("a", "b", "d", "l0", "tie_width", "hinge_s")):
-        return fine
-    return carried(fine, design, read())
+    space (:mod:`softhand.reduced.calibrated.hinge_space`)."""
+    return carried(hinge_table.read(str(TABLE_FILE)), design, read())

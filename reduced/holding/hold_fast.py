@@ -37,7 +37,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from softhand.reduced.calibrated import grasp_fem
+from softhand.reduced.calibrated import finger_hinges
 from softhand.reduced.equations import finger, reservoir
 from softhand.reduced.holding import hand_layout
 from softhand.reduced.holding.hold_closing import FingerState, close_finger
@@ -55,7 +55,7 @@ def finger_design(design: HandDesign, finger_model: str = "fem") -> HandDesign:
     if finger_model not in FINGER_MODELS:
         raise InputError("finger_model", finger_model, f"must be one of {', '.join(FINGER_MODELS)}")
     if finger_model == "fem":
-        return grasp_fem.fem_finger(design)
+        return finger_hinges.fem_finger(design)
     return design if design.finger_model == "paper" else replace(design, finger_model="paper")
 
 

@@ -8,7 +8,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from softhand.reduced.calibrated import grasp_fem
+from softhand.reduced.calibrated import finger_hinges
 from softhand.reduced.equations import finger, hand
 from softhand.reduced.holding import hand_layout
 from softhand.reduced.vocabulary.design import HandDesign
@@ -25,7 +25,7 @@ def hinge_moments(q, P, design: HandDesign) -> np.ndarray:
     """M_j = dE/d theta_hat_j [N mm/rad] (..., n_s) at hinge angles q (..., n_s) [rad], cavity
     pressure P [MPa], for the design's finger model (:mod:`softhand.reduced.holding.hold_fast`)."""
     if design.finger_model == "fem":
-        return grasp_fem.hinge_moments(q, P, design)
+        return finger_hinges.hinge_moments(q, P, design)
     theta = design.n_s * np.asarray(q, float)
     return -finger.volume_rate(theta, design) * (P - hand.finger_pressure(theta, design))
 

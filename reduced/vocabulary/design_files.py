@@ -88,9 +88,9 @@ def design_from_dict(values: dict, base: HandDesign | None = None, *, source: st
         except InputError as exc:
             raise exc.renamed(f"{source}: finger_table") from None
     if changes.get("hinge_table"):
-        from softhand.reduced.calibrated import grasp_fem
+        from softhand.reduced.calibrated import finger_hinges
         try:  # read now, not where a hold first uses it
-            grasp_fem.hinge_data(design)
+            finger_hinges.hinge_data(design)
         except InputError as exc:
             raise exc.renamed(f"{source}: hinge_table") from None
     return design

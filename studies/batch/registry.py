@@ -214,6 +214,8 @@ KINDS: dict[str, Kind] = {
                         required=("pressures_mpa", "theta_target_deg", "p_max_mpa", "p_step_mpa")),
     # one design's blocked-hinge grid (studies.calibration.hinges: --space); no parameters
     "hinge_grid": Kind("softhand.studies.calibration.hinges:grid_case", {}),
+    # one design's free hinges and their condensed stiffness (studies.calibration.hinge_coupling); no parameters
+    "hinge_coupling": Kind("softhand.studies.calibration.hinge_coupling:coupling_case", {}),
 }
 #: the entry-point group where installed packages declare more kinds
 ENTRY_POINT_GROUP = "softhand.kinds"

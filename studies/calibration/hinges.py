@@ -179,33 +179,40 @@ def grid_case(params: dict, design: HandDesign, outdir: Path) -> dict:
     return {"rows": [[float(v) for v in row] for row in grid_rows(design)]}
 
 
-def space_text(space_file: str, results: str = "results", workers: int = 1, command: str = "",
-               scheduler: str | None = None, progress: bool = True) -> str:
-    """The grid CSV of :mod:`softhand.reduced.calibrated.hinge_space` over the designs of a design
-    space (:mod:`softhand.studies.calibration.space`) and the paper's: one ``hinge_grid`` case per
-    design of the batch runner (results/<space>_hinges/, resumable, a local pool or Dask)."""
-    from softhand.reduced.calibrated.finger_fem import groups_of
-    from softhand.reduced.calibrated.hinge_space import COLUMNS
+def run_space(space_file: str, kind: str, suffix: str, description: str, results: str = "results", workers: int = 1,
+              scheduler: str | None = None, progress: bool = True) -> tuple[list, list]:
+    """(designs, each design's case numbers) of one batch case of ``kind`` per design of a design space
+    (:mod:`softhand.studies.calibration.space`) and the paper's, the paper's first (results/<space>_<suffix>/,
+    resumable, a local pool or Dask); RuntimeError naming the designs that failed."""
     from softhand.studies.batch.runner import plan, read_case, run_study, study_dir
     from softhand.studies.calibration.finger import SpaceStudy
     from softhand.studies.calibration.space import VARIABLES, load_space
 
     space = load_space(space_file)
     designs = [HandDesign()] + [d for d in space.designs() if d != HandDesign()]
-    study = SpaceStudy(name=f"{space.name}_hinges", kind="hinge_grid", design=HandDesign(),
+    study = SpaceStudy(name=f"{space.name}_{suffix}", kind=kind, design=HandDesign(),
                        axes=tuple((key, ()) for key in VARIABLES), params={},
-                       description="blocked-hinge grid over a design space",
-                       case_list=tuple(({}, d) for d in designs))
+                       description=description, case_list=tuple(({}, d) for d in designs))
     run = run_study(study, results_root=results, workers=workers, scheduler=scheduler, progress=progress)
     if not run.ok:
         failed = "; ".join(f"{key}: {error}" for key, error in run.failed.items())
-        raise RuntimeError(f"hinge grid: {len(run.failed)} designs failed, {run.not_run} not run "
+        raise RuntimeError(f"{kind}: {len(run.failed)} designs failed, {run.not_run} not run "
                            f"({failed or 'rerun to finish them'})")
+    return designs, [read_case(study_dir(study, results), case)["numbers"] for case in plan(study)]
+
+
+def space_text(space_file: str, results: str = "results", workers: int = 1, command: str = "",
+               scheduler: str | None = None, progress: bool = True) -> str:
+    """The grid CSV of :mod:`softhand.reduced.calibrated.hinge_space` over the designs of a design
+    space and the paper's: one ``hinge_grid`` case per design (:func:`run_space`)."""
+    from softhand.reduced.calibrated.finger_fem import groups_of
+    from softhand.reduced.calibrated.hinge_space import COLUMNS
+
+    designs, numbers = run_space(space_file, "hinge_grid", "hinges", "blocked-hinge grid over a design space", results, workers, scheduler, progress)
     rows = []
-    for i, (d, case) in enumerate(zip(designs, plan(study))):
+    for i, (d, case) in enumerate(zip(designs, numbers)):
         g = groups_of(d)
-        rows += [(i, *(g[k] for k in COLUMNS[1:5]), *row)
-                 for row in read_case(study_dir(study, results), case)["numbers"]["rows"]]
+        rows += [(i, *(g[k] for k in COLUMNS[1:5]), *row) for row in case["rows"]]
     head = [tables.written_by("FEM hinge grid of reduced/calibrated/hinge_space.py"), command,
             f"model: finger FEM (fem/hand/finger.py) on the default mesh, {len(designs)} designs (the paper's and "
             f"those of {Path(space_file).name}); reverse bends {', '.join(f'{b:g}' for b in GRID_REVERSE)} deg and "

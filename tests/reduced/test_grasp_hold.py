@@ -5,12 +5,12 @@ import math
 import numpy as np
 import pytest
 
-from softhand.reduced.calibrated import (grasp_fem, grasp_hold, grasp_hold_end, grasp_hold_fast, grasp_hold_solve,
+from softhand.reduced.calibrated import (finger_hinges, grasp_fem, grasp_hold, grasp_hold_end, grasp_hold_fast, grasp_hold_solve,
                                          hinge_space, hinge_table)
 from softhand.reduced.equations import hand, kinematics
 from softhand.reduced.vocabulary.design import HandDesign
 
-PAPER = grasp_fem.fem_finger(HandDesign(reservoir_model="fem"))
+PAPER = finger_hinges.fem_finger(HandDesign(reservoir_model="fem"))
 #: (design, diameter, mass, F_v [N], pump pressure [MPa]): pad 2 (the paper's task), pad 3 after a
 #: long close (small object, long finger, short lever), the tip link (large object, thick wall);
 #: the task's 2 m g / n and a pump pressure near it, where one pad touches
@@ -86,7 +86,7 @@ def test_the_equations_at_a_batch_are_those_of_each_state():
     # the moment of hinge 1 against grasp_fem's own hinge moment and lever (pad 2 at its closest point)
     q = np.array([0.02, 0.03, 0.04, 0.04, 0.04])
     _, grad, Tq, *_ = grasp_fem._load(q, (0.0, depth), 2, 2.0 * PAPER.g / PAPER.n, PAPER)
-    M = grasp_fem.hinge_moments(q, 0.7, PAPER)
+    M = finger_hinges.hinge_moments(q, 0.7, PAPER)
     assert batch[0, 0] == pytest.approx(M[0] - 5.0 * grad[0] - Tq[0], rel=1e-12)
     assert math.isfinite(F[0])
 
@@ -247,7 +247,7 @@ def test_the_one_pad_model_ends_where_a_second_pad_touches(monkeypatch):
     assert held.P_cavity == pytest.approx(edge, abs=2e-7)
     s = grasp_fem.grasp_state(PAPER, 180.0, held.P_cavity, 1.0)
     assert s.link == held.link and s.F_v == pytest.approx(held.F_v, rel=1e-9)
-    gaps = grasp_hold.contact.pad_gaps(s.q, (0.0, s.depth), 90.0, grasp_fem.fem_finger(PAPER))
+    gaps = grasp_hold.contact.pad_gaps(s.q, (0.0, s.depth), 90.0, finger_hinges.fem_finger(PAPER))
     gaps[s.link] = np.inf
     assert np.min(np.abs(gaps)) < 1e-8  # the second pad, at the object
     assert held.P_pump == pytest.approx(held.P_cavity - float(grasp_hold_solve.reservoir_pressure(s.theta, PAPER)))
@@ -307,9 +307,9 @@ def papers_table(monkeypatch):
     """Every design on the paper's design's hinge table as it is (not carried to its geometry)."""
     fine = hinge_table.read(str(hinge_space.TABLE_FILE))
     monkeypatch.setattr(hinge_space, "design_table", lambda design: fine)
-    grasp_fem._energy_cuts.cache_clear()
+    finger_hinges._energy_cuts.cache_clear()
     yield
-    grasp_fem._energy_cuts.cache_clear()
+    finger_hinges._energy_cuts.cache_clear()
 
 
 @pytest.mark.parametrize("a, d, l0", [(6.0, 13.59, 162.49), (5.99558128, 13.5871418, 162.41546091)])
@@ -353,7 +353,7 @@ def test_a_later_pads_force_is_the_first_root_where_the_root_finder_took_a_secon
     assert fast.P_cavity == pytest.approx(0.9405, abs=1e-3)
     assert min(abs(slow.P_cavity - 0.9405), abs(slow.P_cavity - 1.0438)) < 1e-3
     assert grasp_fem.grasp_state(design, 200.0, 1.0438, 3.0).F_v == pytest.approx(F_v, abs=0.02)  # the second root
-    theta_c, _ = grasp_hold.contact.contact_angle(200.0, grasp_fem.fem_finger(design))
-    P_c = float(grasp_hold.hand.finger_pressure(theta_c, grasp_fem.fem_finger(design)))
+    theta_c, _ = grasp_hold.contact.contact_angle(200.0, finger_hinges.fem_finger(design))
+    P_c = float(grasp_hold.hand.finger_pressure(theta_c, finger_hinges.fem_finger(design)))
     below = [grasp_fem.grasp_state(design, 200.0, P, 3.0).F_v for P in np.arange(P_c + 1e-6, fast.P_cavity, 0.005)]
     assert max(below) < F_v

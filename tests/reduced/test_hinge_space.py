@@ -11,7 +11,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from softhand.reduced.calibrated import grasp_fem, hinge_space, hinge_table
+from softhand.reduced.calibrated import finger_hinges, hinge_space, hinge_table
 from softhand.reduced.calibrated.finger_fem import GROUPS, groups_of
 from softhand.reduced.equations import hand
 from softhand.reduced.vocabulary.design import HandDesign
@@ -132,7 +132,7 @@ def test_the_ratios_are_linear_between_the_grid_nodes_and_pressures(grid):
 def test_the_papers_geometry_keeps_the_table_itself():
     fine = hinge_table.read(str(hinge_space.TABLE_FILE))
     assert hinge_space.design_table(PAPER) is fine
-    assert grasp_fem.hinge_data(HandDesign()) is fine
+    assert finger_hinges.hinge_data(HandDesign()) is fine
 
 
 @pytest.mark.parametrize("change, message", [

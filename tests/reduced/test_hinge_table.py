@@ -5,7 +5,7 @@ its measured moment at zero pressure, and bad tables are refused."""
 import numpy as np
 import pytest
 
-from softhand.reduced.calibrated import grasp_fem, hinge_space, hinge_table
+from softhand.reduced.calibrated import finger_hinges, hinge_space, hinge_table
 from softhand.reduced.vocabulary.design import HandDesign
 from softhand.reduced.vocabulary.errors import InputError
 
@@ -74,19 +74,19 @@ def test_a_hinge_bent_backwards_is_anchored_at_its_moment_at_zero_pressure(tmp_p
 
 def test_the_moments_pressure_rate_is_minus_the_volume_rate():
     """dM_j/dP = -A_j at fixed hinge angles, by differences, on the finger's own table."""
-    design = grasp_fem.fem_finger(HandDesign())
+    design = finger_hinges.fem_finger(HandDesign())
     q, h = np.radians([0.3, 1.2, 2.5, 4.0, 9.0]), 1e-6
     for P in (0.37, 0.9, 1.4):
-        fd = (grasp_fem.hinge_moments(q, P + h, design) - grasp_fem.hinge_moments(q, P - h, design)) / (2 * h)
-        np.testing.assert_allclose(fd, -grasp_fem.volume_rate(design.n_s * q, P, design), rtol=1e-6)
+        fd = (finger_hinges.hinge_moments(q, P + h, design) - finger_hinges.hinge_moments(q, P - h, design)) / (2 * h)
+        np.testing.assert_allclose(fd, -finger_hinges.volume_rate(design.n_s * q, P, design), rtol=1e-6)
 
 
 def test_the_finger_tables_rate_grows_with_the_pressure_at_a_locked_bend():
     """The measured table itself: at a locked bend the tube swells and draws more oil per radian
     as the pressure rises above the free one (the reason the table has P)."""
-    design = grasp_fem.fem_finger(HandDesign())
+    design = finger_hinges.fem_finger(HandDesign())
     theta = np.full(design.n_s, 0.12)
-    low, high = (grasp_fem.volume_rate(theta, P, design) for P in (0.5, 1.5))
+    low, high = (finger_hinges.volume_rate(theta, P, design) for P in (0.5, 1.5))
     assert np.all(high[:4] > 1.05 * low[:4])
 
 
@@ -130,11 +130,11 @@ def test_a_design_with_its_own_hinge_table_uses_it(tmp_path):
     _scaled_copy(tmp_path, 0.9)
     (tmp_path / "hand.toml").write_text('finger_model = "fem"\nhinge_table = "own.csv"\n')
     own = load_design(tmp_path / "hand.toml")
-    paper = grasp_fem.fem_finger(HandDesign())
-    assert own.hinge_table == str(tmp_path / "own.csv") and paper.hash() == grasp_fem.fem_finger(HandDesign()).hash()
+    paper = finger_hinges.fem_finger(HandDesign())
+    assert own.hinge_table == str(tmp_path / "own.csv") and paper.hash() == finger_hinges.fem_finger(HandDesign()).hash()
     q = np.radians([[-2.0, -0.5, 0.3, 3.0, 9.0], [1.0, 2.0, 3.0, 4.0, 5.0]])
     for P in (0.3, 1.2):
-        np.testing.assert_allclose(grasp_fem.hinge_moments(q, P, own), 0.9 * grasp_fem.hinge_moments(q, P, paper),
+        np.testing.assert_allclose(finger_hinges.hinge_moments(q, P, own), 0.9 * finger_hinges.hinge_moments(q, P, paper),
                                    rtol=1e-9)
 
 

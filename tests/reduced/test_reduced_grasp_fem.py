@@ -9,20 +9,20 @@ import numpy as np
 import pytest
 
 from softhand.reduced.equations import contact, grasp, hand, kinematics
-from softhand.reduced.calibrated import grasp_fem
+from softhand.reduced.calibrated import finger_hinges, grasp_fem
 from softhand.reduced.vocabulary.design import HandDesign
 from softhand.reduced.vocabulary.errors import InputError
 from softhand.studies.cli.main import main
 
-DESIGN = grasp_fem.fem_finger(HandDesign())
+DESIGN = finger_hinges.fem_finger(HandDesign())
 STATES = json.loads((Path(__file__).resolve().parents[1] / "data" / "grasp_fem_states.json").read_text())
 
 
 def test_hinge_moments_are_the_gradient_of_the_hinge_energy():
     q, h = np.radians([1.0, 3.0, 5.0, -2.0, 8.0]), 1e-6
-    fd = [(grasp_fem.hinge_energy(q + h * e, 0.7, DESIGN) - grasp_fem.hinge_energy(q - h * e, 0.7, DESIGN))
+    fd = [(finger_hinges.hinge_energy(q + h * e, 0.7, DESIGN) - finger_hinges.hinge_energy(q - h * e, 0.7, DESIGN))
           / (2 * h) for e in np.eye(DESIGN.n_s)]
-    np.testing.assert_allclose(grasp_fem.hinge_moments(q, 0.7, DESIGN), fd, rtol=1e-6, atol=1e-5)
+    np.testing.assert_allclose(finger_hinges.hinge_moments(q, 0.7, DESIGN), fd, rtol=1e-6, atol=1e-5)
 
 
 def test_without_contact_every_hinge_bends_as_the_free_finger():
@@ -30,7 +30,7 @@ def test_without_contact_every_hinge_bends_as_the_free_finger():
     free = float(hand.bend_angle(0.8, DESIGN, reservoir=False))
     assert s.link == -1 and s.F_v == 0.0
     assert s.theta == pytest.approx(free, rel=1e-12)
-    np.testing.assert_allclose(grasp_fem.hinge_moments(s.q, 0.8, DESIGN), 0.0, atol=1e-6)
+    np.testing.assert_allclose(finger_hinges.hinge_moments(s.q, 0.8, DESIGN), 0.0, atol=1e-6)
 
 
 def test_a_large_object_touched_near_the_tip_stops_the_finger_at_every_pressure():
@@ -69,7 +69,7 @@ def test_one_link_contact_is_the_lever_law():
     x = np.array([0.0, depth]) + R * n_out
     lever = (x - p1) @ [-math.sin(alpha), math.cos(alpha)]
     np.testing.assert_allclose(s.point, x, atol=1e-7)
-    M1 = grasp_fem.hinge_moments(s.q, P, DESIGN)[0]
+    M1 = finger_hinges.hinge_moments(s.q, P, DESIGN)[0]
     assert s.N == pytest.approx(-M1 / lever, rel=1e-8)
     tip = s.q.sum() - DESIGN.theta0
     assert s.F_v == pytest.approx(s.N * math.cos(tip - alpha), rel=1e-8)
@@ -90,14 +90,14 @@ def test_the_contact_force_does_the_energys_virtual_work(diameter, P, mass):
 
     h = 1e-6
     for dq in np.random.default_rng(5).normal(size=(4, DESIGN.n_s)):
-        dE = (grasp_fem.hinge_energy(s.q + h * dq, P, DESIGN) - grasp_fem.hinge_energy(s.q - h * dq, P, DESIGN)) / (2 * h)
+        dE = (finger_hinges.hinge_energy(s.q + h * dq, P, DESIGN) - finger_hinges.hinge_energy(s.q - h * dq, P, DESIGN)) / (2 * h)
         dW = s.F @ (point(s.q + h * dq) - point(s.q - h * dq)) / (2 * h)
         assert dE == pytest.approx(dW, rel=1e-5, abs=1e-3)
 
 
 #: a design an optimiser proposed whose 150 mm, 1 kg ball passes from pad 3 to pad 4 between
 #: cavity pressures of about 1.6775 and 1.6800 MPa through the crease between them
-CREASE = grasp_fem.fem_finger(HandDesign(a=6.0, d=13.59, l0=162.49,
+CREASE = finger_hinges.fem_finger(HandDesign(a=6.0, d=13.59, l0=162.49,
                                          hinge_s=tuple(np.array(HandDesign().hinge_s) * 162.49 / 180.0)))
 
 
@@ -132,7 +132,7 @@ def test_an_object_in_the_crease_of_two_pads_does_the_energys_virtual_work():
 
     h = 1e-6
     for dq in np.random.default_rng(7).normal(size=(4, CREASE.n_s)):
-        dE = (grasp_fem.hinge_energy(s.q + h * dq, P, CREASE) - grasp_fem.hinge_energy(s.q - h * dq, P, CREASE)) / (2 * h)
+        dE = (finger_hinges.hinge_energy(s.q + h * dq, P, CREASE) - finger_hinges.hinge_energy(s.q - h * dq, P, CREASE)) / (2 * h)
         dW = sum(F @ (point(s.q + h * dq, k, a) - point(s.q - h * dq, k, a)) / (2 * h)
                  for F, (k, _, _), a in zip(forces, pads, alongs))
         assert dE == pytest.approx(dW, rel=1e-5, abs=1e-3)
@@ -160,7 +160,7 @@ def test_tip_contact_is_eq_25s_virtual_work_balance():
     s = grasp_fem.grasp_state(DESIGN, 150.0, P, mass, depth_mm=180.0)
     assert s.link == DESIGN.n_s
     np.testing.assert_allclose(s.point, kinematics.tip_position(s.q, DESIGN), atol=1e-9)
-    M = grasp_fem.hinge_moments(s.q, P, DESIGN)
+    M = finger_hinges.hinge_moments(s.q, P, DESIGN)
     w = s.q / s.theta
     J_xw, J_yw = grasp.projected_jacobian(s.theta, w, DESIGN)
     assert w @ M == pytest.approx(s.F[0] * J_xw + s.F[1] * J_yw, rel=1e-8)
@@ -235,7 +235,7 @@ def test_the_one_pad_grasp_ends_where_the_grasp_fem_touches_with_a_second_pad(da
     from softhand.reduced.calibrated import grasp_hold_end
     from softhand.reduced.vocabulary.design_files import design_from_dict
 
-    design = grasp_fem.fem_finger(design_from_dict(data["design"], DESIGN, source="stored")) \
+    design = finger_hinges.fem_finger(design_from_dict(data["design"], DESIGN, source="stored")) \
         if data["design"] else DESIGN
     rows = sorted(data["states"], key=lambda r: r["P_cavity_MPa"])
     one = [r["P_cavity_MPa"] for r in rows if np.count_nonzero(r["contact_force_N"]) == 1]

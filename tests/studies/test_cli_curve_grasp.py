@@ -200,7 +200,7 @@ def test_grasp_fem_past_the_free_bend_is_an_error_naming_the_bend(tmp_path, caps
     """At a bend the free finger does not reach at that pressure no placement of the object is
     touched: one line naming the free bend (below which it would press) and the pump pressure
     from which it presses at the bend asked, exit 2 -- not F_v = 0 with the object 480 mm deep."""
-    from softhand.reduced.calibrated import grasp_fem
+    from softhand.reduced.calibrated import finger_hinges
 
     design = tmp_path / "gripper.toml"
     design.write_text(GRIPPER)
@@ -211,7 +211,7 @@ def test_grasp_fem_past_the_free_bend_is_an_error_naming_the_bend(tmp_path, caps
     assert out == "" and err.count("\n") == 1 and err.startswith("softhand grasp: error: --theta-deg")
     from softhand.reduced.vocabulary.design_files import load_design
 
-    fem = grasp_fem.fem_finger(load_design(design))
+    fem = finger_hinges.fem_finger(load_design(design))
     P_cavity = 1.0 + float(hand.pressure(math.radians(60), fem, reservoir=False) - hand.pressure(math.radians(60), fem))
     free = math.degrees(float(hand.bend_angle(P_cavity, fem, reservoir=False)))
     assert f"bends only to {free:.4g} deg" in err and f"bends below {free:.4g} deg" in err
@@ -271,13 +271,13 @@ def test_curve_compare_overlays_designs_and_models_on_one_plot(tmp_path, capsys,
 def test_grasp_fem_in_the_crease_of_two_pads_prints_both(tmp_path, capsys):
     """A ball between pads 3 and 4 (the state of neither pad alone): the JSON names the second
     pad, its normal force and its point beside the first, and F_v is the state's."""
-    from softhand.reduced.calibrated import grasp_fem
+    from softhand.reduced.calibrated import finger_hinges, grasp_fem
     from softhand.reduced.vocabulary.design_files import load_design
 
     design = tmp_path / "crease.toml"
     design.write_text("a_mm = 6.0\nd_mm = 13.59\nl0_mm = 162.49\nhinge_s_mm = ["
                       + ", ".join(f"{s * 162.49 / 180.0!r}" for s in (30.0, 60.0, 90.0, 120.0, 150.0)) + "]\n")
-    fem = grasp_fem.fem_finger(load_design(design))
+    fem = finger_hinges.fem_finger(load_design(design))
     s = grasp_fem.grasp_state(fem, 150.0, 1.6785, 1.0)
     assert s.crease is not None
     P_pump = 1.6785 - float(hand.finger_pressure(s.theta, fem)) + float(hand.pressure(s.theta, fem))
