@@ -71,6 +71,12 @@ class HeldFinger:
         """Condensed stiffness S [N mm/rad] of the whole finger from the last factorisation."""
         return condensed_stiffness(self.solver, self.model.ndofs, self.model.design.n_s)
 
+    def residual_norm(self) -> float:
+        """||r(y; P) - (0, Q/2)|| of the current state [N mm] (the FEM equilibrium check)."""
+        n_s = self.model.design.n_s
+        return float(np.linalg.norm(self.model.residual(
+            self.y, self.P, lambda q: (0.5 * self.Q, np.zeros((n_s, n_s))))))
+
 
 def condensed_stiffness(solver, ndofs: int, n_s: int) -> np.ndarray:
     """S = 2 [(K_r^{-1})_qq]^{-1} [N mm/rad] (module doc) of the whole finger from the reduced tangent
