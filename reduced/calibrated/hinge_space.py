@@ -212,10 +212,13 @@ def design_table(design: HandDesign) -> hinge_table.HingeTable:
     if t.a.shape[-1] != design.n_s:
         raise InputError("hinge_table" if own else "n_s", design.hinge_table if own else design.n_s,
                          f"{'has' if own else 'the hinge table has'} {t.a.shape[-1]} hinges; the design has {design.n_s}")
+    return t if own or _papers_geometry(design) else _carried(design)  # the paper's geometry: the table itself
+
+
+@lru_cache(maxsize=16)
+def _papers_geometry(design: HandDesign) -> bool:
     paper = HandDesign()
-    if own or all(getattr(design, k) == getattr(paper, k) for k in ("a", "b", "d", "l0", "tie_width", "hinge_s")):
-        return t  # the paper's geometry: the table itself
-    return _carried(design)
+    return all(getattr(design, k) == getattr(paper, k) for k in ("a", "b", "d", "l0", "tie_width", "hinge_s"))
 
 
 @lru_cache(maxsize=16)
