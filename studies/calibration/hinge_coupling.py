@@ -101,6 +101,13 @@ def main(argv=None) -> int:
     command = "python -m softhand.studies.calibration.hinge_coupling " + " ".join(sys.argv[1:] if argv is None else argv)
     write_atomic(args.out, space_text(args.space, args.results, max(1, args.workers), command, args.scheduler,
                                       not args.no_progress))
+    from softhand.reduced.calibrated import hinge_coupling
+
+    hinge_coupling.read.cache_clear()
+    loo = hinge_coupling.leave_one_out(hinge_coupling.read(args.out))
+    print(f"leave-one-out over {len(loo)} designs: shares rms {100 * np.sqrt(np.mean(loo[:, 0] ** 2)):.2f} %, "
+          f"worst {100 * loo[:, 0].max():.1f} %; stiffness diagonal rms {100 * np.sqrt(np.mean(loo[:, 1] ** 2)):.1f} %, "
+          f"worst {100 * loo[:, 1].max():.1f} %", file=sys.stderr)
     return 0
 
 
