@@ -105,9 +105,8 @@ def main(argv=None) -> int:
 
     hinge_coupling.read.cache_clear()
     loo = hinge_coupling.leave_one_out(hinge_coupling.read(args.out))
-    print(f"leave-one-out over {len(loo)} designs: shares rms {100 * np.sqrt(np.mean(loo[:, 0] ** 2)):.2f} %, "
-          f"worst {100 * loo[:, 0].max():.1f} %; stiffness diagonal rms {100 * np.sqrt(np.mean(loo[:, 1] ** 2)):.1f} %, "
-          f"worst {100 * loo[:, 1].max():.1f} %", file=sys.stderr)
+    print(tables.leave_one_out_line(len(loo), [("shares", loo[:, 0], loo[:, 0]),
+                                             ("stiffness diagonal", loo[:, 1], loo[:, 1])]), file=sys.stderr)
     return 0
 
 

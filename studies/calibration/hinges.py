@@ -249,9 +249,8 @@ def main(argv=None) -> int:
                                           args.scheduler, not args.no_progress))
         hinge_space.read.cache_clear()
         loo = hinge_space.leave_one_out(hinge_space.read(args.out))
-        print(f"leave-one-out over {len(loo)} designs: rates rms {100 * np.sqrt(np.mean(loo[:, 0] ** 2)):.2f} %, "
-              f"worst {100 * loo[:, 1].max():.1f} %; moments bent backwards rms {100 * np.sqrt(np.mean(loo[:, 2] ** 2)):.2f} "
-              f"%, worst {100 * loo[:, 3].max():.1f} %", file=sys.stderr)
+        print(tables.leave_one_out_line(len(loo), [("rates", loo[:, 0], loo[:, 1]),
+                                                 ("moments bent backwards", loo[:, 2], loo[:, 3])]), file=sys.stderr)
         return 0
     design = HandDesign() if args.design is None else load_design(args.design)
     if not 0.2 <= args.top_mpa <= 10.0:

@@ -10,9 +10,11 @@ import subprocess
 from datetime import datetime, timezone
 from pathlib import Path
 
+import numpy as np
+
 from softhand.studies.io.files import write_atomic
 
-__all__ = ["git_commit", "written_by", "table_text", "write_table"]
+__all__ = ["git_commit", "written_by", "table_text", "write_table", "leave_one_out_line"]
 
 
 def git_commit() -> str:
@@ -42,3 +44,11 @@ def table_text(provenance: list[str], columns, rows, formats: dict | None = None
 def write_table(path, provenance: list[str], columns, rows, formats: dict | None = None) -> Path:
     """Write :func:`table_text` to ``path`` atomically; the path written."""
     return write_atomic(path, table_text(provenance, columns, rows, formats))
+
+
+def leave_one_out_line(designs: int, parts) -> str:
+    """One line of a design-space grid's leave-one-out: parts (name, per-design relative errors (D,),
+    per-design worst errors (D,)) as "name rms R %, worst W %"."""
+    return f"leave-one-out over {designs} designs: " + "; ".join(
+        f"{name} rms {100 * float(np.sqrt(np.mean(np.square(rms)))):.2f} %, worst {100 * float(np.max(worst)):.1f} %"
+        for name, rms, worst in parts)
