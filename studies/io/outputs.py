@@ -96,7 +96,8 @@ def replaced_outputs(folder: str | Path | None, names, *, verb: str = "softhand"
     the block finishes, each output is renamed into place in one step and the earlier run's
     outputs (those its manifest names, nothing else) are removed: the folder holds one run's
     whole result, a reader never sees a half-written one. If the block does not finish (an
-    error, Ctrl-C, SIGTERM) the staging folder is removed and the earlier result stays as it
+    error, Ctrl-C, SIGTERM) the staging folder is removed, with the folders the run made to hold
+    it (``results/bend`` and ``results`` of a first run), and the earlier result stays as it
     was. If some output could not be written (:func:`softhand.studies.io.files.kept_if_unwritable`: disk full, file-size
     limit), the pieces written go to ``folder/incomplete/`` and the earlier result stays too.
     An output of the user's of the same name is refused (:func:`check_owned`). Two runs into
@@ -109,7 +110,7 @@ def replaced_outputs(folder: str | Path | None, names, *, verb: str = "softhand"
         return
     folder, names = Path(folder), tuple(names)
     check_owned(folder, names, field, verb)
-    made = not folder.exists()
+    made = [d for d in (folder, *folder.parents) if not (d.exists() or d.is_symlink())]  # deepest first
     _remove_dead_stages(folder)
     stage = folder / f"{_STAGE}{os.getpid()}-{uuid.uuid4().hex[:8]}"
     stage.mkdir(parents=True)
@@ -120,8 +121,8 @@ def replaced_outputs(folder: str | Path | None, names, *, verb: str = "softhand"
     except BaseException:
         STAGED_RUNS.pop()
         shutil.rmtree(stage, ignore_errors=True)
-        if made:
-            _rmdir_quietly(folder)
+        for d in made:  # the folders this run made, if nothing else went into them meanwhile
+            _rmdir_quietly(d)
         raise
     record = {"run": uuid.uuid4().hex, "verb": verb, "pid": os.getpid(),
               "finished_utc": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime()),

@@ -179,6 +179,14 @@ def test_a_stopped_run_leaves_the_earlier_result_whole(tmp_path):
     with pytest.raises(KeyboardInterrupt):  # a folder the stopped run made goes too
         _run_into(fresh, ("a.txt",), stopped)
     assert not fresh.exists()
+    with pytest.raises(KeyboardInterrupt):  # and every folder it made on the way (results/bend)
+        _run_into(fresh / "results" / "bend", ("a.txt",), stopped)
+    assert not fresh.exists()
+    (tmp_path / "mine").mkdir()
+    with pytest.raises(KeyboardInterrupt):  # the user's folder stays, so does a file put in one meanwhile
+        _run_into(tmp_path / "mine" / "results" / "bend", ("a.txt",),
+                  lambda stage: ((tmp_path / "mine" / "results" / "note").write_text("x"), stopped(stage)))
+    assert sorted(p.name for p in (tmp_path / "mine").rglob("*")) == ["note", "results"]
 
 
 def test_an_output_name_the_user_holds_is_refused_not_deleted(tmp_path):
