@@ -5,8 +5,12 @@ Give it the JSON that ``softhand hold --model fem --json`` printed (one file per
 reduced``, calibrated finger) on the case the FEM ran and prints one row: held or not, the
 holding limit and one pad's normal force in each, and the relative differences. The FEM's rows
 take minutes each (make them first, e.g. with nice in the background); this takes a second.
+``--reference`` runs the fast model on the FEM holds the project keeps instead
+(``studies/data/hold_fem_limits.json``, :mod:`softhand.studies.hold_reference`: 25 cases, ~10 s)
+and prints each error and how many are within 5 and 10 %.
 
     python benchmarks/hold_fast_vs_fem.py RESULT.json [RESULT.json ...] [--markdown]
+    python benchmarks/hold_fast_vs_fem.py --reference [--markdown]
 """
 from __future__ import annotations
 
@@ -53,9 +57,16 @@ def row(fem: dict) -> dict:
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("results", nargs="+", help="FEM hold JSON files (softhand hold --model fem --json)")
+    parser.add_argument("results", nargs="*", help="FEM hold JSON files (softhand hold --model fem --json)")
+    parser.add_argument("--reference", action="store_true",
+                        help="the FEM holds kept in studies/data/hold_fem_limits.json instead")
     parser.add_argument("--markdown", action="store_true", help="print a Markdown table")
     args = parser.parse_args()
+    if args.reference == bool(args.results):
+        parser.error("give FEM result files or --reference")
+    if args.reference:
+        reference(args.markdown)
+        return
     rows = [row(json.loads(open(path, encoding="utf-8").read())) for path in args.results]
     pct = lambda a, b: f"{100.0 * (a / b - 1.0):+.1f} %" if b else "—"  # noqa: E731
     head = ["object", "mass kg", "mu", "P_cavity MPa", "FEM held, limit N", "fast held, limit N", "limit",
@@ -70,6 +81,24 @@ def main() -> None:
                  pct(r["fast_limit_N"], r["fem_limit_N"]) if r["fem_held"] and r["fast_held"] else "",
                  f"{r['fem_pad_N']:.2f}", f"{r['fast_pad_N']:.2f}", pct(r["fast_pad_N"], r["fem_pad_N"])]
         print("| " + " | ".join(cells) + " |" if args.markdown else "  ".join(cells))
+
+
+def reference(markdown: bool) -> None:
+    """The fast model on the kept FEM holds: one row each, then the summary."""
+    from softhand.studies import hold_reference
+
+    rows = hold_reference.compare()
+    sep = " | " if markdown else "  "
+    if markdown:
+        print("| case | P_cavity MPa | FEM limit N | fast limit N | fast / FEM - 1 |\n|---|---|---|---|---|")
+    for r in rows:
+        cells = [r.name, f"{r.P_cavity_MPa:.3f}", f"{r.fem_limit_N:.2f}",
+                 f"{r.fast_limit_N:.2f}" if r.fast_held else "not held", f"{100 * r.error:+.1f} %"]
+        print(("| " if markdown else "") + sep.join(cells) + (" |" if markdown else ""))
+    s = hold_reference.summary(rows)
+    print(f"# {s['cases']} FEM holds: verdicts agree on {s['verdicts_agree']}; the fast limit within 5 % on "
+          f"{s['within_5_percent']}, within 10 % on {s['within_10_percent']}; rms {s['rms_percent']:.1f} %, "
+          f"median {s['median_percent']:.1f} %")
 
 
 if __name__ == "__main__":

@@ -1,0 +1,114 @@
+"""The whole-hand FEM's holding limits kept as the fast hold model's reference.
+
+``studies/data/hold_fem_limits.json`` holds 25 holds the whole-hand FEM ran (``softhand hold
+--model fem``, default finger mesh, the limit resolved to 0.5 % of the pull): the design, the
+object, its mass and friction, the pressure, the pull and the FEM's holding limit. Spheres,
+upright and lying cylinders, cubes (one turned 45°), a capsule, balls that wedge as they slide,
+a sideways pull, two balls read from STL files (built here by the recipe the file names), on the
+paper's design and four others. No fast-model number was fitted to them: they are what the fast
+model is measured against (docs/grasp.md) and what ``tests/reduced/test_hold_reference.py`` holds
+it to. Each FEM run takes minutes; :func:`compare` runs the fast model on all of them in seconds:
+
+    python benchmarks/hold_fast_vs_fem.py --reference
+
+Units: N, mm, MPa, kg.
+"""
+from __future__ import annotations
+
+import json
+import tempfile
+from dataclasses import replace
+from importlib import resources
+from pathlib import Path
+from typing import NamedTuple
+
+import numpy as np
+
+from softhand.reduced.holding import hold_fast
+from softhand.reduced.holding.hand_layout import place_object
+from softhand.reduced.holding.hold import DOWN, cavity_pressure, solve_hold
+from softhand.reduced.holding.objects import object_from_table
+from softhand.reduced.vocabulary.design import HandDesign
+
+
+class Row(NamedTuple):
+    """One reference hold: the FEM's limit and the fast model's on the same case."""
+
+    name: str
+    P_cavity_MPa: float
+    fem_limit_N: float
+    fast_held: bool
+    fast_limit_N: float
+
+    @property
+    def error(self) -> float:
+        """fast / FEM - 1."""
+        return self.fast_limit_N / self.fem_limit_N - 1.0
+
+
+def load() -> dict:
+    """The reference file's contents (``about``, ``designs``, ``meshes``, ``cases``)."""
+    text = resources.files("softhand.studies").joinpath("data/hold_fem_limits.json").read_text(encoding="utf-8")
+    return json.loads(text)
+
+
+def design_of(case: dict, designs: dict) -> HandDesign:
+    """The case's design: the paper's with the named design's changes."""
+    changes = designs[case["design"]]
+    return replace(HandDesign(), **{k: tuple(v) if isinstance(v, list) else v for k, v in changes.items()})
+
+
+def build_mesh(name: str, folder: Path) -> Path:
+    """The STL of the reference mesh ``name`` (the recipe in the file's ``meshes``), written into folder."""
+    path = Path(folder) / f"{name}.stl"
+    if name == "icosphere":
+        import trimesh
+
+        trimesh.creation.icosphere(subdivisions=4, radius=90.0).export(path)
+        return path
+    if name != "scanned":
+        raise ValueError(f"no recipe for the reference mesh {name!r}")
+    import pyvista
+
+    ball = pyvista.Icosphere(radius=1.0, nsub=5)
+    x = np.asarray(ball.points, float)
+    polar, azimuth = np.arccos(np.clip(x[:, 1], -1.0, 1.0)), np.arctan2(x[:, 2], x[:, 0])
+    noise = np.random.default_rng(2).standard_normal(len(x))
+    ball.points = x * (90.0 + 1.5 * np.sin(3 * polar) * np.cos(2 * azimuth + 0.4) + 0.2 * noise)[:, None]
+    ball.save(path)
+    return path
+
+
+def run_case(case: dict, designs: dict, folder: Path) -> Row:
+    """The fast hold model on one reference case (meshes built into ``folder``)."""
+    design = design_of(case, designs)
+    table = dict(case["object"], mass_kg=case["mass_kg"], friction=case["friction"])
+    if table["shape"] == "mesh":
+        table["file"] = str(build_mesh(table["file"], folder))
+    obj = object_from_table(table, source=case["name"])
+    P = case.get("P_cavity_MPa")
+    if P is None:  # a design task's optimum, given by its pump pressure
+        P = cavity_pressure(case["P_pump_MPa"], place_object(obj, hold_fast.finger_design(design, "fem")), design)
+    result = solve_hold(design, obj, P_cavity_MPa=P, pull_direction=case.get("pull", DOWN))
+    return Row(case["name"], float(P), float(case["fem_limit_N"]), result.held, result.holding_limit_N)
+
+
+def compare(progress=None) -> list[Row]:
+    """The fast model on every reference case, in the file's order; ``progress(done, total)``."""
+    data = load()
+    rows = []
+    with tempfile.TemporaryDirectory(prefix="softhand-reference-") as folder:
+        for case in data["cases"]:
+            rows.append(run_case(case, data["designs"], Path(folder)))
+            if progress is not None:
+                progress(len(rows), len(data["cases"]))
+    return rows
+
+
+def summary(rows: list[Row]) -> dict:
+    """How close the fast limits are: how many lie within 5 and 10 % of the FEM's, the rms and the
+    median of the absolute error, and how many verdicts agree (every reference hold is held in the FEM)."""
+    e = np.abs([r.error for r in rows])
+    return {"cases": len(rows), "within_5_percent": int(np.sum(e <= 0.05)),
+            "within_10_percent": int(np.sum(e <= 0.10)), "rms_percent": float(100 * np.sqrt(np.mean(e ** 2))),
+            "median_percent": float(100 * np.median(e)), "verdicts_agree": int(sum(r.fast_held for r in rows))}

@@ -1,0 +1,49 @@
+"""The fast hold model against the whole-hand FEM's stored holding limits (studies/data/hold_fem_limits.json).
+
+The FEM ran each case for minutes; these limits are its, not the fast model's, and nothing in the
+fast model was fitted to them. The bounds are the accuracy docs/grasp.md reports, so a change that
+takes the fast model further from the FEM fails here, one that brings it closer passes.
+"""
+import pytest
+
+from softhand.studies import hold_reference
+
+
+@pytest.fixture(scope="module")
+def rows():
+    return hold_reference.compare()
+
+
+def test_the_reference_set_covers_the_shapes_designs_and_pulls_it_claims():
+    data = hold_reference.load()
+    cases = data["cases"]
+    assert len(cases) == 25
+    assert {c["object"]["shape"] for c in cases} == {"sphere", "cylinder", "box", "capsule", "mesh"}
+    assert {c["design"] for c in cases} == set(data["designs"])
+    assert any(c.get("pull", [0, 1, 0]) != [0, 1, 0] for c in cases)  # the sideways pull
+    assert all(c["fem_limit_N"] > 0 for c in cases)  # every one held in the FEM
+
+
+def test_every_verdict_agrees_with_the_fem(rows):
+    assert [r.name for r in rows if not r.fast_held] == []
+
+
+def test_the_fast_limits_are_as_close_to_the_fem_as_documented(rows):
+    s = hold_reference.summary(rows)
+    assert s["within_5_percent"] >= 12, s
+    assert s["within_10_percent"] >= 18, s
+    assert s["rms_percent"] <= 13.5, s
+    worst = max(rows, key=lambda r: abs(r.error))
+    assert abs(worst.error) < 0.5, worst  # the ball that settles onto pads that barely touch it: +45 %
+
+
+def test_the_reference_meshes_are_built_as_their_recipes_say(tmp_path):
+    import trimesh
+
+    for name, vertices in (("icosphere", 2562), ("scanned", 10242)):
+        mesh = trimesh.load(hold_reference.build_mesh(name, tmp_path))
+        assert len(mesh.vertices) == vertices and mesh.is_watertight
+        r = (mesh.vertices ** 2).sum(axis=1) ** 0.5
+        assert 87.0 < r.min() and r.max() < 93.0  # a 180 mm ball, bumps of 1.5 mm and 0.2 mm noise
+    with pytest.raises(ValueError):
+        hold_reference.build_mesh("teapot", tmp_path)
