@@ -48,7 +48,7 @@ def close_finger(i: int, P: float, placed: Placed, design: HandDesign, near: Fin
     q_free = np.full(n_s, theta_free / n_s)
     if theta_free <= 0.0:
         return _free(i, q_free, P, placed, design)
-    first = first_touch(i, theta_free, placed, design)
+    first = first_touch(i, q_free, placed, design)
     if first is None:
         return _free(i, q_free, P, placed, design)
     found = _active_set(i, first, P, placed, design)
@@ -175,12 +175,12 @@ def _free(i, q, P, placed, design) -> FingerState:
     return FingerState(q, np.zeros(design.n_s + 1), geo, M, float(np.max(np.abs(M))))
 
 
-def first_touch(i: int, theta_free: float, placed: Placed, design: HandDesign):
-    """Uniform hinge angles (n_s,) at which finger i closing with equal hinges first touches the
-    object below its free bend, or None."""
-    n_s = design.n_s
-    th = np.linspace(0.0, theta_free, _SCAN)
-    q = np.repeat(th[:, None] / n_s, n_s, axis=1)
+def first_touch(i: int, q_free, placed: Placed, design: HandDesign):
+    """Hinge angles (n_s,) at which finger i, closing from straight towards its free hinge angles
+    ``q_free`` (all in proportion), first touches the object, or None."""
+    q_free = np.asarray(q_free, float)
+    th = np.linspace(0.0, 1.0, _SCAN)
+    q = th[:, None] * q_free[None, :]
     gaps = hand_layout.pad_distance(placed, hand_layout.pads(q, design, fingers=[i] * _SCAN)).gap
     if np.min(gaps[0]) < 0.0:
         raise InputError("object", placed.obj.describe(), f"overlaps finger {i}'s open pads")
@@ -193,11 +193,10 @@ def first_touch(i: int, theta_free: float, placed: Placed, design: HandDesign):
     k = closed[0]
 
     def gmin(t):
-        qq = np.full((1, n_s), t / n_s)
+        qq = (t * q_free)[None, :]
         return float(np.min(hand_layout.pad_distance(placed, hand_layout.pads(qq, design, fingers=[i])).gap[0, 1:]))
 
-    t = brentq(gmin, th[k - 1], th[k], xtol=1e-12)
-    return np.full(n_s, t / n_s)
+    return brentq(gmin, th[k - 1], th[k], xtol=1e-12) * q_free
 
 
 def _polish(i, q, P, placed, design) -> FingerState:

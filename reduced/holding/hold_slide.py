@@ -12,7 +12,9 @@ object finds no equilibrium near where it is (the FEM hold's limit, where its ne
 longer converges). Under its own weight alone (lam = 0) the object rests at the least y with
 lam(y) >= 0, or falls if lam(y) < 0 up to the first maximum. As in the FEM hold, an object that
 slides more than a quarter of its size (half of :func:`softhand.reduced.holding.object_geometry.size_radius`)
-from where it rests has slipped out: the pull borne there is the holding limit.
+from where it rests has slipped out: the holding limit is the most pull it bore on the way, kept
+over WEDGE_MM of slide before that point (a crease at the point itself is past where the hand
+lets go, not a pull it bore).
 
 :func:`follow` walks y from 0 in steps of :data:`FIRST_STEP` doubling up to :data:`LARGEST_STEP`
 while lam grows, then narrows the maximum's bracket by golden sections to :data:`Y_TOL`; where
@@ -95,6 +97,7 @@ def follow(at: Callable[[float], tuple], first, *, weight_N: float, slip_out_mm:
     y_rest = 0.0 if raw(0.0) >= 0.0 else None
     bound = slip_out_mm if y_rest is not None else LONGEST * slip_out_mm
     y_best, y_before, h, y = 0.0, 0.0, FIRST_STEP, 0.0
+    walked = [0.0]  # the walk's points
     while raw(y_best) < enough_N and y_best < bound:
         y = min(y_best + h, bound)
         # on while lam grows; a rise or a fall that does not last WEDGE_MM of slide is a crease
@@ -102,12 +105,16 @@ def follow(at: Callable[[float], tuple], first, *, weight_N: float, slip_out_mm:
                 or (y > WEDGE_MM and above(y + WEDGE_MM, lam(y_best)))):
             break
         y_before, y_best, h = y_best, y, min(2.0 * h, LARGEST_STEP)
+        walked.append(y)
         if y_rest is None and lam(y_best) >= 0.0:
             y_rest = crossing(y_before, y_best)
             bound = min(y_rest + slip_out_mm, LONGEST * slip_out_mm)
     slipped_out = y_best >= bound and y_rest is not None
     if slipped_out and bound - WEDGE_MM > y_rest:
-        y_best = bound - WEDGE_MM  # the pull kept over the last WEDGE_MM before it slips out
+        # the most pull kept over WEDGE_MM of slide before it slips out: at its last WEDGE_MM, or
+        # where the walk saw more (a crease at the slip-out point itself is past where it lets go)
+        before = [y for y in walked if y_rest <= y <= bound - WEDGE_MM][-1:]
+        y_best = max(before + [bound - WEDGE_MM], key=lam)
     if 0.0 < y_best < y and raw(y_best) < enough_N and not slipped_out:
         a, b = y_before, y  # golden sections on [y_before, y] around y_best
         while b - a > Y_TOL:

@@ -104,7 +104,7 @@ def _touch(d: HandDesign, placed) -> float:
 
 
 def _first_bend(i, theta_free, placed, d):
-    q = hold_closing.first_touch(i, theta_free, placed, d)
+    q = hold_closing.first_touch(i, np.full(d.n_s, theta_free / d.n_s), placed, d)
     return None if q is None else float(np.sum(q))
 
 

@@ -74,6 +74,23 @@ def test_an_object_that_slides_a_quarter_of_its_size_from_its_rest_has_slipped_o
     assert s.y_limit == pytest.approx(s.y_rest + 20.0 - hold_slide.WEDGE_MM)
 
 
+@pytest.mark.parametrize("at", [0.0, 0.2, 0.5, 1.0])
+def test_a_crease_at_the_slip_out_point_does_not_send_the_limit_back_to_the_first_slip(at):
+    """A ball wedging as it slides (lam = 5 + y / 4 from the grasp, where it rests) meets a crease
+    where it has slid its slip-out length, 37.5 mm, or just before: the pull falls to 4 N for
+    0.3 mm and jumps past the trend after it. It slips out there; the limit is the pull borne over
+    the slide before, ~14 N, not the first slip's 5 N (the crease is where the hand lets go, not
+    a pull it bore: before, the last millimetre's least pull, the crease's, fell below the first
+    slip and the limit went back to it)."""
+    def curve(y):
+        if 37.5 - at <= y <= 37.8 - at:
+            return 4.0
+        return 5.0 + y / 4.0 + (3.0 if y > 37.8 - at else 0.0)
+    s, _ = _walk(curve, slip_out=37.5)
+    assert s.slipped_out and s.y_rest == 0.0
+    assert 12.0 <= curve(s.y_limit) <= 5.0 + 37.5 / 4.0  # the walk's payload is y
+
+
 def test_enough_stops_the_walk_and_nothing_to_hold_stops_it_at_once():
     s, calls = _walk(lambda y: y, enough=3.0)
     assert 3.0 <= s.limit <= 6.0 and max(calls) <= 8.0
