@@ -30,6 +30,7 @@ class Body:
     axis: tuple = (0.0, 0.0, 1.0)   #: cylinder axis (unit, hand frame)
     mass_kg: float = 0.0
     friction: float = 0.0           #: Coulomb coefficient against the pads
+    frame: tuple | None = None      #: a box's rotation, its frame -> hand frame (3 x 3 rows); None: none
 
     def __post_init__(self):
         if self.shape not in SHAPES:
@@ -42,6 +43,11 @@ class Body:
             raise InputError("mass_kg", self.mass_kg, "must be >= 0")
         a = np.asarray(self.axis, dtype=float)
         object.__setattr__(self, "axis", tuple(a / np.linalg.norm(a)))
+
+    @property
+    def frame_matrix(self) -> np.ndarray:
+        """A box's rotation (3, 3): its own frame -> hand frame (its edges' directions as columns)."""
+        return np.eye(3) if self.frame is None else np.asarray(self.frame, dtype=float)
 
     @property
     def radius(self) -> float:
@@ -58,13 +64,15 @@ class Body:
             return rho - 0.5 * self.size[0], r / np.where(rho > 0, rho, 1.0)[:, None]
         if self.shape == "cylinder":
             return _cylinder(r, np.asarray(self.axis), 0.5 * self.size[0], 0.5 * self.size[1])
-        return _box(r, 0.5 * np.asarray(self.size, dtype=float))
+        F = self.frame_matrix
+        d, n = _box(r @ F, 0.5 * np.asarray(self.size, dtype=float))
+        return d, n @ F.T
 
     def support(self, u, ref):
         """The body's points deepest along -u (m, 3), those nearest ref where that is an edge or
         a face (:func:`softhand.reduced.holding.object_geometry.support_point`), placed pose."""
         c = np.asarray(self.centre)
-        F = _cylinder_frame(np.asarray(self.axis)) if self.shape == "cylinder" else np.eye(3)
+        F = _cylinder_frame(np.asarray(self.axis)) if self.shape == "cylinder" else self.frame_matrix
         local = support_point(self.shape, self.size, np.asarray(u) @ F, (np.asarray(ref) - c) @ F)
         return c + local @ F.T
 
@@ -75,7 +83,7 @@ class Body:
         if self.shape == "cylinder":
             return _cylinder_surface(np.asarray(self.centre), np.asarray(self.axis),
                                      0.5 * self.size[0], self.size[1], n)
-        return _box_surface(np.asarray(self.centre), 0.5 * np.asarray(self.size, dtype=float))
+        return _box_surface(np.asarray(self.centre), 0.5 * np.asarray(self.size, dtype=float), self.frame_matrix)
 
 
 def _cylinder_frame(e):
@@ -129,11 +137,11 @@ def _cylinder_surface(c, e, R, length, n):
     return np.concatenate(rows), _grid_triangles(4, n)
 
 
-def _box_surface(c, h):
+def _box_surface(c, h, F):
     corners = np.array([[i, j, k] for i in (-1, 1) for j in (-1, 1) for k in (-1, 1)], dtype=float)
     faces = [(0, 1, 3, 2), (4, 6, 7, 5), (0, 4, 5, 1), (2, 3, 7, 6), (0, 2, 6, 4), (1, 5, 7, 3)]
     tris = [[a, b, c_] for a, b, c_, d in faces] + [[a, c_, d] for a, b, c_, d in faces]
-    return c + corners * h, np.array(tris)
+    return c + (corners * h) @ F.T, np.array(tris)
 
 
 def _grid_triangles(rows: int, n: int) -> np.ndarray:
@@ -146,7 +154,7 @@ def _grid_triangles(rows: int, n: int) -> np.ndarray:
 
 @dataclass(frozen=True)
 class PlacedBody:
-    """Any placed object of :mod:`softhand.reduced.holding.objects` (capsule, mesh, rotated box) through its own
+    """Any placed object of :mod:`softhand.reduced.holding.objects` (capsule, mesh) through its own
     distance queries (its normal by central differences)."""
 
     placed: object
@@ -173,7 +181,7 @@ class PlacedBody:
 def body_of(obj, design):
     """The FEM's body for a :class:`softhand.reduced.holding.objects.GraspObject` at its placement (checked:
     InputError if it overlaps the open fingers or the palm): analytic for a sphere, a cylinder
-    and an unrotated box, else the object's own distance queries."""
+    and a box, else the object's own distance queries."""
     from softhand.reduced.holding.hand_layout import place_object
     from softhand.reduced.holding.object_geometry import size_radius
 
@@ -185,6 +193,7 @@ def body_of(obj, design):
     if obj.shape == "cylinder":
         return Body("cylinder", centre, (obj.diameter_mm, obj.length_mm),
                     axis=tuple(placed.R @ [0.0, 1.0, 0.0]), **common)
-    if obj.shape == "box" and not any(obj.rotation_deg):
-        return Body("box", centre, tuple(obj.size_mm), **common)
+    if obj.shape == "box":
+        frame = tuple(map(tuple, placed.R)) if any(obj.rotation_deg) else None
+        return Body("box", centre, tuple(obj.size_mm), frame=frame, **common)
     return PlacedBody(placed, radius=size_radius(obj), **common)

@@ -30,7 +30,10 @@ and its normal with it, while the support point's normal turns with the pad (the
 rounded edge as its radius goes to 0). A mesh's support point is its extreme vertex where that is
 one of its edges or corners (on ties the nearest point of the tied face or edge); on a smooth
 surface's facets the deepest pad point on the mesh's smooth (cubic B-spline) distance stays
-(:func:`softhand.reduced.holding.object_mesh.mesh_support`). A pad whose plane has the
+(:func:`softhand.reduced.holding.object_mesh.mesh_support`). A box (of any rotation) meets a
+pad by separating axes instead (:mod:`softhand.fem.hand.hold_box`), which also gives the normal
+of a pad's side lying across one of its edges (the cross product of the two edges; the
+deepest pad point's face normal flips there). A pad whose plane has the
 object's centre behind it cannot touch: its gap is +inf (as in :mod:`softhand.fem.contact`).
 """
 from __future__ import annotations
@@ -43,6 +46,7 @@ from scipy.spatial.transform import Rotation
 
 from softhand.fem.constraints import PlanarChain
 from softhand.fem.hand.frame import hand_frame
+from softhand.fem.hand.hold_box import box_pad_contacts
 from softhand.reduced.holding.object_geometry import over_pad
 
 
@@ -178,6 +182,14 @@ def pad_contacts(body, pose: Pose, frames, padsets, qs, *, iterations: int = 40)
     sigma = np.clip(np.einsum("ki,ki->k", c - A, AB) / L2, 0.0, 1.0)
     zeta = np.clip(np.einsum("ki,ki->k", c - A, e_n), -half, half)
     point = lambda s, z: A + s[:, None] * AB + z[:, None] * e_n  # noqa: E731
+    facing = np.cross(e_n, AB)  # the pad's normal towards the closing side (finger frame +y)
+    facing /= np.linalg.norm(facing, axis=1)[:, None]
+    if getattr(body, "shape", None) == "box":  # separating axes (:mod:`softhand.fem.hand.hold_box`)
+        L = np.sqrt(L2)
+        d, n, x = box_pad_contacts(c, pose.R @ body.frame_matrix, 0.5 * np.asarray(body.size, float),
+                                   A + 0.5 * AB, AB / L[:, None], 0.5 * L, e_n, half, facing, point(sigma, zeta))
+        sigma, zeta = np.einsum("ki,ki->k", x - A, AB) / L2, np.einsum("ki,ki->k", x - A, e_n)
+        return _contacts(d, n, x, facing, c, A0, B0, sigma, zeta)
     d, n = signed_distance(body, pose, point(sigma, zeta))
     step = 0.25 * np.sqrt(L2)
     active = np.ones(len(sigma), dtype=bool)
@@ -196,8 +208,6 @@ def pad_contacts(body, pose: Pose, frames, padsets, qs, *, iterations: int = 40)
         step = np.where(better, step, 0.5 * step)
         active &= step > 1e-10
     x = point(sigma, zeta)
-    facing = np.cross(e_n, AB)  # the pad's normal towards the closing side (finger frame +y)
-    facing /= np.linalg.norm(facing, axis=1)[:, None]
     support = getattr(body, "support", None)
     S = None if support is None else support(facing @ pose.R, pose.to_body(x))
     if S is not None:  # the object's point deepest through the pad's plane, where it is over the pad
@@ -207,6 +217,10 @@ def pad_contacts(body, pose: Pose, frames, padsets, qs, *, iterations: int = 40)
         d = np.where(over, h, d)
         n = np.where(over[:, None], -facing, n)
         x = point(sigma, zeta)
+    return _contacts(d, n, x, facing, c, A0, B0, sigma, zeta)
+
+
+def _contacts(d, n, x, facing, c, A0, B0, sigma, zeta) -> PadContacts:
+    """The pads' contacts, a pad whose plane has the object's centre c behind it facing away."""
     g = np.where(np.einsum("ki,ki->k", facing, c - x) > 0.0, d, np.inf)
-    X = A0 + sigma[:, None] * (B0 - A0)
-    return PadContacts(g, n, x, X, zeta)
+    return PadContacts(g, n, x, A0 + sigma[:, None] * (B0 - A0), zeta)
