@@ -25,7 +25,7 @@ def _contacts(record) -> tuple:
         T = -np.asarray(c["friction_force_N"])  # on the object
         size = np.linalg.norm(T)
         out.append(Contact(c["finger"], c["link"], c["normal_N"], c["friction_N"], c["state"],
-                           tuple(c["point_mm"]), tuple(-N / np.linalg.norm(N)),
+                           tuple(c["point_mm"]), tuple(N / np.linalg.norm(N)),  # the object's outward normal
                            tuple(T / size) if size > 0 else ()))
     return tuple(out)
 

@@ -101,6 +101,8 @@ def test_two_pads_pinching_a_box_hold_two_mu_N(finger, tmp_path):
     assert data["model"] == "fem" and data["held"] and data["holding_limit_N"] == path.holding_limit_N
     assert data["symmetric"] and len(data["steps"]) == len(path.steps)
     assert {c["finger"] for c in data["contacts"]} == {0, 1} and all(c["state"] == "stick" for c in data["contacts"])
+    for c in data["contacts"]:  # the box's outward normal, as the fast model reports it: away from its centre
+        np.testing.assert_allclose(c["normal"], np.sign(c["point_mm"][0]) * np.array([1.0, 0.0, 0.0]), atol=1e-9)
     assert result_from_json(data).holding_limit_N == result.holding_limit_N
     scene = meshio.read(tmp_path / "hold" / f"hold_{len(path.steps) - 1:04d}" / "contact_forces.vtu")
     np.testing.assert_allclose(np.abs(scene.point_data["normal_force_N"][:, 0]), [c["normal_N"] for c in touching])
