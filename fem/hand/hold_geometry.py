@@ -31,7 +31,7 @@ rounded edge as its radius goes to 0). A mesh's support point is its extreme ver
 one of its edges or corners (on ties the nearest point of the tied face or edge); on a smooth
 surface's facets the deepest pad point on the mesh's smooth (cubic B-spline) distance stays
 (:func:`softhand.reduced.holding.object_mesh.mesh_support`). A box (of any rotation) meets a
-pad by separating axes instead (:mod:`softhand.fem.hand.hold_box`), which also gives the normal
+pad by separating axes instead (:mod:`softhand.reduced.holding.box_contact`), which also gives the normal
 of a pad's side lying across one of its edges (the cross product of the two edges; the
 deepest pad point's face normal flips there). A pad whose plane has the
 object's centre behind it cannot touch: its gap is +inf (as in :mod:`softhand.fem.contact`).
@@ -46,7 +46,7 @@ from scipy.spatial.transform import Rotation
 
 from softhand.fem.constraints import PlanarChain
 from softhand.fem.hand.frame import hand_frame
-from softhand.fem.hand.hold_box import box_pad_contacts
+from softhand.reduced.holding.box_contact import box_pad_contacts
 from softhand.reduced.holding.object_geometry import over_pad
 
 
@@ -184,7 +184,7 @@ def pad_contacts(body, pose: Pose, frames, padsets, qs, *, iterations: int = 40)
     point = lambda s, z: A + s[:, None] * AB + z[:, None] * e_n  # noqa: E731
     facing = np.cross(e_n, AB)  # the pad's normal towards the closing side (finger frame +y)
     facing /= np.linalg.norm(facing, axis=1)[:, None]
-    if getattr(body, "shape", None) == "box":  # separating axes (:mod:`softhand.fem.hand.hold_box`)
+    if getattr(body, "shape", None) == "box":  # separating axes (:mod:`softhand.reduced.holding.box_contact`)
         L = np.sqrt(L2)
         d, n, x = box_pad_contacts(c, pose.R @ body.frame_matrix, 0.5 * np.asarray(body.size, float),
                                    A + 0.5 * AB, AB / L[:, None], 0.5 * L, e_n, half, facing, point(sigma, zeta))

@@ -32,6 +32,7 @@ from scipy.optimize import brentq
 from softhand.reduced.equations import contact, kinematics
 from softhand.reduced.vocabulary.design import HandDesign
 from softhand.reduced.vocabulary.errors import InputError
+from softhand.reduced.holding.box_contact import box_pad_contacts
 from softhand.reduced.holding.object_geometry import Placed, over_pad, place
 from softhand.reduced.holding.objects import CLEARANCE, PALM_GAP, GraspObject
 
@@ -117,7 +118,8 @@ class PadDistance(NamedTuple):
 
 def pad_distance(placed: Placed, p: Pads) -> PadDistance:
     """Gap of every pad to the object: exact for a sphere (the pad rectangle's point nearest the
-    centre); otherwise the least distance on a :data:`PAD_SAMPLES` grid of the pad refined by a
+    centre); for a box by separating axes (:mod:`softhand.reduced.holding.box_contact`, as the FEM
+    hold: a pad's side across a box edge has the two edges' cross product as normal); otherwise the least distance on a :data:`PAD_SAMPLES` grid of the pad refined by a
     parabola through the least sample and its neighbours, along then across (exact for a flat
     face; error O(h^3) on a curved one, h = 1/16 of the link). Then, by the FEM hold's own rule
     (:func:`softhand.reduced.holding.object_geometry.over_pad`), where the object's point deepest
@@ -129,6 +131,8 @@ def pad_distance(placed: Placed, p: Pads) -> PadDistance:
     s = np.minimum(np.maximum(np.einsum("fki,fki->fk", d, p.along), -p.half[:, 0]), p.half[:, 0])
     w = np.minimum(np.maximum(np.einsum("fki,fki->fk", d, p.across), -p.half[:, 1]), p.half[:, 1])
     ref = p.centre + s[..., None] * p.along + w[..., None] * p.across
+    if placed.obj.shape == "box":
+        return _box_distance(placed, p, ref)
     if placed.obj.shape == "sphere":
         x = ref
         gap = placed.sdf(x)
@@ -145,6 +149,18 @@ def pad_distance(placed: Placed, p: Pads) -> PadDistance:
     towards = np.einsum("fki,fki->fk", placed.centre - x, p.normal) > 0.0
     gap = np.where(over, np.where(towards, h, np.inf), gap)
     return PadDistance(gap, x, n)
+
+
+def _box_distance(placed: Placed, p: Pads, ref) -> PadDistance:
+    """A box's gaps by separating axes (:mod:`softhand.reduced.holding.box_contact`, the FEM hold's rule)."""
+    shape = p.centre.shape
+    half = np.broadcast_to(p.half, shape[:-1] + (2,)).reshape(-1, 2)
+    flat = lambda v: np.reshape(v, (-1, 3))  # noqa: E731
+    gap, n, x = box_pad_contacts(placed.centre, placed.R, 0.5 * np.asarray(placed.obj.size_mm, float), flat(p.centre),
+                                 flat(p.along), half[:, 0], flat(p.across), half[:, 1], flat(p.normal), flat(ref))
+    x, n = x.reshape(shape), n.reshape(shape)
+    towards = np.einsum("...i,...i->...", placed.centre - x, p.normal) > 0.0
+    return PadDistance(np.where(towards, gap.reshape(shape[:-1]), np.inf), x, n)
 
 
 def _sampled_closest(placed: Placed, p: Pads):

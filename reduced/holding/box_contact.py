@@ -1,4 +1,6 @@
-r"""Contact of the hold's flat pads with a box, by separating axes.
+r"""Contact of the hold's flat pads with a box, by separating axes: the one rule by which a pad
+meets a box, in the fast hold (:func:`softhand.reduced.holding.hand_layout.pad_distance`) and the
+FEM hold (:func:`softhand.fem.hand.hold_geometry.pad_contacts`) alike.
 
 A pad (a rectangle) and a box are convex polytopes. Their signed distance is the largest
 separation over the separating-axis candidates (Gottschalk, Lin and Manocha 1996, OBBTree;
@@ -14,7 +16,9 @@ face, edge across edge) and minus the penetration depth once they overlap; its a
 contact normal. Where the pad's side crosses an edge of the box the normal is the cross
 product of the two edges, which turns smoothly with the pad -- the distance's own gradient at
 the pad's deepest point does not: it flips between the edge's two faces as that point crosses
-the edge's bisecting plane, and a one-point contact there has no converging Newton.
+the edge's bisecting plane, and a one-point contact there has no converging Newton; and a
+distance sampled along the pad and refined by a parabola misplaces a contact at the edge's kink
+by a fraction of the sample spacing, onto the face, with the face's normal.
 
 Where the two are apart with a corner nearest a corner or an edge (no candidate axis is
 the distance's direction), s is less than the distance: only touching pads bear force, and

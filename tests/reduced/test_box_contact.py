@@ -10,7 +10,7 @@ import pytest
 from scipy.optimize import minimize
 from scipy.spatial.transform import Rotation
 
-from softhand.fem.hand.hold_box import box_pad_contacts
+from softhand.reduced.holding.box_contact import box_pad_contacts
 
 CORNERS = np.array([[i, j, k] for i in (-1, 1) for j in (-1, 1) for k in (-1, 1)], float)
 
