@@ -46,8 +46,8 @@ correction reads only the free states), the moments of the held hinges at 1.5 MP
 worst 2.7 %, where no hinge is held within 1 deg of straight (the table alone: 8.0 %, 14 %), and up
 to 56 % off where one is (a straight hinge between bent ones is far softer than the table, locked
 all straight, says; 66 % for the table alone). In the fast hold, against the whole-hand FEM's kept
-holds (:mod:`softhand.studies.hold_reference`), these moments bring 18 limits within 5 % (the
-table's: 15) and every one of the 42 verdicts (the table's: 41; docs/grasp.md); not adopted yet: the one-finger
+holds (:mod:`softhand.studies.hold_reference`, its first 42, 2026-12-06), these moments brought 18 limits
+within 5 % (the table's then: 15) and every verdict (then 41; docs/grasp.md); not adopted yet: the one-finger
 grasp of :mod:`softhand.reduced.calibrated.grasp_fem`, the hold's special case, must take them
 with it, and with both the design tasks' optima move. The oil the hinges draw (:func:`volume_rate`) is the table's.
 P is the cavity pressure. Units: mm, N, MPa, rad.

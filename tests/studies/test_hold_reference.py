@@ -17,30 +17,31 @@ def rows():
 def test_the_reference_set_covers_the_shapes_designs_and_pulls_it_claims():
     data = hold_reference.load()
     cases = data["cases"]
-    assert len(cases) == 42
+    assert len(cases) == 53
     assert {c["object"]["shape"] for c in cases} == {"sphere", "cylinder", "box", "capsule", "mesh"}
     assert {c["design"] for c in cases} == set(data["designs"])
     assert any(c.get("pull", [0, 1, 0]) != [0, 1, 0] for c in cases)  # the sideways pull
     held = [c for c in cases if c["fem_limit_N"] > 0]
-    assert len(held) == 32 and all(0.0 <= c["fem_weight_share"] < 1.0 for c in cases if c not in held)
+    assert len(held) == 35 and all(0.0 <= c["fem_weight_share"] < 1.0 for c in cases if c not in held)
 
 
 def test_the_verdicts_agree_with_the_fems_wherever_its_margin_exceeds_five_percent(rows):
-    """All 42 agree but one: design A's fingertips on a 150 mm cube, which the FEM holds with 5 % of
-    its weight to spare (0.20 N) and the fast model lets go (its largest load borne 5.5 % below)."""
+    """All 53 agree (design A's fingertips on a 150 mm cube, which the FEM holds with 5 % of its
+    weight to spare, agrees since a box meets the pads by separating axes in both models)."""
     s = hold_reference.summary(rows)
-    assert s["verdicts_agree"] >= 41, s
+    assert s["verdicts_agree"] >= 53, s
     assert all(abs(margin) <= 0.06 for _, margin in s["differ"]), s
 
 
 def test_the_fast_limits_are_as_close_to_the_fem_as_documented(rows):
     s = hold_reference.summary(rows)
-    assert s["both_held"] >= 31, s
-    assert s["within_5_percent"] >= 15, s
-    assert s["within_10_percent"] >= 23, s
-    assert s["rms_percent"] <= 12.5, s
+    assert s["both_held"] >= 35, s
+    assert s["within_5_percent"] >= 16, s
+    assert s["within_10_percent"] >= 25, s
+    assert s["rms_percent"] <= 15.0, s
     worst = max((r for r in rows if r.fem_held and r.fast_held), key=lambda r: abs(r.error))
-    assert abs(worst.error) < 0.5, worst  # the ball that settles onto pads that barely touch it: +45 %
+    # the 180 mm cube turned 15 deg, which turns in the FEM's hand as it slides: +49 %
+    assert abs(worst.error) < 0.5, worst
 
 
 def test_the_reference_meshes_are_built_as_their_recipes_say(tmp_path):
