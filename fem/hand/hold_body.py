@@ -14,6 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from softhand.reduced.holding.cylinder_contact import cylinder_distance, cylinder_frame
 from softhand.reduced.holding.object_geometry import support_point
 from softhand.reduced.vocabulary.errors import InputError
 
@@ -63,7 +64,7 @@ class Body:
             rho = np.linalg.norm(r, axis=1)
             return rho - 0.5 * self.size[0], r / np.where(rho > 0, rho, 1.0)[:, None]
         if self.shape == "cylinder":
-            return _cylinder(r, np.asarray(self.axis), 0.5 * self.size[0], 0.5 * self.size[1])
+            return cylinder_distance(r, np.asarray(self.axis), 0.5 * self.size[0], 0.5 * self.size[1])
         F = self.frame_matrix
         d, n = _box(r @ F, 0.5 * np.asarray(self.size, dtype=float))
         return d, n @ F.T
@@ -72,7 +73,7 @@ class Body:
         """The body's points deepest along -u (m, 3), those nearest ref where that is an edge or
         a face (:func:`softhand.reduced.holding.object_geometry.support_point`), placed pose."""
         c = np.asarray(self.centre)
-        F = _cylinder_frame(np.asarray(self.axis)) if self.shape == "cylinder" else self.frame_matrix
+        F = cylinder_frame(np.asarray(self.axis)) if self.shape == "cylinder" else self.frame_matrix
         local = support_point(self.shape, self.size, np.asarray(u) @ F, (np.asarray(ref) - c) @ F)
         return c + local @ F.T
 
@@ -84,27 +85,6 @@ class Body:
             return _cylinder_surface(np.asarray(self.centre), np.asarray(self.axis),
                                      0.5 * self.size[0], self.size[1], n)
         return _box_surface(np.asarray(self.centre), 0.5 * np.asarray(self.size, dtype=float), self.frame_matrix)
-
-
-def _cylinder_frame(e):
-    """Columns: a unit vector normal to e, e, and their cross product (a cylinder's own frame, axis y)."""
-    u = np.cross(e, [1.0, 0.0, 0.0] if abs(e[0]) < 0.9 else [0.0, 1.0, 0.0])
-    u /= np.linalg.norm(u)
-    return np.column_stack([u, e, np.cross(u, e)])
-
-
-def _cylinder(r, e, R, h):
-    a = r @ e
-    radial = r - a[:, None] * e
-    rho = np.linalg.norm(radial, axis=1)
-    er = radial / np.where(rho > 0, rho, 1.0)[:, None]
-    dr, da = rho - R, np.abs(a) - h
-    ea = np.sign(a)[:, None] * e
-    out = (dr > 0) & (da > 0)
-    d = np.where(out, np.hypot(np.maximum(dr, 0), np.maximum(da, 0)), np.maximum(dr, da))
-    n_out = (dr[:, None] * er + da[:, None] * ea) / np.where(out, d, 1.0)[:, None]
-    n = np.where(out[:, None], n_out, np.where((dr >= da)[:, None], er, ea))
-    return d, n
 
 
 def _box(r, h):
@@ -128,7 +108,7 @@ def _sphere_surface(c, R, n):
 
 
 def _cylinder_surface(c, e, R, length, n):
-    u = _cylinder_frame(e)[:, 0]
+    u = cylinder_frame(e)[:, 0]
     v = np.cross(e, u)
     p = np.linspace(0.0, 2 * math.pi, n, endpoint=False)
     ring = R * (np.cos(p)[:, None] * u + np.sin(p)[:, None] * v)

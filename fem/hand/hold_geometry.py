@@ -30,10 +30,11 @@ and its normal with it, while the support point's normal turns with the pad (the
 rounded edge as its radius goes to 0). A mesh's support point is its extreme vertex where that is
 one of its edges or corners (on ties the nearest point of the tied face or edge); on a smooth
 surface's facets the deepest pad point on the mesh's smooth (cubic B-spline) distance stays
-(:func:`softhand.reduced.holding.object_mesh.mesh_support`). A box (of any rotation) meets a
-pad by separating axes instead (:mod:`softhand.reduced.holding.box_contact`), which also gives the normal
-of a pad's side lying across one of its edges (the cross product of the two edges; the
-deepest pad point's face normal flips there). A pad whose plane has the
+(:func:`softhand.reduced.holding.object_mesh.mesh_support`). A box (of any rotation) and a
+cylinder (of any axis) meet a pad by the largest separation over directions instead
+(:mod:`softhand.reduced.holding.box_contact`, :mod:`softhand.reduced.holding.cylinder_contact`),
+which also gives the normal of a pad's side lying across an edge or a rim (the two edges'
+common normal; the deepest pad point's face normal flips there). A pad whose plane has the
 object's centre behind it cannot touch: its gap is +inf (as in :mod:`softhand.fem.contact`).
 """
 from __future__ import annotations
@@ -47,6 +48,7 @@ from scipy.spatial.transform import Rotation
 from softhand.fem.constraints import PlanarChain
 from softhand.fem.hand.frame import hand_frame
 from softhand.reduced.holding.box_contact import box_pad_contacts
+from softhand.reduced.holding.cylinder_contact import cylinder_pad_contacts
 from softhand.reduced.holding.object_geometry import over_pad
 
 
@@ -184,10 +186,15 @@ def pad_contacts(body, pose: Pose, frames, padsets, qs, *, iterations: int = 40)
     point = lambda s, z: A + s[:, None] * AB + z[:, None] * e_n  # noqa: E731
     facing = np.cross(e_n, AB)  # the pad's normal towards the closing side (finger frame +y)
     facing /= np.linalg.norm(facing, axis=1)[:, None]
-    if getattr(body, "shape", None) == "box":  # separating axes (:mod:`softhand.reduced.holding.box_contact`)
+    shape = getattr(body, "shape", None)
+    if shape in ("box", "cylinder"):  # the largest separation over directions (module doc)
         L = np.sqrt(L2)
-        d, n, x = box_pad_contacts(c, pose.R @ body.frame_matrix, 0.5 * np.asarray(body.size, float),
-                                   A + 0.5 * AB, AB / L[:, None], 0.5 * L, e_n, half, facing, point(sigma, zeta))
+        pads = (A + 0.5 * AB, AB / L[:, None], 0.5 * L, e_n, half, facing, point(sigma, zeta))
+        if shape == "box":
+            d, n, x = box_pad_contacts(c, pose.R @ body.frame_matrix, 0.5 * np.asarray(body.size, float), *pads)
+        else:
+            d, n, x = cylinder_pad_contacts(c, pose.R @ np.asarray(body.axis), 0.5 * body.size[0], 0.5 * body.size[1],
+                                            *pads, lambda p: signed_distance(body, pose, p))
         sigma, zeta = np.einsum("ki,ki->k", x - A, AB) / L2, np.einsum("ki,ki->k", x - A, e_n)
         return _contacts(d, n, x, facing, c, A0, B0, sigma, zeta)
     d, n = signed_distance(body, pose, point(sigma, zeta))

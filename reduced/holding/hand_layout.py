@@ -33,6 +33,7 @@ from softhand.reduced.equations import contact, kinematics
 from softhand.reduced.vocabulary.design import HandDesign
 from softhand.reduced.vocabulary.errors import InputError
 from softhand.reduced.holding.box_contact import box_pad_contacts
+from softhand.reduced.holding.cylinder_contact import cylinder_distance, cylinder_pad_contacts
 from softhand.reduced.holding.object_geometry import Placed, over_pad, place
 from softhand.reduced.holding.objects import CLEARANCE, PALM_GAP, GraspObject
 
@@ -131,8 +132,8 @@ def pad_distance(placed: Placed, p: Pads) -> PadDistance:
     s = np.minimum(np.maximum(np.einsum("fki,fki->fk", d, p.along), -p.half[:, 0]), p.half[:, 0])
     w = np.minimum(np.maximum(np.einsum("fki,fki->fk", d, p.across), -p.half[:, 1]), p.half[:, 1])
     ref = p.centre + s[..., None] * p.along + w[..., None] * p.across
-    if placed.obj.shape == "box":
-        return _box_distance(placed, p, ref)
+    if placed.obj.shape in ("box", "cylinder"):
+        return _polytope_distance(placed, p, ref)
     if placed.obj.shape == "sphere":
         x = ref
         gap = placed.sdf(x)
@@ -151,13 +152,20 @@ def pad_distance(placed: Placed, p: Pads) -> PadDistance:
     return PadDistance(gap, x, n)
 
 
-def _box_distance(placed: Placed, p: Pads, ref) -> PadDistance:
-    """A box's gaps by separating axes (:mod:`softhand.reduced.holding.box_contact`, the FEM hold's rule)."""
+def _polytope_distance(placed: Placed, p: Pads, ref) -> PadDistance:
+    """A box's or a cylinder's gaps by the largest separation over directions, the FEM hold's rule
+    (:mod:`softhand.reduced.holding.box_contact`, :mod:`softhand.reduced.holding.cylinder_contact`)."""
     shape = p.centre.shape
     half = np.broadcast_to(p.half, shape[:-1] + (2,)).reshape(-1, 2)
     flat = lambda v: np.reshape(v, (-1, 3))  # noqa: E731
-    gap, n, x = box_pad_contacts(placed.centre, placed.R, 0.5 * np.asarray(placed.obj.size_mm, float), flat(p.centre),
-                                 flat(p.along), half[:, 0], flat(p.across), half[:, 1], flat(p.normal), flat(ref))
+    pads = (flat(p.centre), flat(p.along), half[:, 0], flat(p.across), half[:, 1], flat(p.normal), flat(ref))
+    obj = placed.obj
+    if obj.shape == "box":
+        gap, n, x = box_pad_contacts(placed.centre, placed.R, 0.5 * np.asarray(obj.size_mm, float), *pads)
+    else:
+        k, r, h = placed.R[:, 1], 0.5 * obj.diameter_mm, 0.5 * obj.length_mm  # a cylinder's axis: its own y
+        gap, n, x = cylinder_pad_contacts(placed.centre, k, r, h, *pads,
+                                          lambda q: cylinder_distance(q - placed.centre, k, r, h))
     x, n = x.reshape(shape), n.reshape(shape)
     towards = np.einsum("...i,...i->...", placed.centre - x, p.normal) > 0.0
     return PadDistance(np.where(towards, gap.reshape(shape[:-1]), np.inf), x, n)
