@@ -6,7 +6,7 @@ reduced``, calibrated finger) on the case the FEM ran and prints one row: held o
 holding limit and one pad's normal force in each, and the relative differences. The FEM's rows
 take minutes each (make them first, e.g. with nice in the background); this takes a second.
 ``--reference`` runs the fast model on the FEM holds the project keeps instead
-(``studies/data/hold_fem_limits.json``, :mod:`softhand.studies.hold_reference`: 53 cases, ~15 s)
+(``studies/data/hold_fem_limits.json``, :mod:`softhand.studies.hold_reference`: 56 cases, ~15 s)
 and prints each verdict and error and how many limits are within 5 and 10 %.
 
     python benchmarks/hold_fast_vs_fem.py RESULT.json [RESULT.json ...] [--markdown]
