@@ -41,31 +41,31 @@ def _separation(U, D, k, r, h, a, hl, e, hw):
     return np.abs(along) - radius, np.where(along < 0.0, -1.0, 1.0)
 
 
-def _circle_max(v1, v2, D, k, r, h, a, hl, e, hw):
-    """The largest separation on the great circle of v1, v2 (m, 3) and its oriented direction."""
+def _circle_max(v1, v2, D, k, r, h, a, hl, e, hw, steps=None):
+    """The largest separation on each great circle of v1, v2 (m, 3) and its oriented direction."""
     args = (D, k, r, h, a, hl, e, hw)
     theta = np.linspace(0.0, np.pi, SAMPLES, endpoint=False)
     U = np.cos(theta)[None, :, None] * v1[:, None] + np.sin(theta)[None, :, None] * v2[:, None]
     best = np.argmax(_separation(U, *args)[0], axis=1)
     step = np.pi / SAMPLES
     lo, hi = theta[best] - step, theta[best] + step
-    at = lambda t: np.cos(t)[:, None] * v1 + np.sin(t)[:, None] * v2  # noqa: E731
-    x1, x2 = hi - _GOLD * (hi - lo), lo + _GOLD * (hi - lo)
-    f1, f2 = _separation(at(x1), *args)[0], _separation(at(x2), *args)[0]
-    for _ in range(STEPS):  # golden section: keep the bracket of the larger
-        left = f1 >= f2
-        lo, hi = np.where(left, lo, x1), np.where(left, x2, hi)
-        x2n = np.where(left, x1, lo + _GOLD * (hi - lo))
-        x1n = np.where(left, hi - _GOLD * (hi - lo), x2)
-        fn = _separation(at(np.where(left, x1n, x2n)), *args)[0]
-        f1, f2 = np.where(left, fn, f2), np.where(left, f1, fn)
-        x1, x2 = x1n, x2n
-    u = at(0.5 * (lo + hi))
+    x = np.stack([hi - _GOLD * (hi - lo), lo + _GOLD * (hi - lo)])          # (2, m): the two probes
+    V1, V2 = np.stack([v1, v1]), np.stack([v2, v2])
+    at = lambda t: np.cos(t)[..., None] * V1 + np.sin(t)[..., None] * V2  # noqa: E731
+    fx = _separation(at(x).transpose(1, 0, 2), *args)[0].T                # (2, m)
+    for _ in range(STEPS if steps is None else steps):  # golden section: keep the bracket of the larger probe
+        left = fx[0] >= fx[1]
+        lo, hi = np.where(left, lo, x[0]), np.where(left, x[1], hi)
+        new = np.where(left, hi - _GOLD * (hi - lo), lo + _GOLD * (hi - lo))
+        fn = _separation(np.cos(new)[:, None] * v1 + np.sin(new)[:, None] * v2, *args)[0]
+        x = np.where(left, np.stack([new, x[0]]), np.stack([x[1], new]))
+        fx = np.where(left, np.stack([fn, fx[0]]), np.stack([fx[1], fn]))
+    u = np.cos(0.5 * (lo + hi))[:, None] * v1 + np.sin(0.5 * (lo + hi))[:, None] * v2
     s, sign = _separation(u, *args)
     return s, u * sign[:, None]
 
 
-def cylinder_pad_contacts(centre, axis, radius, half_length, pc, a, hl, e, hw, facing, ref, sdf):
+def cylinder_pad_contacts(centre, axis, radius, half_length, pc, a, hl, e, hw, facing, ref, sdf, steps=None):
     """Contacts of m pads with one cylinder (centre (3,), unit axis (3,), radius and half length
     [mm], hand frame now); pads as :func:`softhand.reduced.holding.box_contact.box_pad_contacts`,
     ``sdf(points (n, 3)) -> (d, outward normal)`` the cylinder's own signed distance (for the
@@ -82,8 +82,10 @@ def cylinder_pad_contacts(centre, axis, radius, half_length, pc, a, hl, e, hw, f
     cand_u = [facing[:, None], -np.asarray(n_c).reshape(m, 4, 3)]       # face; each corner's own
     s_face, sign = _separation(facing[:, None], *args)
     s_corner, sign_c = _separation(cand_u[1], *args)
-    s_side, u_side = _circle_max(facing, e, *args)
-    s_end, u_end = _circle_max(facing, a, *args)
+    both = _circle_max(np.concatenate([facing, facing]), np.concatenate([e, a]), np.concatenate([D, D]), k,
+                       float(radius), float(half_length), np.concatenate([a, a]), np.concatenate([hl, hl]),
+                       np.concatenate([e, e]), np.concatenate([hw, hw]), steps)   # the sides' circles, then the ends'
+    (s_side, s_end), (u_side, u_end) = np.split(both[0], 2), np.split(both[1], 2)
     S = np.concatenate([s_face, s_side[:, None], s_end[:, None], s_corner], axis=1)   # (m, 7)
     U = np.concatenate([facing[:, None] * sign[..., None], u_side[:, None], u_end[:, None],
                         cand_u[1] * sign_c[..., None]], axis=1)

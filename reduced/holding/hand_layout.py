@@ -164,8 +164,9 @@ def _polytope_distance(placed: Placed, p: Pads, ref) -> PadDistance:
         gap, n, x = box_pad_contacts(placed.centre, placed.R, 0.5 * np.asarray(obj.size_mm, float), *pads)
     else:
         k, r, h = placed.R[:, 1], 0.5 * obj.diameter_mm, 0.5 * obj.length_mm  # a cylinder's axis: its own y
+        # the circles' maxima to 1e-7 rad (the FEM's central differences need them to round-off)
         gap, n, x = cylinder_pad_contacts(placed.centre, k, r, h, *pads,
-                                          lambda q: cylinder_distance(q - placed.centre, k, r, h))
+                                          lambda q: cylinder_distance(q - placed.centre, k, r, h), steps=30)
     x, n = x.reshape(shape), n.reshape(shape)
     towards = np.einsum("...i,...i->...", placed.centre - x, p.normal) > 0.0
     return PadDistance(np.where(towards, gap.reshape(shape[:-1]), np.inf), x, n)
