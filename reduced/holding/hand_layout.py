@@ -133,7 +133,7 @@ def pad_distance(placed: Placed, p: Pads) -> PadDistance:
     w = np.minimum(np.maximum(np.einsum("fki,fki->fk", d, p.across), -p.half[:, 1]), p.half[:, 1])
     ref = p.centre + s[..., None] * p.along + w[..., None] * p.across
     if placed.obj.shape in ("box", "cylinder"):
-        return _polytope_distance(placed, p, ref)
+        return _convex_distance(placed, p, ref)
     if placed.obj.shape == "sphere":
         x = ref
         gap = placed.sdf(x)
@@ -152,7 +152,7 @@ def pad_distance(placed: Placed, p: Pads) -> PadDistance:
     return PadDistance(gap, x, n)
 
 
-def _polytope_distance(placed: Placed, p: Pads, ref) -> PadDistance:
+def _convex_distance(placed: Placed, p: Pads, ref) -> PadDistance:
     """A box's or a cylinder's gaps by the largest separation over directions, the FEM hold's rule
     (:mod:`softhand.reduced.holding.box_contact`, :mod:`softhand.reduced.holding.cylinder_contact`)."""
     shape = p.centre.shape
