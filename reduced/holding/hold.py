@@ -10,7 +10,8 @@ holding limit is the first maximum along that slide; a pull towards the palm is 
 into the hand, the object meets the palm, which is not a contact of this model, and fingers pushed
 open past straight, where the hinge tables do not reach). It returns the common
 :class:`softhand.reduced.holding.hold_result.HoldResult` (model ``"reduced"``); the object's displacement
-is its slide under its own weight, along the pull (it does not turn in this model).
+is its slide under its own weight, along the pull, and its rotation the turn the slide gave it
+(:mod:`softhand.reduced.holding.hold_turn`).
 
 :func:`least_pressure` answers the inverse question: the least pump pressure (and its cavity
 pressure) at which the holding limit along the pull reaches the margin asked -- the object's
@@ -23,14 +24,13 @@ the reservoir's, which falls as the fingers take its oil). Units: N, mm, MPa, kg
 from __future__ import annotations
 
 import math
-from dataclasses import replace
 from typing import NamedTuple
 
 import numpy as np
 from scipy.optimize import brentq
 
 from softhand.reduced.equations import hand
-from softhand.reduced.holding import hold_fast, hold_finger, hold_lp, hold_slide
+from softhand.reduced.holding import hold_fast, hold_finger, hold_lp, hold_slide, hold_turn
 from softhand.reduced.vocabulary.design import HandDesign
 from softhand.reduced.vocabulary.errors import InputError
 from softhand.reduced.holding.hand_layout import place_object
@@ -115,24 +115,40 @@ def solve_hold(design: HandDesign, obj: GraspObject, *, P_cavity_MPa: float, pul
     size = float(np.max(np.ptp(placed.surface(resolution=8)[0], axis=0)))
 
     hands = {} if slide_hands is None else slide_hands
+    hands[(0.0, placed.R.tobytes())] = closed
 
-    def at(y, hand=None):
+    def hand_at(y, moved):
+        """The hand closed on the object at pose ``moved`` (y [mm] along the slide); None where the object
+        has moved into the open fingers (they have let it through)."""
+        key = (y, moved.R.tobytes())
+        if key not in hands:
+            near = hands[min(hands, key=lambda x: abs(x[0] - y))] if hands else None
+            try:
+                hands[key] = hold_fast.close_hand(closed.P_cavity, moved, d, reservoir_on=reservoir, near=near)
+            except InputError:
+                hands[key] = None
+        return hands[key]
+
+    def rate(y, moved):  # the object's turn per mm of slide at this pose (hold_turn)
+        hand = hand_at(y, moved)
+        return np.zeros(3) if hand is None else hold_turn.turn_rate(
+            contact_set(hand, d), moved.centre, weight, pull, obj.friction, size_mm=size)
+
+    path_of = hold_turn.Path(placed, pull, None if obj.shape == "sphere" else rate)
+
+    def at(y):
         """(lam, (placed, closed, contact set, limit state)) with the object moved y [mm] along the pull."""
         if y > 0.0 and pull[1] < 0.0:  # pushed towards the palm: not followed (module doc)
             return -math.inf, None
-        moved = placed if y == 0.0 else replace(placed, centre=placed.centre + y * pull)
-        near = hands[min(hands, key=lambda x: abs(x - y))] if hands else None
-        try:
-            hand = hand or hands.get(y) or hold_fast.close_hand(closed.P_cavity, moved, d, reservoir_on=reservoir,
-                                                                near=near)
-        except InputError:  # moved into the open fingers: they have let it through
+        moved = path_of.at(y)
+        hand = hand_at(y, moved)
+        if hand is None:
             return -math.inf, None
-        hands[y] = hand
         cs = contact_set(hand, d)
         lim = hold_lp.holding_limit(cs, moved.centre, weight, pull, obj.friction, size_mm=size)
         return (lim.pull_N if lim is not None else -math.inf), (moved, hand, cs, lim)
 
-    first = at(0.0, closed)
+    first = at(0.0)
     path = hold_slide.follow(at, first, weight_N=weight, slip_out_mm=0.5 * size_radius(obj), enough_N=enough_N,
                              settle=bool(pull[1] >= 1.0 - 1e-12))  # settles under its weight along a pull down
     moved, closed_rest, cs, _ = path.rest if path.rest is not None else first[1]
@@ -157,9 +173,11 @@ def solve_hold(design: HandDesign, obj: GraspObject, *, P_cavity_MPa: float, pul
     steps = (LoadStep("close", closed.P_cavity, 0.0, bool(len(cs.finger)), contacts=len(cs.finger),
                       extra={"hinge_residual": residual}),
              LoadStep("release", closed.P_cavity, 0.0, held, displacement_mm=shift(y_rest),
+                      rotation_deg=path_of.rotation_deg(y_rest),
                       contacts=len(_contacts(cs, rest, held)) if held else 0,
                       extra={"equilibrium_residual": rest.residual if rest is not None else math.nan}),
              LoadStep("pull", closed.P_cavity, holding, held, displacement_mm=shift(path.y_limit),
+                      rotation_deg=path_of.rotation_deg(path.y_limit),
                       contacts=len(_contacts(cs_limit, limit, held)) if held else 0,
                       extra={"equilibrium_residual": limit.residual if limit is not None else math.nan}))
     return HoldResult(
@@ -167,7 +185,7 @@ def solve_hold(design: HandDesign, obj: GraspObject, *, P_cavity_MPa: float, pul
         contacts=_contacts(cs, rest if held else None, held), P_cavity_MPa=float(closed.P_cavity),
         P_pump_MPa=float((closed_rest if held else closed).P_pump), mass_kg=obj.mass_kg, friction=obj.friction,
         object=obj.to_dict(), steps=steps, symmetric=closed.symmetric, notes=tuple(notes),
-        displacement_mm=shift(y_rest),
+        displacement_mm=shift(y_rest), rotation_deg=path_of.rotation_deg(y_rest),
         extra={"finger_model": d.finger_model, "hinge_residual": residual,
                "limit_contacts": [c._asdict() if hasattr(c, "_asdict") else c.__dict__
                                   for c in _contacts(cs_limit, limit, held)] if held else [],

@@ -161,16 +161,19 @@ def _state(z, cs: ContactSet, gens, mu, A_eq, b_eq, size: float) -> LimitState:
 
 
 def holding_limit(cs: ContactSet, centre, weight_N: float, pull, mu: float, *,
-                  size_mm: float = 100.0) -> LimitState | None:
+                  size_mm: float = 100.0, moment=None) -> LimitState | None:
     """The largest pull lam [N] along the unit vector ``pull`` beyond the weight ``weight_N`` (along
     +y) that an admissible state bears (module doc), and that state; None if none exists even
     with the pull turned into a push of the weight's size (the object is not held at all).
-    ``size_mm`` scales the moment residual."""
+    ``size_mm`` scales the moment residual; ``moment``: a moment [N mm] (3,) applied to the object
+    besides (:mod:`softhand.reduced.holding.hold_turn` differentiates the limit by it)."""
     if not len(cs.finger):
         return None
     load = np.asarray(pull, float)
     gens = tangent_generators(cs.normal, load)
     A_eq, b_eq, A_ub, b_ub, Q = _system(cs, centre, weight_N, load, mu, gens)
+    if moment is not None:
+        b_eq[3:6] -= np.asarray(moment, float)
     c = np.zeros(A_eq.shape[1])
     c[-1] = -1.0
     bounds = _bounds(len(cs.finger), gens.shape[1], Q, (-weight_N - 1.0, MAX_PULL))

@@ -21,8 +21,9 @@ while lam grows, then narrows the maximum's bracket by golden sections to :data:
 lam does not grow over the first step (the usual case: an object held above its widest section,
 a box by its edges, a flat lam) it costs one evaluation more than the limit at the grasp. The
 first step is short, so that a fall right from the grasp is seen as one (a ball touching next to
-a hinge, whose pull falls before the ball passes onto the next pad, is let go at the grasp). The slide
-is a translation along the pull (the object does not turn as it slides). Past y = 0, lam(y) is the
+a hinge, whose pull falls before the ball passes onto the next pad, is let go at the grasp). The object's
+centre moves along the pull; a box turned about the pull's axis also turns as it slides, as the
+limit analysis's mechanism turns it (:mod:`softhand.reduced.holding.hold_turn`). Past y = 0, lam(y) is the
 least pull borne over [y, y + :data:`WEDGE_MM`]: where the object passes the crease between two pads, the
 rigid pads of the limit analysis squeeze it between both for a fraction of a millimetre, and the
 pull they bear there jumps by 20-35 % and falls back, a little below where it was, for a fraction of a
