@@ -161,7 +161,7 @@ class PlacedBody:
 def body_of(obj, design):
     """The FEM's body for a :class:`softhand.reduced.holding.objects.GraspObject` at its placement (checked:
     InputError if it overlaps the open fingers or the palm): analytic for a sphere, a cylinder
-    and a box, else the object's own distance queries."""
+    and a box (and a mesh that is a box), else the object's own distance queries."""
     from softhand.reduced.holding.hand_layout import place_object
     from softhand.reduced.holding.object_geometry import size_radius
 
@@ -176,4 +176,9 @@ def body_of(obj, design):
     if obj.shape == "box":
         frame = tuple(map(tuple, placed.R)) if any(obj.rotation_deg) else None
         return Body("box", centre, tuple(obj.size_mm), frame=frame, **common)
+    box = placed.box()  # a mesh that is a box meets the pads as the box does
+    if box is not None:
+        return Body("box", tuple(float(c) for c in box[0]), tuple(float(2.0 * h) for h in box[2]),
+                    frame=tuple(tuple(float(v) for v in row) for row in box[1]),
+                    **common)
     return PlacedBody(placed, radius=size_radius(obj), **common)

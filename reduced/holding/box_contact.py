@@ -23,6 +23,8 @@ by a fraction of the sample spacing, onto the face, with the face's normal.
 Where the two are apart with a corner nearest a corner or an edge (no candidate axis is
 the distance's direction), s is less than the distance: only touching pads bear force, and
 at touch the largest s is exact.
+
+A mesh that is a rectangular box (:func:`cuboid_of`) is met as the box is.
 """
 from __future__ import annotations
 
@@ -83,3 +85,31 @@ def box_pad_contacts(centre, axes, half, pc, a, hl, e, hw, facing, ref):
     s = np.where(cross & side, np.clip(t, -hl, hl), np.where(cross, s_pad, s))
     w = np.where(cross & ~side, np.clip(t, -hw, hw), np.where(cross, w_pad, w))
     return sep[rows, k], -u, pc + s[:, None] * a + w[:, None] * e
+
+
+#: a mesh is a box when its volume and its oriented bounding box's agree to this (relative)
+CUBOID_TOL = 1e-6
+
+
+def cuboid_of(vertices, faces):
+    """(half edges (3,), axes (3, 3) as columns, centre (3,)) of the mesh if it is a rectangular box --
+    its volume that of its smallest oriented bounding box (trimesh), to :data:`CUBOID_TOL` -- else None.
+    A box read from a file then meets the pads as the box primitive does, by separating axes, in
+    both hold models (its distance grid rounds the edges over a grid step)."""
+    import trimesh
+
+    mesh = trimesh.Trimesh(vertices, faces, process=False)
+    to_origin, extents = trimesh.bounds.oriented_bounds(mesh)
+    if not abs(float(np.prod(extents)) - float(mesh.volume)) <= CUBOID_TOL * float(mesh.volume):
+        return None
+    A = np.asarray(to_origin, float)[:3, :3].T                 # the box's axes in the object frame, to ~1e-8
+    # to round-off: each axis the area-weighted mean of its faces' normals, then the nearest rotation
+    n = mesh.face_normals * mesh.area_faces[:, None]
+    along = n @ A                                               # (nf, 3)
+    side = np.abs(mesh.face_normals @ A).argmax(axis=1)
+    M = np.stack([(np.sign(along[side == i, i])[:, None] * n[side == i]).sum(axis=0) for i in range(3)], axis=1)
+    U, _, Vt = np.linalg.svd(M)
+    A = U @ Vt * [1.0, 1.0, np.sign(np.linalg.det(U @ Vt))]  # a rotation (a box is its own mirror image)
+    x = np.asarray(vertices, float) @ A
+    lo, hi = x.min(axis=0), x.max(axis=0)
+    return 0.5 * (hi - lo), A, A @ (0.5 * (hi + lo))

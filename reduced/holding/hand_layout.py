@@ -119,7 +119,7 @@ class PadDistance(NamedTuple):
 
 def pad_distance(placed: Placed, p: Pads) -> PadDistance:
     """Gap of every pad to the object: exact for a sphere (the pad rectangle's point nearest the
-    centre); for a box by separating axes (:mod:`softhand.reduced.holding.box_contact`, as the FEM
+    centre); for a box (or a mesh that is one) by separating axes (:mod:`softhand.reduced.holding.box_contact`, as the FEM
     hold: a pad's side across a box edge has the two edges' cross product as normal); otherwise the least distance on a :data:`PAD_SAMPLES` grid of the pad refined by a
     parabola through the least sample and its neighbours, along then across (exact for a flat
     face; error O(h^3) on a curved one, h = 1/16 of the link). Then, by the FEM hold's own rule
@@ -132,7 +132,7 @@ def pad_distance(placed: Placed, p: Pads) -> PadDistance:
     s = np.minimum(np.maximum(np.einsum("fki,fki->fk", d, p.along), -p.half[:, 0]), p.half[:, 0])
     w = np.minimum(np.maximum(np.einsum("fki,fki->fk", d, p.across), -p.half[:, 1]), p.half[:, 1])
     ref = p.centre + s[..., None] * p.along + w[..., None] * p.across
-    if placed.obj.shape in ("box", "cylinder"):
+    if placed.obj.shape == "cylinder" or placed.box() is not None:
         return _convex_distance(placed, p, ref)
     if placed.obj.shape == "sphere":
         x = ref
@@ -153,15 +153,16 @@ def pad_distance(placed: Placed, p: Pads) -> PadDistance:
 
 
 def _convex_distance(placed: Placed, p: Pads, ref) -> PadDistance:
-    """A box's or a cylinder's gaps by the largest separation over directions, the FEM hold's rule
+    """A box's (or a box mesh's) or a cylinder's gaps by the largest separation over directions, the FEM hold's rule
     (:mod:`softhand.reduced.holding.box_contact`, :mod:`softhand.reduced.holding.cylinder_contact`)."""
     shape = p.centre.shape
     half = np.broadcast_to(p.half, shape[:-1] + (2,)).reshape(-1, 2)
     flat = lambda v: np.reshape(v, (-1, 3))  # noqa: E731
     pads = (flat(p.centre), flat(p.along), half[:, 0], flat(p.across), half[:, 1], flat(p.normal), flat(ref))
     obj = placed.obj
-    if obj.shape == "box":
-        gap, n, x = box_pad_contacts(placed.centre, placed.R, 0.5 * np.asarray(obj.size_mm, float), *pads)
+    box = placed.box()
+    if box is not None:
+        gap, n, x = box_pad_contacts(*box, *pads)
     else:
         k, r, h = placed.R[:, 1], 0.5 * obj.diameter_mm, 0.5 * obj.length_mm  # a cylinder's axis: its own y
         # the circles' maxima to 1e-7 rad (the FEM's central differences need them to round-off)

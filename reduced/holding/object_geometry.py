@@ -199,6 +199,17 @@ class Placed:
             local = support_point(self.obj.shape, dimensions(self.obj), u, ref)
         return self.centre + local @ self.R.T
 
+    def box(self):
+        """(centre (3,), axes (3, 3) as columns, half edges (3,)) in the hand frame [mm] of a box, or of
+        a mesh that is one (:func:`~softhand.reduced.holding.box_contact.cuboid_of`); None otherwise."""
+        if self.obj.shape == "box":
+            return self.centre, self.R, 0.5 * np.asarray(self.obj.size_mm, float)
+        cuboid = read_mesh(self.obj.file).cuboid if self.obj.shape == "mesh" else None
+        if cuboid is None:
+            return None
+        half, A, c = cuboid
+        return self.centre + self.R @ c, self.R @ A, half
+
     def surface(self, *, resolution: int = 32) -> tuple[np.ndarray, np.ndarray]:
         """The surface as (points (m, 3) in the hand frame [mm], triangles (k, 3))."""
         pts, tris = surface(self.obj, resolution=resolution)

@@ -17,6 +17,7 @@ from pathlib import Path
 
 import numpy as np
 
+from softhand.reduced.holding.box_contact import cuboid_of
 from softhand.reduced.vocabulary.errors import InputError
 
 #: mesh files read (trimesh's loaders)
@@ -39,6 +40,10 @@ class MeshData:
     #: at the grid points, negative inside [mm]
     spline: np.ndarray
     folds: np.ndarray      #: (nv,) True at a vertex of an edge where the surface folds > FOLD_DEG
+    #: a mesh that is a rectangular box (:func:`~softhand.reduced.holding.box_contact.cuboid_of`):
+    #: (half edges (3,) [mm], its axes (3, 3) as columns, its centre (3,) [mm]) in the object
+    #: frame; None for any other solid
+    cuboid: tuple | None = None
 
 
 @lru_cache(maxsize=8)
@@ -86,7 +91,8 @@ def read_mesh(path: str, field: str = "object.file") -> MeshData:
     from scipy.ndimage import spline_filter
 
     return MeshData(vertices, faces, axes, spline_filter(distance, order=3, mode="nearest"),
-                    fold_vertices(vertices, faces))
+                    fold_vertices(vertices, faces), cuboid_of(vertices, faces))
+
 
 
 def check_encloses_once(volume: float, area: float, distance: np.ndarray, step: float, field: str, path) -> None:
