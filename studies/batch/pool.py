@@ -12,6 +12,7 @@ import os
 import shutil
 import signal
 import sys
+import threading
 from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 from concurrent.futures.process import BrokenProcessPool
 
@@ -97,20 +98,34 @@ def limit_threads(threads: int) -> None:
     threadpool_limits(limits=threads)
 
 
-def stop_worker(signum, frame) -> None:
-    """A pool worker's SIGTERM (the parent stopping the pool): the private folder of the case
-    it is computing removed, then exit at once (nothing of the case reaches the results)."""
+def stop_worker(signum, frame=None) -> None:
+    """A pool worker's SIGTERM (the parent stopping the pool, or dying): the private folder of the
+    case it is computing removed, then exit at once (nothing of the case reaches the results)."""
     for folder in list(CASE_FOLDERS):
         shutil.rmtree(folder, ignore_errors=True)
     os._exit(128 + signum)
 
 
+def _await_sigterm() -> None:
+    """A worker's thread that takes its SIGTERM (blocked in every other thread) and stops it."""
+    stop_worker(signal.sigwait({signal.SIGTERM}))
+
+
 def _worker_init(parent: int, threads: int) -> None:
     """In each pool worker: its share of the cores' threads; die with the parent (Linux:
     PR_SET_PDEATHSIG, as SIGTERM); SIGTERM ends it at once, without the case's temporary folder; Ctrl-C
-    (SIGINT to the whole process group) is the parent's to handle: it stops the workers."""
+    (SIGINT to the whole process group) is the parent's to handle: it stops the workers.
+
+    SIGTERM is taken by a thread of its own (:func:`_await_sigterm`), blocked in every other: a
+    process's signal goes to any thread that does not block it, and the worker's libraries start
+    threads (three in a worker here); Python runs a handler only in its main thread, which, waiting
+    for the next case in a read() of the pool's pipe that another thread's signal does not
+    interrupt, slept on (about one killed parent in 60 left a worker alive, measured)."""
+    signal.signal(signal.SIGTERM, stop_worker)  # where a thread that does not block it takes it
+    if hasattr(signal, "pthread_sigmask"):  # first: every thread started later inherits the block
+        signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGTERM})
+        threading.Thread(target=_await_sigterm, name="softhand-sigterm", daemon=True).start()
     limit_threads(threads)
-    signal.signal(signal.SIGTERM, stop_worker)
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     try:
         import ctypes

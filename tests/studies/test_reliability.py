@@ -204,6 +204,52 @@ def test_pool_workers_die_with_a_killed_parent(logged_study, tmp_path):
     assert not any(map(_alive, workers))
 
 
+def _forked_worker(folder: str, report) -> None:
+    """A pool worker's life after its set-up: a case's folder, three threads a library starts, and
+    asleep in a read, as a worker waiting for its next case."""
+    import threading
+
+    from softhand.studies.batch import cases, pool
+
+    pool._worker_init(os.getppid(), 1)
+    os.makedirs(folder)
+    cases.CASE_FOLDERS.add(folder)
+    masks = []
+
+    def library_thread():
+        masks.append(signal.SIGTERM in signal.pthread_sigmask(signal.SIG_BLOCK, set()))
+        time.sleep(60)
+
+    for _ in range(3):
+        threading.Thread(target=library_thread, daemon=True).start()
+    while len(masks) < 3:
+        time.sleep(0.01)
+    report.send(all(masks) and signal.SIGTERM in signal.pthread_sigmask(signal.SIG_BLOCK, set()))
+    os.read(os.pipe()[0], 1)
+
+
+@pytest.mark.skipif(not hasattr(signal, "pthread_sigmask"), reason="needs POSIX signal masks")
+def test_a_worker_takes_its_sigterm_in_a_thread_of_its_own(tmp_path):
+    """A process's signal goes to any of its threads that does not block it, and Python runs handlers
+    only in the main thread: a worker asleep in a read of the pool's pipe, whose library's thread took
+    the parent's death signal, slept on (about one killed parent in 60). In a worker forked as the
+    pool forks them, SIGTERM is blocked in every thread but the one that waits for it; it ends the
+    worker at once and removes the case's folder."""
+    import multiprocessing
+
+    ctx = multiprocessing.get_context("fork")
+    mine, theirs = ctx.Pipe()
+    folder = tmp_path / "case"
+    worker = ctx.Process(target=_forked_worker, args=(str(folder), theirs))
+    worker.start()
+    assert mine.poll(30) and mine.recv() is True  # blocked in the main thread and in the later ones
+    assert folder.is_dir()
+    os.kill(worker.pid, signal.SIGTERM)
+    worker.join(10)
+    assert worker.exitcode == 128 + signal.SIGTERM
+    assert not folder.exists()
+
+
 def test_a_closed_pipe_is_quiet(tmp_path):
     path = tmp_path / "s.toml"
     path.write_text('kind = "curve"\n[sweep]\ntheta_deg = "0:90:1"\n')
