@@ -160,7 +160,10 @@ def write_map(m: HoldMap, rows: list[dict], out) -> list:
             draw(m.max_pump_MPa, color="#1f4fb4", ls="--", label=f"pump limit {m.max_pump_MPa:g} MPa")
     ax.set_xlabel(f"{AXES[xn][0]} [{AXES[xn][1]}]")
     ax.set_ylabel(f"{AXES[yn][0]} [{AXES[yn][1]}]")
-    ax.set_title(f"hold map: {m.obj.describe()}; contours: load borne / weight")
+    pose = "".join(f", {word} {', '.join(f'{v:g}' for v in values)} {unit}" for word, values, unit in
+                   (("turned", m.obj.rotation_deg, "deg about x, y, z"), ("moved", m.obj.offset_mm, "mm"))
+                   if any(values))
+    ax.set_title(f"hold map: {m.obj.describe()}{pose}\ncontours: load borne / weight", fontsize=10)
     ax.legend(loc="best", fontsize=7)
     paths.append(save_figure(fig, out / "hold_map.png"))
     return paths
