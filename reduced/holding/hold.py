@@ -3,14 +3,15 @@ much more can it take along a pull, and what pump pressure holds it with a margi
 
 :func:`solve_hold` runs the path of the FEM hold in the fast model: close at the cavity pressure
 (:func:`softhand.reduced.holding.hold_fast.close_hand`), let go (the object's weight: the admissible state nearest
-the closing forces, :func:`softhand.reduced.holding.hold_lp.weight_state`), pull along a direction until no
+the closing forces, :func:`softhand.reduced.holding.hold_lp.weight_state`; an object whose weight the pads do
+not bear where it was grasped first settles under it, sliding down and turning, whatever the pull), pull along a direction until no
 admissible state is left (:func:`softhand.reduced.holding.hold_lp.holding_limit`), the object sliding along the
 pull where the fingers closing on it there hold it more (:mod:`softhand.reduced.holding.hold_slide`: the
 holding limit is the first maximum along that slide; a pull towards the palm is not followed: pushed
 into the hand, the object meets the palm, which is not a contact of this model, and fingers pushed
 open past straight, where the hinge tables do not reach). It returns the common
 :class:`softhand.reduced.holding.hold_result.HoldResult` (model ``"reduced"``); the object's displacement
-is its slide under its own weight, along the pull, and its rotation the turn the slide gave it
+is where it rests under its own weight, and its rotation the turn its slide there gave it
 (:mod:`softhand.reduced.holding.hold_turn`).
 
 :func:`least_pressure` answers the inverse question: the least pump pressure (and its cavity
@@ -28,6 +29,7 @@ from typing import NamedTuple
 
 import numpy as np
 from scipy.optimize import brentq
+from scipy.spatial.transform import Rotation
 
 from softhand.reduced.equations import hand
 from softhand.reduced.holding import hold_fast, hold_finger, hold_lp, hold_slide, hold_turn
@@ -115,42 +117,50 @@ def solve_hold(design: HandDesign, obj: GraspObject, *, P_cavity_MPa: float, pul
     size = float(np.max(np.ptp(placed.surface(resolution=8)[0], axis=0)))
 
     hands = {} if slide_hands is None else slide_hands
-    hands[(0.0, placed.R.tobytes())] = closed
+    hands[_pose_key(placed)] = closed
 
-    def hand_at(y, moved):
-        """The hand closed on the object at pose ``moved`` (y [mm] along the slide); None where the object
-        has moved into the open fingers (they have let it through)."""
-        key = (y, moved.R.tobytes())
+    def hand_at(moved):
+        """The hand closed on the object at pose ``moved``; None where the object has moved into the open
+        fingers (they have let it through)."""
+        key = _pose_key(moved)
         if key not in hands:
-            near = hands[min(hands, key=lambda x: abs(x[0] - y))] if hands else None
+            near = hands[min(hands, key=lambda k: float(np.linalg.norm(np.frombuffer(k[0]) - moved.centre)))]
             try:
                 hands[key] = hold_fast.close_hand(closed.P_cavity, moved, d, reservoir_on=reservoir, near=near)
             except InputError:
                 hands[key] = None
         return hands[key]
 
-    def rate(y, moved):  # the object's turn per mm of slide at this pose (hold_turn)
-        hand = hand_at(y, moved)
-        return np.zeros(3) if hand is None else hold_turn.turn_rate(
-            contact_set(hand, d), moved.centre, weight, pull, obj.friction, size_mm=size)
+    def slide(start, along, settle, enough):
+        """(the slide from pose ``start`` along the unit vector ``along``, its path, its start's evaluation)."""
+        def rate(y, moved):  # the object's turn per mm of slide at this pose (hold_turn)
+            hand = hand_at(moved)
+            return np.zeros(3) if hand is None else hold_turn.turn_rate(
+                contact_set(hand, d), moved.centre, weight, along, obj.friction, size_mm=size)
 
-    path_of = hold_turn.Path(placed, pull, None if obj.shape == "sphere" else rate)
+        path_of = hold_turn.Path(start, along, None if obj.shape == "sphere" else rate)
 
-    def at(y):
-        """(lam, (placed, closed, contact set, limit state)) with the object moved y [mm] along the pull."""
-        if y > 0.0 and pull[1] < 0.0:  # pushed towards the palm: not followed (module doc)
-            return -math.inf, None
-        moved = path_of.at(y)
-        hand = hand_at(y, moved)
-        if hand is None:
-            return -math.inf, None
-        cs = contact_set(hand, d)
-        lim = hold_lp.holding_limit(cs, moved.centre, weight, pull, obj.friction, size_mm=size)
-        return (lim.pull_N if lim is not None else -math.inf), (moved, hand, cs, lim)
+        def at(y):
+            """(lam, (placed, closed, contact set, limit state)) with the object moved y [mm] along."""
+            if y > 0.0 and along[1] < 0.0:  # pushed towards the palm: not followed (module doc)
+                return -math.inf, None
+            moved = path_of.at(y)
+            hand = hand_at(moved)
+            if hand is None:
+                return -math.inf, None
+            cs = contact_set(hand, d)
+            lim = hold_lp.holding_limit(cs, moved.centre, weight, along, obj.friction, size_mm=size)
+            return (lim.pull_N if lim is not None else -math.inf), (moved, hand, cs, lim)
 
-    first = at(0.0)
-    path = hold_slide.follow(at, first, weight_N=weight, slip_out_mm=0.5 * size_radius(obj), enough_N=enough_N,
-                             settle=bool(pull[1] >= 1.0 - 1e-12))  # settles under its weight along a pull down
+        first = at(0.0)
+        return hold_slide.follow(at, first, weight_N=weight, slip_out_mm=0.5 * size_radius(obj), enough_N=enough,
+                                 settle=settle), path_of, first
+
+    path, _, first = slide(placed, np.array(DOWN), True, enough_N if pull[1] >= 1.0 - 1e-12 else 0.0)
+    evaluations = path.evaluations
+    if pull[1] < 1.0 - 1e-12 and path.y_rest is not None:  # let go, then pulled from where it rests
+        path, _, first = slide(path.rest[0], pull, False, enough_N)
+        evaluations += path.evaluations
     moved, closed_rest, cs, _ = path.rest if path.rest is not None else first[1]
     _, _, cs_limit, limit = path.limit if path.limit is not None else first[1]
     rest = hold_lp.weight_state(cs, moved.centre, weight, obj.friction, size_mm=size) \
@@ -168,16 +178,23 @@ def solve_hold(design: HandDesign, obj: GraspObject, *, P_cavity_MPa: float, pul
     if held and limit.pull_N >= hold_lp.MAX_PULL:
         notes.append(f"the pull is bounded only by the search's {hold_lp.MAX_PULL:g} N")
     residual = max(float(np.max([s.residual for s in closed.fingers])), 0.0)
-    y_rest = path.y_rest if held else 0.0
-    shift = lambda y: tuple((y * pull).tolist())  # noqa: E731
+    at_rest = moved if held else placed
+    at_limit = path.limit[0] if held else placed
+
+    def shift(pose):  # the object's displacement [mm] from its placement
+        return tuple((pose.centre - placed.centre).tolist())
+
+    def turn(pose):  # its turn from its placement: x-y-z Euler angles [deg], as the FEM hold reports it
+        return tuple(np.degrees(Rotation.from_matrix(pose.R @ placed.R.T).as_euler("xyz")).tolist())
+
     steps = (LoadStep("close", closed.P_cavity, 0.0, bool(len(cs.finger)), contacts=len(cs.finger),
                       extra={"hinge_residual": residual}),
-             LoadStep("release", closed.P_cavity, 0.0, held, displacement_mm=shift(y_rest),
-                      rotation_deg=path_of.rotation_deg(y_rest),
+             LoadStep("release", closed.P_cavity, 0.0, held, displacement_mm=shift(at_rest),
+                      rotation_deg=turn(at_rest),
                       contacts=len(_contacts(cs, rest, held)) if held else 0,
                       extra={"equilibrium_residual": rest.residual if rest is not None else math.nan}),
-             LoadStep("pull", closed.P_cavity, holding, held, displacement_mm=shift(path.y_limit),
-                      rotation_deg=path_of.rotation_deg(path.y_limit),
+             LoadStep("pull", closed.P_cavity, holding, held, displacement_mm=shift(at_limit),
+                      rotation_deg=turn(at_limit),
                       contacts=len(_contacts(cs_limit, limit, held)) if held else 0,
                       extra={"equilibrium_residual": limit.residual if limit is not None else math.nan}))
     return HoldResult(
@@ -185,14 +202,19 @@ def solve_hold(design: HandDesign, obj: GraspObject, *, P_cavity_MPa: float, pul
         contacts=_contacts(cs, rest if held else None, held), P_cavity_MPa=float(closed.P_cavity),
         P_pump_MPa=float((closed_rest if held else closed).P_pump), mass_kg=obj.mass_kg, friction=obj.friction,
         object=obj.to_dict(), steps=steps, symmetric=closed.symmetric, notes=tuple(notes),
-        displacement_mm=shift(y_rest), rotation_deg=path_of.rotation_deg(y_rest),
+        displacement_mm=shift(at_rest), rotation_deg=turn(at_rest),
         extra={"finger_model": d.finger_model, "hinge_residual": residual,
                "limit_contacts": [c._asdict() if hasattr(c, "_asdict") else c.__dict__
                                   for c in _contacts(cs_limit, limit, held)] if held else [],
                "friction_polygon": hold_lp.GENERATORS, "object_centre_mm": placed.centre.tolist(),
                "limit_pull_N": float(limit.pull_N) if limit is not None else None,
                "first_slip_pull_N": float(first[0]) if math.isfinite(first[0]) else None,
-               "slide_mm": float(path.y_limit), "slide_evaluations": path.evaluations})
+               "slide_mm": float(path.y_limit), "slide_evaluations": evaluations})
+
+
+def _pose_key(placed: Placed) -> tuple:
+    """A pose as a key of the hands closed along the slides (its centre and rotation, bit for bit)."""
+    return placed.centre.tobytes(), placed.R.tobytes()
 
 
 def cavity_pressure(P_pump: float, placed: Placed, design: HandDesign, *, finger_model: str = "fem",
