@@ -65,8 +65,8 @@ def turn_rate(cs: hold_lp.ContactSet, centre, weight_N: float, pull, mu: float, 
 
 class Path:
     """The object's pose along the slide: ``at(y)`` is the placement moved y [mm] along the pull and
-    turned as the mechanism turns it on the way; ``rate(y, placed)`` gives omega (3,) [rad/mm] at the pose after y [mm]
-    (None: the object does not turn, a translation along the pull)."""
+    turned as the mechanism turns it on the way; ``rate(y, placed)`` gives omega (3,) [rad/mm] at the
+    pose after y [mm] (None: the object does not turn, a translation along the pull)."""
 
     def __init__(self, placed: Placed, pull, rate: Callable[[float, Placed], np.ndarray] | None):
         self._pull = np.asarray(pull, float)
@@ -94,9 +94,9 @@ class Path:
         return tuple(float(a) for a in np.degrees(Rotation.from_matrix(R).as_euler("xyz")))
 
     def _turn(self, k: int) -> np.ndarray:
-        while len(self._omega) <= k:
-            k = len(self._omega)
-            self._omega.append(np.asarray(self._rate(self._y[k], self._placed[k]), float))
+        while len(self._omega) <= k:  # the knots' rates, in order
+            j = len(self._omega)
+            self._omega.append(np.asarray(self._rate(self._y[j], self._placed[j]), float))
         return self._omega[k]
 
     def _advance(self, k: int, dy: float) -> Placed:
