@@ -87,12 +87,6 @@ class Path:
         k = bisect_right(self._y, y) - 1
         return self._placed[k] if y == self._y[k] else self._advance(k, y - self._y[k])
 
-    def rotation_deg(self, y: float) -> tuple:
-        """The turn after y [mm] of slide: x-y-z Euler angles [deg] of the rotation from the placement
-        (as the FEM hold reports its object's)."""
-        R = self.at(y).R @ self._placed[0].R.T
-        return tuple(float(a) for a in np.degrees(Rotation.from_matrix(R).as_euler("xyz")))
-
     def _turn(self, k: int) -> np.ndarray:
         while len(self._omega) <= k:  # the knots' rates, in order
             j = len(self._omega)
