@@ -42,6 +42,8 @@ from dataclasses import dataclass, field
 import numpy as np
 import scipy.sparse as sp
 
+from softhand.fem.compiled import chain as chain_kernels
+
 #: rotation of an in-plane vector by +90 degrees
 OMEGA = np.array([[0.0, -1.0], [1.0, 0.0]])
 
@@ -249,13 +251,18 @@ class ChainConstraint:
         r = np.concatenate((R[self.free], R[rows_m] @ Jm))
         K = K.tocsr()  # K.data below must be in CSR order
         pat = self._reduced_pattern(K, rows_m)
-        KJ = pat["cols"](K.data) @ Jm                  # (n_dofs, n_s) = K J_m
+        compiled = symmetric and chain_kernels.available()  # then one pass over K (fem.compiled.chain)
+        if compiled and "compiled" not in pat:
+            pat["compiled"] = chain_kernels.SymmetricReduction(K, pat, rows_m)
+        data, KJ = pat["compiled"](K, Jm) if compiled else (None, pat["cols"](K.data) @ Jm)  # KJ = K J_m
         KtJ = KJ if symmetric else pat["rows"](K.data).T @ Jm  # (n_dofs, n_s) = K^T J_m
         Kqq = Jm.T @ KJ[rows_m] + self.chain.force_hessian(self.q(y), self.links, x, R[self.nodes[:, :2]])
         if K_qq is not None:
             Kqq = Kqq + K_qq
-        src = np.concatenate((K.data, KJ[pat["fq"]].ravel(), KtJ[pat["qf"]].ravel(), Kqq.ravel()))
-        Kr = sp.csr_matrix((src[pat["ids"]], pat["indices"], pat["indptr"]),
+        rest = (KJ[pat["fq"]].ravel(), KtJ[pat["qf"]].ravel(), Kqq.ravel())
+        data = (pat["compiled"].fill(data, np.concatenate(rest)) if compiled
+                else np.concatenate((K.data,) + rest)[pat["ids"]])
+        Kr = sp.csr_matrix((data, pat["indices"], pat["indptr"]),
                            shape=(self.n_reduced, self.n_reduced))
         Kr.has_sorted_indices = True
         return r, Kr

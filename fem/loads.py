@@ -37,6 +37,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from softhand.fem import kinematics as kin
+from softhand.fem.compiled import cavity as cavity_kernels
 from softhand.fem.kinematics import EPS
 from softhand.fem.mapping import facet_basis
 
@@ -135,9 +136,13 @@ class CavityVolume:
     cavity is closed by planes x_k = 0 (symmetry planes, or a lid lying in such a plane).
     """
 
-    def __init__(self, solid, facets, *, symmetry_normal: int | None = None, intorder: int | None = None):
+    def __init__(self, solid, facets, *, symmetry_normal: int | None = None, intorder: int | None = None,
+                 compiled: bool = True):
         self.f = _Facets(solid, facets, intorder)
         self.D = np.eye(3) / 3.0 if symmetry_normal is None else np.diag(np.eye(3)[symmetry_normal])
+        #: the compiled gradient and Hessian (fem.compiled.cavity), or None: the NumPy forms below
+        self.kernels = (cavity_kernels.CompiledCavity(self.f, np.diag(self.D))
+                        if compiled and cavity_kernels.available() else None)
 
     def volume(self, u) -> float:
         """V [mm^3]."""
@@ -147,8 +152,13 @@ class CavityVolume:
 
     value = volume  #: V(u), the name of every volume functional (:func:`volume_control`)
 
-    def gradient(self, u) -> np.ndarray:
-        """dV/du [mm^2], shape (ndofs,)."""
+    def gradient(self, u, data=None, factor: float = 1.0) -> np.ndarray:
+        """dV/du [mm^2], shape (ndofs,); with ``data`` (CSR data in the solid's pattern), also
+        data += factor * d^2V/du^2 (:meth:`add_hessian_data`), in one pass where compiled."""
+        if self.kernels is not None:
+            return self.kernels.gradient(u, data, factor)
+        if data is not None:
+            self.add_hessian_data(data, u, factor)
         x, F = self.f.fields(u)
         cofN = np.einsum("aKeq,Keq->aeq", kin.cofactor(F), self.f.N)
         y = np.einsum("ab,beq->aeq", self.D, x)  # D x (D symmetric)
@@ -186,6 +196,9 @@ class CavityVolume:
     def add_hessian_data(self, data, u, factor: float = 1.0) -> None:
         """data += factor * d^2V/du^2, data: CSR data in the solid's pattern (only the
         positions of the wall's elements are touched)."""
+        if self.kernels is not None:
+            self.kernels.gradient(u, data, factor)
+            return
         self.f.add_matrix_data(data, self._hessian_blocks(u), -factor)
 
     def hessian(self, u) -> sp.csr_matrix:

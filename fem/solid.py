@@ -105,6 +105,12 @@ class Solid(ElementKernels):
         soft.law = None  # no single law: the deviatoric part's and this volume energy
         return soft
 
+    @property
+    def parts(self) -> tuple:
+        """(the law's isochoric part, its volumetric part or None): what the formulation
+        integrates (the displacement formulation: (the whole law, None))."""
+        return self._dev, self._vol
+
     # -- dofs ---------------------------------------------------------------------------
     def dofs(self, facets=None, components=(0, 1, 2)) -> np.ndarray:
         """Vector dofs of the given components on a boundary (name, facet indices, or all if None)."""

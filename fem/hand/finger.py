@@ -43,17 +43,17 @@ import numpy as np
 from skfem import Basis, ElementTetP2, ElementVector
 
 from softhand.fem import kinematics as kin
+from softhand.fem.compiled import rubber as compiled_kernels
 from softhand.fem.constraints import ChainConstraint, PlanarChain
-from softhand.fem.hand.finger_options import FingerOptions, build_mesh, check_size, describe_mesh, ring_width, tie_bands
+from softhand.fem.hand.finger_options import (FingerOptions, build_mesh, check_size, describe_mesh, finger_tube,
+                                              refuse_folds, ring_width, tie_bands)
 from softhand.fem.hand.finger_sweep import SweepStats, solve_pressures
 from softhand.fem.hand.frame import to_hand_frame
 from softhand.fem.hand.windings import Windings, WindingFibers, hoop_directions
 from softhand.fem.hyperelastic import rubber_law
 from softhand.fem.loads import CavityVolume
-from softhand.fem.mapping import folded_elements
 from softhand.fem.rubber_stretch import Averager
 from softhand.fem.solid import Solid
-from softhand.meshes.finger import FingerTube
 from softhand.reduced.vocabulary.design import HandDesign
 from softhand.reduced.vocabulary.errors import MeshRejected
 
@@ -89,48 +89,6 @@ class FingerState:
         return float(np.sum(self.q))
 
 
-def finger_tube(design: HandDesign, options: FingerOptions) -> FingerTube:
-    """The half tube the finger FEM meshes: the design's radii and length, the options' end cap
-    (default: the wall b) and tie bands."""
-    cap = options.cap if options.cap is not None else design.b
-    return FingerTube(design.a, design.b, design.l0, cap, tie_bands(design, options),
-                      options.edge_ratio, options.edge_reach)
-
-
-def refuse_folds(mesh, options: FingerOptions) -> None:
-    """MeshRejected if curved elements of ``mesh`` fold over themselves (positive at the
-    quadrature points, folded between them: the FEM stops or balloons the tube)."""
-    folded = folded_elements(mesh)
-    if folded.size:
-        raise MeshRejected(describe_mesh(options),
-                           f"has {folded.size} curved elements that fold over themselves (its FEM "
-                           f"stops or balloons the tube); try a finer mesh size, edge_ratio 1 "
-                           f"(uniform) or the layered mesher")
-
-
-def check_finger_mesh(design: HandDesign, options: FingerOptions) -> None:
-    """The finger mesh of ``design`` is one the FEM takes (size, folds), without the FEM: a
-    study checks each case's mesh before any case runs. A gmsh mesh goes through the cache,
-    which keeps it only if it is taken (a refused run leaves nothing behind)."""
-    tube = finger_tube(design, options)
-    check_size(tube, options)
-    if options.mesher == "layered":
-        refuse_folds(build_mesh(tube, options), options)
-        return
-    from softhand.meshes.cache import cache_dir, discard, mesh_key, valid_entry
-    from softhand.meshes.finger import finger_geometry
-
-    key = mesh_key(finger_geometry, tube, size=options.mesh_size, order=2, refine=options.mesh_refine)
-    path = cache_dir() / f"{finger_geometry.__name__}-{key}.msh"
-    cached, made = valid_entry(path), [d for d in (path.parent, path.parent.parent) if not d.exists()]
-    try:
-        refuse_folds(build_mesh(tube, options), options)
-    except MeshRejected:
-        if not cached:
-            discard(path, made)
-        raise
-
-
 class FingerModel:
     """The built finger FEM: mesh, solid, shell constraint and pressure load."""
 
@@ -161,6 +119,8 @@ class FingerModel:
         self.chain = PlanarChain(np.c_[design.hinge_s, np.full(design.n_s, design.d)])
         self.constraint = self._tie()
         self.V0 = self.cavity.volume(np.zeros(self.solid.ndofs))
+        #: the rubber and windings by the compiled kernel, or None: the NumPy kernels (fem.compiled)
+        self.kernels = compiled_kernels.for_finger(self.solid, self.windings)
 
     def _tie(self) -> ChainConstraint:
         """Every node follows the link over its x position; the tie bands' nodes are tied."""
@@ -197,11 +157,12 @@ class FingerModel:
         [N mm] and their derivative (e.g. from :meth:`~softhand.fem.constraints.PlanarChain.point_load`).
         """
         u = self.constraint.expand(y)
-        # rubber + windings: one kernel pass, one product, one scatter
-        R, Ke = self.solid.residual_element_matrices(u, extra=lambda c: self.windings.terms(u, c))
-        R = R - P * self.cavity.gradient(u)
-        data = self.solid.scatter.block_matrix_data(Ke)
-        self.cavity.add_hessian_data(data, u, -P)
+        if self.kernels is not None:  # rubber + windings: one compiled pass, scattered as it goes
+            R, data = self.kernels.residual_tangent_data(u, self.solid)
+        else:  # rubber + windings: one kernel pass, one product, one scatter
+            R, Ke = self.solid.residual_element_matrices(u, extra=lambda c: self.windings.terms(u, c))
+            data = self.solid.scatter.block_matrix_data(Ke)
+        R = R - P * self.cavity.gradient(u, data, -P)  # and the cavity's load stiffness into data
         K = self.solid.scatter.csr(data)
         Q, dQ = (None, None) if link_load is None else link_load(self.constraint.q(y))
         r, Kr = self.constraint.reduce(y, R, K, None if dQ is None else -np.asarray(dQ), symmetric=True)
@@ -212,8 +173,11 @@ class FingerModel:
     def residual(self, y, P: float, link_load=None) -> np.ndarray:
         """The reduced residual of :meth:`residual_tangent` alone (a line search's trial points)."""
         u = self.constraint.expand(y)
-        R = self.solid.residual(u)
-        self.windings.add_residual(u, R)
+        if self.kernels is not None:
+            R = self.kernels.residual(u, self.solid)
+        else:
+            R = self.solid.residual(u)
+            self.windings.add_residual(u, R)
         r = self.constraint.reduce(y, R - P * self.cavity.gradient(u))
         if link_load is not None:
             r[len(self.constraint.free):] -= link_load(self.constraint.q(y))[0]

@@ -1,4 +1,5 @@
-"""The finger FEM's discretisation and modelling options, the tie bands and the mesh they give."""
+"""The finger FEM's discretisation and modelling options, the tie bands and the mesh they give
+(and whether the FEM takes it)."""
 from __future__ import annotations
 
 import os
@@ -8,9 +9,10 @@ import numpy as np
 from skfem.quadrature import get_quadrature
 from skfem.refdom import RefTet
 
+from softhand.fem.mapping import folded_elements
 from softhand.meshes.finger import FingerTube, finger_tube_mesh, layered_tets, layered_tube_mesh
 from softhand.reduced.vocabulary.design import HandDesign
-from softhand.reduced.vocabulary.errors import InputError, MeshTooLarge
+from softhand.reduced.vocabulary.errors import InputError, MeshRejected, MeshTooLarge
 
 TIES = ("ring", "full")
 MESHERS = ("layered", "gmsh")
@@ -187,3 +189,44 @@ def describe_mesh(options: FingerOptions) -> str:
     return (f"gmsh mesh_size={options.mesh_size} edge_ratio={options.edge_ratio} "
             f"refine={options.mesh_refine}")
 
+
+def finger_tube(design: HandDesign, options: FingerOptions) -> FingerTube:
+    """The half tube the finger FEM meshes: the design's radii and length, the options' end cap
+    (default: the wall b) and tie bands."""
+    cap = options.cap if options.cap is not None else design.b
+    return FingerTube(design.a, design.b, design.l0, cap, tie_bands(design, options),
+                      options.edge_ratio, options.edge_reach)
+
+
+def refuse_folds(mesh, options: FingerOptions) -> None:
+    """MeshRejected if curved elements of ``mesh`` fold over themselves (positive at the
+    quadrature points, folded between them: the FEM stops or balloons the tube)."""
+    folded = folded_elements(mesh)
+    if folded.size:
+        raise MeshRejected(describe_mesh(options),
+                           f"has {folded.size} curved elements that fold over themselves (its FEM "
+                           f"stops or balloons the tube); try a finer mesh size, edge_ratio 1 "
+                           f"(uniform) or the layered mesher")
+
+
+def check_finger_mesh(design: HandDesign, options: FingerOptions) -> None:
+    """The finger mesh of ``design`` is one the FEM takes (size, folds), without the FEM: a
+    study checks each case's mesh before any case runs. A gmsh mesh goes through the cache,
+    which keeps it only if it is taken (a refused run leaves nothing behind)."""
+    tube = finger_tube(design, options)
+    check_size(tube, options)
+    if options.mesher == "layered":
+        refuse_folds(build_mesh(tube, options), options)
+        return
+    from softhand.meshes.cache import cache_dir, discard, mesh_key, valid_entry
+    from softhand.meshes.finger import finger_geometry
+
+    key = mesh_key(finger_geometry, tube, size=options.mesh_size, order=2, refine=options.mesh_refine)
+    path = cache_dir() / f"{finger_geometry.__name__}-{key}.msh"
+    cached, made = valid_entry(path), [d for d in (path.parent, path.parent.parent) if not d.exists()]
+    try:
+        refuse_folds(build_mesh(tube, options), options)
+    except MeshRejected:
+        if not cached:
+            discard(path, made)
+        raise

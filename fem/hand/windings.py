@@ -103,7 +103,8 @@ class Windings:
         grads = np.stack([basis.basis[i][0].grad for i in range(basis.Nbfun)])  # (nloc, 3, nel, nq)
         self.g = np.einsum("nkeq,keq->eqn", grads, a0)                      # (nel, nq, nloc)
         self.W = np.asarray(basis.dx)                                       # (nel, nq)
-        self._a0q = np.ascontiguousarray(a0.transpose(1, 2, 0))             # (nel, nq, 3)
+        #: the fiber directions at the rule's points, (nel, nq, 3)
+        self.a0q = np.ascontiguousarray(a0.transpose(1, 2, 0))
         self.scatter = scatter
         nel = self.W.shape[0]
         self.chunks = [slice(i, min(i + chunk, nel)) for i in range(0, nel, chunk)]
@@ -124,7 +125,7 @@ class Windings:
         of chunk c."""
         g, W, k = self.g[c], self.W[c], self.law.k
         ne, nq, nloc = g.shape
-        f = self._a0q[c] + np.matmul(g, u[self.scatter.vector_dofs(c)].reshape(ne, nloc, 3))
+        f = self.a0q[c] + np.matmul(g, u[self.scatter.vector_dofs(c)].reshape(ne, nloc, 3))
         lam = np.sqrt(np.einsum("eqa,eqa->eq", f, f))
         _, G1, G2 = self.law._g(lam - 1.0)
         return f, W * k * (G2 / lam ** 2 - G1 / lam ** 3), W * k * G1 / lam

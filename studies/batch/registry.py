@@ -85,7 +85,7 @@ def _one_mesh(params: dict, design: HandDesign, src: str) -> None:
 def finger_mesh_fits(params: dict, design: HandDesign, src: str) -> None:
     """The case's finger mesh fits this machine's memory (a lower bound on its unknowns, counted
     without meshing): one line when the study is read, not a case failing after the others ran."""
-    from softhand.fem.hand.finger import finger_tube
+    from softhand.fem.hand.finger_options import finger_tube
     from softhand.fem.hand.finger_options import check_size, mesh_options
     from softhand.reduced.vocabulary.errors import MeshTooLarge
 

@@ -160,7 +160,7 @@ def check_meshes(kind: str, cases, src: str) -> None:
     """Each case's finger mesh one the FEM takes (not folded), before any case runs: one line
     naming the case, as ``bend`` and ``design`` refuse such a mesh up front, not a failed case
     after the others ran. ``cases``: (key, params, design)."""
-    from softhand.fem.hand.finger import check_finger_mesh
+    from softhand.fem.hand.finger_options import check_finger_mesh
     from softhand.reduced.vocabulary.errors import InputError, MeshRejected
 
     for key, params, design in cases:

@@ -292,7 +292,8 @@ def test_a_mesh_too_large_for_the_memory_is_refused_before_meshing(monkeypatch):
     about 73 000 unknowns, so the 2 mm gmsh finger (>= 46 000) passes and one refinement of the
     layered mesh (>= 277 000) does not; nothing is meshed (gmsh is not called)."""
     from softhand.fem.hand import finger_options as fo
-    from softhand.fem.hand.finger import FingerModel, FingerOptions, finger_tube
+    from softhand.fem.hand.finger import FingerModel, FingerOptions
+    from softhand.fem.hand.finger_options import finger_tube
     from softhand.reduced.vocabulary.design import HandDesign
     from softhand.reduced.vocabulary.errors import MeshRejected
 
