@@ -77,6 +77,18 @@ class Averager:
         a /= np.bincount(i, weights=a, minlength=self.n)[i]  # rows summing to 1, before the matrix
         return csr_matrix((a, (i, j)), shape=(self.n, self.n))  # mirror images summed
 
+    def subset(self, mask) -> "Averager":
+        """The averages over the points ``mask`` (N,) selects alone, as an Averager of those points
+        built from them would give, from this operator (no second k-d tree query): its rows and
+        columns of those points, each row scaled to sum to 1 again (a row's scale cancels)."""
+        keep = np.flatnonzero(np.asarray(mask, bool).ravel())
+        sub = self.operator[keep][:, keep].tocsr()
+        sub = csr_matrix(sub.multiply(1.0 / np.asarray(sub.sum(axis=1)).ravel()[:, None]))
+        out = object.__new__(Averager)
+        out.points, out.weights, out.radius, out.n = self.points[keep], self.weights[keep], self.radius, len(keep)
+        out.__dict__["operator"] = sub  # the cached_property, set
+        return out
+
     def at(self, values, centres=None) -> np.ndarray:
         """lambda_bar at the points ``centres`` (indices; default all) of ``values`` (N,)."""
         values = np.asarray(values, dtype=float).ravel()

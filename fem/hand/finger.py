@@ -225,7 +225,7 @@ class FingerModel:
     @cached_property
     def wall_averager(self) -> Averager:
         """Ball averages over the rubber's quadrature points of the wall (the windings), both halves."""
-        return Averager(self._X_q[:, self.wall].reshape(3, -1).T, self.solid.W[self.wall], mirror=2)
+        return self.averager.subset(np.repeat(self.wall, self.solid.W.shape[1]))
 
     def principal_stretch(self, y) -> np.ndarray:
         """The largest principal stretch at the rubber's quadrature points (nel, nq) [-]."""

@@ -51,6 +51,20 @@ def test_mirror_adds_the_other_half():
     np.testing.assert_allclose(half, whole, rtol=1e-12)
 
 
+def test_a_subset_averages_as_an_averager_of_its_points_alone():
+    """Averages over part of the body (the finger's wall without its cap) taken from the whole
+    body's operator equal those of an Averager built on that part alone (rtol: round-off)."""
+    X, W = grid(0.5)
+    lam = 1.0 + 0.1 * np.exp(-X[:, 2]) + 0.02 * np.sin(X[:, 0])
+    part = X[:, 0] < 5.0
+    whole = Averager(X, W * (1.0 + X[:, 1]), 1.5, mirror=2)
+    alone = Averager(X[part], (W * (1.0 + X[:, 1]))[part], 1.5, mirror=2)
+    sub = whole.subset(part)
+    np.testing.assert_allclose(sub.at(lam[part]), alone.at(lam[part]), rtol=1e-12)
+    assert abs(sub.at(lam[part]) - whole.at(lam)[part]).max() > 1e-4  # the part's edge sees less
+    assert sub.peak(lam[part])[0] == pytest.approx(alone.peak(lam[part])[0], rel=1e-12)
+
+
 def test_peak_is_the_largest_average():
     """The pruned search finds the same largest average as averaging at every point (exact)."""
     rng = np.random.default_rng(3)
