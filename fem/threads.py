@@ -70,3 +70,21 @@ def quiet_blas() -> None:
 
     ThreadpoolController().select(internal_api="openblas").limit(limits=1)
     _quiet.add(os.getpid())
+
+
+def slabs(centroids: np.ndarray, dofs: np.ndarray, parts: int) -> list[np.ndarray]:
+    """Element lists [slab 0, ..., slab parts-1, the rest]: the elements cut into ``parts`` slabs of
+    equal count along the axis of the centroids' (nel, 3) largest extent; a slab keeps only the
+    elements whose nodes (``dofs`` (nel, nloc)) no other slab's elements touch; the rest is last."""
+    nel = len(centroids)
+    if parts <= 1:
+        return [np.arange(nel), np.arange(0)]
+    axis = int(np.argmax(np.ptp(centroids, axis=0)))
+    slab = np.empty(nel, dtype=np.int64)
+    slab[np.argsort(centroids[:, axis], kind="stable")] = np.arange(nel) * parts // nel
+    lo = np.full(dofs.max() + 1, parts, dtype=np.int64)
+    hi = np.full(dofs.max() + 1, -1, dtype=np.int64)
+    np.minimum.at(lo, dofs, slab[:, None])
+    np.maximum.at(hi, dofs, slab[:, None])
+    own = np.all((lo[dofs] == slab[:, None]) & (hi[dofs] == slab[:, None]), axis=1)
+    return [np.flatnonzero(own & (slab == k)) for k in range(parts)] + [np.flatnonzero(~own)]

@@ -1,4 +1,11 @@
-r"""The finger's rubber (Neo-Hookean, mean dilatation) and windings in one compiled pass per element.
+r"""The finger's rubber (mean dilatation) and windings in one compiled pass per element.
+
+The rubber: the Neo-Hookean law, or any rubber whose energy depends on :math:`\bar I_1` alone
+(Yeoh, Gent: :data:`I1_ONLY`), whose tangent is the Neo-Hookean form with :math:`\mu = 2W_1` at
+each point plus the rank-one :math:`W_{11}\,(g_1 : \nabla\delta u)(g_1 : \nabla\Delta u)`,
+:math:`g_1 = \partial\bar I_1/\partial F` (a first compiled pass gives :math:`\bar I_1` at the
+points, the rubber's own NumPy functions W_1 and W_11 there). Mooney-Rivlin and Ogden take the
+NumPy kernels.
 
 Per element: F, J, F^{-T} at the rubber's 4 points, the mean-dilatation pressure, the windings
 at their 14 points, the element's forces and its 30 x 30 stiffness, added straight into the
@@ -22,14 +29,22 @@ import numpy as np
 
 from softhand.fem import threads
 from softhand.fem.compiled import available, compiled
+from softhand.fem.hyperelastic import IsochoricRubber
+from softhand.fem.materials import NeoHookeanIsochoric
+from softhand.reduced.materials import rubber as rubber_models
 
 #: the rubber's quadrature points and the element's nodes the kernel is written for
 _NQ, _NLOC = 4, 10
+#: the rubbers whose energy depends on I1bar alone, which the kernel takes besides the
+#: Neo-Hookean law (its tangent: the Neo-Hookean form with mu = 2 W_1, plus W_11 g1 g1 per point)
+I1_ONLY = (rubber_models.NeoHookean, rubber_models.Yeoh, rubber_models.Gent)
 
 
 @compiled
-def _kernel(u, sd, G, W, mu, kappa, gw, Ww, a0, kw, toe, elems, pos, data, R, tangent, scratch):
-    """Adds the elements ``elems``' forces into R and (``tangent``) their stiffness into data."""
+def _kernel(u, sd, G, W, m1, m11, rank1, kappa, gw, Ww, a0, kw, toe, elems, pos, data, R, tangent, scratch):
+    """Adds the elements ``elems``' forces into R and (``tangent``) their stiffness into data; m1 =
+    2 W_1 and m11 = W_11 at each rubber point (nel, nq) (the Neo-Hookean law: mu and 0; ``rank1``:
+    some m11 is not 0)."""
     ue, Fq, Fi, Jq, Lt, Rm, K, re, b, St, Sr, X = scratch
     nq, nw = G.shape[1], gw.shape[1]
     for idx in range(elems.shape[0]):
@@ -68,7 +83,8 @@ def _kernel(u, sd, G, W, mu, kappa, gw, Ww, a0, kw, toe, elems, pos, data, R, ta
             for a in range(3):
                 for k in range(3):
                     I1 += Fq[a, k, q] * Fq[a, k, q]
-            muj = mu * J ** (-2.0 / 3.0) * w
+            j23 = J ** (-2.0 / 3.0)
+            muj = m1[e, q] * j23 * w
             pJ = p * J * w
             for n in range(10):
                 for a in range(3):
@@ -85,6 +101,18 @@ def _kernel(u, sd, G, W, mu, kappa, gw, Ww, a0, kw, toe, elems, pos, data, R, ta
             if not tangent:
                 continue
             cvh, chh, b3 = -2.0 / 3.0 * muj, 5.0 / 9.0 * I1 * muj, I1 / 3.0 * muj - pJ
+            c11 = m11[e, q] * w
+            if not rank1:
+                pass
+            elif c11 != 0.0:  # W_11 (g1 : grad du)(g1 : grad Du), g1 = dI1bar/dF = j (2 F - 2/3 I1 F^-T)
+                for i in range(30):
+                    t = j23 * (2.0 * Lt[q, i] - 2.0 / 3.0 * I1 * Lt[nq + q, i])
+                    Lt[2 * nq + 1 + q, i] = t
+                    Rm[2 * nq + 1 + q, i] = c11 * t
+            else:
+                for i in range(30):
+                    Lt[2 * nq + 1 + q, i] = 0.0
+                    Rm[2 * nq + 1 + q, i] = 0.0
             for i in range(30):
                 Rm[q, i] = cvh * Lt[nq + q, i]
                 Rm[nq + q, i] = cvh * Lt[q, i] + chh * Lt[nq + q, i]
@@ -105,7 +133,7 @@ def _kernel(u, sd, G, W, mu, kappa, gw, Ww, a0, kw, toe, elems, pos, data, R, ta
             for i in range(30):
                 Lt[rows, i] = b[i]
                 Rm[rows, i] = cb * b[i]
-            rows += 1
+            rows += 1 + (nq if rank1 else 0)
         for q in range(nw):  # the windings: f = F a0 at their own points
             f0, f1, f2 = 0.0, 0.0, 0.0
             for n in range(10):
@@ -167,46 +195,49 @@ def _kernel(u, sd, G, W, mu, kappa, gw, Ww, a0, kw, toe, elems, pos, data, R, ta
                 data[pos[e, i, j]] += K[i, j]
 
 
+@compiled
+def _isochoric_I1(u, sd, G, elems, out):
+    """out[e, q] = J^{-2/3} tr(F^T F) at the rubber's points of the elements ``elems`` (where W_1,
+    W_11 are evaluated)."""
+    F = np.empty((3, 3))
+    for idx in range(elems.shape[0]):
+        e = elems[idx]
+        for q in range(G.shape[1]):
+            for a in range(3):
+                for k in range(3):
+                    s = 1.0 if a == k else 0.0
+                    for n in range(10):
+                        s += u[3 * sd[e, n] + a] * G[e, q, n, k]
+                    F[a, k] = s
+            J = (F[0, 0] * (F[1, 1] * F[2, 2] - F[1, 2] * F[2, 1]) - F[0, 1] * (F[1, 0] * F[2, 2] - F[1, 2] * F[2, 0])
+                 + F[0, 2] * (F[1, 0] * F[2, 1] - F[1, 1] * F[2, 0]))
+            I1 = 0.0
+            for a in range(3):
+                for k in range(3):
+                    I1 += F[a, k] * F[a, k]
+            out[e, q] = I1 * J ** (-2.0 / 3.0)
+
+
 def _scratch(nw):
-    rows = 2 * _NQ + 1 + nw
+    rows = 3 * _NQ + 1 + nw
     return (np.empty((_NLOC, 3)), np.empty((3, 3, _NQ)), np.empty((3, 3, _NQ)), np.empty(_NQ),
             np.zeros((rows, 30)), np.zeros((rows, 30)), np.empty((30, 30)), np.empty(30), np.empty(30),
             np.zeros((3 * _NQ + nw, _NLOC)), np.zeros((3 * _NQ + nw, _NLOC)), np.zeros((3, _NLOC, _NLOC)))
 
 
-def slabs(centroids: np.ndarray, dofs: np.ndarray, parts: int) -> list[np.ndarray]:
-    """Element lists [slab 0, ..., slab parts-1, the rest]: the elements cut into ``parts`` slabs of
-    equal count along the axis of the centroids' (nel, 3) largest extent; a slab keeps only the
-    elements whose nodes (``dofs`` (nel, nloc)) no other slab's elements touch; the rest is last."""
-    nel = len(centroids)
-    if parts <= 1:
-        return [np.arange(nel), np.arange(0)]
-    axis = int(np.argmax(np.ptp(centroids, axis=0)))
-    slab = np.empty(nel, dtype=np.int64)
-    slab[np.argsort(centroids[:, axis], kind="stable")] = np.arange(nel) * parts // nel
-    lo = np.full(dofs.max() + 1, parts, dtype=np.int64)
-    hi = np.full(dofs.max() + 1, -1, dtype=np.int64)
-    np.minimum.at(lo, dofs, slab[:, None])
-    np.maximum.at(hi, dofs, slab[:, None])
-    own = np.all((lo[dofs] == slab[:, None]) & (hi[dofs] == slab[:, None]), axis=1)
-    return [np.flatnonzero(own & (slab == k)) for k in range(parts)] + [np.flatnonzero(~own)]
-
-
 def for_finger(solid, windings) -> "CompiledAssembly | None":
     """The compiled kernel of a finger's rubber and windings where it applies (numba installed,
-    a Neo-Hookean rubber in the mean-dilatation formulation on quadratic tetrahedra with the
-    4-point rule), else None: the NumPy kernels serve."""
-    from softhand.fem.materials import NeoHookeanIsochoric
-
+    a Neo-Hookean or :data:`I1_ONLY` rubber in the mean-dilatation formulation on quadratic
+    tetrahedra with the 4-point rule), else None: the NumPy kernels serve."""
     dev, vol = solid.parts
-    if not (available() and vol is not None and type(dev) is NeoHookeanIsochoric
-            and solid.G.shape[1:] == (_NQ, _NLOC, 3)):
+    law = type(dev) is NeoHookeanIsochoric or (type(dev) is IsochoricRubber and type(dev.material) in I1_ONLY)
+    if not (available() and vol is not None and law and solid.G.shape[1:] == (_NQ, _NLOC, 3)):
         return None
     return CompiledAssembly(solid, windings)
 
 
 class CompiledAssembly:
-    """The finger's rubber (Neo-Hookean, mean dilatation) and windings by the compiled kernel.
+    """The finger's rubber (Neo-Hookean or :data:`I1_ONLY`, mean dilatation) and windings by the compiled kernel.
 
     ``solid``: the :class:`softhand.fem.solid.Solid` (its mesh, quadrature and CSR pattern; the
     solid is passed again per call for its moduli, so a copy with another bulk modulus
@@ -232,7 +263,7 @@ class CompiledAssembly:
         mesh = solid.mesh
         centroids = mesh.p[:, mesh.t[:4]].mean(axis=1).T
         self.threads = threads.count()
-        self.parts = slabs(centroids, self.sd, self.threads)
+        self.parts = threads.slabs(centroids, self.sd, self.threads)
 
     def residual(self, u: np.ndarray, solid) -> np.ndarray:
         """The rubber's and the windings' internal force (ndofs,) [N]; ``solid``: this mesh's
@@ -245,14 +276,22 @@ class CompiledAssembly:
 
     def _run(self, u, solid, tangent):
         dev, vol = solid.parts
-        mu, kappa = dev.mu, vol.kappa
+        u = np.ascontiguousarray(u, dtype=float)
+        if isinstance(dev, NeoHookeanIsochoric):
+            m1, m11 = np.full(self.W.shape, float(dev.mu)), np.zeros(self.W.shape)
+        else:  # a rubber of I1 alone: its W_1, W_11 at the points' I1bar
+            I1b = np.empty(self.W.shape)
+            threads.map_chunks(lambda elems: _isochoric_I1(u, self.sd, self.G, elems, I1b), self.parts)
+            zero = np.zeros_like(I1b)
+            m1 = 2.0 * np.asarray(dev.material.dI(I1b, zero)[0], dtype=float)
+            m11 = np.ascontiguousarray(dev.material.d2I(I1b, zero)[0], dtype=float)
+        rank1 = bool(np.any(m11))
         R = np.zeros(self.n)
         data = np.zeros(self.nnz if tangent else 0)
-        u = np.ascontiguousarray(u, dtype=float)
         nw = self.gw.shape[1]
 
         def run(elems):
-            _kernel(u, self.sd, self.G, self.W, float(mu), float(kappa), self.gw, self.Ww, self.a0,
+            _kernel(u, self.sd, self.G, self.W, m1, m11, rank1, float(vol.kappa), self.gw, self.Ww, self.a0,
                     self.kw, self.toe, elems, self.pos, data, R, tangent, _scratch(nw))
 
         threads.map_chunks(run, self.parts[:-1])

@@ -2,10 +2,12 @@
 import numpy as np
 import pytest
 
+from softhand.fem import threads
 from softhand.fem.compiled import available, cavity, chain, rubber
 from softhand.fem.hand.finger import FingerModel, FingerOptions, solve_pressures
 from softhand.fem.hand.finger_sweep import softened
 from softhand.fem.loads import CavityVolume
+from softhand.reduced.materials import rubber as rubbers
 from softhand.reduced.vocabulary.design import HandDesign
 
 from conftest import CI_FINGER
@@ -51,6 +53,24 @@ def test_rubber_and_windings_equal_the_numpy_kernels(model, toe):
     assert relative(m.kernels.residual(u, m.solid), R_ref) < 1e-12
 
 
+@pytest.mark.parametrize("material", [rubbers.Yeoh(0.44, -0.017, 0.0037), rubbers.Gent(0.9, 20.0),
+                                      rubbers.MooneyRivlin(0.35, 0.1)], ids=lambda m: m.model)
+def test_a_rubber_of_i1_alone_takes_the_kernel_and_equals_the_general_kernel(material):
+    """Yeoh and Gent (W of I1bar alone): the compiled pass (mu = 2 W_1 per point and the W_11
+    rank-one term) against the general NumPy kernel of the same law, at a stretched state where
+    W_11 is far from 0; Mooney-Rivlin keeps the NumPy kernels."""
+    m = FingerModel(DESIGN.replace(finger_material=material, mu_sf=material.mu0), FingerOptions(**CI_FINGER))
+    if isinstance(material, rubbers.MooneyRivlin):
+        assert m.kernels is None
+        return
+    u = stretched(m, scale=0.1)
+    R_ref, data_ref = numpy_rubber_and_windings(m.solid, m.windings, u)
+    R, data = m.kernels.residual_tangent_data(u, m.solid)
+    assert relative(R, R_ref) < 1e-12
+    assert relative(data, data_ref) < 1e-12
+    assert relative(m.kernels.residual(u, m.solid), R_ref) < 1e-12
+
+
 def test_a_softer_copy_of_the_model_shares_the_kernel_with_its_own_bulk_modulus(model):
     soft = softened(model, kappa_ratio=100.0)
     assert soft.kernels is model.kernels
@@ -67,7 +87,7 @@ def test_threads_never_add_into_the_same_entry(model, monkeypatch):
     centroids = model.mesh.p[:, model.mesh.t[:4]].mean(axis=1).T
     dofs = model.solid.scatter.dofs
     for parts in (2, 3):
-        lists = rubber.slabs(centroids, dofs, parts)
+        lists = threads.slabs(centroids, dofs, parts)
         assert np.array_equal(np.sort(np.concatenate(lists)), np.arange(len(dofs)))
         nodes = [set(dofs[e].ravel()) for e in lists[:-1]]
         assert all(not (nodes[i] & nodes[j]) for i in range(parts) for j in range(i + 1, parts))
