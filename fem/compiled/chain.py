@@ -35,8 +35,9 @@ class SymmetricReduction:
     """T'^T K T' of a symmetric K in the reduced pattern ``pattern`` (the dict of
     ``ChainConstraint._reduced_pattern``): built once per pattern.
 
-    ``n_ff``: entries of K that go to the reduced pattern; ``rows_m``: K's rows of the moving
-    nodes' x, y unknowns, in J_m's order.
+    ``K``: a CSR matrix of the pattern to reduce; ``pattern``: where each reduced entry comes
+    from (``ids``: an index into K.data, or past its end into the (f, q), (q, f), (q, q) blocks);
+    ``rows_m``: K's rows of the moving nodes' x, y unknowns, in J_m's order.
     """
 
     def __init__(self, K, pattern: dict, rows_m: np.ndarray):
