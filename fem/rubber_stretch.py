@@ -86,6 +86,7 @@ class Averager:
         sub = csr_matrix(sub.multiply(1.0 / np.asarray(sub.sum(axis=1)).ravel()[:, None]))
         out = object.__new__(Averager)
         out.points, out.weights, out.radius, out.n = self.points[keep], self.weights[keep], self.radius, len(keep)
+        out.owner = out.tree = None  # no k-d tree: the operator is given
         out.__dict__["operator"] = sub  # the cached_property, set
         return out
 

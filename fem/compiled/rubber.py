@@ -101,18 +101,12 @@ def _kernel(u, sd, G, W, m1, m11, rank1, kappa, gw, Ww, a0, kw, toe, elems, pos,
             if not tangent:
                 continue
             cvh, chh, b3 = -2.0 / 3.0 * muj, 5.0 / 9.0 * I1 * muj, I1 / 3.0 * muj - pJ
-            c11 = m11[e, q] * w
-            if not rank1:
-                pass
-            elif c11 != 0.0:  # W_11 (g1 : grad du)(g1 : grad Du), g1 = dI1bar/dF = j (2 F - 2/3 I1 F^-T)
+            if rank1:  # W_11 (g1 : grad du)(g1 : grad Du), g1 = dI1bar/dF = j (2 F - 2/3 I1 F^-T)
+                c11 = m11[e, q] * w
                 for i in range(30):
                     t = j23 * (2.0 * Lt[q, i] - 2.0 / 3.0 * I1 * Lt[nq + q, i])
                     Lt[2 * nq + 1 + q, i] = t
                     Rm[2 * nq + 1 + q, i] = c11 * t
-            else:
-                for i in range(30):
-                    Lt[2 * nq + 1 + q, i] = 0.0
-                    Rm[2 * nq + 1 + q, i] = 0.0
             for i in range(30):
                 Rm[q, i] = cvh * Lt[nq + q, i]
                 Rm[nq + q, i] = cvh * Lt[q, i] + chh * Lt[nq + q, i]
