@@ -6,8 +6,9 @@ reduced``, calibrated finger) on the case the FEM ran and prints one row: held o
 holding limit and one pad's normal force in each, and the relative differences. The FEM's rows
 take minutes each (make them first, e.g. with nice in the background); this takes a second.
 ``--reference`` runs the fast model on the FEM holds the project keeps instead
-(``studies/data/hold_fem_limits.json``, :mod:`softhand.studies.hold_reference`: 56 cases, ~15 s)
-and prints each verdict and error and how many limits are within 5 and 10 %.
+(``studies/data/hold_fem_limits.json``, :mod:`softhand.studies.hold_reference`: 61 cases, ~20 s)
+and prints each verdict and error and how many limits (and loads borne, weight + limit) are
+within 5 and 10 %.
 
     python benchmarks/hold_fast_vs_fem.py RESULT.json [RESULT.json ...] [--markdown]
     python benchmarks/hold_fast_vs_fem.py --reference [--markdown]
@@ -90,18 +91,22 @@ def reference(markdown: bool) -> None:
     rows = hold_reference.compare()
     sep = " | " if markdown else "  "
     if markdown:
-        print("| case | P_cavity MPa | FEM limit N | fast limit N | fast / FEM - 1 |\n|---|---|---|---|---|")
+        print("| case | P_cavity MPa | FEM limit N | fast limit N | fast / FEM - 1 | load borne: fast / FEM - 1 |\n"
+              "|---|---|---|---|---|---|")
     for r in rows:
         cells = [r.name, f"{r.P_cavity_MPa:.3f}",
                  f"{r.fem_limit_N:.2f}" if r.fem_held else f"not held ({100 * (1 + r.fem_margin):.0f} % of the weight)",
                  f"{r.fast_limit_N:.2f}" if r.fast_held else "not held",
-                 f"{100 * r.error:+.1f} %" if r.fem_held and r.fast_held else ""]
+                 f"{100 * r.error:+.1f} %" if r.fem_held and r.fast_held else "",
+                 f"{100 * r.load_error:+.1f} %" if r.fem_held and r.fast_held else ""]
         print(("| " if markdown else "") + sep.join(cells) + (" |" if markdown else ""))
     s = hold_reference.summary(rows)
     print(f"# {s['cases']} FEM holds: verdicts agree on {s['verdicts_agree']}"
           + "".join(f" (differ: {name}, the FEM's margin {100 * m:+.1f} %)" for name, m in s["differ"])
           + f"; of the {s['both_held']} both hold, the fast limit within 5 % on {s['within_5_percent']}, within "
-          f"10 % on {s['within_10_percent']}; rms {s['rms_percent']:.1f} %, median {s['median_percent']:.1f} %")
+          f"10 % on {s['within_10_percent']}; rms {s['rms_percent']:.1f} %, median {s['median_percent']:.1f} %; the load "
+          f"borne (weight + limit) within 5 % on {s['load_within_5_percent']}, within 10 % on {s['load_within_10_percent']}, "
+          f"median {s['load_median_percent']:.1f} %")
 
 
 if __name__ == "__main__":

@@ -27,7 +27,7 @@ design space (:mod:`softhand.reduced.calibrated.hinge_space`), or a table of its
 finger's W_f and Q split equally over the hinges, the contact force of a finger held by
 the object low on it comes out 50 % too large.
 
-**Coupled through the tube (measured; not yet the grasp's and the hold's).** The table's hinges
+**Coupled through the tube (the fast hold's hinges).** The table's hinges
 were locked at one bend; the finger FEM's are coupled (:mod:`softhand.reduced.calibrated.hinge_coupling`):
 its free finger shares the bend unequally, q_f(P), and its condensed stiffness S(P) there is
 below the table's and couples neighbours. :func:`coupled_moments` and :func:`coupled_energy` are
@@ -45,11 +45,12 @@ correction reads only the free states), the moments of the held hinges at 1.5 MP
 1.6 % rms of the FEM's, worst 5.0 % (the table alone: 8.1 %, 17 %); at 0.9 MPa within 1.6 % rms,
 worst 2.7 %, where no hinge is held within 1 deg of straight (the table alone: 8.0 %, 14 %), and up
 to 56 % off where one is (a straight hinge between bent ones is far softer than the table, locked
-all straight, says; 66 % for the table alone). In the fast hold, against the whole-hand FEM's kept
-holds (:mod:`softhand.studies.hold_reference`, its first 42, 2026-12-06), these moments brought 18 limits
-within 5 % (the table's then: 15) and every verdict (then 41; docs/grasp.md); not adopted yet: the one-finger
-grasp of :mod:`softhand.reduced.calibrated.grasp_fem`, the hold's special case, must take them
-with it, and with both the design tasks' optima move. The oil the hinges draw (:func:`volume_rate`) is the table's.
+all straight, says; 66 % for the table alone). The fast hold
+(:mod:`softhand.reduced.holding.hold_finger`) takes these; the one-finger grasp of
+:mod:`softhand.reduced.calibrated.grasp_fem` and the design tasks' F_v keep the table's separable
+hinges (their solvers reduce the distal hinges to one free angle), so a hold's pad force and the
+grasp's differ by what the coupling gives (1-3 % on the paper's 180 mm sphere). The oil the hinges
+draw (:func:`volume_rate`) is the table's.
 P is the cavity pressure. Units: mm, N, MPa, rad.
 """
 from __future__ import annotations
@@ -103,6 +104,15 @@ def coupled_moments(q, P, design: HandDesign) -> np.ndarray:
         at = Pq == p
         M[at] += (q[at] - q_f) @ C.T - M_f
     return M
+
+
+def coupled_stiffness(q, P: float, design: HandDesign) -> np.ndarray:
+    """dM_j/d theta_hat_j [N mm/rad] (..., n_s) of :func:`coupled_moments`, the diagonal: the table's
+    (each M_sep,j depends on q_j alone: one central difference of every hinge at once) plus C's."""
+    design = fem_finger(design)
+    q = np.asarray(q, float)
+    M = hinge_moments(np.stack([q + _DQ, q - _DQ]), P, design)
+    return (M[0] - M[1]) / (2.0 * _DQ) + np.diagonal(coupling(design, float(P))[2])
 
 
 def coupled_free_angles(P: float, design: HandDesign) -> np.ndarray:

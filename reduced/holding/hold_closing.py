@@ -13,7 +13,7 @@ from scipy.optimize import brentq, minimize, nnls, root
 
 from softhand.reduced.equations import hand
 from softhand.reduced.holding import hand_layout
-from softhand.reduced.holding.hold_finger import TOUCH, FingerGeometry, finger_geometry, hinge_energy, hinge_moments
+from softhand.reduced.holding.hold_finger import TOUCH, FingerGeometry, finger_geometry, free_angles, hinge_energy, hinge_moments
 from softhand.reduced.vocabulary.design import HandDesign
 from softhand.reduced.vocabulary.errors import InputError
 from softhand.reduced.holding.object_geometry import Placed
@@ -43,10 +43,8 @@ def close_finger(i: int, P: float, placed: Placed, design: HandDesign, near: Fin
         found = _active_set(i, near.q, P, placed, design, touching, {k: float(near.N[k]) for k in touching})
         if found is not None:
             return _state_of(i, found[0], found[2], P, placed, design, found[3])
-    n_s = design.n_s
-    theta_free = float(hand.bend_angle(P, design, reservoir=False))
-    q_free = np.full(n_s, theta_free / n_s)
-    if theta_free <= 0.0:
+    q_free = free_angles(P, design)
+    if float(np.sum(q_free)) <= 0.0:
         return _free(i, q_free, P, placed, design)
     first = first_touch(i, q_free, placed, design)
     if first is None:

@@ -7,21 +7,23 @@ energy least with no pad inside the object,
 .. math:: \min_{\hat\theta} E(\hat\theta; P) \quad \text{s.t.} \quad g_k(\hat\theta) \ge 0
           \ (k = 1..n_s),
 
-E = sum_j int M_j the hinges' energy at cavity pressure P
+E the hinges' energy at cavity pressure P, M_j = dE/d theta_hat_j
 (:func:`softhand.reduced.holding.hold_finger.hinge_moments`), g_k the gap
 of pad k to the object (:func:`softhand.reduced.holding.hand_layout.pad_distance`). Its optimality conditions
 are the hinge equilibrium with the pads' contact forces, M_j = sum_k N_k dg_k/d theta_hat_j,
-N_k >= 0, N_k g_k = 0: exactly the one-finger grasp's equations (:mod:`softhand.reduced.calibrated.grasp_fem`,
-whose frictionless circle in the bending plane is the special case, a test) for any number of
-touching pads. Solved by SLSQP from the pose where the finger, closing with equal hinges, first
-touches; then the active pads' equations by Newton (scipy's hybrid method) to 1e-10.
+N_k >= 0, N_k g_k = 0: the one-finger grasp's equations (:mod:`softhand.reduced.calibrated.grasp_fem`)
+for any number of touching pads, with the hinges coupled through the tube (the grasp's are the
+blocked-hinge table's, uncoupled: on a frictionless circle in the bending plane the two differ by
+the coupling alone, a test). Solved from the pose where the finger, closing towards its free hinge
+angles, first touches: the touching pads' equations by Newton, pads added and dropped until every
+gap is open and every force presses (SLSQP where that does not settle), to 1e-10.
 
 **Holding**: the touching pads, their normals and closing forces, and each finger's hinge
 moments M_j and stiffnesses dM_j/d theta_hat_j at the closed state go to the limit analysis of
 :mod:`softhand.reduced.holding.hold_lp` (elastic fingers).
 
-Finger models: ``"fem"`` (default), the calibrated finger of :mod:`softhand.reduced.calibrated.grasp_fem` (hinge by
-hinge, from the finger FEM); ``"paper"``, the paper's finger (W_f, Q of eqs. (2), (10)) with its
+Finger models: ``"fem"`` (default), the calibrated finger hinge by hinge, from the finger FEM
+(:mod:`softhand.reduced.calibrated.finger_hinges`: the blocked-hinge table coupled through the tube); ``"paper"``, the paper's finger (W_f, Q of eqs. (2), (10)) with its
 energy shared equally by the hinges, M_j = -dQ/dtheta (P - P_free(n_s theta_hat_j)).
 Where every finger sees the object alike (:func:`softhand.reduced.holding.hand_layout.symmetric`: a centred sphere,
 an upright cylinder, a square box under four fingers), one finger is solved and its state turned to the others.

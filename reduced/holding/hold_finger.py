@@ -23,9 +23,11 @@ _GX, _GW = 0.5 * (_GX + 1.0), 0.5 * _GW
 
 def hinge_moments(q, P, design: HandDesign) -> np.ndarray:
     """M_j = dE/d theta_hat_j [N mm/rad] (..., n_s) at hinge angles q (..., n_s) [rad], cavity
-    pressure P [MPa], for the design's finger model (:mod:`softhand.reduced.holding.hold_fast`)."""
+    pressure P [MPa], for the design's finger model: the calibrated finger's hinges coupled through
+    the tube (:func:`softhand.reduced.calibrated.finger_hinges.coupled_moments`), or the paper's
+    finger shared equally by its hinges."""
     if design.finger_model == "fem":
-        return finger_hinges.hinge_moments(q, P, design)
+        return finger_hinges.coupled_moments(q, P, design)
     theta = design.n_s * np.asarray(q, float)
     return -finger.volume_rate(theta, design) * (P - hand.finger_pressure(theta, design))
 
@@ -35,18 +37,33 @@ _DQ = 1e-6
 
 
 def hinge_stiffness(q, P, design: HandDesign) -> np.ndarray:
-    """K_j = dM_j/d theta_hat_j [N mm/rad] (..., n_s) at hinge angles q (M_j depends on q_j alone: one
-    central difference of every hinge at once)."""
+    """K_j = dM_j/d theta_hat_j [N mm/rad] (..., n_s) at hinge angles q, cavity pressure P [MPa] (the
+    diagonal of the hinges' stiffness; the paper's finger's M_j depends on q_j alone: one central
+    difference of every hinge at once)."""
+    if design.finger_model == "fem":
+        return finger_hinges.coupled_stiffness(q, P, design)
     q = np.asarray(q, float)
     M = hinge_moments(np.stack([q + _DQ, q - _DQ]), P, design)
     return (M[0] - M[1]) / (2.0 * _DQ)
 
 
 def hinge_energy(q, P, design: HandDesign) -> float:
-    """E = sum_j int_0^q_j M_j [N mm] (16-point Gauss along each hinge; M_j depends on q_j alone)."""
+    """E [N mm] at hinge angles q (n_s,): the coupled hinges' (:func:`softhand.reduced.calibrated.
+    finger_hinges.coupled_energy`), or sum_j int_0^q_j M_j of the paper's finger (16-point Gauss
+    along each hinge; M_j depends on q_j alone)."""
+    if design.finger_model == "fem":
+        return finger_hinges.coupled_energy(q, P, design)
     q = np.asarray(q, float)
     M = hinge_moments(_GX[:, None] * q[None, :], P, design)
     return float(np.sum(_GW[:, None] * M * q[None, :]))
+
+
+def free_angles(P: float, design: HandDesign) -> np.ndarray:
+    """The free finger's hinge angles (n_s,) [rad] at cavity pressure P [MPa]: the calibrated finger's
+    bend shared among its hinges as the finger FEM's (every coupled M_j = 0), the paper's equally."""
+    if design.finger_model == "fem":
+        return finger_hinges.coupled_free_angles(P, design)
+    return np.full(design.n_s, float(hand.bend_angle(P, design, reservoir=False)) / design.n_s)
 
 
 class FingerGeometry(NamedTuple):

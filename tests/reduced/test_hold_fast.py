@@ -4,7 +4,10 @@ import math
 import numpy as np
 import pytest
 
-from softhand.reduced.calibrated import grasp_fem
+from scipy.optimize import minimize
+
+from softhand.reduced.calibrated import finger_hinges, grasp_fem
+from softhand.reduced.equations import contact, hand
 from softhand.reduced.holding import hold, hold_fast, hold_lp, objects
 from softhand.reduced.vocabulary.design import HandDesign
 from softhand.reduced.vocabulary.errors import InputError
@@ -14,10 +17,17 @@ G = 9.80665
 
 
 @pytest.mark.parametrize("diameter, P", [(180.0, 0.6), (180.0, 1.5), (240.0, 0.9), (200.0, 2.0)])
-def test_one_finger_grasp_is_the_special_case(diameter, P):
-    """A frictionless sphere centred under the hand: each finger's closing state is the one-finger
-    grasp's (frictionless circle in its bending plane) -- hinge angles to 1e-10 rad, the normal
-    force to 1e-8 relative (both Newton tolerances), on the same pad."""
+def test_one_finger_grasp_is_the_special_case(diameter, P, monkeypatch):
+    """A frictionless sphere centred under the hand, the hold's fingers given the one-finger grasp's
+    hinges (the blocked-hinge table, uncoupled, closing with equal hinges): each finger's closing
+    state is the one-finger grasp's (frictionless circle in its bending plane, its own geometry) --
+    hinge angles to 1e-10 rad, the normal force to 1e-8 relative (both Newton tolerances), on the
+    same pad."""
+    monkeypatch.setattr(finger_hinges, "coupled_moments", finger_hinges.hinge_moments)
+    monkeypatch.setattr(finger_hinges, "coupled_energy", finger_hinges.hinge_energy)
+    monkeypatch.setattr(finger_hinges, "coupled_stiffness", _table_stiffness)
+    monkeypatch.setattr(finger_hinges, "coupled_free_angles", lambda P, d: np.full(
+        d.n_s, float(hand.bend_angle(P, d, reservoir=False)) / d.n_s))
     d = hold_fast.finger_design(HandDesign())
     obj = objects.GraspObject(diameter_mm=diameter)
     closed = hold_fast.close_hand(P, place_object(obj, d), d)
@@ -27,6 +37,39 @@ def test_one_finger_grasp_is_the_special_case(diameter, P):
         assert int(np.argmax(s.N)) == ref.link
         assert s.N[ref.link] == pytest.approx(ref.N, rel=1e-8)
     assert closed.symmetric
+
+
+def _table_stiffness(q, P, design):
+    q = np.asarray(q, float)
+    M = finger_hinges.hinge_moments(np.stack([q + 1e-6, q - 1e-6]), P, design)
+    return (M[0] - M[1]) / 2e-6
+
+
+@pytest.mark.parametrize("diameter, P", [(180.0, 0.9), (240.0, 1.4), (150.0, 1.7)])
+def test_closing_on_coupled_hinges_is_the_least_energy_with_no_pad_inside(diameter, P):
+    """The hold's own fingers (hinges coupled through the tube): a finger closing on a centred
+    sphere takes the least coupled energy with every pad outside the circle, found here by SLSQP
+    over the one-finger grasp's geometry (reduced.equations.contact, not the hold's pads), to 1e-6
+    rad; the coupled moments are that energy's gradient."""
+    d = hold_fast.finger_design(HandDesign())
+    closed = hold_fast.close_hand(P, place_object(objects.GraspObject(diameter_mm=diameter), d), d)
+    s = closed.fingers[0]
+    centre, r = (0.0, contact.object_depth(diameter, d)), 0.5 * diameter
+    q0 = finger_hinges.coupled_free_angles(P, d)
+    h = 1e-6
+    fd = [(finger_hinges.coupled_energy(s.q + h * e, P, d) - finger_hinges.coupled_energy(s.q - h * e, P, d)) / (2 * h)
+          for e in np.eye(d.n_s)]
+    np.testing.assert_allclose(finger_hinges.coupled_moments(s.q, P, d), fd, rtol=1e-6, atol=1e-4)
+    sol = minimize(lambda q: finger_hinges.coupled_energy(q, P, d), 0.5 * q0, method="SLSQP",
+                   jac=lambda q: finger_hinges.coupled_moments(q, P, d),
+                   constraints=[{"type": "ineq", "fun": lambda q: np.nan_to_num(
+                       contact.pad_gaps(q, centre, r, d)[1:], posinf=1e3)}],
+                   bounds=[(-0.1, 0.3)] * d.n_s, options={"ftol": 1e-10, "maxiter": 200})
+    # SLSQP may end on "positive directional derivative" at the optimum (the energy's quadrature
+    # round-off); where it ends is what is checked
+    np.testing.assert_allclose(sol.x, s.q, rtol=0, atol=1e-6)
+    assert np.min(contact.pad_gaps(s.q, centre, r, d)) > -1e-8
+    assert float(np.max(s.N)) > 0.0
 
 
 def _pinch(N_cap: float, mu: float, *, along=0.0, K=(1000.0,)):
