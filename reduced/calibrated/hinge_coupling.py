@@ -19,8 +19,9 @@ cubic kernel, a linear polynomial, in the finger table's kernel features; exact 
 the grid), linearly in P between the table's pressures and constant beyond them. Its free hinge
 angles are q_j = theta_free(P) s_j / n_s with theta_free the calibrated finger's bend (so the free
 finger bends as the calibrated finger does, shared as the FEM shares it). The grid is of the
-paper's rubber; another rubber's stiffness is scaled as its moments bent backwards are
-(:func:`~softhand.reduced.calibrated.hinge_space.reverse_scale`).
+paper's rubber, and so is S here: :func:`softhand.reduced.calibrated.finger_hinges.condensed_stiffness`
+carries it to another rubber by the blocked-hinge table's stiffness (S over the table's diagonal
+stiffness is the tube's geometry, not its rubber's: measured on a fitted Yeoh rubber).
 """
 from __future__ import annotations
 
@@ -102,19 +103,19 @@ def _at(grid: Grid, x, leave_out: int | None = None):
 
 @lru_cache(maxsize=16)
 def design_data(design: HandDesign) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """(pressures (K,), shares s (K, n), S (K, n, n) [N mm/rad]) of the design's free hinges."""
+    """(pressures (K,), shares s (K, n), S (K, n, n) [N mm/rad]) of the design's free hinges (S of its
+    geometry in the paper's rubber: module doc)."""
     grid = read()
     n = grid.s.shape[-1]
     if n != design.n_s:
         raise InputError("n_s", design.n_s, f"the hinge coupling table has {n} hinges")
     s, sigma = _at(grid, (hinge_space.features(design) - grid.lo) / grid.span)
-    unit = design.a ** 2 * math.pi * design.d * hinge_space.reverse_scale(design)
-    return grid.p, s, sigma * unit
+    return grid.p, s, sigma * design.a ** 2 * math.pi * design.d
 
 
 def free_state(design: HandDesign, P: float) -> tuple[np.ndarray, np.ndarray]:
-    """(free hinge angles q_f (n,) [rad], condensed stiffness S (n, n) [N mm/rad]) of the design's
-    calibrated finger at cavity pressure P [MPa] (module doc)."""
+    """(free hinge angles q_f (n,) [rad], condensed stiffness S (n, n) [N mm/rad], of its geometry in the
+    paper's rubber) of the design's calibrated finger at cavity pressure P [MPa] (module doc)."""
     p, s, S = design_data(design)
     i0, i1, w = hinge_space._lerp(float(P), p)
     theta = float(hand.bend_angle(float(P), design, reservoir=False))

@@ -192,14 +192,19 @@ REVERSE_SECANT = math.radians(2.0)
 
 
 @lru_cache(maxsize=16)
+def paper_rubber(design: HandDesign) -> HandDesign:
+    """The design's geometry in the paper's rubber, on the carried table (no ``hinge_table`` of its own)."""
+    return replace(design, mu_sf=HandDesign().mu_sf, finger_material=None, hinge_table="")
+
+
 def reverse_scale(design: HandDesign) -> float:
     """The factor carrying the table's moments at zero pressure of a hinge bent backwards (those of
     the design's geometry with the paper's rubber) to the design's rubber: the ratio of the two
     free curves' pressures at a small bend, P_free(2 deg), 1 for the paper's rubber."""
-    paper_rubber = replace(design, mu_sf=HandDesign().mu_sf, finger_material=None, hinge_table="")
-    if design.hinge_table or replace(design, hinge_table="") == paper_rubber:
+    twin = paper_rubber(design)
+    if design.hinge_table or replace(design, hinge_table="") == twin:
         return 1.0
-    return float(hand.finger_pressure(REVERSE_SECANT, design) / hand.finger_pressure(REVERSE_SECANT, paper_rubber))
+    return float(hand.finger_pressure(REVERSE_SECANT, design) / hand.finger_pressure(REVERSE_SECANT, twin))
 
 
 def design_table(design: HandDesign) -> hinge_table.HingeTable:

@@ -14,6 +14,7 @@ import pytest
 from softhand.reduced.calibrated import finger_hinges, hinge_coupling
 from softhand.reduced.equations import hand
 from softhand.reduced.vocabulary.design import HandDesign
+from softhand.reduced.vocabulary.design_files import load_design
 from softhand.reduced.vocabulary.errors import InputError
 
 PAPER = finger_hinges.fem_finger(HandDesign())
@@ -69,6 +70,22 @@ def test_the_coupling_carried_to_held_out_designs_is_their_own_fems():
             q_f, S_f = hinge_coupling.free_state(design, P)
             np.testing.assert_allclose(q_f / q_f.mean(), np.array(q) / np.mean(q), rtol=5e-3)
             np.testing.assert_allclose(np.diag(S_f), np.diag(S), rtol=3e-2)
+
+
+def test_another_rubbers_condensed_stiffness_is_its_own_fems():
+    """The tutorial's gripper (a fitted Yeoh rubber, a geometry of none of the grid): S of its geometry
+    in the paper's rubber, carried by the blocked-hinge table's stiffness to its rubber, within 3 % of its
+    own free finger FEM's on the diagonal and 6 % off it (measured 1.6 % and 3 %; scaled by the free
+    curves' pressures at 2 deg instead, as the moments bent backwards are, it was 10-14 % high); the
+    shares within 0.5 %."""
+    own = json.loads((Path(__file__).resolve().parents[1] / "data" / "hinge_coupling_heldout.json").read_text())
+    for case in own["rubbers"]:
+        design = finger_hinges.fem_finger(load_design(Path(__file__).resolve().parents[2] / case["design_file"]))
+        for P, s, S in zip(case["P"], case["shares"], case["S"]):
+            q_f, S_f = finger_hinges.condensed_stiffness(design, P)
+            np.testing.assert_allclose(q_f / q_f.mean(), np.array(s) / np.mean(s), rtol=5e-3)
+            np.testing.assert_allclose(np.diag(S_f), np.diag(S), rtol=3e-2)
+            np.testing.assert_allclose(np.diag(S_f, 1), np.diag(np.array(S), 1), rtol=6e-2)
 
 
 def test_pressures_broadcast_against_the_hinge_angles():
