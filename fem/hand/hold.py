@@ -63,12 +63,14 @@ def run_hold(model: HoldModel, P: float, *, progress=None) -> HoldPath:
             if dP < P / (16 * o.close_steps):
                 raise
     model.released = Pose(model.body.centre, model.pose).t.copy()
-    # of the weight: let go at once; where the hand is symmetric, in smaller parts if that fails
-    # (the largest share held is reported); else the release was followed as a path
+    # of the weight: let go at once, the release followed as a path where it finds no equilibrium near
+    # the grasp; where the hand is symmetric, in smaller parts if that fails (the largest share held is
+    # reported, each part a plain step)
     share, d_share = 0.0, 1.0
     while share < 1.0:
         try:
-            steps.append(model.step(P, gravity=min(share + d_share, 1.0), pull=0.0, stage="release"))
+            steps.append(model.step(P, gravity=min(share + d_share, 1.0), pull=0.0, stage="release",
+                                    path=d_share == 1.0))
             tick(steps[-1])
             share = min(share + d_share, 1.0)
         except (NotConverged, NoEquilibrium) as err:

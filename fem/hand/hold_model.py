@@ -21,7 +21,8 @@ condensed stiffness (:mod:`softhand.fem.hand.hold_finger`). A load step:
 Letting go (stage "release") of an object placed without the hand's symmetry can need the
 object to slide far from where its support held it: closed on an object held off the palm
 axis, one finger pushes harder than its opposite, and the unbalanced push must be taken up
-by pads that slip. No equilibrium is then near the last state, and one load step's Newton
+by pads that slip; a box turned about the palm's axis (symmetric or not) is twisted by its pads
+more than friction carries and must turn. No equilibrium is then near the last state, and one load step's Newton
 does not find one (its corrections grow to millimetres along the slipping pads' zero
 stiffness). Such a step is followed as a path (``HoldModel._relax``): the object moves
 against a viscous support that fades from step to step, each step anchoring friction where
@@ -137,15 +138,17 @@ class HoldModel:
                        np.array([len(images) for _, images in self.orbits], dtype=float),
                        [f.q for f in self.fingers], [f.Q.copy() for f in self.fingers], [f.S for f in self.fingers])
 
-    def step(self, P: float, *, gravity: bool, pull: float, stage: str) -> StepRecord:
+    def step(self, P: float, *, gravity: bool, pull: float, stage: str, path: bool = False) -> StepRecord:
         """One load step to (P, gravity, pull); the state is kept only if it converges
-        (NotConverged or :class:`NoEquilibrium` leave the last state)."""
+        (NotConverged or :class:`NoEquilibrium` leave the last state). A release step that finds no
+        equilibrium near the last state is followed as a path (:meth:`_relax`) where the hand is not
+        symmetric, or with ``path``."""
         saved = self._save()
         try:
             return self._step(P, gravity, pull, stage)
         except (NotConverged, NoEquilibrium, np.linalg.LinAlgError) as err:
             self._restore(saved)
-            if stage != "release" or self.symmetric or not self.options.relax_steps \
+            if stage != "release" or (self.symmetric and not path) or not self.options.relax_steps \
                     or isinstance(err, NoEquilibrium):
                 raise
         try:
