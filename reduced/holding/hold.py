@@ -4,7 +4,8 @@ much more can it take along a pull, and what pump pressure holds it with a margi
 :func:`solve_hold` runs the path of the FEM hold in the fast model: close at the cavity pressure
 (:func:`softhand.reduced.holding.hold_fast.close_hand`), let go (the object's weight: the admissible state nearest
 the closing forces, :func:`softhand.reduced.holding.hold_lp.weight_state`; an object whose weight the pads do
-not bear where it was grasped first settles under it, sliding down and turning, whatever the pull), pull along a direction until no
+not bear where it was grasped first settles under it, sliding down and turning, whatever the pull;
+one the closing forces twist more than friction carries turns first, :func:`softhand.reduced.holding.hold_turn.let_go`), pull along a direction until no
 admissible state is left (:func:`softhand.reduced.holding.hold_lp.holding_limit`), the object sliding along the
 pull where the fingers closing on it there hold it more (:mod:`softhand.reduced.holding.hold_slide`: the
 holding limit is the first maximum along that slide; a pull towards the palm is not followed: pushed
@@ -64,12 +65,8 @@ def pull_unit(pull, field: str = "--pull") -> np.ndarray:
 
 def contact_set(closed: hold_fast.Closed, design: HandDesign) -> hold_lp.ContactSet:
     """The touching pads of the closed hand and its fingers' hinges (moments, stiffness) for the LP."""
-    rows = []
-    for i, s in enumerate(closed.fingers):
-        for k in np.flatnonzero((s.N > 0.0) | (s.geometry.gap <= hold_finger.TOUCH)):
-            if k == 0:
-                continue
-            rows.append((i, int(k)))
+    rows = [(i, int(k)) for i, s in enumerate(closed.fingers)
+            for k in np.flatnonzero((s.N > 0.0) | (s.geometry.gap <= hold_finger.TOUCH)) if k > 0]
     C, n_s = len(rows), design.n_s
     J = np.zeros((design.n * n_s, C, 3))
     for c, (i, k) in enumerate(rows):
@@ -116,13 +113,14 @@ def solve_hold(design: HandDesign, obj: GraspObject, *, P_cavity_MPa: float, pul
     weight = obj.mass_kg * d.g
     size = float(np.max(np.ptp(placed.surface(resolution=8)[0], axis=0)))
 
-    hands = {} if slide_hands is None else slide_hands
-    hands[_pose_key(placed)] = closed
+    hands = {} if slide_hands is None else slide_hands  # by pose: its centre and rotation, bit for bit
+    pose_key = lambda p: (p.centre.tobytes(), p.R.tobytes())  # noqa: E731
+    hands[pose_key(placed)] = closed
 
     def hand_at(moved):
         """The hand closed on the object at pose ``moved``; None where the object has moved into the open
         fingers (they have let it through)."""
-        key = _pose_key(moved)
+        key = pose_key(moved)
         if key not in hands:
             near = hands[min(hands, key=lambda k: float(np.linalg.norm(np.frombuffer(k[0]) - moved.centre)))]
             try:
@@ -156,7 +154,15 @@ def solve_hold(design: HandDesign, obj: GraspObject, *, P_cavity_MPa: float, pul
         return hold_slide.follow(at, first, weight_N=weight, slip_out_mm=0.5 * size_radius(obj), enough_N=enough,
                                  settle=settle), path_of, first
 
-    path, _, first = slide(placed, np.array(DOWN), True, enough_N if pull[1] >= 1.0 - 1e-12 else 0.0)
+    def borne(moved):  # the pull the pads bear at this pose beyond the weight (-inf: none)
+        hand = hand_at(moved)
+        lim = None if hand is None else hold_lp.holding_limit(contact_set(hand, d), moved.centre, weight, DOWN,
+                                                              obj.friction, size_mm=size)
+        return -math.inf if lim is None else lim.pull_N
+
+    start = placed if obj.shape == "sphere" else hold_turn.let_go(placed, contact_set(closed, d), obj.friction,
+                                                                  size, DOWN, borne)
+    path, _, first = slide(start, np.array(DOWN), True, enough_N if pull[1] >= 1.0 - 1e-12 else 0.0)
     evaluations = path.evaluations
     if pull[1] < 1.0 - 1e-12 and path.y_rest is not None:  # let go, then pulled from where it rests
         path, _, first = slide(path.rest[0], pull, False, enough_N)
@@ -210,11 +216,6 @@ def solve_hold(design: HandDesign, obj: GraspObject, *, P_cavity_MPa: float, pul
                "limit_pull_N": float(limit.pull_N) if limit is not None else None,
                "first_slip_pull_N": float(first[0]) if math.isfinite(first[0]) else None,
                "slide_mm": float(path.y_limit), "slide_evaluations": evaluations})
-
-
-def _pose_key(placed: Placed) -> tuple:
-    """A pose as a key of the hands closed along the slides (its centre and rotation, bit for bit)."""
-    return placed.centre.tobytes(), placed.R.tobytes()
 
 
 def cavity_pressure(P_pump: float, placed: Placed, design: HandDesign, *, finger_model: str = "fem",

@@ -25,10 +25,19 @@ tolerance on some fingers and not on others gave it tilt rates of 0.4-0.8 deg/mm
 :class:`Path` follows the pose: the centre moves along the pull (the mechanism's sideways velocity
 is not followed), the rotation integrated by explicit Euler steps from knot to knot,
 one every :data:`TURN_STEP` of turn at most. A ball (rotating it changes no contact) is not turned.
-Units: mm, rad, N, N mm.
+
+**Let go with a twist** (:func:`untwist`). Where the pads cannot hold the object in place even
+without its weight -- the closing forces twist it about the palm's axis (a box turned about it,
+pressed off its faces' centre lines) more than friction carries -- no admissible state exists and
+so no mechanism: the object turns first, as the closing forces twist it, until friction carries
+what twist is left and the pads bear its weight, where it rests (or, where no turn lets them
+bear it, until they first hold it at all; it settles on from there). It is turned in steps of
+:data:`TURN_STEP` (the hand closed afresh at each) up to :data:`LARGEST_UNTWIST`, that pose
+bisected to :data:`UNTWIST_TOL`. Units: mm, rad, N, N mm.
 """
 from __future__ import annotations
 
+import math
 from bisect import bisect_right
 from dataclasses import replace
 from typing import Callable
@@ -43,6 +52,58 @@ from softhand.reduced.holding.object_geometry import Placed
 TURN_STEP = np.radians(1.0)
 #: the applied moment of the central difference, per (weight [N] x size [mm])
 MOMENT_STEP = 1e-3
+#: the largest turn [rad] of an object let go with a twist (:func:`untwist`)
+LARGEST_UNTWIST = np.radians(45.0)
+#: the untwisted pose is bisected to this turn [rad]
+UNTWIST_TOL = np.radians(0.05)
+
+
+def closing_twist(cs: hold_lp.ContactSet, centre, axis) -> float:
+    """The closing forces' moment [N mm] on the object about ``axis`` (unit vector) through ``centre``."""
+    moments = np.cross(cs.point - np.asarray(centre, float), -cs.closing_N[:, None] * cs.normal)
+    return float(np.sum(moments @ np.asarray(axis, float)))
+
+
+def let_go(placed: Placed, cs: hold_lp.ContactSet, mu: float, size_mm: float, axis,
+           pull_at: Callable[[Placed], float]) -> Placed:
+    """The pose the object let go turns to before it settles (module doc): :func:`untwist` where the pads
+    of the grasp ``cs`` cannot hold it in place without its weight and can once the closing forces'
+    twist about ``axis`` is taken off it; else ``placed``."""
+    axis = np.asarray(axis, float)
+    twist = closing_twist(cs, placed.centre, axis)
+    if not len(cs.finger) or hold_lp.holding_limit(cs, placed.centre, 0.0, axis, mu, size_mm=size_mm) is not None \
+            or hold_lp.holding_limit(cs, placed.centre, 0.0, axis, mu, size_mm=size_mm, moment=-twist * axis) is None:
+        return placed
+    return untwist(placed, axis, twist, pull_at)
+
+
+def untwist(placed: Placed, axis, twist: float, pull_at: Callable[[Placed], float]) -> Placed:
+    """The pose the object let go with the closing forces' ``twist`` about ``axis`` (through its centre)
+    turns to (module doc): turned with the twist until ``pull_at(pose)`` -- the pull the pads bear there
+    beyond the weight, -inf for no admissible state -- is >= 0 (it rests there), or, where no turn up to
+    :data:`LARGEST_UNTWIST` gets there, until the pads first hold it at all (it settles on from there);
+    ``placed`` itself where no turn does."""
+    axis = np.asarray(axis, float) * np.sign(twist)
+    if twist == 0.0:
+        return placed
+
+    def turned(angle):
+        return replace(placed, R=Rotation.from_rotvec(angle * axis).as_matrix() @ placed.R)
+
+    def first(ok, lo, hi):  # bisected: ok(hi), not ok(lo)
+        while hi - lo > UNTWIST_TOL:
+            mid = 0.5 * (lo + hi)
+            lo, hi = (mid, hi) if not ok(pull_at(turned(mid))) else (lo, mid)
+        return turned(hi)
+
+    angles = np.arange(int(LARGEST_UNTWIST / TURN_STEP) + 1) * TURN_STEP
+    pulls = []
+    for k, angle in enumerate(angles[1:], start=1):
+        pulls.append(pull_at(turned(angle)))
+        if pulls[-1] >= 0.0:
+            return first(lambda lam: lam >= 0.0, angles[k - 1], angle)
+    held = [k for k, lam in enumerate(pulls, start=1) if math.isfinite(lam)]
+    return first(math.isfinite, angles[held[0] - 1], angles[held[0]]) if held else placed
 
 
 def turn_rate(cs: hold_lp.ContactSet, centre, weight_N: float, pull, mu: float, *, size_mm: float,

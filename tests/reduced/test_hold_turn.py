@@ -113,3 +113,70 @@ def test_a_ball_is_not_turned_and_a_turned_cube_rests_turned_back():
     assert cube.held
     assert -3.0 < cube.rotation_deg[1] < 0.0      # the FEM's: -0.44 deg at rest
     assert cube.steps[-1].rotation_deg[1] < cube.rotation_deg[1]
+
+
+def test_the_closing_twist_is_the_moment_of_the_closing_forces():
+    """Two pads pressing a box's opposite faces x = +-20 off its centre line by +-5 mm along z, each
+    with N = 10: the forces -N n on it twist it by 2 x 5 x 10 = 100 N mm about -y."""
+    normal = np.array([[1.0, 0, 0], [-1.0, 0, 0]])
+    point = np.array([[20.0, 0, 5.0], [-20.0, 0, -5.0]])
+    cs = hold_lp.ContactSet(np.array([0, 1]), np.array([1, 1]), point, normal, np.array([10.0, 10.0]),
+                            np.zeros((2, 2, 3)), np.zeros(2), np.ones(2))
+    assert hold_turn.closing_twist(cs, np.zeros(3), DOWN) == pytest.approx(-100.0)
+    assert hold_turn.closing_twist(cs, np.zeros(3), [1.0, 0, 0]) == pytest.approx(0.0)
+
+
+@pytest.mark.parametrize("twist, rest_deg", [(-3.0, 2.37), (2.0, 7.9), (-1.0, 30.0)])
+def test_untwist_turns_with_the_twist_to_where_the_weight_is_borne(twist, rest_deg):
+    """A synthetic hand whose pads bear the weight once the object has turned ``rest_deg`` with the
+    twist (the pull borne grows with the turn past it, none admissible before 1 deg): the untwisted
+    pose is turned there, about the palm's axis, to the tolerance; the direction is the twist's."""
+    placed = place_object(objects.GraspObject(shape="box", size_mm=(150.0, 150.0, 150.0)),
+                          hold_fast.finger_design(HandDesign()))
+    sign = np.sign(twist)
+
+    def turn_deg(p):  # the pose's turn about y from the placement, in the twist's sense
+        return sign * math.degrees(Rotation.from_matrix(p.R @ placed.R.T).as_rotvec()[1])
+
+    def pull_at(p):
+        a = turn_deg(p)
+        return -math.inf if a < 1.0 else a - rest_deg
+
+    moved = hold_turn.untwist(placed, DOWN, twist, pull_at)
+    assert np.allclose(moved.centre, placed.centre)
+    assert turn_deg(moved) == pytest.approx(rest_deg, abs=math.degrees(hold_turn.UNTWIST_TOL))
+    assert turn_deg(moved) >= rest_deg
+
+
+def test_untwist_where_the_weight_is_never_borne_turns_to_the_first_hold_or_not_at_all():
+    placed = place_object(objects.GraspObject(shape="box", size_mm=(150.0, 150.0, 150.0)),
+                          hold_fast.finger_design(HandDesign()))
+
+    def turn_deg(p):
+        return -math.degrees(Rotation.from_matrix(p.R @ placed.R.T).as_rotvec()[1])
+
+    moved = hold_turn.untwist(placed, DOWN, -5.0, lambda p: -math.inf if turn_deg(p) < 4.3 else -1.0)
+    assert turn_deg(moved) == pytest.approx(4.3, abs=math.degrees(hold_turn.UNTWIST_TOL))
+    assert hold_turn.untwist(placed, DOWN, -5.0, lambda p: -math.inf) is placed
+    assert hold_turn.untwist(placed, DOWN, 0.0, lambda p: 1.0) is placed
+
+
+def test_a_box_twisted_more_than_friction_carries_turns_back_when_let_go_and_is_held():
+    """Design A's 160 x 110 x 140 mm box turned 25 deg (0.4 kg, mu 0.6, 1.3 MPa): closed on, its pads
+    twist it more than friction carries (no admissible state at the grasp, not even without its
+    weight). The whole-hand FEM turns it 3 deg back while it lets go and holds 1.78 N
+    (studies/data/hold_fem_limits.json); the fast model turns it back 2-4 deg and holds it."""
+    from softhand.studies import hold_reference
+
+    data = hold_reference.load()
+    case = next(c for c in data["cases"] if c["name"].startswith("design A, box 160 x 110 x 140"))
+    design = hold_reference.design_of(case, data["designs"])
+    obj = objects.object_from_table(dict(case["object"], mass_kg=case["mass_kg"], friction=case["friction"]),
+                                    source="test")
+    d = hold_fast.finger_design(design)
+    placed = place_object(obj, d)
+    cs = hold.contact_set(hold_fast.close_hand(case["P_cavity_MPa"], placed, d), d)
+    assert hold_lp.holding_limit(cs, placed.centre, 0.0, DOWN, obj.friction, size_mm=160.0) is None
+    r = hold.solve_hold(design, obj, P_cavity_MPa=case["P_cavity_MPa"])
+    assert r.held and -4.0 < r.rotation_deg[1] < -2.0
+    assert r.holding_limit_N == pytest.approx(case["fem_limit_N"], rel=0.05)
