@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
 from pathlib import Path
 
 from softhand.reduced.holding.hold import solve_hold
@@ -97,7 +98,7 @@ def reference(markdown: bool) -> None:
         cells = [r.name, f"{r.P_cavity_MPa:.3f}",
                  f"{r.fem_limit_N:.2f}" if r.fem_held else f"not held ({100 * (1 + r.fem_margin):.0f} % of the weight)",
                  f"{r.fast_limit_N:.2f}" if r.fast_held else "not held",
-                 f"{100 * r.error:+.1f} %" if r.fem_held and r.fast_held else "",
+                 f"{100 * r.error:+.1f} %" if math.isfinite(r.error) else "",
                  f"{100 * r.load_error:+.1f} %" if r.fem_held and r.fast_held else ""]
         print(("| " if markdown else "") + sep.join(cells) + (" |" if markdown else ""))
     s = hold_reference.summary(rows)
