@@ -191,12 +191,12 @@ def carry(fine: hinge_table.HingeTable, design: HandDesign, space: Space, r, rm)
 REVERSE_SECANT = math.radians(2.0)
 
 
-@lru_cache(maxsize=16)
 def paper_rubber(design: HandDesign) -> HandDesign:
     """The design's geometry in the paper's rubber, on the carried table (no ``hinge_table`` of its own)."""
     return replace(design, mu_sf=HandDesign().mu_sf, finger_material=None, hinge_table="")
 
 
+@lru_cache(maxsize=16)
 def reverse_scale(design: HandDesign) -> float:
     """The factor carrying the table's moments at zero pressure of a hinge bent backwards (those of
     the design's geometry with the paper's rubber) to the design's rubber: the ratio of the two
