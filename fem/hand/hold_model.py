@@ -141,7 +141,7 @@ class HoldModel:
     def step(self, P: float, *, gravity: bool, pull: float, stage: str, path: bool = False) -> StepRecord:
         """One load step to (P, gravity, pull); the state is kept only if it converges
         (NotConverged or :class:`NoEquilibrium` leave the last state). A release step that finds no
-        equilibrium near the last state is followed as a path (:meth:`_relax`) where the hand is not
+        equilibrium near the last state is followed as a path (``HoldModel._relax``) where the hand is not
         symmetric, or with ``path``."""
         saved = self._save()
         try:

@@ -48,9 +48,9 @@ def hinge_stiffness(q, P, design: HandDesign) -> np.ndarray:
 
 
 def hinge_energy(q, P, design: HandDesign) -> float:
-    """E [N mm] at hinge angles q (n_s,): the coupled hinges' (:func:`softhand.reduced.calibrated.
-    finger_hinges.coupled_energy`), or sum_j int_0^q_j M_j of the paper's finger (16-point Gauss
-    along each hinge; M_j depends on q_j alone)."""
+    """E [N mm] at hinge angles q (n_s,): the coupled hinges'
+    (:func:`softhand.reduced.calibrated.finger_hinges.coupled_energy`), or sum_j int_0^q_j M_j of
+    the paper's finger (16-point Gauss along each hinge; M_j depends on q_j alone)."""
     if design.finger_model == "fem":
         return finger_hinges.coupled_energy(q, P, design)
     q = np.asarray(q, float)
