@@ -34,11 +34,12 @@ import numpy as np
 from scipy.sparse import csr_matrix
 from scipy.spatial import cKDTree
 
-#: the averaging radius rho [mm]: the scale below which the rubber's stretch is not judged
-#: pointwise; of 1, 1.5, 2 and 3 mm the smallest whose value moved by less than 2 % between
-#: the layered meshes with 5 and 2.5 mm slices (the paper's and a thin finger at 2.0 MPa;
-#: docs/finger.md, "The rubber's stretch")
-RADIUS_MM = 2.0
+from softhand.reduced.materials.rubber_parameters import CRITICAL_DISTANCE_MM
+
+#: the averaging radius rho [mm]: the rubber's critical distance, the scale below which its
+#: stretch is not judged pointwise (a property of the rubber, so a part's measure depends on
+#: the part's size: the calibrated models carry it as a/rho and R/rho)
+RADIUS_MM = CRITICAL_DISTANCE_MM
 
 
 def bell(s, radius: float):

@@ -232,6 +232,18 @@ class FingerModel:
         C = kin.right_cauchy_green(self.solid.F(self.constraint.expand(y)))
         return np.sqrt(np.linalg.eigvalsh(np.moveaxis(C, (0, 1), (-2, -1)))[..., -1])
 
+    def rubber_stretches(self, ys, radii) -> np.ndarray:
+        """The converged rubber stretch of each state ``ys`` with the averaging ball's radius each
+        of ``radii`` [mm], (len(ys), len(radii)): the calibration's record of how the measure
+        depends on the finger's size (the radius is the rubber's, so a/rho is a group)."""
+        lam = [self.principal_stretch(y) for y in ys]
+        points = self._X_q.reshape(3, -1).T
+        columns = []
+        for r in radii:
+            averager = Averager(points, self.solid.W, radius=r, mirror=2)
+            columns.append([averager.peak(x)[0] for x in lam])
+        return np.array(columns).T.reshape(len(lam), len(radii))
+
     def rubber_stretch_field(self, y) -> np.ndarray:
         """The ball-averaged principal stretch at every quadrature point (nel, nq) [-]."""
         lam = self.principal_stretch(y)

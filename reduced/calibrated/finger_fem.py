@@ -59,9 +59,11 @@ from softhand.reduced.calibrated.finger_curves import Curves, energy_curves
 from softhand.reduced.vocabulary.design import HandDesign
 from softhand.reduced.vocabulary.errors import InputError
 from softhand.reduced.calibrated.finger_fem_terms import KernelFit, term_matrix
-from softhand.reduced.calibrated.finger_fem_table import COLUMNS, GROUPS, LABELS, PRIORS, STRETCH, TABLE_FILE, Table, table_error, read_table
+from softhand.reduced.calibrated.finger_fem_table import (A_RHO, COLUMNS, GROUPS, LABELS, PRIORS, SIZE_STRETCH, STRETCH,
+                                                     TABLE_FILE, Table, table_error, read_table)
+from softhand.reduced.materials.rubber_parameters import CRITICAL_DISTANCE_MM, between_sizes
 
-__all__ = ["TABLE_FILE", "GROUPS", "COLUMNS", "STRETCH", "PRIORS", "Table", "read_table", "check_table", "groups_of",
+__all__ = ["TABLE_FILE", "GROUPS", "COLUMNS", "STRETCH", "SIZE_STRETCH", "A_RHO", "PRIORS", "Table", "read_table", "check_table", "groups_of",
            "curves", "rubber_stretch", "FEM"]
 
 N_LINKS = 6
@@ -143,9 +145,17 @@ def stretch_prior(theta, groups: dict):
     return (groups["d_a"] + 1.0 + groups["b_a"]) * np.asarray(theta, float) / (N_LINKS * groups["link_a"])
 
 
+def stretch_columns(rows: dict) -> tuple[str, ...]:
+    """The table's stretch columns the fit uses: one per a/rho of :data:`~softhand.reduced.calibrated.finger_fem_table.A_RHO` where it has them,
+    else its designs' own ``s_tilde`` (older tables), else none."""
+    if SIZE_STRETCH[0] in rows:
+        return SIZE_STRETCH
+    return (STRETCH,) if STRETCH in rows else ()
+
+
 def fit_targets(rows: dict, prior: str, path="table") -> tuple[np.ndarray, ...]:
-    """The residuals a table's rows give the fit: y = ln(P / P_prior), ln kappa and, where the
-    table has the rubber's converged stretch, z = ln(s_tilde / eq. (8)'s strain)."""
+    """The residuals a table's rows give the fit: y = ln(P / P_prior), ln kappa and, per stretch
+    column (:func:`stretch_columns`), z = ln(s_tilde / eq. (8)'s strain)."""
     y = np.empty(rows["theta"].size)
     for i in np.unique(rows["design"]):  # the prior per design, all its angles at once
         at = rows["design"] == i
@@ -156,9 +166,8 @@ def fit_targets(rows: dict, prior: str, path="table") -> tuple[np.ndarray, ...]:
         raise table_error(path, "has dQ/a^3 <= pi (d/a) theta in a row: below the tube's kinematic "
                          "oil volume of eq. (2)")
     ln_kappa = np.log(dilation / rows["p_tilde"])
-    if STRETCH not in rows:
-        return y, ln_kappa
-    return y, ln_kappa, np.log(rows[STRETCH] / stretch_prior(rows["theta"], rows))
+    strain = stretch_prior(rows["theta"], rows)
+    return (y, ln_kappa, *(np.log(rows[c] / strain) for c in stretch_columns(rows)))
 
 
 class _TermsFit:
@@ -166,7 +175,7 @@ class _TermsFit:
 
     def __init__(self, table: Table, targets, path):
         r = table.rows
-        self.terms, self.betas = (table.p_terms, table.q_terms, table.p_terms)[:len(targets)], []
+        self.terms, self.betas = (table.p_terms, table.q_terms, *[table.p_terms] * (len(targets) - 2)), []
         for terms, target in zip(self.terms, targets):  # the stretch's z in P's terms
             try:
                 beta = lstsq_terms(r, r["theta"], target, terms)
@@ -231,14 +240,19 @@ def residuals(theta, design: HandDesign) -> tuple[np.ndarray, np.ndarray]:
 def rubber_stretch(theta, design: HandDesign):
     """The tube's converged rubber stretch (the FEM's ``rubber_stretch``) at bend theta [rad],
     calibrated: 1 + eq. (8)'s strain x e^z, z fitted over the design space like y and ln kappa
-    (held at its end value beyond the table's angles); None if the design's table has no
-    stretch column (tables written before it)."""
+    (held at its end value beyond the table's angles), per a/rho column of the table, and
+    between them linear in ln(a/rho) (continued by the end columns' line beyond them): the
+    averaging radius rho is the rubber's, so the measure depends on the tube's size a as well as
+    on the groups. None if the design's table has no stretch column (tables written before it;
+    a table with the designs' own ``s_tilde`` only predicts that, whatever a is)."""
     table, fit, theta_max = _fit(_table_path(design))
-    if STRETCH not in table.rows:
+    columns = stretch_columns(table.rows)
+    if not columns:
         return None
     groups = check_space(design, table)
     theta = np.asarray(theta, float)
-    z = fit(groups, np.clip(theta, 1e-9, theta_max))[2]
+    zs = np.array(fit(groups, np.clip(theta, 1e-9, theta_max))[2:])
+    z = between_sizes(zs, A_RHO, design.a / CRITICAL_DISTANCE_MM) if len(columns) > 1 else zs[0]
     return 1.0 + stretch_prior(theta, groups) * np.exp(z)
 
 

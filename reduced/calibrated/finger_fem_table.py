@@ -25,9 +25,14 @@ TABLE_FILE = Path(__file__).resolve().parent / "data" / "finger_fem.csv"
 GROUPS = ("b_a", "d_a", "link_a", "tie_link")
 LABELS = {"b_a": "b/a", "d_a": "d/a", "link_a": "link/a", "tie_link": "tie/link"}
 COLUMNS = ("design", *GROUPS, "theta", "p_tilde", "q_tilde")
-#: the optional last column: the FEM's converged rubber stretch less 1
-#: (:mod:`softhand.fem.rubber_stretch`)
+#: the optional column after them: the FEM's converged rubber stretch less 1
+#: (:mod:`softhand.fem.rubber_stretch`) of the table's own designs
 STRETCH = "s_tilde"
+#: a / rho of the optional last columns: the stretch less 1 averaged over a ball of radius a / x
+#: (rho the rubber's critical distance, a length of its own, so the measure is not the groups'
+#: alone: a finger of a = 3 mm and its twin of a = 4 mm differ by ~5 %); a = 2 to 8 mm at 2 mm
+A_RHO = (1.0, 1.5, 2.0, 3.0, 4.0)
+SIZE_STRETCH = tuple(f"s_a_rho_{x:g}" for x in A_RHO)
 #: the physics a table's residual is taken against (see :func:`~softhand.reduced.calibrated.finger_fem.prior_pressure`)
 PRIORS = ("paper", "rings")
 #: the radial basis functions a kernel fit may use (scipy.interpolate.RBFInterpolator's)
@@ -63,14 +68,14 @@ def table_error(path, allowed: str) -> InputError:
 #: column -> (lowest, highest) of a row: theta [rad] of a bend up to a full turn; the
 #: pressure and oil per mu_sf and a^3 of any finger the FEM can solve
 ROW_LIMITS = {"theta": (1e-6, 2 * math.pi), "p_tilde": (1e-9, 1e6), "q_tilde": (1e-9, 1e6),
-              STRETCH: (1e-9, 100.0)}
+              **{c: (1e-9, 100.0) for c in (STRETCH, *SIZE_STRETCH)}}
 
 
 def read_table(path: str | Path = TABLE_FILE) -> Table:
     """Read a finger calibration CSV; InputError naming the file on any problem."""
     path = Path(path)
     comments, header, values = read_number_table(path, "finger_table", "a CSV written by softhand calibrate finger",
-                                                 COLUMNS, optional=(STRETCH,))
+                                                 COLUMNS, optional=(STRETCH, *SIZE_STRETCH))
     rows = {c: values[:, i] for i, c in enumerate(header)}
     if np.any(rows["theta"] <= 0) or np.any(rows["p_tilde"] <= 0) or np.any(rows["q_tilde"] <= 0):
         raise table_error(path, "theta, p_tilde and q_tilde must be positive (the P = 0 state is implied)")

@@ -96,11 +96,16 @@ def legacy_terms(kind: str, varying: dict, design_degree: int, theta_degree: int
 KERNEL_FEATURES = ("lb", "ld", "lL", "lt", "s2")
 
 
-#: per residual (y, ln kappa, the stretch's z) the variable its per-design line is in: theta for P
+#: per residual (y, ln kappa, the stretch's z at each averaging radius) the variable its per-design line is in: theta for P
 #: and Delta Q; ln theta for z, so the stretch is a power law of the bend, rubber_stretch - 1 =
 #: eq. (8)'s strain x C theta^b (over the shipped table's designs left out one by one: rms 1.58 %,
 #: worst 6.7 % against a line in theta's 1.97 %, 13.5 %: docs/finger.md)
 LINE_IN = ("theta", "theta", "log theta")
+
+
+def _lines_in(n: int) -> tuple[str, ...]:
+    """The variables of n residuals: y, ln kappa, then the stretch's z at each of the table's radii."""
+    return LINE_IN[:2] + LINE_IN[2:] * (n - 2)
 
 
 def _variable(name: str, theta):
@@ -124,7 +129,7 @@ class KernelFit:
             at = rows["design"] == i
             th = rows["theta"][at]
             line = [np.polyfit(_variable(x, th), v[at], 1) if np.ptp(th) > 0 else (0.0, v[at].mean())
-                    for v, x in zip(targets, LINE_IN)]
+                    for v, x in zip(targets, _lines_in(len(targets)))]
             coef.append([c for slope, intercept in line for c in (intercept, slope)])
             g = {k: rows[k][at][0] for k in ("b_a", "d_a", "link_a", "tie_link")}
             X.append([float(BASE[f](g, 0.0)) for f in features])
@@ -140,4 +145,4 @@ class KernelFit:
         x = np.array([float(BASE[f](groups, 0.0)) for f in self.features])
         c = self.rbf(((x - self.lo) / self.span)[None, :])[0]
         theta = np.asarray(theta, float)
-        return tuple(c[k] + c[k + 1] * _variable(x, theta) for k, x in zip(range(0, c.size, 2), LINE_IN))
+        return tuple(c[k] + c[k + 1] * _variable(x, theta) for k, x in zip(range(0, c.size, 2), _lines_in(c.size // 2)))

@@ -9,6 +9,8 @@ from __future__ import annotations
 import math
 from dataclasses import fields
 
+import numpy as np
+
 from softhand.reduced.vocabulary.errors import InputError
 from softhand.reduced.materials.rubber import MODELS, Ogden, drucker_check
 from softhand.reduced.materials.rubber_base import PUBLIC_NAMES, Rubber
@@ -19,6 +21,23 @@ MAX_OGDEN_ALPHA = 30.0
 #: material must be defined and Drucker-stable over them, or the models' answers are nonsense
 #: (negative pressures from an unstable Mooney-Rivlin, nan past Gent's locking)
 WORKING_STRETCHES = (0.5, 2.0)
+#: the rubber's critical distance rho [mm]: its stretch is judged averaged over a ball of this
+#: radius (softhand.fem.rubber_stretch), a length of the material, not of the part; of 1, 1.5,
+#: 2 and 3 mm the smallest whose value moved by less than 2 % between the layered meshes with
+#: 5 and 2.5 mm slices (the paper's and a thin finger at 2.0 MPa; docs/finger.md)
+CRITICAL_DISTANCE_MM = 2.0
+
+
+def between_sizes(values, ratios, ratio: float):
+    """A measure at a part's size ratio (size / CRITICAL_DISTANCE_MM) from its ``values`` (k, ...)
+    at the tabulated increasing ``ratios`` (k,): piecewise linear in the ratio's logarithm (a
+    power law of the part's size between neighbours, as near a bonded corner), the end
+    segments continued beyond them."""
+    nodes = np.log(np.asarray(ratios, float))
+    x = math.log(ratio)
+    k = int(np.clip(np.searchsorted(nodes, x) - 1, 0, len(nodes) - 2))
+    t = (x - nodes[k]) / (nodes[k + 1] - nodes[k])
+    return (1.0 - t) * np.asarray(values[k]) + t * np.asarray(values[k + 1])
 
 
 def parameter_names(model: str, terms: int = 3) -> tuple[str, ...]:

@@ -134,9 +134,13 @@ def bend_case(params: dict, design: HandDesign, outdir: Path) -> dict:
     ``mesh_size_mm`` (optional): a uniform gmsh mesh of that size instead of the default mesh;
     ``axial_size_mm`` (optional): the default (layered) mesh with slices of at most that length.
     Returns P_cavity_MPa, theta_deg, dQ_mm3 (whole finger) and rubber_stretch
-    (:mod:`softhand.fem.rubber_stretch`) per converged pressure.
+    (:mod:`softhand.fem.rubber_stretch`) per converged pressure, and ``rubber_stretch_a_rho``:
+    per converged pressure, per a/rho of the table's
+    :data:`~softhand.reduced.calibrated.finger_fem_table.A_RHO`, the stretch averaged over a ball
+    of radius a / (a/rho) (what a finger of that size, these groups, would report).
     """
     from softhand.fem.hand.finger import FingerModel, solve_pressures
+    from softhand.reduced.calibrated.finger_fem_table import A_RHO
 
     model = FingerModel(design, case_options(params))
     states, stats = solve_pressures(model, params["pressures_mpa"])
@@ -151,6 +155,7 @@ def bend_case(params: dict, design: HandDesign, outdir: Path) -> dict:
     return {"P_cavity_MPa": [s.P for s in states], "theta_deg": [math.degrees(s.theta) for s in states],
             "dQ_mm3": [s.dQ for s in states],
             "rubber_stretch": [s.rubber_stretch for s in states],
+            "rubber_stretch_a_rho": model.rubber_stretches([s.y for s in states], [design.a / x for x in A_RHO]).tolist(),
             "mesh": {"mesher": model.options.mesher, "dofs": model.ndofs,
                      "elements": model.mesh.nelements},
             "solver": {"newton_iterations": its, "factorizations": facs, "wall_time_s": wall,

@@ -96,10 +96,14 @@ def leave_one_out(path: str | Path | None = None) -> list[dict]:
     """Each design of a table predicted by the table without it (its rows removed, the fit
     redone, the ranges kept): per FEM row, theta at the FEM's pressure and dQ at the FEM's
     theta, errors [%]. A check of the fit that runs no FEM (the designs are at a = 4 mm, which
-    the groups do not see)."""
+    the groups do not see). Where the table has the rubber's stretch: its error [%] at a = 4 mm
+    (``rubber_stretch_err_pct``) and, where the table has it at each a/rho, the largest at the
+    sizes a = rho a/rho of those columns (``rubber_stretch_sizes_err_pct``, signed)."""
     import tempfile
 
-    from softhand.reduced.calibrated.finger_fem import STRETCH, TABLE_FILE, read_table, rubber_stretch
+    from softhand.reduced.calibrated.finger_fem import (A_RHO, SIZE_STRETCH, STRETCH, TABLE_FILE, read_table,
+                                                        rubber_stretch)
+    from softhand.reduced.materials.rubber_parameters import CRITICAL_DISTANCE_MM
 
     table = read_table(path or TABLE_FILE)
     r = table.rows
@@ -108,7 +112,7 @@ def leave_one_out(path: str | Path | None = None) -> list[dict]:
     with tempfile.TemporaryDirectory() as tmp:
         for i in np.unique(r["design"]):
             at = r["design"] == i
-            columns = [c for c in (*COLUMNS, STRETCH) if c in r]
+            columns = [c for c in (*COLUMNS, STRETCH, *SIZE_STRETCH) if c in r]
             rest = [{c: r[c][k] for c in columns} for k in np.flatnonzero(~at)]
             lines = [line.lstrip("#").strip() for line in header]
             text = "\n".join(f"# {line}" for line in lines) + "\n" + ",".join(columns) + "\n"
@@ -124,11 +128,24 @@ def leave_one_out(path: str | Path | None = None) -> list[dict]:
             th_m = hand.bend_angle(P, model, reservoir=False)
             dQ_m = finger.oil_taken(theta, model)
             lam_m = rubber_stretch(theta, model)
+            own = r[SIZE_STRETCH[A_RHO.index(a / CRITICAL_DISTANCE_MM)]] if SIZE_STRETCH[0] in r else r.get(STRETCH)
+            sizes = None
+            if SIZE_STRETCH[0] in r:  # the same groups at each a of the table's a/rho
+                e = np.array([100 * (rubber_stretch(theta, _scaled(model, x * CRITICAL_DISTANCE_MM / a)) / (1 + r[c][at]) - 1)
+                              for c, x in zip(SIZE_STRETCH, A_RHO)])
+                sizes = e[np.argmax(np.abs(e), axis=0), np.arange(theta.size)]
             for k in range(theta.size):
                 out.append({"design": int(i), **{key: round(v, 4) for key, v in g.items()},
                             "P_cavity_MPa": float(P[k]), "theta_fem_deg": math.degrees(theta[k]),
                             "theta_err_pct": 100 * (th_m[k] / theta[k] - 1),
                             "dQ_err_pct": 100 * (dQ_m[k] / (r["q_tilde"][at][k] * a**3) - 1),
                             **({} if lam_m is None else  # of the stretch itself, not of its strain
-                               {"rubber_stretch_err_pct": 100 * (lam_m[k] / (1 + r[STRETCH][at][k]) - 1)})})
+                               {"rubber_stretch_err_pct": 100 * (lam_m[k] / (1 + own[at][k]) - 1)}),
+                            **({} if sizes is None else {"rubber_stretch_sizes_err_pct": float(sizes[k])})})
     return out
+
+
+def _scaled(design: HandDesign, k: float) -> HandDesign:
+    """The design with its tube's lengths scaled by k: the same groups, another size."""
+    return design.replace(a=design.a * k, b=design.b * k, d=design.d * k, l0=design.l0 * k,
+                          hinge_s=tuple(s * k for s in design.hinge_s), tie_width=design.tie_width * k)

@@ -16,7 +16,7 @@ import numpy as np
 from scipy.interpolate import PchipInterpolator
 
 from softhand.reduced.vocabulary.design import HandDesign
-from softhand.reduced.calibrated.finger_fem import COLUMNS, GROUPS, STRETCH, groups_of
+from softhand.reduced.calibrated.finger_fem import COLUMNS, GROUPS, SIZE_STRETCH, STRETCH, groups_of
 from softhand.studies.calibration.finger import MIN_GAP_SLICES, cavity_pressures
 from softhand.studies.calibration.space import DesignSpace, VARIABLES
 from softhand.studies.calibration.tables import written_by
@@ -42,17 +42,20 @@ def designs_ranges(rows: list[dict]) -> dict:
 
 def table_rows(results: list[tuple[HandDesign, dict]]) -> list[dict]:
     """Nondimensional table rows from (design, numbers of its finger_bend case), P > 0 only;
-    with the converged rubber stretch (s_tilde = lambda - 1) where every case has it."""
+    with the converged rubber stretch (s_tilde = lambda - 1) where every case has it, and at
+    each a/rho (s_a_rho_X) where every case has those."""
     rows = []
     stretch = all("rubber_stretch" in numbers for _, numbers in results)
+    sizes = stretch and all("rubber_stretch_a_rho" in numbers for _, numbers in results)
     for i, (design, numbers) in enumerate(results):
         groups = groups_of(design)
-        lam = numbers["rubber_stretch"] if stretch else [math.nan] * len(numbers["theta_deg"])
-        for P, theta, dQ, lam_k in zip(cavity_pressures(numbers), numbers["theta_deg"], numbers["dQ_mm3"], lam):
+        for k, (P, theta, dQ) in enumerate(zip(cavity_pressures(numbers), numbers["theta_deg"], numbers["dQ_mm3"])):
             if P > 0:
                 rows.append({"design": i, **groups, "theta": math.radians(theta),
                              "p_tilde": P / design.mu_sf, "q_tilde": dQ / design.a**3,
-                             **({STRETCH: lam_k - 1.0} if stretch else {})})
+                             **({STRETCH: numbers["rubber_stretch"][k] - 1.0} if stretch else {}),
+                             **(dict(zip(SIZE_STRETCH, np.array(numbers["rubber_stretch_a_rho"][k], float) - 1.0))
+                                if sizes else {})})
     return rows
 
 
@@ -92,10 +95,12 @@ def table_csv(rows: list[dict], ranges: dict, provenance: list[str], fit: str,
     lines.append("# groups: b_a = b/a, d_a = d/a, link_a = (l0/6)/a, tie_link = tie width/(l0/6); "
                  "theta [rad]; p_tilde = P/mu_sf; q_tilde = dQ/a^3 (one finger)"
                  + ("; s_tilde = rubber_stretch - 1 (the converged stretch, fem.rubber_stretch)"
-                    if rows and STRETCH in rows[0] else ""))
+                    if rows and STRETCH in rows[0] else "")
+                 + ("; s_a_rho_X = the same, averaged over a ball of radius a/X (X = a/rho)"
+                    if rows and SIZE_STRETCH[0] in rows[0] else ""))
     lines.append("# range: " + ", ".join(f"{g}={ranges[g][0]:.10g}:{ranges[g][1]:.10g}" for g in GROUPS))
     lines.append(f"# fit: prior={prior}, {fit}")
-    columns = (*COLUMNS, STRETCH) if rows and STRETCH in rows[0] else COLUMNS
+    columns = tuple(c for c in (*COLUMNS, STRETCH, *SIZE_STRETCH) if not rows or c in rows[0])
     lines.append(",".join(columns))
     for r in rows:
         lines.append(",".join(str(int(r[c])) if c == "design" else f"{r[c]:.10g}" for c in columns))

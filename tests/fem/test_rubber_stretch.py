@@ -124,3 +124,26 @@ def test_inspect_colours_by_the_converged_stretch_by_default():
     assert default_field(["displacement_mm", "von_mises_MPa", "rubber_stretch"]) == "rubber_stretch"
     assert default_field(["displacement_mm", "von_mises_MPa"]) == "von_mises_MPa"
     assert colour_label("rubber_stretch") == "rubber stretch (ball average) [-]"
+
+
+def test_a_scaled_finger_reports_its_twins_stretch_at_the_scaled_radius():
+    """What the calibration's a/rho columns rest on: a Neo-Hookean finger scaled by k (its mesh too)
+    bends alike at the same pressure, and its stretch averaged over rho is the original's over
+    rho / k, so the converged stretch depends on the groups and a/rho alone. And the radius matters:
+    the 3 mm tube's stretch over 2 mm is ~5 % below that over 1.5 mm (docs/finger.md)."""
+    from softhand.fem.hand.finger import FingerModel, FingerOptions, solve_pressures
+    from softhand.studies.calibration.space import finger_design
+
+    k, P = 4.0 / 3.0, [0.8]
+    small = finger_design({"a_mm": 3.0, "b_mm": 3.0, "d_mm": 10.0, "l0_mm": 120.0, "tie_width_mm": 5.0})
+    large = finger_design({"a_mm": 3.0 * k, "b_mm": 3.0 * k, "d_mm": 10.0 * k, "l0_mm": 120.0 * k,
+                           "tie_width_mm": 5.0 * k})
+    out = []
+    for design, scale in ((small, 1.0), (large, k)):
+        model = FingerModel(design, FingerOptions(axial_size=5.0 * scale, layer_first=0.2 * scale))
+        state = solve_pressures(model, P)[0][0]
+        out.append((state.theta, model.rubber_stretches([state.y], [1.5 * scale, 2.0 * scale])[0]))
+    (th_s, lam_s), (th_l, lam_l) = out
+    assert th_l == pytest.approx(th_s, rel=1e-6)
+    np.testing.assert_allclose(lam_l, lam_s, rtol=1e-6)
+    assert lam_s[1] < 0.97 * lam_s[0]

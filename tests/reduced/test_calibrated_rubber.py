@@ -19,12 +19,13 @@ THETA = np.radians([-20.0, 0.0, 5.0, 30.0, 60.0, 95.0])
 
 def test_neo_hookean_written_as_another_model_gives_the_calibrated_curves_unchanged():
     """Yeoh with C20 = C30 = 0 is Neo-Hookean with mu = 2 C10: the general pure-shear integral
-    of eq. (10) against the paper's closed form, and the sheet's factor 1."""
+    of eq. (10) against the paper's closed form (to round-off of its quadrature: 1.9e-10 measured at
+    the largest angle's energy), and the sheet's factor 1."""
     as_yeoh = FEM.replace(finger_material=rubber.Yeoh(0.575, 0.0, 0.0),
                           reservoir_material=rubber.MooneyRivlin(0.575, 0.0))
     assert not as_yeoh.finger_is_neo_hookean and not as_yeoh.reservoir_is_neo_hookean
     for f in (finger.energy_rate, finger.energy, finger.volume):
-        np.testing.assert_allclose(f(THETA, as_yeoh), f(THETA, FEM), rtol=1e-10, atol=1e-9)
+        np.testing.assert_allclose(f(THETA, as_yeoh), f(THETA, FEM), rtol=1e-9, atol=1e-9)
     V = np.array([3000.0, FEM.V0, 25000.0])
     np.testing.assert_allclose(reservoir_fem.pressure(V, as_yeoh), reservoir_fem.pressure(V, FEM), rtol=1e-12)
     np.testing.assert_allclose(reservoir_fem.strain_energy(V, as_yeoh), reservoir_fem.strain_energy(V, FEM),

@@ -217,8 +217,10 @@ def test_a_sliver_of_feasible_designs_is_found_not_called_infeasible():
         assert opt.evaluation.feasible
         assert "stopped" not in opt.message or opt.message.endswith("SLSQP from the least-violating design met the constraints")
         assert best * (1 - 1e-3) < opt.evaluation.P_grasp <= best * factor
-    # a hair below: no design meets it, and the stall rule ends DE before its last generation
-    task = task_from_dict({**loose, "pump": {"max_pressure_MPa": best * 0.99999}})
+    # below it by more than the flat optimum's spread (two basins, d 16.8 and 17.5 mm, 3e-4 apart
+    # in pressure; the seed decides which DE finds): no design meets it, and the stall rule ends
+    # DE before its last generation
+    task = task_from_dict({**loose, "pump": {"max_pressure_MPa": best * 0.999}})
     opt = design_opt.optimise(task, design_opt.OptimiserOptions(seed=1))
     assert not opt.evaluation.feasible and opt.generations < 60
 
