@@ -22,7 +22,8 @@ from pathlib import Path
 
 import numpy as np
 
-from softhand.fem.hand.reservoir import ReservoirResult, SheetModel, inflate
+from softhand.fem.hand.reservoir import ReservoirResult, SheetModel, inflate, rubber_stretches
+from softhand.reduced.calibrated.reservoir_fem import R_RHO, SIZE_STRETCH
 from softhand.reduced.equations import finger
 from softhand.reduced.equations import reservoir as ellipse
 from softhand.reduced.vocabulary.design import HandDesign
@@ -175,10 +176,13 @@ def calibration_rows(model: SheetModel, *, v_max: float = 1.75, n: int = 71, pro
     R, t, mu = model.R, model.t, model.mu
     v = np.linspace(0.0, v_max, n)[1:]
     fem = inflate(model, v * R**3, progress=progress)
-    rows = [{"tau": t / R, "v": 0.0, "p_tilde": 0.0, "W_tilde": 0.0, "h_tilde": 0.0, "s_tilde": 0.0}]
+    sizes = rubber_stretches(model, fem.states, [R / x for x in R_RHO])
+    rows = [{"tau": t / R, "v": 0.0, "p_tilde": 0.0, "W_tilde": 0.0, "h_tilde": 0.0, "s_tilde": 0.0,
+             **dict.fromkeys(SIZE_STRETCH, 0.0)}]
     rows += [{"tau": t / R, "v": s.volume / R**3, "p_tilde": s.pressure * R / (mu * t),
               "W_tilde": s.energy / (mu * t * R**2), "h_tilde": s.apex / R,
-              "s_tilde": s.rubber_stretch - 1.0} for s in fem.states]
+              "s_tilde": s.rubber_stretch - 1.0, **dict(zip(SIZE_STRETCH, lam - 1.0))}
+             for s, lam in zip(fem.states, sizes)]
     return rows
 
 
@@ -190,12 +194,13 @@ def calibration_provenance(models: list, command: str) -> list[str]:
                     f"kappa/mu={m.kappa_ratio}, Q2/P1disc, {m.n_radial} x {m.n_thick} elements "
                     f"(clamp ratio {m.clamp_ratio})")
     head.append("tau = t/R, v = V/R^3, p_tilde = p R/(mu t), W_tilde = W/(mu t R^2), h_tilde = h/R, "
-                "s_tilde = rubber_stretch - 1 (the converged stretch, softhand.fem.rubber_stretch)")
+                "s_tilde = rubber_stretch - 1 (the converged stretch, softhand.fem.rubber_stretch); "
+                "s_R_rho_X = the same, averaged over a ball of radius R/X (X = R/rho)")
     return head
 
 
 #: the reservoir table's columns (:mod:`softhand.reduced.calibrated.reservoir_fem`)
-CALIBRATION_COLUMNS = ("tau", "v", "p_tilde", "W_tilde", "h_tilde", "s_tilde")
+CALIBRATION_COLUMNS = ("tau", "v", "p_tilde", "W_tilde", "h_tilde", "s_tilde", *SIZE_STRETCH)
 
 
 def write_calibration(study: ReservoirStudy, path) -> int:

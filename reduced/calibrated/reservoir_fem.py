@@ -28,18 +28,25 @@ from pathlib import Path
 
 import numpy as np
 
+from softhand.reduced.materials.rubber_parameters import CRITICAL_DISTANCE_MM, between_sizes
 from softhand.reduced.vocabulary.design import HandDesign
 from softhand.reduced.vocabulary.errors import InputError
 from softhand.reduced.vocabulary.inputfiles import read_number_table
 from softhand.reduced.equations import reservoir as ellipse
 from softhand.reduced.equations.reservoir import register_model
 
-__all__ = ["TABLE_FILE", "table", "pressure", "strain_energy", "height", "rubber_stretch"]
+__all__ = ["TABLE_FILE", "table", "pressure", "strain_energy", "height", "rubber_stretch", "R_RHO", "SIZE_STRETCH"]
 
 TABLE_FILE = Path(__file__).resolve().parent / "data" / "reservoir_fem.csv"
 COLUMNS = ("v", "p_tilde", "W_tilde", "h_tilde")
 #: the optional column: the FEM's converged rubber stretch less 1 (fem.rubber_stretch)
 STRETCH = "s_tilde"
+#: R / rho of the optional last columns: the stretch less 1 averaged over a ball of radius R / x
+#: (rho the rubber's critical distance, so the measure is not v and tau's alone: the sheet's
+#: worst place is its clamp, where the average over 1 or 4 mm differs by 10-30 %); R = 12 to
+#: 48 mm at 2 mm
+R_RHO = (6.0, 8.0, 12.0, 16.0, 24.0)
+SIZE_STRETCH = tuple(f"s_R_rho_{x:g}" for x in R_RHO)
 
 
 @lru_cache(maxsize=1)
@@ -47,9 +54,9 @@ def table() -> dict:
     """The calibration tables: τ = t/R -> {v = V/R³, p̃ = pR/(μt), W̃ = W/(μtR²), h̃ = h/R}."""
     _, header, values = read_number_table(TABLE_FILE, "reservoir_table", "the reservoir calibration CSV "
                                           "(softhand reservoir --write-calibration)", ("tau", *COLUMNS),
-                                          optional=(STRETCH,))
+                                          optional=(STRETCH, *SIZE_STRETCH))
     tau = values[:, 0]
-    return {float(t): {name: values[tau == t, header.index(name)] for name in (*COLUMNS, STRETCH)
+    return {float(t): {name: values[tau == t, header.index(name)] for name in (*COLUMNS, STRETCH, *SIZE_STRETCH)
                        if name in header}
             for t in np.unique(tau)}
 
@@ -134,13 +141,18 @@ def height(V, design: HandDesign):
 
 def rubber_stretch(V, design: HandDesign):
     """The sheet's converged rubber stretch (the FEM's ``rubber_stretch``) at oil volume V
-    [mm^3]: s_tilde linear in v and in tau, continued linearly beyond the table's last volume;
-    None if the table has no stretch column. A Neo-Hookean sheet's stretch depends on v and
-    tau only."""
-    if any(STRETCH not in tab for tab in table().values()):
+    [mm^3]: s_tilde linear in v and in tau, continued linearly beyond the table's last volume,
+    and where the table has it at each R/rho, linear in ln(R/rho) between those (the end
+    columns' line beyond them): a Neo-Hookean sheet's stretch depends on v, tau and, as the
+    averaging radius rho is the rubber's, on the sheet's size R/rho. None if the table has no
+    stretch column."""
+    tables = table().values()
+    columns = SIZE_STRETCH if all(SIZE_STRETCH[0] in tab for tab in tables) else (STRETCH,)
+    if any(columns[0] not in tab for tab in tables):
         return None
     v = np.asarray(V, float) / design.R**3
-    return 1.0 + sum(w * _linear(v, tab["v"], tab[STRETCH]) for tab, w in _weights(design))
+    s = [sum(w * _linear(v, tab["v"], tab[c]) for tab, w in _weights(design)) for c in columns]
+    return 1.0 + (between_sizes(s, R_RHO, design.R / CRITICAL_DISTANCE_MM) if len(columns) > 1 else s[0])
 
 
 def _linear(v, x, y):
