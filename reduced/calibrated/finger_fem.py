@@ -63,8 +63,8 @@ from softhand.reduced.calibrated.finger_fem_table import (A_RHO, COLUMNS, GROUPS
                                                      TABLE_FILE, Table, table_error, read_table)
 from softhand.reduced.materials.rubber_parameters import CRITICAL_DISTANCE_MM, between_sizes
 
-__all__ = ["TABLE_FILE", "GROUPS", "COLUMNS", "STRETCH", "SIZE_STRETCH", "A_RHO", "PRIORS", "Table", "read_table", "check_table", "groups_of",
-           "curves", "rubber_stretch", "FEM"]
+__all__ = ["TABLE_FILE", "GROUPS", "COLUMNS", "STRETCH", "SIZE_STRETCH", "A_RHO", "PRIORS", "Table", "read_table",
+           "check_table", "groups_of", "curves", "rubber_stretch", "FEM"]
 
 N_LINKS = 6
 # ---------------------------------------------------------------------- groups and the fit
@@ -146,8 +146,9 @@ def stretch_prior(theta, groups: dict):
 
 
 def stretch_columns(rows: dict) -> tuple[str, ...]:
-    """The table's stretch columns the fit uses: one per a/rho of :data:`~softhand.reduced.calibrated.finger_fem_table.A_RHO` where it has them,
-    else its designs' own ``s_tilde`` (older tables), else none."""
+    """The table's stretch columns the fit uses: one per a/rho of
+    :data:`~softhand.reduced.calibrated.finger_fem_table.A_RHO` where it has them, else its
+    designs' own ``s_tilde`` (older tables), else none."""
     if SIZE_STRETCH[0] in rows:
         return SIZE_STRETCH
     return (STRETCH,) if STRETCH in rows else ()

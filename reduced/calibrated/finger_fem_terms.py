@@ -96,10 +96,11 @@ def legacy_terms(kind: str, varying: dict, design_degree: int, theta_degree: int
 KERNEL_FEATURES = ("lb", "ld", "lL", "lt", "s2")
 
 
-#: per residual (y, ln kappa, the stretch's z at each averaging radius) the variable its per-design line is in: theta for P
-#: and Delta Q; ln theta for z, so the stretch is a power law of the bend, rubber_stretch - 1 =
-#: eq. (8)'s strain x C theta^b (over the shipped table's designs left out one by one: rms 1.58 %,
-#: worst 6.7 % against a line in theta's 1.97 %, 13.5 %: docs/finger.md)
+#: per residual (y, ln kappa, the stretch's z at each averaging radius) the variable its per-design
+#: line is in: theta for P and Delta Q; ln theta for z, so the stretch is a power law of the bend,
+#: rubber_stretch - 1 = eq. (8)'s strain x C theta^b (over the shipped table's designs left out one
+#: by one, at a/rho = 2: rms 1.12 %, worst 6.5 % against a line in theta's 1.24 %, 8.9 %:
+#: docs/finger.md)
 LINE_IN = ("theta", "theta", "log theta")
 
 

@@ -131,8 +131,8 @@ def leave_one_out(path: str | Path | None = None) -> list[dict]:
             own = r[SIZE_STRETCH[A_RHO.index(a / CRITICAL_DISTANCE_MM)]] if SIZE_STRETCH[0] in r else r.get(STRETCH)
             sizes = None
             if SIZE_STRETCH[0] in r:  # the same groups at each a of the table's a/rho
-                e = np.array([100 * (rubber_stretch(theta, _scaled(model, x * CRITICAL_DISTANCE_MM / a)) / (1 + r[c][at]) - 1)
-                              for c, x in zip(SIZE_STRETCH, A_RHO)])
+                e = np.array([100 * (rubber_stretch(theta, _scaled(model, x * CRITICAL_DISTANCE_MM / a))
+                                     / (1 + r[c][at]) - 1) for c, x in zip(SIZE_STRETCH, A_RHO)])
                 sizes = e[np.argmax(np.abs(e), axis=0), np.arange(theta.size)]
             for k in range(theta.size):
                 out.append({"design": int(i), **{key: round(v, 4) for key, v in g.items()},
