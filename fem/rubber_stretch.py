@@ -106,3 +106,14 @@ class Averager:
             lam = np.where(np.asarray(where, bool).ravel(), lam, -np.inf)
         k = int(np.argmax(lam))
         return float(lam[k]), k
+
+
+def peaks_at_radii(points, weights, fields, radii, *, mirror: int | None = None) -> np.ndarray:
+    """The converged stretch of each of ``fields`` (stretches at ``points``) averaged over a ball of
+    each of ``radii`` [mm], (len(fields), len(radii)): how the measure depends on a part's size, the
+    averaging radius being the rubber's (one Averager, one k-d tree query, per radius)."""
+    columns = []
+    for radius in radii:
+        averager = Averager(points, weights, radius, mirror=mirror)
+        columns.append([averager.peak(f)[0] for f in fields])
+    return np.array(columns, float).T.reshape(len(fields), len(radii))

@@ -52,7 +52,7 @@ from softhand.fem.hand.frame import to_hand_frame
 from softhand.fem.hand.windings import Windings, WindingFibers, hoop_directions
 from softhand.fem.hyperelastic import rubber_law
 from softhand.fem.loads import CavityVolume
-from softhand.fem.rubber_stretch import Averager
+from softhand.fem.rubber_stretch import Averager, peaks_at_radii
 from softhand.fem.solid import Solid
 from softhand.reduced.vocabulary.design import HandDesign
 from softhand.reduced.vocabulary.errors import MeshRejected
@@ -236,13 +236,8 @@ class FingerModel:
         """The converged rubber stretch of each state ``ys`` with the averaging ball's radius each
         of ``radii`` [mm], (len(ys), len(radii)): the calibration's record of how the measure
         depends on the finger's size (the radius is the rubber's, so a/rho is a group)."""
-        lam = [self.principal_stretch(y) for y in ys]
-        points = self._X_q.reshape(3, -1).T
-        columns = []
-        for r in radii:
-            averager = Averager(points, self.solid.W, radius=r, mirror=2)
-            columns.append([averager.peak(x)[0] for x in lam])
-        return np.array(columns).T.reshape(len(lam), len(radii))
+        return peaks_at_radii(self._X_q.reshape(3, -1).T, self.solid.W,
+                              [self.principal_stretch(y) for y in ys], radii, mirror=2)
 
     def rubber_stretch_field(self, y) -> np.ndarray:
         """The ball-averaged principal stretch at every quadrature point (nel, nq) [-]."""

@@ -29,7 +29,7 @@ import numpy as np
 
 from softhand.fem.axisym import AxisymSolid, RevolvedVolume
 from softhand.fem.hyperelastic import rubber_law
-from softhand.fem.rubber_stretch import RADIUS_MM, Averager
+from softhand.fem.rubber_stretch import RADIUS_MM, Averager, peaks_at_radii
 from softhand.reduced.materials.rubber import NeoHookean
 from softhand.reduced.materials.rubber_base import Rubber
 from softhand.fem.volume_path import PathOptions, follow_volume, volume_path_options
@@ -160,8 +160,12 @@ def principal_stretch(solid, u) -> np.ndarray:
 def sheet_averager(solid, radius: float = RADIUS_MM) -> Averager:
     """Averages over the sheet's r-z quadrature points weighted by their ring volumes (a ball's
     average of an axisymmetric field becomes one over a ring of the same radius), mirrored in the axis."""
-    points = np.asarray(solid.basis.mapping.F(solid.basis.X)).reshape(2, -1).T
-    return Averager(points, solid.wdV, radius, mirror=0)
+    return Averager(_quadrature_points(solid), solid.wdV, radius, mirror=0)
+
+
+def _quadrature_points(solid) -> np.ndarray:
+    """The sheet's r-z quadrature points (N, 2) [mm]."""
+    return np.asarray(solid.basis.mapping.F(solid.basis.X)).reshape(2, -1).T
 
 
 def rubber_stretches(model: SheetModel, states, radii) -> np.ndarray:
@@ -169,12 +173,7 @@ def rubber_stretches(model: SheetModel, states, radii) -> np.ndarray:
     radius each of ``radii`` [mm], (len(states), len(radii)): the calibration's record of how the
     measure depends on the sheet's size (the radius is the rubber's, so R/rho is a group)."""
     solid = model.build()[0]
-    lam = [principal_stretch(solid, s.u) for s in states]
-    columns = []
-    for r in radii:
-        averager = sheet_averager(solid, r)
-        columns.append([averager.peak(x)[0] for x in lam])
-    return np.array(columns).T.reshape(len(lam), len(radii))
+    return peaks_at_radii(_quadrature_points(solid), solid.wdV, [principal_stretch(solid, s.u) for s in states], radii, mirror=0)
 
 
 def pressure_maximum(V, p):
