@@ -51,6 +51,12 @@ all straight, says; 66 % for the table alone). The fast hold
 hinges (their solvers reduce the distal hinges to one free angle), so a hold's pad force and the
 grasp's differ by what the coupling gives (1-3 % on the paper's 180 mm sphere). The oil the hinges
 draw (:func:`volume_rate`) is the table's.
+
+**Held far below the free bends.** Beyond second order the coupled moments miss what the finger
+FEM needs where a held hinge has a neighbour bent more than itself, or is the base hinge held near
+straight (a grasp's: the base hinge of a finger on the paper's 180 mm sphere sits at a fifth of its
+free bend); :mod:`softhand.reduced.calibrated.hinge_blocked` adds the gradient of an energy fitted to
+the finger FEM held by grasp-like loads over the hinge grid's designs (``blocked=False``: without it).
 P is the cavity pressure. Units: mm, N, MPa, rad.
 """
 from __future__ import annotations
@@ -61,7 +67,7 @@ from functools import lru_cache
 
 import numpy as np
 
-from softhand.reduced.calibrated import hinge_coupling, hinge_space, hinge_table
+from softhand.reduced.calibrated import hinge_blocked, hinge_coupling, hinge_space, hinge_table
 from softhand.reduced.equations import hand
 from softhand.reduced.vocabulary.design import HandDesign
 
@@ -89,28 +95,35 @@ def hinge_moments(q, P, design: HandDesign) -> np.ndarray:
     return M * design.a ** 2 * math.pi * design.d
 
 
-def coupled_moments(q, P, design: HandDesign) -> np.ndarray:
+def coupled_moments(q, P, design: HandDesign, *, blocked: bool = True) -> np.ndarray:
     """M_j [N mm/rad] (..., n_s) of the hinges coupled through the tube (module doc) at hinge angles q
-    (..., n_s) [rad] and cavity pressure P [MPa] (broadcast against q[..., :1])."""
+    (..., n_s) [rad] and cavity pressure P [MPa] (broadcast against q[..., :1]); ``blocked``: with the
+    correction for hinges held far below their free bends (:mod:`~softhand.reduced.calibrated.hinge_blocked`)."""
     design = fem_finger(design)
     q = np.asarray(q, float)
     M = hinge_moments(q, P, design)
     if np.ndim(P) == 0:
         q_f, M_f, C = coupling(design, float(P))
-        return M + (q - q_f) @ C.T - M_f
+        M = M + (q - q_f) @ C.T - M_f
+        return M + hinge_blocked.moments(q, q_f, float(P), design) if blocked else M
     Pq = np.broadcast_to(P, q.shape)[..., 0]
     for p in np.unique(Pq):  # a few pressures at most
         q_f, M_f, C = coupling(design, float(p))
         at = Pq == p
         M[at] += (q[at] - q_f) @ C.T - M_f
+        if blocked:
+            M[at] += hinge_blocked.moments(q[at], q_f, float(p), design)
     return M
 
 
 def coupled_stiffness(q, P: float, design: HandDesign) -> np.ndarray:
     """dM_j/d theta_hat_j [N mm/rad] (..., n_s) of :func:`coupled_moments`, the diagonal: the table's
-    (each M_sep,j depends on q_j alone: one central difference of every hinge at once) plus C's."""
+    (each M_sep,j depends on q_j alone: one central difference of every hinge at once) plus C's and the
+    held hinges' correction's (:func:`softhand.reduced.calibrated.hinge_blocked.stiffness`)."""
     design = fem_finger(design)
-    return _table_stiffness(np.asarray(q, float), P, design) + np.diagonal(coupling(design, float(P))[2])
+    q_f, _, C = coupling(design, float(P))
+    return (_table_stiffness(np.asarray(q, float), P, design) + np.diagonal(C)
+            + hinge_blocked.stiffness(q, q_f, float(P), design))
 
 
 def coupled_free_angles(P: float, design: HandDesign) -> np.ndarray:
@@ -132,8 +145,10 @@ def coupling(design: HandDesign, P: float) -> tuple[np.ndarray, np.ndarray, np.n
 
 @lru_cache(maxsize=16)
 def _corrections(design: HandDesign) -> tuple[np.ndarray, np.ndarray]:
-    """(the coupling table's pressures (K,), C = S - diag dM_sep/d theta_hat at q_f (K, n_s, n_s)) [N mm/rad]."""
+    """(the coupling table's pressures the design's calibrated finger reaches (K,), C = S - diag dM_sep/d
+    theta_hat at q_f (K, n_s, n_s)) [N mm/rad]; C is constant beyond the last."""
     p = hinge_coupling.design_data(design)[0]
+    p = p[p < hand.pressure_span(design, reservoir=False)[1]]
     C = []
     for pk in p:
         q_f, S = condensed_stiffness(design, float(pk))
@@ -166,10 +181,13 @@ def _table_stiffness(q, P: float, design: HandDesign) -> np.ndarray:
 
 def coupled_energy(q, P: float, design: HandDesign) -> float:
     """E [N mm] of the hinges coupled through the tube at hinge angles q (n_s,) [rad]: the table's
-    :func:`hinge_energy` - M_sep(q_f) . q + (q - q_f) C (q - q_f) / 2 (module doc)."""
-    q_f, M_f, C = coupling(fem_finger(design), float(P))
+    :func:`hinge_energy` - M_sep(q_f) . q + (q - q_f) C (q - q_f) / 2 (module doc) + the held hinges'
+    correction's (:func:`softhand.reduced.calibrated.hinge_blocked.energy`)."""
+    design = fem_finger(design)
+    q_f, M_f, C = coupling(design, float(P))
     dq = np.asarray(q, float) - q_f
-    return hinge_energy(q, P, design) + float(-M_f @ q + 0.5 * dq @ C @ dq)
+    return (hinge_energy(q, P, design) + float(-M_f @ q + 0.5 * dq @ C @ dq)
+            + float(hinge_blocked.energy(q, q_f, float(P), design)))
 
 
 def hinge_data(design: HandDesign) -> hinge_table.HingeTable:

@@ -216,6 +216,8 @@ KINDS: dict[str, Kind] = {
     "hinge_grid": Kind("softhand.studies.calibration.hinges:grid_case", {}),
     # one design's free hinges and their condensed stiffness (studies.calibration.hinge_coupling); no parameters
     "hinge_coupling": Kind("softhand.studies.calibration.hinge_coupling:coupling_case", {}),
+    # one design's finger held by grasp-like hinge loads (studies.calibration.hinge_blocked); no parameters
+    "hinge_blocked": Kind("softhand.studies.calibration.hinge_blocked:blocked_case", {}),
 }
 #: the entry-point group where installed packages declare more kinds
 ENTRY_POINT_GROUP = "softhand.kinds"

@@ -18,7 +18,6 @@ for Dask).
 """
 from __future__ import annotations
 
-import argparse
 import math
 import sys
 from pathlib import Path
@@ -27,7 +26,7 @@ import numpy as np
 
 from softhand.reduced.vocabulary.design import HandDesign
 from softhand.studies.calibration import tables
-from softhand.studies.calibration.hinges import run_space
+from softhand.studies.calibration.hinges import run_space, space_parser
 from softhand.studies.io.files import write_atomic
 
 #: cavity pressures of the free states [MPa]
@@ -90,14 +89,7 @@ def space_text(space_file: str, results: str = "results", workers: int = 1, comm
 
 
 def main(argv=None) -> int:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--space", required=True, help="design-space TOML file")
-    parser.add_argument("--out", required=True, help="CSV file to write")
-    parser.add_argument("--results", default="results", help="the batch runner's results folder (resumable)")
-    parser.add_argument("--workers", type=int, default=1, help="designs run at once")
-    parser.add_argument("--scheduler", default=None, help="a Dask scheduler address, or 'local'")
-    parser.add_argument("--no-progress", action="store_true", help="no progress bar")
-    args = parser.parse_args(argv)
+    args = space_parser(__doc__.splitlines()[0]).parse_args(argv)
     command = "python -m softhand.studies.calibration.hinge_coupling " + " ".join(sys.argv[1:] if argv is None else argv)
     write_atomic(args.out, space_text(args.space, args.results, max(1, args.workers), command, args.scheduler,
                                       not args.no_progress))

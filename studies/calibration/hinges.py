@@ -201,6 +201,19 @@ def run_space(space_file: str, kind: str, suffix: str, description: str, results
     return designs, [read_case(study_dir(study, results), case)["numbers"] for case in plan(study)]
 
 
+def space_parser(description: str) -> argparse.ArgumentParser:
+    """The command line of a study over a design space (:func:`run_space`): --space, --out, --results,
+    --workers, --scheduler, --no-progress."""
+    parser = argparse.ArgumentParser(description=description)
+    parser.add_argument("--space", required=True, help="design-space TOML file")
+    parser.add_argument("--out", required=True, help="CSV file to write")
+    parser.add_argument("--results", default="results", help="the batch runner's results folder (resumable)")
+    parser.add_argument("--workers", type=int, default=1, help="designs run at once")
+    parser.add_argument("--scheduler", default=None, help="a Dask scheduler address, or 'local'")
+    parser.add_argument("--no-progress", action="store_true", help="no progress bar")
+    return parser
+
+
 def space_text(space_file: str, results: str = "results", workers: int = 1, command: str = "",
                scheduler: str | None = None, progress: bool = True) -> str:
     """The grid CSV of :mod:`softhand.reduced.calibrated.hinge_space` over the designs of a design

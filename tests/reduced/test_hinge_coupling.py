@@ -11,7 +11,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from softhand.reduced.calibrated import finger_hinges, hinge_coupling
+from softhand.reduced.calibrated import finger_hinges, hinge_blocked, hinge_coupling
 from softhand.reduced.equations import hand
 from softhand.reduced.vocabulary.design import HandDesign
 from softhand.reduced.vocabulary.design_files import load_design
@@ -120,17 +120,20 @@ def test_against_the_blocked_finger_fem_the_coupled_moments_are_within_a_few_per
         assert np.sqrt(np.mean(e0 ** 2)) > 2 * np.sqrt(np.mean(e ** 2))   # the test tells the two apart
 
 
-def test_a_coupling_table_with_a_wrong_header_or_too_few_designs_is_refused(tmp_path):
-    text = Path(hinge_coupling.COUPLING_FILE).read_text().splitlines()
+@pytest.mark.parametrize("module, path, column", [(hinge_coupling, hinge_coupling.COUPLING_FILE, "sigma_11"),
+                                                   (hinge_blocked, hinge_blocked.FIT_FILE, "c_pair")])
+def test_a_hinge_table_with_a_wrong_header_or_too_few_designs_is_refused(tmp_path, module, path, column):
+    """The coupling table and the held hinges' coefficients."""
+    text = Path(path).read_text().splitlines()
     head = next(i for i, line in enumerate(text) if line.startswith("design,"))
     bad = tmp_path / "bad.csv"
-    bad.write_text("\n".join(text[:head] + [text[head].replace("sigma_11", "sigma_x")] + text[head + 1:]))
+    bad.write_text("\n".join(text[:head] + [text[head].replace(column, "x_x")] + text[head + 1:]))
     with pytest.raises(InputError, match="header"):
-        hinge_coupling.read(str(bad))
+        module.read(str(bad))
     few = tmp_path / "few.csv"
     few.write_text("\n".join(text[:head + 1] + [r for r in text[head + 1:] if r.split(",")[0] in ("0", "1")]))
     with pytest.raises(InputError, match="designs or more"):
-        hinge_coupling.read(str(few))
+        module.read(str(few))
 
 
 def test_each_grid_design_left_out_is_predicted_by_the_others():
@@ -145,3 +148,17 @@ def test_each_grid_design_left_out_is_predicted_by_the_others():
     s, sigma = hinge_coupling._at(grid, grid.x[3])
     np.testing.assert_allclose(s, grid.s[3], rtol=1e-9)
     np.testing.assert_allclose(sigma, grid.sigma[3], rtol=1e-7, atol=1e-9)
+
+
+def test_a_design_whose_finger_stops_below_the_tables_top_pressure_is_coupled():
+    """A grid design whose calibrated finger answers only to 2.3 MPa (the table's pressures reach 2.4): its
+    coupling is the table's up to there and constant beyond (it raised an InputError at any pressure before)."""
+    from softhand.studies.calibration.space import finger_design
+
+    design = finger_hinges.fem_finger(finger_design({"a_mm": 3.97, "b_mm": 3.001, "d_mm": 12.434, "l0_mm": 165.968,
+                                                     "tie_width_mm": 10.785}))
+    top = hand.pressure_span(design, reservoir=False)[1]
+    assert top < hinge_coupling.read().p[-1]
+    for P in (0.9, 0.99 * top):
+        q_f = finger_hinges.coupled_free_angles(P, design)
+        np.testing.assert_allclose(finger_hinges.coupled_moments(q_f, P, design), 0.0, atol=1e-9)
