@@ -10,7 +10,8 @@ first hinges alike), each scaled by S so that its most-held hinge reaches 0.6, 0
 free bend; the hinge angles q it settles at are kept. The moments the coupled hinges miss there,
 Q - M(q) less their miss at the free state, over P a^2 pi d, are fitted at each pressure by least
 squares on the gradients of the three terms of the correction's energy, every hinge of every state
-(held or free), design by design. Run::
+(held or free), design by design (r against the FEM's own free angles; the fast hold takes its
+coupled free angles, which are the FEM's shares of the calibrated finger's bend). Run::
 
     python -m softhand.studies.calibration.hinge_blocked --space studies/hinge_space.toml --workers 2 \\
         --out reduced/calibrated/data/grasp_hinge_blocked.csv

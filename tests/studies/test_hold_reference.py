@@ -41,20 +41,20 @@ def test_the_verdicts_agree_with_the_fems_wherever_its_margin_exceeds_five_perce
 def test_the_fast_limits_are_as_close_to_the_fem_as_documented(rows):
     s = hold_reference.summary(rows)
     assert s["both_held"] >= 43, s
-    assert s["within_5_percent"] >= 26, s
-    assert s["within_10_percent"] >= 35, s
-    assert s["median_percent"] <= 3.4, s
+    assert s["within_5_percent"] >= 27, s
+    assert s["within_10_percent"] >= 38, s
+    assert s["median_percent"] <= 2.6, s
     # the load borne (weight + limit): what a margin of "hold k times the weight" asks for
-    assert s["load_within_5_percent"] >= 37 and s["load_within_10_percent"] >= 41, s
-    assert s["load_median_percent"] <= 2.7, s
+    assert s["load_within_5_percent"] >= 38 and s["load_within_10_percent"] >= 41, s
+    assert s["load_median_percent"] <= 2.0, s
     worst = max((r for r in rows if np.isfinite(r.error)), key=lambda r: abs(r.error))
     # the 180 mm cube turned 15 deg: the fast model's slide catches it on the next pads 12 mm down
     # (the FEM, the cube placed there, holds 5.67 N; fast 5.43 N), the FEM's pull passes over that
-    # pose in one step and catches it 25 mm down (docs/grasp.md): +153 %
+    # pose in one step and catches it 25 mm down (docs/grasp.md): +151 %
     assert worst.name.startswith("cube 180 mm turned 15 deg") and abs(worst.error) < 1.6, worst
     rest = [r for r in rows if np.isfinite(r.error) and r is not worst]
     assert max(abs(r.error) for r in rest) < 0.45
-    assert 100 * np.sqrt(np.mean([r.error ** 2 for r in rest])) <= 10.0
+    assert 100 * np.sqrt(np.mean([r.error ** 2 for r in rest])) <= 9.6
 
 
 def test_the_reference_meshes_are_built_as_their_recipes_say(tmp_path):
