@@ -173,7 +173,8 @@ def rubber_stretches(model: SheetModel, states, radii) -> np.ndarray:
     radius each of ``radii`` [mm], (len(states), len(radii)): the calibration's record of how the
     measure depends on the sheet's size (the radius is the rubber's, so R/rho is a group)."""
     solid = model.build()[0]
-    return peaks_at_radii(_quadrature_points(solid), solid.wdV, [principal_stretch(solid, s.u) for s in states], radii, mirror=0)
+    return peaks_at_radii(_quadrature_points(solid), solid.wdV, [principal_stretch(solid, s.u) for s in states],
+                          radii, mirror=0)
 
 
 def pressure_maximum(V, p):

@@ -63,7 +63,8 @@ class Table(NamedTuple):
 def read(path: str = str(FIT_FILE)) -> Table:
     """The CSV: design, the finger table's groups, P, the coefficients; every design on the same pressures."""
     head = ("design", *GROUPS, "P", *TERMS)
-    _, _, data = read_number_table(path, "hinge_blocked", "the CSV of softhand.studies.calibration.hinge_blocked", head)
+    _, _, data = read_number_table(path, "hinge_blocked", "the CSV of softhand.studies.calibration.hinge_blocked",
+                                   head)
     return table(data, path)
 
 
@@ -75,27 +76,33 @@ def table(data: np.ndarray, path: str = "") -> Table:
     for i in np.unique(data[:, 0]):
         rows = data[data[:, 0] == i]
         if not np.array_equal(np.round(rows[:, P], 9), p):
-            raise InputError("hinge_blocked", path, f"design {i:g}: needs the pressures {', '.join(map(str, p))} in order")
+            raise InputError("hinge_blocked", path,
+                             f"design {i:g}: needs the pressures {', '.join(map(str, p))} in order")
         C.append(rows[:, P + 1:])
     if len(C) < MIN_DESIGNS:
         raise InputError("hinge_blocked", path, f"needs {MIN_DESIGNS} designs or more")
     return Table(p, np.array(C))
 
 
+@lru_cache(maxsize=256)
 def coefficients(P: float, path: str = str(FIT_FILE)) -> np.ndarray:
     """The coefficients (len(TERMS),) at cavity pressure P [MPa]: the mean over the table's designs,
     linear between its pressures, constant above them and fading linearly to zero below the first
     (a pressure effect: with r = q / q_f and q_f shrinking with P, held constant the correction's
-    stiffness would not vanish with P)."""
+    stiffness would not vanish with P). Read-only (cached per pressure)."""
     t = read(path)
     i0, i1, w = hinge_space._lerp(float(P), t.p)
     c = t.c.mean(axis=0)
-    return ((1 - w) * c[i0] + w * c[i1]) * min(1.0, max(float(P), 0.0) / t.p[0])
+    out = ((1 - w) * c[i0] + w * c[i1]) * min(1.0, max(float(P), 0.0) / t.p[0])
+    out.setflags(write=False)
+    return out
 
 
 def _clamp(r):
     """(rho, d rho/dr, d2 rho/dr2) of the smooth clamp of r to [LOW, HIGH] (C2: tanh beyond)."""
     rho, d1, d2 = np.array(r, float), np.ones(np.shape(r)), np.zeros(np.shape(r))
+    if LOW <= rho.min() and rho.max() <= HIGH:  # the usual case: nothing to clamp
+        return rho, d1, d2
     for edge, side in ((LOW, -1.0), (HIGH, 1.0)):
         out = side * (rho - edge) > 0
         t = np.tanh((rho[out] - edge) / WIDTH)
@@ -126,6 +133,20 @@ def basis(rho) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return value, grad, hess
 
 
+def _gradient(rho, c) -> np.ndarray:
+    """sum_t c_t d(term_t)/d rho (..., n): the gradient of :func:`basis` weighted by the coefficients c,
+    without its values and curvatures (the moments, the fast hold's most called)."""
+    x, y = rho[..., :-1], rho[..., 1:]
+    d, s = x - y, 2 - x - y
+    pair = 2 * d * s * (s - d)                 # d/dx of d^2 s^2; its d/dy is -2 d s (s + d)
+    o = 1 - rho
+    out = -3 * c[2] * o * o
+    out[..., :-1] += c[0] * pair
+    out[..., 1:] -= c[0] * 2 * d * s * (s + d)
+    out[..., 0] -= 3 * c[1] * o[..., 0] ** 2
+    return out
+
+
 def _scaled(q, q_f, P: float, design):
     """(c, rho, d rho/dq, d2 rho/dq2, P a^2 pi d mean(q_f)) of hinge angles q (..., n) about q_f (n,)
     (a free angle below ``_Q_MIN``, a finger not yet bending, is taken as ``_Q_MIN``: the clamp then
@@ -145,7 +166,7 @@ def energy(q, q_f, P: float, design) -> np.ndarray:
 def moments(q, q_f, P: float, design) -> np.ndarray:
     """de/dq_j [N mm/rad] (..., n) (:func:`energy`)."""
     c, rho, d1, _, scale = _scaled(q, q_f, P, design)
-    return scale * (basis(rho)[1] @ c) * d1
+    return scale * _gradient(rho, c) * d1
 
 
 def stiffness(q, q_f, P: float, design) -> np.ndarray:

@@ -144,7 +144,8 @@ def leave_one_out(coefficients: np.ndarray, per_design: list) -> np.ndarray:
     for k, rows in enumerate(per_design):
         others = np.delete(coefficients, k, axis=0).mean(axis=0)
         before, after = held_errors(rows, others)
-        out.append([f(v) for v in (before, after) for f in (lambda v: np.sqrt(np.mean(v ** 2)), lambda v: np.max(np.abs(v)))])
+        out.append([f(v) for v in (before, after)
+                    for f in (lambda v: np.sqrt(np.mean(v ** 2)), lambda v: np.max(np.abs(v)))])
     return np.array(out)
 
 
