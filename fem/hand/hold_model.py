@@ -143,24 +143,25 @@ class HoldModel:
         (NotConverged or :class:`NoEquilibrium` leave the last state). A release step that finds no
         equilibrium near the last state is followed as a path (``HoldModel._relax``) where the hand is not
         symmetric, or with ``path``."""
-        saved = self._save()
+        saved = self.snapshot()
         try:
             return self._step(P, gravity, pull, stage)
         except (NotConverged, NoEquilibrium, np.linalg.LinAlgError) as err:
-            self._restore(saved)
+            self.restore(saved)
             if stage != "release" or (self.symmetric and not path) or not self.options.relax_steps \
                     or isinstance(err, NoEquilibrium):
                 raise
         try:
             return self._relax(P, gravity, pull, stage)
         except (NotConverged, NoEquilibrium, np.linalg.LinAlgError):
-            self._restore(saved)
+            self.restore(saved)
             raise
 
-    def _save(self):
+    def snapshot(self):
+        """The state to go back to with :meth:`restore` (the fingers' FEM states, pose, pressure, contacts)."""
         return [f.copy_state() for f in self.fingers], self.pose.copy(), self.P, self.cs
 
-    def _restore(self, saved) -> None:
+    def restore(self, saved) -> None:
         states, pose, self.P, self.cs = saved
         self.pose = pose.copy()
         for f, s in zip(self.fingers, states):
@@ -190,13 +191,13 @@ class HoldModel:
                 self.on_path_step(k, support)
             settling, last = support < 0.5 * last, support
             if settling and support <= self.options.relax_force * load:
-                saved = self._save()
+                saved = self.snapshot()
                 try:
                     record = self._step(P, gravity, pull, stage)
                     record.relaxed = k + 1
                     return record
                 except (NotConverged, np.linalg.LinAlgError):
-                    self._restore(saved)
+                    self.restore(saved)
             c = (0.5 if settling else 0.25) * c
         raise NotConverged(f"no equilibrium after {self.options.relax_steps} relaxation steps", [], self.pose)
 
