@@ -99,17 +99,30 @@ def run_hold(model: HoldModel, P: float, *, progress=None) -> HoldPath:
         try:
             record = model.step(P, gravity=True, pull=F + dF, stage="pull")
         except (NotConverged, NoEquilibrium) as err:
-            failure, dF = str(err).split("; residual history")[0], 0.5 * dF
-            continue
-        slipping = _slipping(record) - _slipping(steps[-1])
-        if slipping and 0.5 * dF >= resolution:  # a pad begins to slip within the step: find where
-            model.restore(saved)
-            failure, dF = f"pads (finger, link) {sorted(slipping)} begin to slip", 0.5 * dF
-            continue
+            failure = str(err).split("; residual history")[0]
+            record = _slide(model, P, F + dF) if 0.5 * dF < resolution and o.relax_steps else None
+            if record is None:
+                dF = 0.5 * dF
+                continue
+        else:
+            slipping = _slipping(record) - _slipping(steps[-1])
+            if slipping and 0.5 * dF >= resolution:  # a pad begins to slip within the step: find where
+                model.restore(saved)
+                failure, dF = f"pads (finger, link) {sorted(slipping)} begin to slip", 0.5 * dF
+                continue
         steps.append(record)
         tick(record)
         F, dF = F + dF, 1.5 * dF
     return HoldPath(model, steps, True, F, False, "", time.perf_counter() - t0)
+
+
+def _slide(model: HoldModel, P: float, pull: float):
+    """The pull step no equilibrium near the last state meets, followed as the object slides
+    (``HoldModel.follow``): its record where the object comes to rest, None where it slips out."""
+    try:
+        return model.follow(P, gravity=True, pull=pull, stage="pull")
+    except (NotConverged, NoEquilibrium):
+        return None
 
 
 def _slipping(record) -> set:

@@ -139,10 +139,8 @@ class HoldModel:
                        [f.q for f in self.fingers], [f.Q.copy() for f in self.fingers], [f.S for f in self.fingers])
 
     def step(self, P: float, *, gravity: bool, pull: float, stage: str, path: bool = False) -> StepRecord:
-        """One load step to (P, gravity, pull); the state is kept only if it converges
-        (NotConverged or :class:`NoEquilibrium` leave the last state). A release step that finds no
-        equilibrium near the last state is followed as a path (``HoldModel._relax``) where the hand is not
-        symmetric, or with ``path``."""
+        """One load step to (P, gravity, pull), kept only if it converges (else the last state stays);
+        a release step finding no equilibrium near is followed (:meth:`follow`) unless symmetric without ``path``."""
         saved = self.snapshot()
         try:
             return self._step(P, gravity, pull, stage)
@@ -151,14 +149,18 @@ class HoldModel:
             if stage != "release" or (self.symmetric and not path) or not self.options.relax_steps \
                     or isinstance(err, NoEquilibrium):
                 raise
+        return self.follow(P, gravity=gravity, pull=pull, stage=stage)
+
+    def follow(self, P: float, *, gravity: bool, pull: float, stage: str) -> StepRecord:
+        """The load step followed as a path (``HoldModel._relax``), kept only if the object comes to rest."""
+        saved = self.snapshot()
         try:
             return self._relax(P, gravity, pull, stage)
         except (NotConverged, NoEquilibrium, np.linalg.LinAlgError):
             self.restore(saved)
             raise
 
-    def snapshot(self):
-        """The state to go back to with :meth:`restore` (the fingers' FEM states, pose, pressure, contacts)."""
+    def snapshot(self):  # the state for :meth:`restore`: the fingers' FEM states, pose, pressure, contacts
         return [f.copy_state() for f in self.fingers], self.pose.copy(), self.P, self.cs
 
     def restore(self, saved) -> None:
