@@ -139,31 +139,28 @@ class HoldModel:
                        [f.q for f in self.fingers], [f.Q.copy() for f in self.fingers], [f.S for f in self.fingers])
 
     def step(self, P: float, *, gravity: bool, pull: float, stage: str, path: bool = False) -> StepRecord:
-        """One load step to (P, gravity, pull), kept only if it converges (else the last state stays);
-        a release step finding no equilibrium near is followed (:meth:`follow`) unless symmetric without ``path``."""
-        saved = self.snapshot()
+        """One load step to (P, gravity, pull); the state is kept only if it converges
+        (NotConverged or :class:`NoEquilibrium` leave the last state). A release step that finds no
+        equilibrium near the last state is followed as a path (``HoldModel._relax``) where the hand is not
+        symmetric, or with ``path``."""
+        saved = self._save()
         try:
             return self._step(P, gravity, pull, stage)
         except (NotConverged, NoEquilibrium, np.linalg.LinAlgError) as err:
-            self.restore(saved)
+            self._restore(saved)
             if stage != "release" or (self.symmetric and not path) or not self.options.relax_steps \
                     or isinstance(err, NoEquilibrium):
                 raise
-        return self.follow(P, gravity=gravity, pull=pull, stage=stage)
-
-    def follow(self, P: float, *, gravity: bool, pull: float, stage: str) -> StepRecord:
-        """The load step followed as a path (``HoldModel._relax``), kept only if the object comes to rest."""
-        saved = self.snapshot()
         try:
             return self._relax(P, gravity, pull, stage)
         except (NotConverged, NoEquilibrium, np.linalg.LinAlgError):
-            self.restore(saved)
+            self._restore(saved)
             raise
 
-    def snapshot(self):  # the state for :meth:`restore`: the fingers' FEM states, pose, pressure, contacts
+    def _save(self):
         return [f.copy_state() for f in self.fingers], self.pose.copy(), self.P, self.cs
 
-    def restore(self, saved) -> None:
+    def _restore(self, saved) -> None:
         states, pose, self.P, self.cs = saved
         self.pose = pose.copy()
         for f, s in zip(self.fingers, states):
@@ -193,13 +190,13 @@ class HoldModel:
                 self.on_path_step(k, support)
             settling, last = support < 0.5 * last, support
             if settling and support <= self.options.relax_force * load:
-                saved = self.snapshot()
+                saved = self._save()
                 try:
                     record = self._step(P, gravity, pull, stage)
                     record.relaxed = k + 1
                     return record
                 except (NotConverged, np.linalg.LinAlgError):
-                    self.restore(saved)
+                    self._restore(saved)
             c = (0.5 if settling else 0.25) * c
         raise NotConverged(f"no equilibrium after {self.options.relax_steps} relaxation steps", [], self.pose)
 
