@@ -120,22 +120,18 @@ def basis(rho) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     d, s = x - y, 2 - x - y
     o = 1 - rho
     value = np.stack([np.sum(d ** 2 * s ** 2, axis=-1), o[..., 0] ** 3, np.sum(o ** 3, axis=-1)], axis=-1)
-    grad = np.zeros(rho.shape + (3,))
+    grad = np.stack([_gradient(rho, e) for e in np.eye(3)], axis=-1)
     hess = np.zeros(rho.shape + (3,))
-    grad[..., :-1, 0] += 2 * d * s * s - 2 * d * d * s        # d/dx of d^2 s^2
-    grad[..., 1:, 0] += -2 * d * s * s - 2 * d * d * s        # d/dy
-    hess[..., :-1, 0] += 2 * s * s - 8 * d * s + 2 * d * d    # d2/dx2
+    hess[..., :-1, 0] += 2 * s * s - 8 * d * s + 2 * d * d    # d2/dx2 of d^2 s^2
     hess[..., 1:, 0] += 2 * s * s + 8 * d * s + 2 * d * d     # d2/dy2
-    grad[..., 0, 1] = -3 * o[..., 0] ** 2
     hess[..., 0, 1] = 6 * o[..., 0]
-    grad[..., 2] = -3 * o ** 2
     hess[..., 2] = 6 * o
     return value, grad, hess
 
 
 def _gradient(rho, c) -> np.ndarray:
-    """sum_t c_t d(term_t)/d rho (..., n): the gradient of :func:`basis` weighted by the coefficients c,
-    without its values and curvatures (the moments, the fast hold's most called)."""
+    """sum_t c_t d(term_t)/d rho (..., n): the terms' gradients (:func:`basis`) weighted by the
+    coefficients c, without their values and curvatures (the moments, the fast hold's most called)."""
     x, y = rho[..., :-1], rho[..., 1:]
     d, s = x - y, 2 - x - y
     pair = 2 * d * s * (s - d)                 # d/dx of d^2 s^2; its d/dy is -2 d s (s + d)
