@@ -333,6 +333,7 @@ def hold_cases() -> list[tuple[str, list[str]]]:
               ["hold", "--object", "sphere:150", "--map", "pressure=0:2:0.001", "mass=0:5:0.001"],
               ["hold", "--object", "sphere:150", "--map", "pressure=0.5:1:0.5", "colour=1,2"],
               ["hold", "--object", "sphere:150", "--check"],
+              ["hold", "--object", "sphere:150", "--pull-control", "displacement", *at],  # the FEM's option
               ["hold", "--object", "sphere:150", "--model", "fem", "--margin", "2", "--no-progress"],
               ["design", "--task", "task_open_mesh.toml", "--no-fem", "--no-progress"],
               ["design", "--task", "task_hold_force_factor.toml", "--no-fem", "--no-progress"],

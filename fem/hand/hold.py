@@ -18,12 +18,22 @@ along ``pull_direction`` grows -- increments grow 1.5x after a converged step an
 after a failed one -- until no equilibrium is found (the contact problem or a finger fails,
 or the object slides farther than ``max_slide`` from where it was let go). The holding
 limit is the largest pull converged, resolved to ``pull_resolution``.
+
+That limit depends on how the pull is stepped where friction gives way: a large step can land on
+a state where every pad slips and nothing larger converges, or carry the object over a pose where
+the fingers would have caught it. With ``pull_control = "displacement"`` the pull is drawn instead:
+the far end of a stiff spring on the object (a load cell) moves along the pull in steps that keep
+each step's change of pull and slide small, the pull borne is the spring's force, and the holding
+limit is the first maximum of that force along the slide (as the fast model's,
+:mod:`softhand.reduced.holding.hold_slide`), the steps around it walked again finer to
+``pull_resolution``.
 """
 from __future__ import annotations
 
 import math
 import time
 from dataclasses import dataclass, replace
+from typing import NamedTuple
 
 from softhand.fem.hand.hold_geometry import Pose
 from softhand.fem.hand.hold_model import HoldModel, NoEquilibrium
@@ -82,6 +92,8 @@ def run_hold(model: HoldModel, P: float, *, progress=None) -> HoldPath:
             if d_share < o.min_weight_step:
                 return HoldPath(model, steps, False, 0.0, True, f"held {share:.0%} of its weight at "
                                 f"most ({why})", time.perf_counter() - t0)
+    if o.pull_control == "displacement":
+        return _drawn(model, P, steps, tick, t0)
     F, failure = 0.0, ""
     dF = o.pull_step or max(0.5 * model.weight, 1.0)
     while F < o.max_pull:
@@ -94,6 +106,72 @@ def run_hold(model: HoldModel, P: float, *, progress=None) -> HoldPath:
         except (NotConverged, NoEquilibrium) as err:
             failure, dF = str(err).split("; residual history")[0], 0.5 * dF
     return HoldPath(model, steps, True, F, False, "", time.perf_counter() - t0)
+
+
+class _Drawn(NamedTuple):
+    s: float        #: where the spring's far end is, along the pull from where the object was let go [mm]
+    F: float        #: the spring's pull [N]
+    u: float        #: the object's slide along the pull from there [mm]
+    state: tuple    #: the model's state (``HoldModel.save``)
+
+
+def _drawn(model: HoldModel, P: float, steps: list, tick, t0: float) -> HoldPath:
+    """The pull drawn by displacement (``pull_control = "displacement"``): the far end of a stiff spring
+    on the object moves along the pull; the pull borne is the spring's force. The holding limit is the
+    first maximum of that pull along the slide: the largest pull borne before it has fallen more than
+    ``pull_resolution`` below it ``drive_past_peak`` further on, or the object slips out or finds no
+    equilibrium (a pull that stays within the resolution of its maximum, an object sliding at a constant
+    pull, is followed on: it can rise again as the object wedges). The steps around that maximum are
+    walked again four times finer until its neighbours are within ``pull_resolution`` of it; where the
+    finer walk finds no equilibrium short of a maximum the coarser one reached (the object's edge
+    meeting the next pad between two of its steps), the coarser walk is kept and the answer says so."""
+    o, e = model.options, model.pull_direction
+    dF_max = o.pull_step or max(0.5 * model.weight, 1.0)
+    u = float(e @ (model.pose[:3] - model.released))
+    walk, first = [_Drawn(u, 0.0, u, model.save())], len(steps)  # walk[i > 0] is steps[first + i - 1]
+    # the first move: drive_step, or less where the spring alone would pull more than a pull step
+    ds, cap, end, failure, out, finer = min(o.drive_step, dF_max / o.drive_stiffness), math.inf, math.inf, "", False, 0
+    coarse = None  # (walk, steps) before the last walk again around a maximum
+    while True:
+        best = max(range(len(walk)), key=lambda i: (walk[i].F, -i))  # the first largest
+        last = walk[-1]
+        if last.F > o.max_pull:
+            return HoldPath(model, steps, True, last.F, False, "", time.perf_counter() - t0)
+        if last.s >= end and best == len(walk) - 1:  # still rising past the bracket walked again: walk on
+            end = cap = math.inf
+        tol = max(o.pull_resolution * walk[best].F, o.pull_floor)
+        if out or (failure and ds < min(o.drive_step, cap) / 64) or last.s >= end \
+                or (last.u - walk[best].u >= o.drive_past_peak and last.F < walk[best].F - tol):
+            if coarse is not None and last.s < end and walk[best].F < max(w.F for w in coarse[0]) - tol:
+                # the finer walk found no equilibrium where the coarser one went on: keep that one's
+                walk, steps[:] = coarse
+                model.restore(walk[-1].state)
+                best = max(range(len(walk)), key=lambda i: (walk[i].F, -i))
+                failure = f"the maximum's neighbourhood walked again finer found no equilibrium ({failure})"
+                return HoldPath(model, steps, True, walk[best].F, True, failure, time.perf_counter() - t0)
+            near = [walk[i].F for i in (best - 1, best + 1) if 0 <= i < len(walk)]
+            if best == 0 or finer >= 4 or all(walk[best].F - F <= tol for F in near):
+                return HoldPath(model, steps, True, walk[best].F, True, failure, time.perf_counter() - t0)
+            # walk the bracket around the maximum again, finer
+            finer, failure, out, coarse = finer + 1, "", False, (list(walk), list(steps))
+            end = walk[best + 1].s if best + 1 < len(walk) else 2 * walk[best].s - walk[best - 1].s
+            cap = ds = (end - walk[best - 1].s) / 8
+            model.restore(walk[best - 1].state)
+            del steps[first + best - 1:]
+            walk = walk[:best]
+            continue
+        try:
+            record = model.step(P, gravity=True, pull=0.0, stage="pull", drive=last.s + ds)
+        except (NotConverged, NoEquilibrium) as err:
+            failure, out = str(err).split("; residual history")[0], isinstance(err, NoEquilibrium)
+            ds *= 0.5
+            continue
+        tick(record)
+        steps.append(record)
+        walk.append(_Drawn(last.s + ds, record.pull_N, float(e @ (model.pose[:3] - model.released)), model.save()))
+        failure = ""
+        r = max(abs(walk[-1].F - last.F) / dF_max, abs(walk[-1].u - last.u) / o.drive_max_slide)
+        ds = min(cap, ds * min(1.5, 1.0 / r if r > 0 else 1.5))
 
 
 def solve_hold(design: HandDesign, obj, *, P_cavity_MPa: float, pull_direction=(0.0, 1.0, 0.0),

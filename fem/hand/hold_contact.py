@@ -150,6 +150,9 @@ class Problem:
     #: (6,) viscous support on the object's pose, c (p - pose0) [N/mm, N mm/rad]: a relaxation
     #: step (:meth:`softhand.fem.hand.hold_model.HoldModel.step`); None: none
     damping: np.ndarray | None = None
+    #: the pull applied through a stiff spring (a load cell whose far end is moved): (k [N/mm],
+    #: e (3,), a (3,)), the force k e.(a - t) e on the object at translation t; None: none
+    drive: tuple | None = None
 
     def unpack(self, x):
         n = len(self.fingers.frames) * self.fingers.n_s
@@ -165,6 +168,9 @@ class Problem:
         F = cs.wrench + self.load
         if self.damping is not None:
             F = F - self.damping * (np.r_[pose.t, pose.r] - self.pose0)
+        if self.drive is not None:
+            k, e, a = self.drive
+            F[:3] += k * float(e @ (a - pose.t)) * e
         R.append(F[self.free])
         return np.concatenate(R), cs
 

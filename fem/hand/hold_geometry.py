@@ -231,3 +231,23 @@ def _contacts(d, n, x, facing, c, A0, B0, sigma, zeta) -> PadContacts:
     """The pads' contacts, a pad whose plane has the object's centre c behind it facing away."""
     g = np.where(np.einsum("ki,ki->k", facing, c - x) > 0.0, d, np.inf)
     return PadContacts(g, n, x, A0 + sigma[:, None] * (B0 - A0), zeta)
+
+
+def contact_rows(orbits, frames, n_links: int, cs) -> list:
+    """The contact state ``cs`` as rows, every finger's pads (the images of a solved finger of ``orbits``
+    rotated about the palm axis)."""
+    rows, n = [], n_links
+    for i, (j, images) in enumerate(orbits):
+        for k in images:
+            R = rot_y(frames[k].azimuth - frames[j].azimuth)
+            for link in range(n):
+                r = i * n + link
+                N = float(cs.N[r])
+                rows.append({"finger": int(k), "link": int(link), "normal_N": N,
+                             "friction_N": float(np.linalg.norm(cs.T[r])),
+                             "state": ("stick" if cs.stick[r] else "slip") if N > 0 else "open",
+                             "gap_mm": float(cs.g[r]) if np.isfinite(cs.g[r]) else None,
+                             "point_mm": (R @ cs.x[r]).tolist(),
+                             "normal_force_N": (R @ (N * cs.normal[r])).tolist(),
+                             "friction_force_N": (R @ cs.T[r]).tolist()})
+    return rows

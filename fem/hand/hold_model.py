@@ -38,7 +38,7 @@ import numpy as np
 from softhand.fem.hand.finger import FingerModel
 from softhand.fem.hand.hold_contact import ContactHistory, Fingers, Problem, solve_contact
 from softhand.fem.hand.hold_finger import HeldFinger
-from softhand.fem.hand.hold_geometry import PadSet, Pose, default_layout, pad_contacts, rot_y
+from softhand.fem.hand.hold_geometry import PadSet, Pose, contact_rows, default_layout, pad_contacts
 from softhand.fem.hand.hold_options import HoldOptions, symmetry_orbits
 from softhand.fem.newton import NotConverged
 from softhand.reduced.vocabulary.design import HandDesign
@@ -138,29 +138,34 @@ class HoldModel:
                        np.array([len(images) for _, images in self.orbits], dtype=float),
                        [f.q for f in self.fingers], [f.Q.copy() for f in self.fingers], [f.S for f in self.fingers])
 
-    def step(self, P: float, *, gravity: bool, pull: float, stage: str, path: bool = False) -> StepRecord:
+    def step(self, P: float, *, gravity: bool, pull: float, stage: str, path: bool = False,
+             drive: float | None = None) -> StepRecord:
         """One load step to (P, gravity, pull); the state is kept only if it converges
         (NotConverged or :class:`NoEquilibrium` leave the last state). A release step that finds no
         equilibrium near the last state is followed as a path (``HoldModel._relax``) where the hand is not
-        symmetric, or with ``path``."""
-        saved = self._save()
+        symmetric, or with ``path``. ``drive`` [mm]: the pull is a spring of ``options.drive_stiffness``
+        [N/mm] along the pull direction whose far end is ``drive`` along it from where the object was let go
+        (``pull`` is then ignored, and the record's pull is the spring's force)."""
+        saved = self.save()
         try:
-            return self._step(P, gravity, pull, stage)
+            return self._step(P, gravity, pull, stage, drive=drive)
         except (NotConverged, NoEquilibrium, np.linalg.LinAlgError) as err:
-            self._restore(saved)
+            self.restore(saved)
             if stage != "release" or (self.symmetric and not path) or not self.options.relax_steps \
                     or isinstance(err, NoEquilibrium):
                 raise
         try:
             return self._relax(P, gravity, pull, stage)
         except (NotConverged, NoEquilibrium, np.linalg.LinAlgError):
-            self._restore(saved)
+            self.restore(saved)
             raise
 
-    def _save(self):
+    def save(self):
+        """The state along the path (the fingers' FEM states, pose, pressure, contact state)."""
         return [f.copy_state() for f in self.fingers], self.pose.copy(), self.P, self.cs
 
-    def _restore(self, saved) -> None:
+    def restore(self, saved) -> None:
+        """Back to a state of :meth:`save`."""
         states, pose, self.P, self.cs = saved
         self.pose = pose.copy()
         for f, s in zip(self.fingers, states):
@@ -190,18 +195,21 @@ class HoldModel:
                 self.on_path_step(k, support)
             settling, last = support < 0.5 * last, support
             if settling and support <= self.options.relax_force * load:
-                saved = self._save()
+                saved = self.save()
                 try:
                     record = self._step(P, gravity, pull, stage)
                     record.relaxed = k + 1
                     return record
                 except (NotConverged, np.linalg.LinAlgError):
-                    self._restore(saved)
+                    self.restore(saved)
             c = (0.5 if settling else 0.25) * c
         raise NotConverged(f"no equilibrium after {self.options.relax_steps} relaxation steps", [], self.pose)
 
-    def _step(self, P, gravity, pull, stage, damping=None) -> StepRecord:
+    def _step(self, P, gravity, pull, stage, damping=None, drive=None) -> StepRecord:
         o = self.options
+        spring = None
+        if drive is not None:
+            spring, pull = (o.drive_stiffness, self.pull_direction, self.released + drive * self.pull_direction), 0.0
         hist = self.history()
         steps = 1 if self.cs is not None or P == self.P else 2
         for f in self.fingers:
@@ -216,7 +224,7 @@ class HoldModel:
         cs = None
         for it in range(1, o.max_stagger + 1):
             problem = Problem(self.body, self._fingers_view(), self.pose.copy(), free, load, hist, self.scale,
-                              damping)
+                              damping, spring)
             x, cs, updates, its, R = solve_contact(problem, x, o.contact, warm=cs if it > 1 else None)
             qs, pose = problem.unpack(x)
             if self._slid(pose):
@@ -228,6 +236,8 @@ class HoldModel:
                 p = self.pose.copy()
                 p[free] = x[len(x) - len(free):]
                 self.pose, self.cs = p, cs
+                if spring is not None:  # the spring's force along the pull
+                    pull = spring[0] * float(spring[1] @ (spring[2] - p[:3]))
                 return self._record(stage, P, pull, gravity, cs, problem, R, mismatch, it)
             x = np.concatenate([f.q for f in self.fingers] + [x[len(x) - len(free):]])
         raise NotConverged(f"contact and fingers disagree by {mismatch:.3g} rad after {o.max_stagger} "
@@ -272,26 +282,9 @@ class HoldModel:
         cone = float(np.max(T[touching] / (mu * cs.N[touching]), initial=0.0)) if mu > 0 else \
             float(np.max(T, initial=0.0))
         return StepRecord(
-            stage, float(P), float(pull), float(gravity), self.pose.copy(), self.contacts(cs),
+            stage, float(P), float(pull), float(gravity), self.pose.copy(),
+            contact_rows(self.orbits, self.frames, self.pads.n_links, cs),
             float(np.linalg.norm(R[len(R) - len(problem.free):])) if len(problem.free) else 0.0, cone,
             float(np.max(-cs.g[touching], initial=0.0)),
             float(np.max(np.linalg.norm(cs.slip[cs.stick], axis=1), initial=0.0)), float(mismatch),
             max(f.residual_norm() for f in self.fingers), it, [f.y.copy() for f in self.fingers])
-
-    def contacts(self, cs) -> list:
-        """Every finger's pads (images of a solved finger rotated about the palm axis)."""
-        rows, n = [], self.pads.n_links
-        for i, (j, images) in enumerate(self.orbits):
-            for k in images:
-                R = rot_y(self.frames[k].azimuth - self.frames[j].azimuth)
-                for link in range(n):
-                    r = i * n + link
-                    N = float(cs.N[r])
-                    rows.append({"finger": int(k), "link": int(link), "normal_N": N,
-                                 "friction_N": float(np.linalg.norm(cs.T[r])),
-                                 "state": ("stick" if cs.stick[r] else "slip") if N > 0 else "open",
-                                 "gap_mm": float(cs.g[r]) if np.isfinite(cs.g[r]) else None,
-                                 "point_mm": (R @ cs.x[r]).tolist(),
-                                 "normal_force_N": (R @ (N * cs.normal[r])).tolist(),
-                                 "friction_force_N": (R @ cs.T[r]).tolist()})
-        return rows

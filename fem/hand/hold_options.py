@@ -68,12 +68,28 @@ class HoldOptions:
     relax_force: float = 0.05        #: the step without the viscous support is tried below this share of the load
     min_weight_step: float = 1 / 16  #: not held when letting go of this share of the weight fails
     pull_floor: float = 0.02         #: the holding limit's resolution is at least this [N]
+    #: "force": the pull is a force stepped up until no equilibrium is found; "displacement": the
+    #: object is drawn along the pull through a stiff spring (a load cell) whose far end moves, and
+    #: the limit is the first maximum of the spring's force along that path
+    #: (:func:`softhand.fem.hand.hold.run_hold`)
+    pull_control: str = "force"
+    drive_stiffness: float = 100.0   #: the drawing spring's stiffness [N/mm]
+    drive_step: float = 0.05         #: the first move of the spring's far end [mm]
+    drive_max_slide: float = 1.0     #: the object slides at most about this far in one drawn step [mm]
+    #: a maximum of the drawn pull is where the hand lets go once the pull is more than
+    #: ``pull_resolution`` below it this much more slide on [mm] (a crease between two pads is passed)
+    drive_past_peak: float = 1.0
 
     def __post_init__(self):
         if not self.close_steps >= 1:
             raise InputError("close_steps", self.close_steps, "must be >= 1")
         if not self.q_tol > 0:
             raise InputError("q_tol", self.q_tol, "must be positive [rad]")
+        if self.pull_control not in ("force", "displacement"):
+            raise InputError("pull_control", self.pull_control, 'must be "force" or "displacement"')
+        for name in ("drive_stiffness", "drive_step", "drive_max_slide", "drive_past_peak"):
+            if not getattr(self, name) > 0:
+                raise InputError(name, getattr(self, name), "must be positive")
 
 
 def symmetry_orbits(body, frames, pull_direction, tol: float = 1e-9):

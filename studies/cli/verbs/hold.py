@@ -60,6 +60,9 @@ def configure(parser) -> None:
     parser.add_argument("--map", nargs=2, metavar=("X=RANGE", "Y=RANGE"),
                         help="map over two of pressure, mass, size, friction, pull (RANGE start:stop:step or a,b,c)")
     parser.add_argument("--check", action="store_true", help="with --map: the FEM at the corners and centre too")
+    parser.add_argument("--pull-control", choices=("force", "displacement"),
+                        help="the FEM's pull: force (stepped up until no equilibrium, default) or displacement "
+                             "(drawn through a stiff spring; the limit is the pull's first maximum along the slide)")
     parser.add_argument("--out", metavar="DIR", help="write result.json (or hold_map.csv, hold_map.png) here")
     add_design_option(parser)
     add_json_option(parser)
@@ -77,6 +80,8 @@ def run(args) -> int:
         from softhand.studies.io.outputs import check_owned
 
         check_owned(args.out, OUTPUT_NAMES, "--out", "hold")
+    if args.pull_control is not None and args.model != "fem" and not args.check:
+        raise InputError("--pull-control", args.pull_control, "is the FEM hold's; give --model fem (or --map with --check)")
     if args.map:
         return _run_map(args, design, obj, pull, max_pump)
     if args.check:
@@ -110,6 +115,13 @@ def run(args) -> int:
     return 0
 
 
+def _fem_options(args):
+    """The FEM hold's options: the defaults, with the pull's control if given."""
+    from softhand.fem.hand.hold_options import HoldOptions
+
+    return HoldOptions() if args.pull_control is None else HoldOptions(pull_control=args.pull_control)
+
+
 def _fem_hold(args, design, obj, P_cav, P_pump, pull):
     """The whole-hand FEM hold with a progress bar (one tick per converged load step); with
     --out its result.json and hold.pvd (every finger, the object, the contact forces per load
@@ -135,7 +147,7 @@ def _fem_hold(args, design, obj, P_cav, P_pump, pull):
         bar.set_postfix_str(f"letting go: path step {k + 1}, support {support_N:.3g} N")
     try:
         result, path = solve_hold(design, obj, P_cavity_MPa=P_cav, pull_direction=tuple(pull), progress=tick,
-                                  path_progress=path_tick, keep_path=True,
+                                  path_progress=path_tick, keep_path=True, options=_fem_options(args),
                                   P_pump_MPa=math.nan if P_pump is None else P_pump)
     except NotConverged as exc:
         print(f"softhand hold: error: the FEM did not converge while the fingers closed: "
@@ -222,7 +234,7 @@ def _run_map(args, design, obj, pull, max_pump) -> int:
         rows = run_map(m, progress=update)
     finally:
         bar.close()
-    checks = _map_checks(m, rows, design) if args.check else []
+    checks = _map_checks(m, rows, design, _fem_options(args)) if args.check else []
     if args.out:
         with staged(args) as stage:
             write_map(m, rows, stage)
@@ -255,7 +267,7 @@ def _refuse_with_map(args, axes) -> None:
             raise InputError(option, value, f"is not used with --map: {why}")
 
 
-def _map_checks(m, rows, design) -> list[dict]:
+def _map_checks(m, rows, design, options) -> list[dict]:
     """The FEM at the map's corners and centre (the FEM's solver is required)."""
     from softhand.studies.hold import map_point
 
@@ -267,7 +279,7 @@ def _map_checks(m, rows, design) -> list[dict]:
     for xv, yv in sorted(picks):
         row = next(r for r in rows if r[xn] == xv and r[yn] == yv)
         obj, _, pull = map_point(m, {xn: xv, yn: yv})
-        r = solve(design, obj, P_cavity_MPa=row["P_cavity_MPa"], pull_direction=tuple(pull))
+        r = solve(design, obj, P_cavity_MPa=row["P_cavity_MPa"], pull_direction=tuple(pull), options=options)
         out.append({"at": {xn: xv, yn: yv}, "reduced_N": row["holding_limit_N"], "fem_N": r.holding_limit_N,
                     "reduced_held": row["held"], "fem_held": r.held})
     return out
