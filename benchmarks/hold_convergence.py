@@ -10,7 +10,8 @@ long run (nice, background).
 
     nice python benchmarks/hold_convergence.py [--fine-mm 7] [--object sphere:150 --mass-kg 0.2]
     nice python benchmarks/hold_convergence.py --object sphere:180 --mass-kg 2 --friction 0.8 \
-        --pressure-mpa 0.9 --axial-mm 5 2.5 1.25 --tols 1e-6 --resolution 0.002 --floor-n 0.002
+        --pressure-mpa 0.9 --axial-mm 5 2.5 1.25 --tols 1e-6 --resolution 0.002 --floor-n 0.002 \
+        [--pull-control displacement]
 """
 from __future__ import annotations
 
@@ -44,6 +45,8 @@ def main() -> None:
                         help="the holding limit's resolution, a share of the pull (default 0.02)")
     parser.add_argument("--floor-n", type=float, default=0.1,
                         help="... and at least this many newtons (default 0.1)")
+    parser.add_argument("--pull-control", choices=("force", "displacement"), default="force",
+                        help="the pull stepped as a force (default) or drawn by displacement")
     args = parser.parse_args()
     design = HandDesign()
     meshes = [("layered", h) for h in args.axial_mm] if args.axial_mm else [("gmsh", 10.0), ("gmsh", args.fine_mm)]
@@ -57,13 +60,13 @@ def main() -> None:
                 obj = replace(parse_object(args.object), mass_kg=args.mass_kg, friction=args.friction)
                 r = solve_hold(design, obj, P_cavity_MPa=args.pressure_mpa,
                                options=HoldOptions(finger=finger, contact=contact, pull_resolution=args.resolution,
-                                                   pull_floor=args.floor_n))
+                                                   pull_floor=args.floor_n, pull_control=args.pull_control))
                 held, limit = r.held, r.holding_limit_N
             else:
                 box = Body("box", (0.0, 130.0, 0.0), (150.0, 140.0, 40.0), mass_kg=0.005, friction=args.friction)
                 hold = HoldModel(design, box, layout=[FingerFrame(0.0), FingerFrame(math.pi)], finger_model=model,
                                  options=HoldOptions(finger=finger, contact=contact, close_steps=3,
-                                                     pull_step=0.02, pull_floor=0.002))
+                                                     pull_step=0.02, pull_floor=0.002, pull_control=args.pull_control))
                 path = run_hold(hold, args.pressure_mpa)
                 held, limit = path.held, path.holding_limit_N
             print(f"{mesher} mesh {h:g} mm ({model.ndofs} unknowns), tol {tol:g} mm: held {held}, "

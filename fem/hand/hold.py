@@ -170,7 +170,9 @@ def _drawn(model: HoldModel, P: float, steps: list, tick, t0: float) -> HoldPath
         steps.append(record)
         walk.append(_Drawn(last.s + ds, record.pull_N, float(e @ (model.pose[:3] - model.released)), model.save()))
         failure = ""
-        r = max(abs(walk[-1].F - last.F) / dF_max, abs(walk[-1].u - last.u) / o.drive_max_slide)
+        # a step changes the pull by at most a pull step or a quarter of the pull, and slides drive_max_slide
+        r = max(abs(walk[-1].F - last.F) / max(dF_max, 0.25 * abs(last.F)),
+                abs(walk[-1].u - last.u) / o.drive_max_slide)
         ds = min(cap, ds * min(1.5, 1.0 / r if r > 0 else 1.5))
 
 
