@@ -7,7 +7,6 @@ import math
 from types import SimpleNamespace
 
 import numpy as np
-import pytest
 from scipy.optimize import brentq
 
 from softhand.fem.hand.hold import run_hold
