@@ -44,10 +44,7 @@ def done(out: Path) -> dict:
 def run(out: Path, worker: tuple[int, int], only: str | None) -> None:
     from softhand.fem.hand.hold import solve_hold
     from softhand.fem.hand.hold_options import HoldOptions
-    from softhand.reduced.holding import hold_fast
-    from softhand.reduced.holding.hand_layout import place_object
-    from softhand.reduced.holding.hold import DOWN, cavity_pressure
-    from softhand.reduced.holding.objects import object_from_table
+    from softhand.reduced.holding.hold import DOWN
 
     data, (k, n) = reference.load(), worker
     finished = done(out)
@@ -56,15 +53,7 @@ def run(out: Path, worker: tuple[int, int], only: str | None) -> None:
         for i, case in enumerate(held_cases(data)):
             if i % n != k or case["name"] in finished or (only and only not in case["name"]):
                 continue
-            design = reference.design_of(case, data["designs"])
-            table = dict(case["object"], mass_kg=case["mass_kg"], friction=case["friction"])
-            if table["shape"] == "mesh":
-                table["file"] = str(reference.build_mesh(table["file"], Path(folder)))
-            obj = object_from_table(table, source=case["name"])
-            P = case.get("P_cavity_MPa")
-            if P is None:  # a design task's optimum, given by its pump pressure
-                P = cavity_pressure(case["P_pump_MPa"], place_object(obj, hold_fast.finger_design(design, "fem")),
-                                    design)
+            design, obj, P = reference.case_inputs(case, data["designs"], Path(folder))
             t0, pulls = time.perf_counter(), []
 
             def tick(record, name=case["name"]):

@@ -98,8 +98,8 @@ def build_mesh(name: str, folder: Path) -> Path:
     return path
 
 
-def run_case(case: dict, designs: dict, folder: Path) -> Row:
-    """The fast hold model on one reference case (meshes built into ``folder``)."""
+def case_inputs(case: dict, designs: dict, folder: Path):
+    """(design, object, cavity pressure [MPa]) of one reference case (meshes built into ``folder``)."""
     design = design_of(case, designs)
     table = dict(case["object"], mass_kg=case["mass_kg"], friction=case["friction"])
     if table["shape"] == "mesh":
@@ -108,6 +108,12 @@ def run_case(case: dict, designs: dict, folder: Path) -> Row:
     P = case.get("P_cavity_MPa")
     if P is None:  # a design task's optimum, given by its pump pressure
         P = cavity_pressure(case["P_pump_MPa"], place_object(obj, hold_fast.finger_design(design, "fem")), design)
+    return design, obj, P
+
+
+def run_case(case: dict, designs: dict, folder: Path) -> Row:
+    """The fast hold model on one reference case (meshes built into ``folder``)."""
+    design, obj, P = case_inputs(case, designs, folder)
     result = solve_hold(design, obj, P_cavity_MPa=P, pull_direction=case.get("pull", DOWN))
     weight = case["mass_kg"] * design.g
     limit = float(case["fem_limit_N"])

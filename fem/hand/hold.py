@@ -130,7 +130,8 @@ def _drawn(model: HoldModel, P: float, steps: list, tick, t0: float) -> HoldPath
     u = float(e @ (model.pose[:3] - model.released))
     walk, first = [_Drawn(u, 0.0, u, model.save())], len(steps)  # walk[i > 0] is steps[first + i - 1]
     # the first move: drive_step, or less where the spring alone would pull more than a pull step
-    ds, cap, end, failure, out, finer = min(o.drive_step, dF_max / o.drive_stiffness), math.inf, math.inf, "", False, 0
+    ds = min(o.drive_step, dF_max / o.drive_stiffness)
+    cap, end, failure, out, finer = math.inf, math.inf, "", False, 0
     coarse = None  # (walk, steps) before the last walk again around a maximum
     while True:
         best = max(range(len(walk)), key=lambda i: (walk[i].F, -i))  # the first largest
@@ -168,7 +169,8 @@ def _drawn(model: HoldModel, P: float, steps: list, tick, t0: float) -> HoldPath
             continue
         tick(record)
         steps.append(record)
-        walk.append(_Drawn(last.s + ds, record.pull_N, float(e @ (model.pose[:3] - model.released)), model.save()))
+        u = float(e @ (model.pose[:3] - model.released))
+        walk.append(_Drawn(last.s + ds, record.pull_N, u, model.save()))
         failure = ""
         # a step changes the pull by at most a pull step or a quarter of the pull, and slides drive_max_slide
         r = max(abs(walk[-1].F - last.F) / max(dF_max, 0.25 * abs(last.F)),

@@ -2,8 +2,8 @@
 spring's pull is the object's equilibrium load, two pads pinching a box hold the friction's 2 mu N,
 and a sphere's drawn pull peaks where the stepped force finds no more equilibrium."""
 import math
+from dataclasses import replace
 
-import numpy as np
 import pytest
 
 from softhand.fem.hand.finger import FingerModel, FingerOptions
@@ -63,7 +63,7 @@ def test_a_drawn_sphere_peaks_where_the_stepped_force_stops(finger):
     the stepped force's limit (the largest pull with an equilibrium; two independent paths) to
     within both resolutions; past it the sphere slides and the pull falls (the path kept ends there:
     the steps around the maximum were walked again finer)."""
-    obj = replace_mass(parse_object("sphere:180"), 2.0, 0.8)
+    obj = replace(parse_object("sphere:180"), mass_kg=2.0, friction=0.8)
     body = body_of(obj, DESIGN)
     stepped = run_hold(HoldModel(DESIGN, body, finger_model=finger, options=HoldOptions()), 0.9)
     model = HoldModel(DESIGN, body, finger_model=finger, options=HoldOptions(**DRAWN))
@@ -76,12 +76,6 @@ def test_a_drawn_sphere_peaks_where_the_stepped_force_stops(finger):
     for s in pulls:
         assert s.cone <= 1.0 + 1e-12 and s.q_mismatch <= model.options.q_tol
         assert _load_on_pads(s) == pytest.approx(model.weight + s.pull_N, abs=model.options.contact.rtol * model.scale)
-
-
-def replace_mass(obj, mass_kg, friction):
-    from dataclasses import replace
-
-    return replace(obj, mass_kg=mass_kg, friction=friction)
 
 
 @pytest.mark.parametrize("field, value", [("pull_control", "speed"), ("drive_stiffness", 0.0),
