@@ -1,12 +1,13 @@
 """The FEM hold's limit with its pull stepped as a force and drawn by displacement, on the kept reference holds.
 
 The holding limits kept as the fast model's reference (``studies/data/hold_fem_limits.json``) were
-measured with the pull stepped as a force (``HoldOptions(pull_control="force")``). This runs the
-same whole-hand FEM holds with the pull drawn (``pull_control="displacement"``: a stiff spring's
-far end moved along the pull, the limit the first maximum of its force along the slide) and prints,
-per case, the kept (stepped) limit, the drawn one, the fast model's and the fast model's error
-against each. Only the cases the FEM holds are run: the pull's control does not change the
-closing or the letting go.
+first measured with the pull stepped as a force (``HoldOptions(pull_control="force")``); those
+re-run with the pull drawn (``pull_control="displacement"``: a stiff spring's far end moved along
+the pull, the limit the first maximum of its force along the slide) keep the drawn limit as
+``fem_limit_N`` and the stepped one as ``fem_limit_stepped_N``. This runs the kept whole-hand FEM
+holds drawn and prints, per case, the stepped limit, the drawn one, the fast model's and the fast
+model's error against each. Only the cases the FEM holds are run: the pull's control does not
+change the closing or the letting go.
 
 Each FEM hold takes minutes (2-12 min on the default mesh, one core each); rows are appended to a
 JSON-lines file as they finish, and a run started again skips the cases already there. Split the
@@ -32,6 +33,11 @@ DEFAULT_OUT = Path("results/hold_pull_control.jsonl")
 def held_cases(data: dict) -> list[dict]:
     """The kept cases the FEM holds (a limit, or its whole weight with no pull to spare)."""
     return [c for c in data["cases"] if c["fem_limit_N"] > 0 or c.get("fem_weight_share", 0.0) >= 1.0]
+
+
+def stepped(case: dict) -> float:
+    """The case's holding limit with the pull stepped as a force."""
+    return case.get("fem_limit_stepped_N", case["fem_limit_N"])
 
 
 def done(out: Path) -> dict:
@@ -63,12 +69,12 @@ def run(out: Path, worker: tuple[int, int], only: str | None) -> None:
 
             result = solve_hold(design, obj, P_cavity_MPa=P, pull_direction=case.get("pull", DOWN),
                                 options=HoldOptions(pull_control="displacement"), progress=tick)
-            row = {"name": case["name"], "stepped_N": case["fem_limit_N"], "drawn_N": result.holding_limit_N,
+            row = {"name": case["name"], "stepped_N": stepped(case), "drawn_N": result.holding_limit_N,
                    "held": result.held, "P_cavity_MPa": P, "seconds": time.perf_counter() - t0,
                    "notes": list(result.notes), "pulls": pulls}
             with out.open("a", encoding="utf-8") as f:
                 f.write(json.dumps(row) + "\n")
-            print(f"{case['name']}: stepped {case['fem_limit_N']:.3f} N, drawn {result.holding_limit_N:.3f} N "
+            print(f"{case['name']}: stepped {stepped(case):.3f} N, drawn {result.holding_limit_N:.3f} N "
                   f"({row['seconds']:.0f} s)", flush=True)
 
 
@@ -90,7 +96,7 @@ def table(out: Path, markdown: bool) -> None:
             within[key][1] += abs(errors[key]) <= 0.10
         cells = [case["name"], f"{r['stepped_N']:.2f}", f"{r['drawn_N']:.2f}",
                  f"{f.fast_limit_N:.2f}" if f.fast_held else "not held",
-                 f"{100 * errors['stepped']:+.1f} %", f"{100 * errors['drawn']:+.1f} %"]
+                 *(f"{100 * e:+.1f} %" if e == e else "—" for e in (errors["stepped"], errors["drawn"]))]
         print(("| " + sep.join(cells) + " |") if markdown else sep.join(cells))
     total = sum(r["seconds"] for r in rows.values())
     print(f"# {len(cases)} FEM holds drawn ({total / 60:.0f} min of FEM); the fast limit within 5 % / 10 % of the "

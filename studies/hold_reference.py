@@ -3,12 +3,17 @@
 ``studies/data/hold_fem_limits.json`` holds 61 holds the whole-hand FEM ran (``softhand hold
 --model fem``, default finger mesh, the limit resolved to 0.5 % of the pull): the design, the
 object, its mass and friction, the pressure, the pull and the FEM's holding limit (0: not held;
-then the share of the weight it bore). Spheres, upright, tilted and lying cylinders, cubes (one
-turned 45°) and a flat box, capsules, balls that wedge as they slide, a sideways pull, two balls
-read from STL files (built here by the recipe the file names), boxes and cubes turned about the
-palm's axis, cylinders at other angles, on the paper's design and four others; 43 held (one with
-5 % of its weight to spare), one held with no pull to spare, 17 not; most of them were run after
-the fast model had been built, to test it. No fast-model number was fitted to them: they are what
+then the share of the weight it bore). A case re-run with the FEM's pull drawn by displacement
+(``--pull-control displacement``: the limit the first maximum of the pull along the slide) keeps
+that limit, and the one its pull stepped as a force reached as ``fem_limit_stepped_N``; the rest
+keep the stepped limit until they are re-run (``benchmarks/hold_pull_control.py``).
+
+Spheres, upright, tilted and lying cylinders, cubes (one turned 45°) and a flat box, capsules,
+balls that wedge as they slide, a sideways pull, two balls read from STL files (built here by the
+recipe the file names), boxes and cubes turned about the palm's axis, cylinders at other angles,
+on the paper's design and four others; 43 held (one with 5 % of its weight to spare), one held
+with no pull to spare, 17 not; most of them were run after the fast model had been built, to test
+it. No fast-model number was fitted to them: they are what
 the fast model is measured against (docs/grasp.md) and what ``tests/studies/test_hold_reference.py``
 holds it to. Each FEM run takes minutes; :func:`compare` runs the fast model on all of them in seconds:
 
